@@ -1,0 +1,32 @@
+# Two commands for a fresh machine:
+#   make repro   create .venv, install, run the whole DVC pipeline with params.yaml
+#   make test    create .venv, install with dev extras, run the test suite
+PYTHON ?= python3.11
+VENV := .venv
+BIN := $(VENV)/bin
+export DVC_NO_ANALYTICS := 1
+export PATH := $(abspath $(BIN)):$(PATH)
+
+.PHONY: repro test install bench clean-venv
+
+$(BIN)/python:
+	$(PYTHON) -m venv $(VENV)
+	$(BIN)/python -m pip install --quiet --upgrade pip
+
+$(VENV)/.installed: pyproject.toml | $(BIN)/python
+	$(BIN)/python -m pip install --quiet -e '.[dev]'
+	touch $@
+
+install: $(VENV)/.installed
+
+repro: install
+	dvc repro
+
+test: install
+	$(BIN)/python -m pytest -n 2 --dist loadfile -q
+
+bench: install
+	cd bench && ../$(BIN)/python voxelize_speed.py && ../$(BIN)/python voxelize_accuracy.py
+
+clean-venv:
+	rm -rf $(VENV)

@@ -1,0 +1,175 @@
+"""Typed parameters, read from params.yaml.
+
+One frozen dataclass per params section. Every field says what it is in its
+``help`` metadata (the CLI's ``--help`` prints them) and what values it allows.
+An unknown key, a wrong type or an out-of-range value raises :class:`ParamsError`
+whose message is one line naming the key and what is allowed.
+"""
+from __future__ import annotations
+
+import dataclasses
+import types
+import typing
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+
+class ParamsError(ValueError):
+    """Invalid params; the message is one line naming the key."""
+
+
+def param(default: Any, help: str, *, choices: tuple | None = None, ge: float | None = None, le: float | None = None, gt: float | None = None) -> Any:
+    """A dataclass field with its help text and allowed values."""
+    return field(default=default, metadata={"help": help, "choices": choices, "ge": ge, "le": le, "gt": gt})
+
+
+@dataclass(frozen=True)
+class DataParams:
+    """Where the shape corpus comes from."""
+
+    source: str = param("pybullet", "`pybullet`: the 1000 objects of pybullet_data/random_urdfs (URDF mesh scale applied); `folder`: every .obj/.stl/.ply/.off/.glb under `path`, recursively (e.g. a local 3DNet copy).", choices=("pybullet", "folder"))
+    path: str | None = param(None, "Folder of meshes when source is `folder`, relative to the project or absolute; its files are taken as meters times `unit_scale`.")
+    unit_scale: float = param(1.0, "Meters per file unit for `folder` sources (0.001 for millimeter files).", gt=0)
+    limit: int | None = param(None, "Use only the first `limit` files in sorted order (null: all).", ge=1)
+
+
+@dataclass(frozen=True)
+class IngestParams:
+    """Checking, rebuilding, sizing and splitting the shapes."""
+
+    max_faces: int = param(1_000_000, "A file with more triangles is rejected.", ge=1)
+    max_file_mb: float = param(100.0, "A larger file is rejected before it is read, MB.", gt=0)
+    min_shapes: int = param(10, "The stage fails if fewer shapes survive the checks.", ge=1)
+    surface_resolution: int = param(96, "Marching-cubes samples along a shape's largest extent when its closed outer surface is rebuilt (cell = extent / resolution).", ge=16, le=512)
+    face_budget: int = param(5000, "Triangles per outer surface after quadric decimation.", ge=100)
+    size_rule: str = param("mid", "Which extent the size rule fixes: `min`, `mid` (the middle one) or `max`.", choices=("min", "mid", "max"))
+    size_m: float = param(0.06, "That extent after scaling, meters. Default: middle extent 0.06 m, so a Franka Panda (0.08 m opening) closes across the two smaller extents of most objects.", gt=0)
+    max_dropped: float = param(0.1, "Reject a shape whose largest connected piece misses more than this share of its volume.", ge=0, le=1)
+    test_fraction: float = param(0.2663, "Share of shapes in the test split (0.2663 = the paper's 363 test : 1000 train).", gt=0, le=0.9)
+
+
+@dataclass(frozen=True)
+class VoxelizeParams:
+    """Solid occupancy grids for the AutoEncoder."""
+
+    resolution: int = param(32, "Voxels per side R (32 on CPU, 64 in the paper).", choices=(16, 32, 64, 128))
+    margin: int = param(1, "Empty voxels kept around the shape's largest extent.", ge=0, le=4)
+
+
+@dataclass(frozen=True)
+class Params:
+    """All parameters of the pipeline."""
+
+    seed: int = param(0, "Seeds every random choice of every stage.", ge=0)
+    device: str = param("auto", "Torch device: `auto` (CUDA when present), `cpu` or `cuda`.", choices=("auto", "cpu", "cuda"))
+    n_jobs: int = param(2, "Worker processes for per-shape loops (-1: all cores).", ge=-1)
+    data: DataParams = field(default_factory=DataParams)
+    ingest: IngestParams = field(default_factory=IngestParams)
+    voxelize: VoxelizeParams = field(default_factory=VoxelizeParams)
+
+
+def _type_name(tp: Any) -> str:
+    if typing.get_origin(tp) in (typing.Union, types.UnionType):
+        return " or ".join(_type_name(a) for a in typing.get_args(tp))
+    return "null" if tp is type(None) else getattr(tp, "__name__", str(tp))
+
+
+def _coerce(key: str, value: Any, tp: Any) -> Any:
+    """Check ``value`` against the annotation ``tp``; ints are accepted for floats."""
+    origin = typing.get_origin(tp)
+    if origin in (typing.Union, types.UnionType):
+        for arg in typing.get_args(tp):
+            try:
+                return _coerce(key, value, arg)
+            except ParamsError:
+                continue
+        raise ParamsError(f"{key}: expected {_type_name(tp)}, got {value!r}")
+    if origin is list:
+        (item,) = typing.get_args(tp)
+        if not isinstance(value, list):
+            raise ParamsError(f"{key}: expected a list of {_type_name(item)}, got {value!r}")
+        return tuple(_coerce(f"{key}[{i}]", v, item) for i, v in enumerate(value))
+    if tp is type(None):
+        if value is None:
+            return None
+    elif tp is float:
+        if isinstance(value, (int, float)) and not isinstance(value, bool):
+            return float(value)
+    elif tp is int:
+        if isinstance(value, int) and not isinstance(value, bool):
+            return value
+    elif isinstance(value, tp):
+        return value
+    raise ParamsError(f"{key}: expected {_type_name(tp)}, got {value!r}")
+
+
+def _check_range(key: str, value: Any, meta: typing.Mapping) -> None:
+    if value is None:
+        return
+    choices = meta.get("choices")
+    if choices is not None and value not in choices:
+        raise ParamsError(f"{key}: must be one of {', '.join(map(str, choices))}; got {value!r}")
+    for bound, ok, word in (("ge", lambda v, b: v >= b, ">="), ("gt", lambda v, b: v > b, ">"), ("le", lambda v, b: v <= b, "<=")):
+        b = meta.get(bound)
+        if b is not None and not ok(value, b):
+            raise ParamsError(f"{key}: must be {word} {b:g}; got {value!r}")
+
+
+def _build(cls: type, raw: Any, prefix: str) -> Any:
+    if raw is None:
+        raw = {}
+    if not isinstance(raw, dict):
+        raise ParamsError(f"{prefix or 'params'}: expected a mapping of keys, got {raw!r}")
+    hints = typing.get_type_hints(cls)
+    fields = {f.name: f for f in dataclasses.fields(cls)}
+    unknown = sorted(set(raw) - set(fields))
+    if unknown:
+        name = f"{prefix}{unknown[0]}"
+        raise ParamsError(f"{name}: unknown key; allowed here: {', '.join(fields)}")
+    values = {}
+    for name, f in fields.items():
+        if name not in raw:
+            continue
+        key = f"{prefix}{name}"
+        tp = hints[name]
+        if dataclasses.is_dataclass(tp):
+            values[name] = _build(tp, raw[name], f"{key}.")
+        else:
+            values[name] = _coerce(key, raw[name], tp)
+            _check_range(key, values[name], f.metadata)
+    return cls(**values)
+
+
+def parse_params(raw: Any) -> Params:
+    """Typed :class:`Params` from a parsed params.yaml mapping; raises :class:`ParamsError`."""
+    params = _build(Params, raw, "")
+    if params.data.source == "folder" and not params.data.path:
+        raise ParamsError("data.path: required when data.source is folder")
+    return params
+
+
+def load_params(path: str | Path = "params.yaml") -> Params:
+    """Read and check params.yaml; raises :class:`ParamsError` (also for a missing or broken file)."""
+    path = Path(path)
+    if not path.exists():
+        raise ParamsError(f"{path}: params file not found")
+    try:
+        raw = yaml.safe_load(path.read_text())
+    except yaml.YAMLError as exc:
+        raise ParamsError(f"{path}: not valid YAML ({str(exc).splitlines()[0]})") from None
+    return parse_params(raw)
+
+
+def describe(cls: type) -> str:
+    """Markdown list of a params section's keys, types, defaults and help (for ``--help``)."""
+    hints = typing.get_type_hints(cls)
+    lines = []
+    for f in dataclasses.fields(cls):
+        if dataclasses.is_dataclass(hints[f.name]):
+            continue
+        default = f.default
+        lines.append(f"* **{f.name}** ({_type_name(hints[f.name])}, default {default!r}): {f.metadata.get('help', '')}")
+    return "\n".join(lines)

@@ -1,0 +1,118 @@
+"""Loading mesh files into checked triangle meshes, with a reason when they are unusable.
+
+A file becomes either a :class:`LoadedShape` (its triangles, and its convex parts
+when it is an assembly of closed convex pieces like pybullet's ``random_urdfs``)
+or a :class:`MeshRejected` exception whose message is the one-line reason that
+the ingest stage records.
+"""
+from __future__ import annotations
+
+import hashlib
+import os
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import trimesh
+
+from graspaug.geometry.solid import ConvexPart, convex_part
+
+MESH_SUFFIXES = (".obj", ".stl", ".ply", ".off", ".glb")
+
+# extents below this share of the largest one make a shape flat (no volume)
+_FLAT_RATIO = 1e-4
+
+
+class MeshRejected(Exception):
+    """A mesh file that cannot become a shape; ``str(exc)`` is the one-line reason."""
+
+
+@dataclass
+class LoadedShape:
+    """Triangles of one source file in meters, and its convex parts when it is made of them.
+
+    Attributes
+    ----------
+    mesh : all triangles (parts concatenated), meters
+    parts : convex parts as half-spaces, meters; empty unless every piece is a closed convex body
+    """
+
+    mesh: trimesh.Trimesh
+    parts: list[ConvexPart]
+
+
+def sha256_of(path: str | os.PathLike) -> str:
+    """Hex sha256 of a file's bytes."""
+    digest = hashlib.sha256()
+    with open(path, "rb") as f:
+        for block in iter(lambda: f.read(1 << 20), b""):
+            digest.update(block)
+    return digest.hexdigest()
+
+
+def _first_line(exc: BaseException) -> str:
+    text = str(exc).strip().splitlines()
+    return f"{type(exc).__name__}: {text[0][:120]}" if text else type(exc).__name__
+
+
+def load_shape(path: str | os.PathLike, unit_scale: float = 1.0, max_faces: int = 1_000_000, max_file_mb: float = 100.0) -> LoadedShape:
+    """Load and check one mesh file.
+
+    Parameters
+    ----------
+    path : a .obj/.stl/.ply/.off/.glb file
+    unit_scale : float — meters per file unit (a URDF's mesh scale)
+    max_faces : int — more triangles than this is rejected
+    max_file_mb : float — a larger file is rejected before it is read
+
+    Raises
+    ------
+    MeshRejected
+        with the reason: file too large, empty file, unreadable, not a mesh, no
+        triangles, too many faces, non-finite vertex coordinates, or degenerate.
+    """
+    path = Path(path)
+    size_mb = path.stat().st_size / 2**20
+    if size_mb > max_file_mb:
+        raise MeshRejected(f"file too large: {size_mb:.1f} MB > max_file_mb={max_file_mb:g}")
+    if size_mb == 0:
+        raise MeshRejected("empty file")
+    try:
+        loaded = trimesh.load(path, split_objects=True, group_material=False, process=False)
+    except Exception as exc:  # noqa: BLE001 — any parser failure is a reason, not a crash
+        raise MeshRejected(f"unreadable: {_first_line(exc)}") from None
+
+    if isinstance(loaded, trimesh.Scene):
+        pieces = list(loaded.dump()) if loaded.geometry else []
+    else:
+        pieces = [loaded]
+    if not pieces:
+        raise MeshRejected("no triangles: the file holds no geometry")
+    not_mesh = [type(p).__name__ for p in pieces if not isinstance(p, trimesh.Trimesh)]
+    if not_mesh:
+        raise MeshRejected(f"not a mesh: holds {not_mesh[0]}")
+    pieces = [p for p in pieces if len(p.faces)]
+    n_faces = sum(len(p.faces) for p in pieces)
+    if n_faces == 0:
+        raise MeshRejected("no triangles: the file holds no faces")
+    if n_faces > max_faces:
+        raise MeshRejected(f"too many faces: {n_faces} > max_faces={max_faces}")
+    for p in pieces:
+        if not np.isfinite(p.vertices).all():
+            raise MeshRejected("non-finite vertex coordinates (NaN or inf)")
+        p.apply_scale(unit_scale)
+
+    mesh = trimesh.util.concatenate(pieces) if len(pieces) > 1 else pieces[0].copy()
+    mesh.merge_vertices()
+    mesh.update_faces(mesh.nondegenerate_faces())
+    mesh.remove_unreferenced_vertices()
+    if len(mesh.faces) == 0 or not mesh.area > 0:
+        raise MeshRejected("degenerate: zero surface area")
+    extents = mesh.extents
+    if extents.min() <= _FLAT_RATIO * extents.max():
+        raise MeshRejected(f"degenerate: flat, extents {np.array2string(extents, precision=4)} m")
+
+    parts: list[ConvexPart] = []
+    if all(p.is_watertight and p.is_convex for p in pieces):
+        parts = [part for part in map(convex_part, (p.vertices for p in pieces)) if part is not None]
+    return LoadedShape(mesh=mesh, parts=parts)

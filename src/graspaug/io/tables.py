@@ -1,0 +1,19 @@
+"""Parquet tables (pandas + pyarrow), written atomically."""
+from __future__ import annotations
+
+import os
+
+import pandas as pd
+
+from graspaug.io.atomic import atomic_path
+
+
+def write_table(df: pd.DataFrame, path: str | os.PathLike) -> None:
+    """Write ``df`` to a parquet file (no index)."""
+    with atomic_path(path) as tmp:
+        df.to_parquet(tmp, index=False)
+
+
+def read_table(path: str | os.PathLike) -> pd.DataFrame:
+    """Read a parquet table written by :func:`write_table`."""
+    return pd.read_parquet(path)

@@ -1,0 +1,59 @@
+"""``voxels.npz``: all occupancy grids of a corpus in one bit-packed file.
+
+Keys
+----
+shape_id : (N,) str
+occupancy : (N, R³/8) uint8 — ``numpy.packbits`` of the C-ordered (R, R, R) grids
+resolution : () int — R
+pitch : (N,) float — voxel edge, meters
+origin : (N, 3) float — grid corner in the shape's normalized frame, meters;
+    voxel (i, j, k) has its center at ``origin + pitch * (ijk + 0.5)``
+"""
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+
+import numpy as np
+
+from graspaug.geometry.voxelize import VoxelGrid, pack_bits, unpack_bits
+from graspaug.io.atomic import atomic_path
+
+
+@dataclass
+class VoxelSet:
+    """Occupancy grids with their shape ids and metric placement."""
+
+    shape_id: np.ndarray  # (N,) str
+    occupancy: np.ndarray  # (N, R, R, R) bool
+    pitch: np.ndarray  # (N,) meters
+    origin: np.ndarray  # (N, 3) meters
+
+    @property
+    def resolution(self) -> int:
+        return int(self.occupancy.shape[1])
+
+    def grid(self, i: int) -> VoxelGrid:
+        """Placement of grid ``i`` in its shape's normalized frame."""
+        return VoxelGrid(self.resolution, float(self.pitch[i]), self.origin[i])
+
+
+def write_voxels(voxels: VoxelSet, path: str | os.PathLike) -> None:
+    """Write a :class:`VoxelSet` to a compressed npz (atomic)."""
+    with atomic_path(path) as tmp:
+        with open(tmp, "wb") as f:
+            np.savez_compressed(
+                f,
+                shape_id=np.asarray(voxels.shape_id, dtype=str),
+                occupancy=pack_bits(voxels.occupancy),
+                resolution=np.int64(voxels.resolution),
+                pitch=np.asarray(voxels.pitch, dtype=np.float64),
+                origin=np.asarray(voxels.origin, dtype=np.float64),
+            )
+
+
+def read_voxels(path: str | os.PathLike) -> VoxelSet:
+    """Read a file written by :func:`write_voxels`."""
+    with np.load(path, allow_pickle=False) as z:
+        r = int(z["resolution"])
+        return VoxelSet(shape_id=z["shape_id"], occupancy=unpack_bits(z["occupancy"], r), pitch=z["pitch"], origin=z["origin"])

@@ -1,0 +1,111 @@
+"""The ingest and voxelize stages through the real CLI, on a folder corpus with broken files."""
+import os
+
+import numpy as np
+import pandas as pd
+import pytest
+import trimesh
+import yaml
+from typer.testing import CliRunner
+
+from graspaug.cli import app
+from graspaug.io.voxels import read_voxels
+
+from ..geometry.test_loading import write_broken_corpus
+
+
+def make_corpus(folder):
+    expected = write_broken_corpus(folder / "broken")
+    good = folder / "good"
+    good.mkdir()
+    trimesh.creation.box(extents=(0.1, 0.05, 0.03)).export(good / "box.stl")
+    trimesh.creation.icosphere(subdivisions=3, radius=0.04).export(good / "ball.ply")
+    trimesh.creation.cylinder(radius=0.02, height=0.08).export(good / "can.obj")
+    torus = trimesh.creation.torus(major_radius=0.04, minor_radius=0.012)
+    torus.export(good / "ring.off")
+    two = trimesh.util.concatenate([trimesh.creation.box(extents=(0.04, 0.04, 0.04)),
+                                    trimesh.creation.box(extents=(0.04, 0.04, 0.04)).apply_translation((0.04, 0, 0))])
+    two.export(good / "two_boxes.glb")
+    return expected
+
+
+def run_stage(tmp_path, stage, params):
+    (tmp_path / "params.yaml").write_text(yaml.safe_dump(params))
+    cwd = os.getcwd()
+    os.chdir(tmp_path)
+    try:
+        return CliRunner().invoke(app, [stage])
+    finally:
+        os.chdir(cwd)
+
+
+@pytest.fixture
+def corpus_params(tmp_path):
+    expected = make_corpus(tmp_path / "meshes")
+    params = {"seed": 3, "n_jobs": 2, "data": {"source": "folder", "path": "meshes"},
+              "ingest": {"max_faces": 50000, "min_shapes": 3, "test_fraction": 0.4},
+              "voxelize": {"resolution": 16}}
+    return params, expected
+
+
+def test_ingest_keeps_good_shapes_and_records_every_reject(tmp_path, corpus_params):
+    params, expected = corpus_params
+    result = run_stage(tmp_path, "ingest", params)
+    assert result.exit_code == 0, result.output
+    shapes = pd.read_parquet(tmp_path / "data/shapes.parquet")
+    rejects = pd.read_parquet(tmp_path / "data/rejects.parquet")
+    assert sorted(shapes.shape_id) == ["f_good_ball", "f_good_box", "f_good_can", "f_good_ring", "f_good_two_boxes"]
+    assert len(rejects) == len(expected)
+    for _, row in rejects.iterrows():
+        stem = row.source.rsplit("/", 1)[1].rsplit(".", 1)[0]
+        assert row.reason.startswith(expected[stem]), row.reason
+    assert shapes.watertight.all()
+    assert set(shapes.split) == {"train", "test"} and (shapes.split == "test").sum() == 2
+    assert (shapes.origin == "original").all()
+    for col in ("source", "source_sha256", "faces", "vertices", "volume", "extent_x", "scale"):
+        assert col in shapes
+    # the two touching boxes became one piece; the mid extent is 0.06 m after scaling
+    for _, row in shapes.iterrows():
+        mesh = trimesh.load(tmp_path / f"data/shapes/{row.shape_id}.ply", process=False)
+        assert mesh.is_watertight and mesh.body_count == 1
+        assert np.sort(mesh.extents)[1] == pytest.approx(0.06, rel=1e-6)
+        assert np.allclose(mesh.center_mass, 0, atol=1e-6)
+    assert sorted(os.listdir(tmp_path / "data/shapes")) == sorted(f"{s}.ply" for s in shapes.shape_id)
+
+    result = run_stage(tmp_path, "voxelize", params)
+    assert result.exit_code == 0, result.output
+    vox = read_voxels(tmp_path / "data/voxels.npz")
+    assert list(vox.shape_id) == list(shapes.shape_id)
+    assert vox.occupancy.shape == (5, 16, 16, 16) and vox.occupancy.any(axis=(1, 2, 3)).all()
+    # the grid puts the voxels back in meters: occupied volume near the mesh volume
+    vol = vox.occupancy.sum(axis=(1, 2, 3)) * vox.pitch**3
+    assert np.allclose(vol, shapes.volume, rtol=0.35)
+
+
+def test_split_is_seeded_and_deterministic(tmp_path, corpus_params):
+    params, _ = corpus_params
+    assert run_stage(tmp_path, "ingest", params).exit_code == 0
+    first = pd.read_parquet(tmp_path / "data/shapes.parquet")
+    assert run_stage(tmp_path, "ingest", params).exit_code == 0
+    again = pd.read_parquet(tmp_path / "data/shapes.parquet")
+    pd.testing.assert_frame_equal(first, again)
+
+
+def test_too_few_shapes_fails_clearly_and_writes_nothing(tmp_path, corpus_params):
+    params, _ = corpus_params
+    params["ingest"]["min_shapes"] = 6
+    result = run_stage(tmp_path, "ingest", params)
+    assert result.exit_code == 1
+    assert "error: only 5 of 12 shapes are usable, ingest.min_shapes=6" in result.output
+    assert not (tmp_path / "data/shapes.parquet").exists()
+    assert not (tmp_path / "data/shapes").exists()
+    assert not [p for p in (tmp_path / "data").iterdir() if p.name.startswith(".")]
+
+
+def test_split_sizes_follow_the_paper_ratio():
+    from graspaug.stages.ingest import assign_split
+
+    split = assign_split([f"rnd_{i:03d}" for i in range(999)], 0.2663, seed=0)
+    assert sum(v == "test" for v in split.values()) == 266
+    assert split == assign_split([f"rnd_{i:03d}" for i in reversed(range(999))], 0.2663, seed=0)
+    assert split != assign_split([f"rnd_{i:03d}" for i in range(999)], 0.2663, seed=1)

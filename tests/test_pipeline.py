@@ -1,0 +1,74 @@
+"""Real ``dvc repro`` in a temporary copy of the repository, on tiny params."""
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+import yaml
+
+from graspaug.io.voxels import read_voxels
+
+pytestmark = pytest.mark.slow
+
+TINY = {
+    "data": {"limit": 20},
+    "ingest": {"surface_resolution": 48, "face_budget": 2000, "min_shapes": 5},
+    "voxelize": {"resolution": 16},
+}
+
+
+def copy_repo(src: Path, dst: Path) -> None:
+    """The files a user's clone has (tracked by git), without outputs or caches."""
+    listed = subprocess.run(["git", "ls-files", "-co", "--exclude-standard"], cwd=src, capture_output=True, text=True, check=True)
+    for rel in listed.stdout.splitlines():
+        if not (src / rel).is_file():
+            continue
+        (dst / rel).parent.mkdir(parents=True, exist_ok=True)
+        shutil.copy2(src / rel, dst / rel)
+
+
+def set_params(path: Path, overrides: dict) -> None:
+    params = yaml.safe_load(path.read_text())
+    for section, values in overrides.items():
+        params[section].update(values)
+    path.write_text(yaml.safe_dump(params, sort_keys=False))
+
+
+def run(cmd, cwd, env):
+    result = subprocess.run(cmd, cwd=cwd, env=env, capture_output=True, text=True)
+    assert result.returncode == 0, f"{cmd} failed:\n{result.stdout}\n{result.stderr}"
+    return result
+
+
+@pytest.fixture(scope="module")
+def tiny_repo(repo_root, tmp_path_factory):
+    work = tmp_path_factory.mktemp("repo")
+    copy_repo(repo_root, work)
+    set_params(work / "params.yaml", TINY)
+    env = {**os.environ, "DVC_NO_ANALYTICS": "1", "PATH": f"{Path(sys.executable).parent}{os.pathsep}{os.environ['PATH']}"}
+    run(["git", "init", "-q"], work, env)
+    return work, env
+
+
+def test_dvc_repro_voxelize_then_nothing_to_do(tiny_repo):
+    work, env = tiny_repo
+    run(["dvc", "repro", "voxelize"], work, env)
+
+    shapes = pd.read_parquet(work / "data/shapes.parquet")
+    assert len(shapes) == 20 and shapes.watertight.all()
+    assert set(shapes.split) == {"train", "test"}
+    vox = read_voxels(work / "data/voxels.npz")
+    assert vox.occupancy.shape == (20, 16, 16, 16)
+    assert list(vox.shape_id) == list(shapes.shape_id)
+    assert np.all(vox.occupancy.any(axis=(1, 2, 3)))
+    assert (work / "dvc.lock").exists()
+
+    again = run(["dvc", "repro", "voxelize"], work, env)
+    assert "didn't change, skipping" in again.stdout
+    assert "Running stage" not in again.stdout
+    status = run(["dvc", "status"], work, env)
+    assert "up to date" in status.stdout
