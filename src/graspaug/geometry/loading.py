@@ -101,6 +101,7 @@ def load_shape(path: str | os.PathLike, unit_scale: float = 1.0, max_faces: int 
         if not np.isfinite(p.vertices).all():
             raise MeshRejected("non-finite vertex coordinates (NaN or inf)")
         p.apply_scale(unit_scale)
+        p.merge_vertices()  # STL and some PLY store each triangle's corners separately
 
     mesh = trimesh.util.concatenate(pieces) if len(pieces) > 1 else pieces[0].copy()
     mesh.merge_vertices()

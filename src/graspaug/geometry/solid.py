@@ -152,14 +152,14 @@ def largest_piece(mesh: trimesh.Trimesh) -> tuple[trimesh.Trimesh, float]:
 def decimate(mesh: trimesh.Trimesh, face_budget: int) -> trimesh.Trimesh:
     """Quadric decimation to at most ``face_budget`` faces, kept only if still closed and in one piece.
 
-    fast-simplification's default aggression (7) sometimes pinches edges into
-    non-manifold ones; gentler settings (3, then 1) rarely do, and 0 stays closed
-    but may stop above the budget. If none stays closed and in one piece, the
-    undecimated mesh is returned.
+    fast-simplification sometimes pinches a few edges into non-manifold ones, at
+    some aggression settings and not others; settings are tried in turn (3, 7, 1,
+    0; the gentlest may stop above the budget) and the first result that is
+    closed and in one piece is kept. If none is, the undecimated mesh is returned.
     """
     if len(mesh.faces) <= face_budget:
         return mesh
-    for aggression in (3, 1, 0):
+    for aggression in (3, 7, 1, 0):
         try:
             small = mesh.simplify_quadric_decimation(face_count=face_budget, aggression=aggression)
         except Exception:  # noqa: BLE001 — the decimator is optional, the undecimated mesh is valid

@@ -71,7 +71,7 @@ def _slug(text: str) -> str:
 
 def folder_sources(folder: str | Path, unit_scale: float = 1.0, limit: int | None = None) -> list[Source]:
     """Every mesh file under ``folder`` (recursively), sorted; ids from the relative path."""
-    folder = Path(folder)
+    folder = Path(folder).resolve()
     if not folder.is_dir():
         raise FileNotFoundError(f"mesh folder not found: {folder}")
     files = sorted(p for p in folder.rglob("*") if p.is_file() and p.suffix.lower() in MESH_SUFFIXES)

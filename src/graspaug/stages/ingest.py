@@ -88,6 +88,7 @@ def run(params: Params) -> None:
     settings = SurfaceSettings(cfg.surface_resolution, cfg.face_budget, cfg.size_rule, cfg.size_m, cfg.max_dropped)
 
     with atomic_path(SHAPES_DIR, directory=True) as tmp_dir:
+        tmp_dir = tmp_dir.resolve()  # worker processes may have another working directory
         rows = parallel_map(lambda s: _ingest_one(s, cfg.max_faces, cfg.max_file_mb, settings, tmp_dir), sources, params.n_jobs, "ingest")
         shapes = pd.DataFrame([r for r in rows if r.pop("ok")])
         rejects = pd.DataFrame([r for r in rows if "reason" in r], columns=["shape_id", "source", "source_sha256", "reason"])

@@ -33,7 +33,7 @@ def run(params: Params) -> None:
     start = time.perf_counter()
     cfg = params.voxelize
     shape_ids = list(read_table(SHAPES_TABLE)["shape_id"])
-    paths = [mesh_path(SHAPES_DIR, s) for s in shape_ids]
+    paths = [mesh_path(SHAPES_DIR.resolve(), s) for s in shape_ids]  # workers may have another cwd
     out = parallel_map(lambda p: voxelize_file(p, cfg.resolution, cfg.margin), paths, params.n_jobs, "voxelize")
     voxels = VoxelSet(
         shape_id=np.array(shape_ids),
