@@ -144,7 +144,8 @@ def largest_piece(mesh: trimesh.Trimesh) -> tuple[trimesh.Trimesh, float]:
     pieces = mesh.split(only_watertight=False)
     if len(pieces) <= 1:
         return mesh, 0.0
-    volumes = np.array([abs(p.volume) for p in pieces])
+    with np.errstate(divide="ignore", invalid="ignore"):  # slivers of zero volume warn in trimesh
+        volumes = np.array([abs(p.volume) for p in pieces])
     best = int(np.argmax(volumes))
     return pieces[best], float(1.0 - volumes[best] / volumes.sum())
 
@@ -215,7 +216,9 @@ def outer_surface_of_mesh(mesh: trimesh.Trimesh, resolution: int, face_budget: i
 
     from graspaug.geometry.voxelize import VoxelGrid, voxelize_solid
 
-    if mesh.is_watertight and mesh.body_count == 1 and mesh.volume > 0:
+    with np.errstate(divide="ignore", invalid="ignore"):
+        closed = mesh.is_watertight and mesh.body_count == 1 and mesh.volume > 0
+    if closed:
         return decimate(mesh, face_budget), 0.0
     bounds = mesh.bounds
     origin, pitch, shape = _field_grid(bounds, resolution)
