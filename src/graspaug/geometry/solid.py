@@ -208,7 +208,8 @@ def outer_surface_of_parts(parts: list[ConvexPart], resolution: int, face_budget
 def outer_surface_of_mesh(mesh: trimesh.Trimesh, resolution: int, face_budget: int) -> tuple[trimesh.Trimesh, float]:
     """One closed outer surface for an arbitrary mesh (several bodies, holes, inner faces).
 
-    A single closed body is kept as it is (decimated to the budget). Anything else
+    Small holes are filled and the winding made consistent first; a single closed
+    body is then kept as it is (decimated to the budget). Anything else
     is rebuilt: solid occupancy on a fine grid (winding count for closed bodies,
     a filled surface shell for open ones), lightly smoothed, then marching cubes.
     """
@@ -216,6 +217,9 @@ def outer_surface_of_mesh(mesh: trimesh.Trimesh, resolution: int, face_budget: i
 
     from graspaug.geometry.voxelize import VoxelGrid, voxelize_solid
 
+    mesh = mesh.copy()
+    trimesh.repair.fill_holes(mesh)  # closes holes of one or a few missing triangles
+    trimesh.repair.fix_normals(mesh)
     with np.errstate(divide="ignore", invalid="ignore"):
         closed = mesh.is_watertight and mesh.body_count == 1 and mesh.volume > 0
     if closed:

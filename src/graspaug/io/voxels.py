@@ -12,6 +12,7 @@ origin : (N, 3) float — grid corner in the shape's normalized frame, meters;
 from __future__ import annotations
 
 import os
+import zipfile
 from dataclasses import dataclass
 
 import numpy as np
@@ -38,18 +39,32 @@ class VoxelSet:
         return VoxelGrid(self.resolution, float(self.pitch[i]), self.origin[i])
 
 
+def write_npz(arrays: dict[str, np.ndarray], path: str | os.PathLike) -> None:
+    """A compressed ``.npz`` whose bytes depend only on ``arrays`` (atomic).
+
+    ``numpy.savez_compressed`` stamps every member with the current time, so the
+    same arrays would hash differently on every run and DVC would see a change.
+    """
+    with atomic_path(path) as tmp, zipfile.ZipFile(tmp, "w", compression=zipfile.ZIP_DEFLATED) as zf:
+        for key, value in arrays.items():
+            info = zipfile.ZipInfo(f"{key}.npy", date_time=(1980, 1, 1, 0, 0, 0))
+            info.compress_type = zipfile.ZIP_DEFLATED
+            with zf.open(info, "w", force_zip64=True) as member:
+                np.lib.format.write_array(member, np.asanyarray(value), allow_pickle=False)
+
+
 def write_voxels(voxels: VoxelSet, path: str | os.PathLike) -> None:
-    """Write a :class:`VoxelSet` to a compressed npz (atomic)."""
-    with atomic_path(path) as tmp:
-        with open(tmp, "wb") as f:
-            np.savez_compressed(
-                f,
-                shape_id=np.asarray(voxels.shape_id, dtype=str),
-                occupancy=pack_bits(voxels.occupancy),
-                resolution=np.int64(voxels.resolution),
-                pitch=np.asarray(voxels.pitch, dtype=np.float64),
-                origin=np.asarray(voxels.origin, dtype=np.float64),
-            )
+    """Write a :class:`VoxelSet` to a compressed, byte-reproducible npz (atomic)."""
+    write_npz(
+        {
+            "shape_id": np.asarray(voxels.shape_id, dtype=str),
+            "occupancy": pack_bits(voxels.occupancy),
+            "resolution": np.int64(voxels.resolution),
+            "pitch": np.asarray(voxels.pitch, dtype=np.float64),
+            "origin": np.asarray(voxels.origin, dtype=np.float64),
+        },
+        path,
+    )
 
 
 def read_voxels(path: str | os.PathLike) -> VoxelSet:
