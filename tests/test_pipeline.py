@@ -16,8 +16,10 @@ pytestmark = pytest.mark.slow
 
 TINY = {
     "data": {"limit": 20},
-    "ingest": {"surface_resolution": 48, "face_budget": 2000, "min_shapes": 5},
+    "ingest": {"surface_resolution": 48, "finest_surface_resolution": 48, "face_budget": 2000, "min_shapes": 5},
     "voxelize": {"resolution": 16},
+    "ae": {"base_width": 4, "top_width": 16, "z_dim": 16, "batch_size": 8, "epochs_ae": 1, "epochs_critic": 1},
+    "critic_eval": {"n_shapes": 10, "n_pairs": 3, "n_examples": 2},
 }
 
 
@@ -49,8 +51,11 @@ def tiny_repo(repo_root, tmp_path_factory):
     work = tmp_path_factory.mktemp("repo")
     copy_repo(repo_root, work)
     set_params(work / "params.yaml", TINY)
-    env = {**os.environ, "DVC_NO_ANALYTICS": "1", "PATH": f"{Path(sys.executable).parent}{os.pathsep}{os.environ['PATH']}"}
+    env = {**os.environ, "DVC_NO_ANALYTICS": "1", "PATH": f"{Path(sys.executable).parent}{os.pathsep}{os.environ['PATH']}",
+           "GIT_AUTHOR_NAME": "test", "GIT_AUTHOR_EMAIL": "test@example.com", "GIT_COMMITTER_NAME": "test", "GIT_COMMITTER_EMAIL": "test@example.com"}
     run(["git", "init", "-q"], work, env)
+    run(["git", "add", "-A"], work, env)
+    run(["git", "commit", "-q", "-m", "clone"], work, env)  # a user's clone has commits (DVCLive needs one)
     return work, env
 
 
@@ -70,5 +75,26 @@ def test_dvc_repro_voxelize_then_nothing_to_do(tiny_repo):
     again = run(["dvc", "repro", "voxelize"], work, env)
     assert "didn't change, skipping" in again.stdout
     assert "Running stage" not in again.stdout
-    status = run(["dvc", "status"], work, env)
+    status = run(["dvc", "status", "voxelize"], work, env)
     assert "up to date" in status.stdout
+
+
+def test_dvc_repro_critic_eval_and_embed(tiny_repo):
+    import json
+
+    work, env = tiny_repo
+    run(["dvc", "repro", "critic_eval", "embed"], work, env)
+    for path in ("models/ae.pt", "models/ae_critic.pt", "reports/critic_eval/interpolations.png",
+                 "reports/critic_eval/outliers.png", "reports/embed/tsne.png", "metrics/train_ae/ae/metrics.json"):
+        assert (work / path).stat().st_size > 0, path
+    result = json.loads((work / "metrics/critic_eval.json").read_text())
+    assert result["n_pairs"] == 3 and result["n_decoded_per_model"] == 18
+    assert set(result["outlier_pct"]) == {"ae", "ae_critic"}
+    assert list(result["outlier_pct"]["ae"]) == ["0.00", "0.10", "0.20", "0.30", "0.40", "0.50"]
+    summary = json.loads((work / "metrics/train_ae.json").read_text())
+    assert 0 <= summary["ae_iou_test"] <= 1 and summary["ae_shapes_per_s"] > 0
+    latents = pd.read_parquet(work / "data/latents.parquet")
+    assert len(latents) == 20 and len(latents.z[0]) == 16
+    assert set(latents.split) == {"train", "test"}
+    shown = run(["dvc", "metrics", "show", "--json"], work, env)
+    assert "ae_critic_iou_test" in shown.stdout

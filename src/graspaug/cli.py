@@ -7,7 +7,7 @@ from pathlib import Path
 
 import typer
 
-from graspaug.config import DataParams, IngestParams, Params, ParamsError, VoxelizeParams, describe, load_params
+from graspaug.config import AEParams, CriticEvalParams, DataParams, EmbedParams, IngestParams, Params, ParamsError, VoxelizeParams, describe, load_params
 
 app = typer.Typer(
     help="graspaug: augment a grasp planner's training objects with generated shapes.\n\n"
@@ -31,11 +31,12 @@ def _load(path: Path) -> Params:
 
 
 def _run(stage_run, params: Params) -> None:
+    from graspaug.io.checkpoints import CheckpointMismatch
     from graspaug.stages.ingest import StageError
 
     try:
         stage_run(params)
-    except StageError as exc:
+    except (StageError, CheckpointMismatch, FileNotFoundError) as exc:
         typer.echo(f"error: {exc}", err=True)
         raise typer.Exit(code=1) from None
 
@@ -60,6 +61,40 @@ def ingest(params: Path = ParamsOption) -> None:
 )
 def voxelize(params: Path = ParamsOption) -> None:
     from graspaug.stages import voxelize as stage
+
+    _run(stage.run, _load(params))
+
+
+@app.command(
+    help="Train the AutoEncoder (phase 1, binary cross-entropy) and then the AE-Critic (phase 2, eqs. (1)-(2) "
+    "of the paper) on the train split's voxel grids; test shapes stay unseen.\n\n"
+    "Writes `models/ae.pt`, `models/ae_critic.pt`, DVCLive logs in `metrics/train_ae/`, and `metrics/train_ae.json` "
+    f"(test/train reconstruction IoU, time, shapes/s).\n\nParams `ae`:\n\n{describe(AEParams)}\n\n"
+    "Also `voxelize.resolution`, `seed`, `device`."
+)
+def train_ae(params: Path = ParamsOption) -> None:
+    from graspaug.stages import train_ae as stage
+
+    _run(stage.run, _load(params))
+
+
+@app.command(
+    help="Encode every shape with the AE-Critic: `data/latents.parquet` (shape_id, split, z) and a 2-D t-SNE map "
+    f"(`reports/embed/tsne.csv`, `.png`).\n\nParams `embed`:\n\n{describe(EmbedParams)}"
+)
+def embed(params: Path = ParamsOption) -> None:
+    from graspaug.stages import embed as stage
+
+    _run(stage.run, _load(params))
+
+
+@app.command(
+    help="The paper's critic study: decode interpolations of random train pairs with the AE and the AE-Critic, "
+    "cluster each with DBSCAN, report the mean outlier percentage per α (`metrics/critic_eval.json`) with plots "
+    f"in `reports/critic_eval/`.\n\nParams `critic_eval`:\n\n{describe(CriticEvalParams)}"
+)
+def critic_eval(params: Path = ParamsOption) -> None:
+    from graspaug.stages import critic_eval as stage
 
     _run(stage.run, _load(params))
 

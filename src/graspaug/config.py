@@ -21,9 +21,14 @@ class ParamsError(ValueError):
     """Invalid params; the message is one line naming the key."""
 
 
-def param(default: Any, help: str, *, choices: tuple | None = None, ge: float | None = None, le: float | None = None, gt: float | None = None) -> Any:
-    """A dataclass field with its help text and allowed values."""
-    return field(default=default, metadata={"help": help, "choices": choices, "ge": ge, "le": le, "gt": gt})
+def param(default: Any, help: str, *, choices: tuple | None = None, ge: float | None = None, le: float | None = None, gt: float | None = None, key: str | None = None) -> Any:
+    """A dataclass field with its help text and allowed values; ``key`` is its name in
+    params.yaml when that is not a Python identifier (``lambda``)."""
+    return field(default=default, metadata={"help": help, "choices": choices, "ge": ge, "le": le, "gt": gt, "key": key})
+
+
+def _key(f: dataclasses.Field) -> str:
+    return f.metadata.get("key") or f.name
 
 
 @dataclass(frozen=True)
@@ -44,6 +49,8 @@ class IngestParams:
     max_file_mb: float = param(100.0, "A larger file is rejected before it is read, MB.", gt=0)
     min_shapes: int = param(10, "The stage fails if fewer shapes survive the checks.", ge=1)
     surface_resolution: int = param(96, "Marching-cubes samples along a shape's largest extent when its closed outer surface is rebuilt (cell = extent / resolution).", ge=16, le=512)
+    finest_surface_resolution: int = param(160, "Upper limit of that resolution for shapes made of thin convex parts (lattices), which get a finer grid.", ge=16, le=512)
+    cells_per_thickness: float = param(6.0, "Field cells across a typical (median) convex part; sets the finer grid for thin-part shapes (0: always surface_resolution).", ge=0)
     face_budget: int = param(5000, "Triangles per outer surface after quadric decimation.", ge=100)
     size_rule: str = param("mid", "Which extent the size rule fixes: `min`, `mid` (the middle one) or `max`.", choices=("min", "mid", "max"))
     size_m: float = param(0.06, "That extent after scaling, meters. Default: middle extent 0.06 m, so a Franka Panda (0.08 m opening) closes across the two smaller extents of most objects.", gt=0)
@@ -60,6 +67,42 @@ class VoxelizeParams:
 
 
 @dataclass(frozen=True)
+class AEParams:
+    """AutoEncoder-Critic network and its two training phases."""
+
+    z_dim: int = param(128, "Latent size (paper: 128).", ge=2)
+    base_width: int = param(16, "Channels of the first conv layer; doubles per down-sampling layer up to top_width (paper profile: 64).", ge=1)
+    top_width: int = param(128, "Channels of the 4×4×4 map before the FC layer (paper: 512).", ge=1)
+    batch_size: int = param(32, "Shapes per batch.", ge=2)
+    epochs_ae: int = param(20, "Phase 1 epochs: plain AutoEncoder, binary cross-entropy.", ge=0)
+    epochs_critic: int = param(10, "Phase 2 epochs: AE-Critic initialised from phase 1.", ge=0)
+    lr_ae: float = param(1e-3, "Phase 1 Adam learning rate (paper: 1e-3).", gt=0)
+    lr_ae_critic: float = param(1e-4, "Phase 2 Adam learning rate of the AutoEncoder (paper: 1e-4).", gt=0)
+    lr_critic: float = param(1e-3, "Phase 2 Adam learning rate of the Critic (paper: 1e-3).", gt=0)
+    gamma: float = param(0.2, "γ of eq. (1): the critic sees γx + (1−γ)x̂ as non-interpolated (ACAI: 0.2).", ge=0, le=1)
+    lam: float = param(0.5, "λ of eq. (2): weight of the critic term in the AE loss (ACAI: 0.5).", ge=0, key="lambda")
+    flips: bool = param(True, "Flip training grids along random axes (the AE learns shape, not pose).")
+
+
+@dataclass(frozen=True)
+class EmbedParams:
+    """Latents of every shape and their t-SNE map."""
+
+    perplexity: float = param(30.0, "t-SNE perplexity (lowered automatically below the number of shapes).", gt=0)
+
+
+@dataclass(frozen=True)
+class CriticEvalParams:
+    """The paper's critic study: outliers of decoded interpolations, AE vs AE-Critic."""
+
+    n_shapes: int = param(200, "Random train shapes to draw pairs from (paper: 200).", ge=2)
+    n_pairs: int = param(68, "Random pairs among them; 6 weights each gives 408 shapes per model (paper: ~409).", ge=1)
+    alphas: list[float] = param((0.0, 0.1, 0.2, 0.3, 0.4, 0.5), "Interpolation weights.")
+    threshold: float = param(0.5, "Occupancy threshold of decoded grids.", gt=0, le=1)
+    n_examples: int = param(4, "Interpolation sequences drawn in the picture.", ge=1)
+
+
+@dataclass(frozen=True)
 class Params:
     """All parameters of the pipeline."""
 
@@ -69,6 +112,9 @@ class Params:
     data: DataParams = field(default_factory=DataParams)
     ingest: IngestParams = field(default_factory=IngestParams)
     voxelize: VoxelizeParams = field(default_factory=VoxelizeParams)
+    ae: AEParams = field(default_factory=AEParams)
+    embed: EmbedParams = field(default_factory=EmbedParams)
+    critic_eval: CriticEvalParams = field(default_factory=CriticEvalParams)
 
 
 def _type_name(tp: Any) -> str:
@@ -124,7 +170,7 @@ def _build(cls: type, raw: Any, prefix: str) -> Any:
     if not isinstance(raw, dict):
         raise ParamsError(f"{prefix or 'params'}: expected a mapping of keys, got {raw!r}")
     hints = typing.get_type_hints(cls)
-    fields = {f.name: f for f in dataclasses.fields(cls)}
+    fields = {_key(f): f for f in dataclasses.fields(cls)}
     unknown = sorted(set(raw) - set(fields))
     if unknown:
         name = f"{prefix}{unknown[0]}"
@@ -134,12 +180,12 @@ def _build(cls: type, raw: Any, prefix: str) -> Any:
         if name not in raw:
             continue
         key = f"{prefix}{name}"
-        tp = hints[name]
+        tp = hints[f.name]
         if dataclasses.is_dataclass(tp):
-            values[name] = _build(tp, raw[name], f"{key}.")
+            values[f.name] = _build(tp, raw[name], f"{key}.")
         else:
-            values[name] = _coerce(key, raw[name], tp)
-            _check_range(key, values[name], f.metadata)
+            values[f.name] = _coerce(key, raw[name], tp)
+            _check_range(key, values[f.name], f.metadata)
     return cls(**values)
 
 
@@ -148,6 +194,9 @@ def parse_params(raw: Any) -> Params:
     params = _build(Params, raw, "")
     if params.data.source == "folder" and not params.data.path:
         raise ParamsError("data.path: required when data.source is folder")
+    alphas = params.critic_eval.alphas
+    if not alphas or not all(0 <= a <= 1 for a in alphas):
+        raise ParamsError(f"critic_eval.alphas: must be a non-empty list of weights in [0, 1]; got {list(alphas)}")
     return params
 
 
@@ -171,5 +220,5 @@ def describe(cls: type) -> str:
         if dataclasses.is_dataclass(hints[f.name]):
             continue
         default = f.default
-        lines.append(f"* **{f.name}** ({_type_name(hints[f.name])}, default {default!r}): {f.metadata.get('help', '')}")
+        lines.append(f"* **{_key(f)}** ({_type_name(hints[f.name])}, default {default!r}): {f.metadata.get('help', '')}")
     return "\n".join(lines)

@@ -82,12 +82,14 @@ def test_folder_ids_are_stable_and_unique(tmp_path):
 
 
 def test_a_watertight_single_body_keeps_its_triangles(tmp_path):
-    from graspaug.geometry.prepare import SurfaceSettings, prepare_shape
+    from graspaug.config import IngestParams
+    from graspaug.geometry.prepare import prepare_shape
+    from graspaug.stages.ingest import surface_settings
 
     path = tmp_path / "box.stl"
     trimesh.creation.box(extents=(0.1, 0.06, 0.03)).export(path)
     loaded = load_shape(path)
     assert loaded.parts  # one closed convex body counts as one convex part
-    prepared = prepare_shape(loaded, SurfaceSettings(size_rule="mid", size_m=0.06))
+    prepared = prepare_shape(loaded, surface_settings(IngestParams(size_rule="mid", size_m=0.06)))
     assert np.allclose(sorted(prepared.mesh.extents), [0.03, 0.06, 0.1], atol=1e-3)
     assert np.allclose(prepared.mesh.center_mass, 0, atol=1e-6)

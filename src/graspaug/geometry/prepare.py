@@ -8,27 +8,31 @@ import trimesh
 
 from graspaug.geometry.loading import LoadedShape, MeshRejected
 from graspaug.geometry.normalize import Normalization, normalization
-from graspaug.geometry.solid import outer_surface_of_mesh, outer_surface_of_parts
+from graspaug.geometry.solid import outer_surface_of_mesh, outer_surface_of_parts, resolution_for_parts
 
 
 @dataclass(frozen=True)
 class SurfaceSettings:
-    """How the outer surface is rebuilt and sized.
+    """How the outer surface is rebuilt and sized (the ``ingest`` params hold the defaults).
 
     Attributes
     ----------
     resolution : field samples along the largest extent for marching cubes
+    finest_resolution : upper limit when thin parts ask for a finer grid
+    cells_per_thickness : field cells across a typical (median) convex part
     face_budget : at most this many triangles after decimation
     size_rule : which extent is fixed: ``min``, ``mid`` or ``max``
     size_m : that extent after normalization, meters
     max_dropped : largest share of volume that may lie outside the kept piece
     """
 
-    resolution: int = 96
-    face_budget: int = 5000
-    size_rule: str = "mid"
-    size_m: float = 0.06
-    max_dropped: float = 0.1
+    resolution: int
+    finest_resolution: int
+    cells_per_thickness: float
+    face_budget: int
+    size_rule: str
+    size_m: float
+    max_dropped: float
 
 
 @dataclass
@@ -38,6 +42,7 @@ class PreparedShape:
     mesh: trimesh.Trimesh  # normalized frame, meters, outward normals
     normalization: Normalization  # loaded frame -> normalized frame
     n_parts: int  # convex parts used (0 when rebuilt from the triangles)
+    resolution: int  # field samples along the largest extent that were used
     dropped_volume: float  # share of the solid's volume not in the kept piece
 
 
@@ -51,9 +56,11 @@ def prepare_shape(loaded: LoadedShape, settings: SurfaceSettings) -> PreparedSha
         largest misses more than ``settings.max_dropped`` of the volume.
     """
     if loaded.parts:
-        surface, dropped = outer_surface_of_parts(loaded.parts, settings.resolution, settings.face_budget)
+        resolution = resolution_for_parts(loaded.parts, settings.resolution, settings.finest_resolution, settings.cells_per_thickness)
+        surface, dropped = outer_surface_of_parts(loaded.parts, resolution, settings.face_budget)
     else:
-        surface, dropped = outer_surface_of_mesh(loaded.mesh, settings.resolution, settings.face_budget)
+        resolution = settings.resolution
+        surface, dropped = outer_surface_of_mesh(loaded.mesh, resolution, settings.face_budget)
     if len(surface.faces) == 0 or not surface.volume > 0:
         raise MeshRejected("degenerate: the rebuilt solid has no volume")
     if dropped > settings.max_dropped:
@@ -64,4 +71,4 @@ def prepare_shape(loaded: LoadedShape, settings: SurfaceSettings) -> PreparedSha
     mesh = norm.apply(surface)
     if not np.isfinite(mesh.vertices).all():
         raise MeshRejected("degenerate: normalization produced non-finite coordinates")
-    return PreparedShape(mesh=mesh, normalization=norm, n_parts=len(loaded.parts), dropped_volume=dropped)
+    return PreparedShape(mesh=mesh, normalization=norm, n_parts=len(loaded.parts), resolution=resolution, dropped_volume=dropped)

@@ -77,6 +77,21 @@ def union_contains(parts: list[ConvexPart], points: np.ndarray, tol: float = 0.0
     return inside
 
 
+def resolution_for_parts(parts: list[ConvexPart], base: int, finest: int, cells_per_thickness: float) -> int:
+    """Field samples along the largest extent so that a typical part is ``cells_per_thickness`` cells thick.
+
+    A part's thickness is taken as the smallest extent of its bounding box; the
+    median over parts is used. Lattices of thin parts get a finer grid (up to
+    ``finest``); ordinary shapes stay at ``base``.
+    """
+    extents = np.array([p.bounds[1] - p.bounds[0] for p in parts])
+    size = float(np.max(np.max([p.bounds[1] for p in parts], axis=0) - np.min([p.bounds[0] for p in parts], axis=0)))
+    thickness = float(np.median(extents.min(axis=1)))
+    if not thickness > 0:
+        return finest
+    return int(np.clip(np.ceil(cells_per_thickness * size / thickness), base, max(base, finest)))
+
+
 def _field_grid(bounds: np.ndarray, resolution: int) -> tuple[np.ndarray, float, tuple[int, int, int]]:
     """Sample points around ``bounds``: cubic cells, ``resolution`` along the largest extent."""
     extent = bounds[1] - bounds[0]

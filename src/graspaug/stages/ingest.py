@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from graspaug.config import Params
+from graspaug.config import IngestParams, Params
 from graspaug.geometry.loading import MeshRejected, load_shape, sha256_of
 from graspaug.geometry.prepare import SurfaceSettings, prepare_shape
 from graspaug.io.atomic import atomic_path
@@ -61,8 +61,22 @@ def _ingest_one(source: Source, max_faces: int, max_file_mb: float, settings: Su
         "offset_y": float(norm.offset[1]),
         "offset_z": float(norm.offset[2]),
         "n_parts": prepared.n_parts,
+        "surface_resolution": prepared.resolution,
         "dropped_volume": prepared.dropped_volume,
     }
+
+
+def surface_settings(cfg: IngestParams) -> SurfaceSettings:
+    """The library's settings from the ``ingest`` params section."""
+    return SurfaceSettings(
+        resolution=cfg.surface_resolution,
+        finest_resolution=cfg.finest_surface_resolution,
+        cells_per_thickness=cfg.cells_per_thickness,
+        face_budget=cfg.face_budget,
+        size_rule=cfg.size_rule,
+        size_m=cfg.size_m,
+        max_dropped=cfg.max_dropped,
+    )
 
 
 def assign_split(shape_ids: list[str], test_fraction: float, seed: int) -> dict[str, str]:
@@ -85,7 +99,7 @@ def run(params: Params) -> None:
         sources = folder_sources(data.path, data.unit_scale, data.limit)
     if not sources:
         raise StageError(f"no mesh files found for data.source={data.source}")
-    settings = SurfaceSettings(cfg.surface_resolution, cfg.face_budget, cfg.size_rule, cfg.size_m, cfg.max_dropped)
+    settings = surface_settings(cfg)
 
     with atomic_path(SHAPES_DIR, directory=True) as tmp_dir:
         tmp_dir = tmp_dir.resolve()  # worker processes may have another working directory

@@ -1,0 +1,61 @@
+"""Network checkpoints: weights plus the settings they were trained with.
+
+A checkpoint is a plain dict (tensors, numbers, strings) so it loads with
+``torch.load(..., weights_only=True)``. Loading checks the network settings
+against what the caller expects and says what differs.
+"""
+from __future__ import annotations
+
+import dataclasses
+import os
+from pathlib import Path
+from typing import Any
+
+import torch
+
+from graspaug.io.atomic import atomic_path
+from graspaug.nets.ae_critic import AEConfig, AutoEncoder, Critic
+
+
+class CheckpointMismatch(RuntimeError):
+    """A checkpoint was trained with other settings than the ones asked for."""
+
+
+def save_autoencoder(path: str | os.PathLike, ae: AutoEncoder, critic: Critic | None, train_params: dict[str, Any]) -> None:
+    """Write the AE (and critic) weights with the network config and training params (atomic)."""
+    state = {
+        "format": "graspaug.autoencoder/1",
+        "config": dataclasses.asdict(ae.cfg),
+        "resolution": ae.cfg.resolution,
+        "train_params": dict(train_params),
+        "autoencoder": {k: v.detach().cpu() for k, v in ae.state_dict().items()},
+    }
+    if critic is not None:
+        state["critic"] = {k: v.detach().cpu() for k, v in critic.state_dict().items()}
+    with atomic_path(path) as tmp:
+        torch.save(state, tmp)
+
+
+def load_autoencoder(path: str | os.PathLike, expected: AEConfig) -> tuple[AutoEncoder, Critic | None, dict[str, Any]]:
+    """Load a checkpoint written by :func:`save_autoencoder`.
+
+    Raises
+    ------
+    CheckpointMismatch
+        naming every setting that differs between the checkpoint and ``expected``.
+    """
+    path = Path(path)
+    if not path.exists():
+        raise FileNotFoundError(f"{path}: no checkpoint (run `dvc repro train_ae`)")
+    state = torch.load(path, map_location="cpu", weights_only=True)
+    saved = AEConfig(**state["config"])
+    if saved != expected:
+        diffs = [f"{k}={getattr(saved, k)} (params: {getattr(expected, k)})" for k in state["config"] if getattr(saved, k) != getattr(expected, k)]
+        raise CheckpointMismatch(f"{path} was trained with {', '.join(diffs)}; retrain it with `dvc repro train_ae`")
+    ae = AutoEncoder(saved)
+    ae.load_state_dict(state["autoencoder"])
+    critic = None
+    if "critic" in state:
+        critic = Critic(saved)
+        critic.load_state_dict(state["critic"])
+    return ae, critic, state["train_params"]

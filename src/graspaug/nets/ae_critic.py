@@ -1,0 +1,155 @@
+"""AutoEncoder-Critic for solid voxel grids (paper Section III; ACAI, Berthelot et al. 2018).
+
+Encoder: conv3d layers with 4³ kernels, BatchNorm + ReLU between, down to a
+``top_width × 4 × 4 × 4`` map, flatten, FC → z (128). Decoder mirrors it and
+outputs R³ logits. Critic: the encoder's layout, then FC 128 → 1.
+
+The paper's "five conv layers, stride 2" cannot take 64³ to 4³ (five halvings
+give 2³). The nearest consistent design, used here: log2(R/4) stride-2 layers
+(64³ → 4³ in four) followed by one stride-1 layer with a 4³ kernel and "same"
+padding, which keeps the paper's five layers, 4³ kernels and the 512×4×4×4 map
+(flattened 32768 → FC 128) at R = 64. The decoder mirrors it: FC → top×4³, one
+stride-1 conv, then log2(R/4) stride-2 transposed convs back to R³.
+
+Widths: layer i of the down path has ``min(base_width * 2**i, top_width)``
+channels and the stride-1 layer ``top_width``. Paper profile (R = 64): base 64 →
+64, 128, 256, 512, then 512. The CPU default (R = 32) is narrower.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import torch
+import torch.nn.functional as F
+from torch import nn
+
+
+@dataclass(frozen=True)
+class AEConfig:
+    resolution: int = 32  # R: voxels per side, a power of two >= 8
+    z_dim: int = 128  # latent size (paper: 128)
+    base_width: int = 16  # channels of the first conv (paper profile: 64)
+    top_width: int = 128  # channels of the 4³ map (paper: 512)
+
+    @property
+    def n_down(self) -> int:
+        """Stride-2 layers from R³ to 4³."""
+        return int(round(math.log2(self.resolution // 4)))
+
+    @property
+    def widths(self) -> list[int]:
+        """Channels after each down-sampling conv, then after the stride-1 conv."""
+        down = [min(self.base_width * 2**i, self.top_width) for i in range(self.n_down)]
+        return down + [self.top_width]
+
+    def __post_init__(self):
+        r = self.resolution
+        if r < 8 or r & (r - 1):
+            raise ValueError(f"resolution must be a power of two >= 8, got {r}")
+
+
+def _down(c_in: int, c_out: int) -> list[nn.Module]:
+    return [nn.Conv3d(c_in, c_out, kernel_size=4, stride=2, padding=1, bias=False), nn.BatchNorm3d(c_out), nn.ReLU(inplace=True)]
+
+
+def _same(c_in: int, c_out: int) -> list[nn.Module]:
+    return [nn.Conv3d(c_in, c_out, kernel_size=4, stride=1, padding="same", bias=False), nn.BatchNorm3d(c_out), nn.ReLU(inplace=True)]
+
+
+class Encoder(nn.Module):
+    """(B, 1, R, R, R) occupancy in [0, 1] → (B, z_dim) latent."""
+
+    def __init__(self, cfg: AEConfig):
+        super().__init__()
+        w = cfg.widths
+        layers: list[nn.Module] = []
+        c = 1
+        for width in w[:-1]:
+            layers += _down(c, width)
+            c = width
+        layers += _same(c, w[-1])
+        self.features = nn.Sequential(*layers)
+        self.fc = nn.Linear(w[-1] * 4**3, cfg.z_dim)  # 512·4³ = 32768 → 128 at the paper's widths
+
+    def forward(self, x: torch.Tensor) -> torch.Tensor:
+        h = self.features(x)  # (B, top, 4, 4, 4)
+        return self.fc(h.flatten(1))  # (B, z_dim)
+
+
+class Decoder(nn.Module):
+    """(B, z_dim) latent → (B, 1, R, R, R) logits."""
+
+    def __init__(self, cfg: AEConfig):
+        super().__init__()
+        w = cfg.widths
+        self.top = w[-1]
+        self.fc = nn.Linear(cfg.z_dim, w[-1] * 4**3)
+        up_widths = w[-2::-1] if len(w) > 1 else []  # e.g. 128 → 64 → 32 → 16
+        layers: list[nn.Module] = [nn.BatchNorm3d(w[-1]), nn.ReLU(inplace=True)]
+        layers += _same(w[-1], up_widths[0] if up_widths else w[-1])
+        c = up_widths[0] if up_widths else w[-1]
+        for i in range(cfg.n_down):
+            last = i == cfg.n_down - 1
+            c_out = 1 if last else up_widths[i + 1]
+            layers.append(nn.ConvTranspose3d(c, c_out, kernel_size=4, stride=2, padding=1, bias=last))
+            if not last:
+                layers += [nn.BatchNorm3d(c_out), nn.ReLU(inplace=True)]
+            c = c_out
+        self.net = nn.Sequential(*layers)
+
+    def forward(self, z: torch.Tensor) -> torch.Tensor:
+        h = self.fc(z).view(-1, self.top, 4, 4, 4)  # (B, top, 4, 4, 4)
+        return self.net(h)  # (B, 1, R, R, R) logits
+
+
+class Critic(nn.Module):
+    """(B, 1, R, R, R) voxel grid → (B,) estimated interpolation weight α."""
+
+    def __init__(self, cfg: AEConfig):
+        super().__init__()
+        self.encoder = Encoder(cfg)
+        self.head = nn.Linear(cfg.z_dim, 1)
+
+    def forward(self, x: torch.Tensor) -> torch.Tensor:
+        return self.head(self.encoder(x)).squeeze(1)
+
+
+class AutoEncoder(nn.Module):
+    """Encoder + Decoder; ``interpolate`` decodes ``α z_a + (1 − α) z_b``... see its doc."""
+
+    def __init__(self, cfg: AEConfig):
+        super().__init__()
+        self.cfg = cfg
+        self.encoder = Encoder(cfg)
+        self.decoder = Decoder(cfg)
+
+    def forward(self, x: torch.Tensor) -> torch.Tensor:
+        return self.decoder(self.encoder(x))
+
+    def interpolate(self, z_a: torch.Tensor, z_b: torch.Tensor, alpha: torch.Tensor) -> torch.Tensor:
+        """Logits of the shape at ``(1 − α) z_a + α z_b``: α = 0 gives a, α = 1 gives b.
+
+        alpha : (B,) weights in [0, 1]; the critic is trained to recover min(α, 1 − α).
+        """
+        alpha = alpha.view(-1, 1)
+        return self.decoder((1 - alpha) * z_a + alpha * z_b)
+
+
+def critic_loss(critic: Critic, x: torch.Tensor, x_hat: torch.Tensor, x_alpha: torch.Tensor, alpha: torch.Tensor, gamma: float) -> torch.Tensor:
+    """Eq. (1): ‖C(x̂_α) − α‖² + ‖C(γx + (1 − γ)x̂)‖², batch means.
+
+    x : (B, 1, R, R, R) real grids; x_hat : their reconstructions (probabilities);
+    x_alpha : decoded interpolations (probabilities); alpha : (B,) their weights in [0, 0.5].
+    All inputs are detached here: this loss trains the critic only.
+    """
+    fit = (critic(x_alpha.detach()) - alpha).pow(2).mean()
+    real = critic(gamma * x + (1 - gamma) * x_hat.detach()).pow(2).mean()
+    return fit + real
+
+
+def autoencoder_loss(recon_logits: torch.Tensor, x: torch.Tensor, critic_on_interp: torch.Tensor, lam: float) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+    """Eq. (2): L_B(x̂, x) + λ‖C(x̂_α)‖². Returns (total, reconstruction BCE, regularizer)."""
+    bce = F.binary_cross_entropy_with_logits(recon_logits, x)
+    reg = critic_on_interp.pow(2).mean()
+    return bce + lam * reg, bce, reg

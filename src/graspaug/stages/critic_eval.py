@@ -1,0 +1,86 @@
+"""Stage ``critic_eval``: the paper's critic study (Section IV-B).
+
+Random pairs of train shapes are interpolated at each α with the AE and with the
+AE-Critic (same pairs); every decoded grid is clustered with DBSCAN and the voxels
+outside its largest cluster are outliers. Outputs: ``metrics/critic_eval.json``
+(mean outlier % per model per α), ``reports/critic_eval/outliers.{csv,png}`` and
+``reports/critic_eval/interpolations.png`` (AE row above AE-Critic row, per pair).
+"""
+from __future__ import annotations
+
+import json
+import logging
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import torch
+
+from graspaug.config import Params
+from graspaug.geometry.clusters import largest_cluster, outlier_percentage
+from graspaug.io.atomic import atomic_path
+from graspaug.io.checkpoints import load_autoencoder
+from graspaug.plots import lines, voxel_rows
+from graspaug.stages.train_ae import AE_CRITIC_MODEL, AE_MODEL, net_config, split_voxels
+from graspaug.training.autoencoder import decode, encode, resolve_device
+
+log = logging.getLogger(__name__)
+
+METRICS = Path("metrics/critic_eval.json")
+OUTLIERS_CSV = Path("reports/critic_eval/outliers.csv")
+OUTLIERS_PNG = Path("reports/critic_eval/outliers.png")
+EXAMPLES_PNG = Path("reports/critic_eval/interpolations.png")
+MODELS = {"ae": AE_MODEL, "ae_critic": AE_CRITIC_MODEL}
+
+
+def random_pairs(n: int, n_shapes: int, n_pairs: int, rng: np.random.Generator) -> np.ndarray:
+    """(P, 2) index pairs: ``n_shapes`` of ``n`` drawn at random, paired off at random, first ``n_pairs``."""
+    chosen = rng.choice(n, size=min(n, n_shapes), replace=False)
+    pairs = rng.permutation(chosen)[: 2 * (len(chosen) // 2)].reshape(-1, 2)
+    return pairs[:n_pairs]
+
+
+def interpolate(z: np.ndarray, pairs: np.ndarray, alphas: np.ndarray) -> np.ndarray:
+    """(P, A, d) latents ``(1 − α) z_a + α z_b`` for every pair and weight."""
+    a, b = z[pairs[:, 0]][:, None], z[pairs[:, 1]][:, None]
+    return (1 - alphas[None, :, None]) * a + alphas[None, :, None] * b
+
+
+def run(params: Params) -> None:
+    cfg = params.critic_eval
+    torch.manual_seed(params.seed)
+    device = resolve_device(params.device)
+    train = split_voxels(params)["train"]
+    pairs = random_pairs(len(train), cfg.n_shapes, cfg.n_pairs, np.random.default_rng(params.seed))
+    alphas = np.asarray(cfg.alphas, dtype=np.float32)
+    seq_alphas = np.linspace(0, 1, 7, dtype=np.float32)
+    examples = pairs[: cfg.n_examples]
+
+    table, rows, row_labels = {}, [], []
+    decoded_examples = {}
+    for name, path in MODELS.items():
+        ae, _, _ = load_autoencoder(path, net_config(params))
+        z = encode(ae, train, device)
+        grids = decode(ae, interpolate(z, pairs, alphas).reshape(-1, z.shape[1]), device) > cfg.threshold
+        pct = np.array([outlier_percentage(g) for g in grids]).reshape(len(pairs), len(alphas))
+        table[name] = {f"{a:.2f}": float(np.nanmean(pct[:, i])) if np.isfinite(pct[:, i]).any() else None for i, a in enumerate(alphas)}
+        table[f"{name}_empty"] = int(np.isnan(pct).sum())
+        decoded_examples[name] = decode(ae, interpolate(z, examples, seq_alphas).reshape(-1, z.shape[1]), device).reshape(len(examples), len(seq_alphas), *train.shape[2:]) > cfg.threshold
+
+    for p in range(len(examples)):
+        for name, label in (("ae", "AE"), ("ae_critic", "AE-Critic")):
+            rows.append([(g, largest_cluster(g)) for g in decoded_examples[name][p]])
+            row_labels.append(f"pair {p + 1} {label}")
+
+    result = {"n_pairs": int(len(pairs)), "n_decoded_per_model": int(len(pairs) * len(alphas)), "outlier_pct": {k: v for k, v in table.items() if not k.endswith("_empty")},
+              "empty_grids": {k[: -len("_empty")]: v for k, v in table.items() if k.endswith("_empty")}}
+    with atomic_path(METRICS) as tmp:
+        tmp.write_text(json.dumps(result, indent=2) + "\n")
+    long = pd.DataFrame([{"alpha": float(a), "model": m, "outlier_pct": result["outlier_pct"][m][f"{a:.2f}"]} for m in MODELS for a in alphas])
+    OUTLIERS_CSV.parent.mkdir(parents=True, exist_ok=True)
+    long.to_csv(OUTLIERS_CSV, index=False)
+    lines(alphas, {m: long[long.model == m].outlier_pct.to_numpy() for m in MODELS}, OUTLIERS_PNG, "interpolation weight α", "mean outlier voxels (%)", f"Outliers of decoded interpolations ({len(pairs)} pairs)")
+    voxel_rows(rows, row_labels, [f"α={a:.2f}" for a in seq_alphas], EXAMPLES_PNG, "Interpolations: AE (upper) vs AE-Critic (lower); outliers red")
+    log.info("critic_eval: outlier %% by α %s — AE %s, AE-Critic %s", list(result["outlier_pct"]["ae"]),
+             [round(v, 2) if v is not None else None for v in result["outlier_pct"]["ae"].values()],
+             [round(v, 2) if v is not None else None for v in result["outlier_pct"]["ae_critic"].values()])

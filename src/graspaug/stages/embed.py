@@ -1,0 +1,58 @@
+"""Stage ``embed``: the AE-Critic latent z of every shape, and a t-SNE map of them.
+
+Outputs: ``data/latents.parquet`` (``shape_id``, ``split``, ``z``: 128 float32),
+``reports/embed/tsne.csv`` (for ``dvc plots``) and ``reports/embed/tsne.png``.
+"""
+from __future__ import annotations
+
+import logging
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import torch
+
+from graspaug.config import Params
+from graspaug.io.checkpoints import load_autoencoder
+from graspaug.io.tables import read_table, write_table
+from graspaug.io.voxels import read_voxels
+from graspaug.plots import scatter_2d
+from graspaug.stages.ingest import SHAPES_TABLE
+from graspaug.stages.train_ae import AE_CRITIC_MODEL, net_config
+from graspaug.stages.voxelize import VOXELS
+from graspaug.training.autoencoder import encode, resolve_device
+
+log = logging.getLogger(__name__)
+
+LATENTS = Path("data/latents.parquet")
+TSNE_CSV = Path("reports/embed/tsne.csv")
+TSNE_PNG = Path("reports/embed/tsne.png")
+
+
+def tsne_2d(z: np.ndarray, perplexity: float, seed: int) -> np.ndarray:
+    """(N, 2) t-SNE of (N, d) latents (scikit-learn, PCA init, seeded)."""
+    from sklearn.manifold import TSNE
+
+    if len(z) < 3:
+        return np.zeros((len(z), 2))
+    perplexity = min(perplexity, (len(z) - 1) / 3)
+    return TSNE(n_components=2, perplexity=perplexity, init="pca", random_state=seed).fit_transform(z)
+
+
+def run(params: Params) -> None:
+    torch.manual_seed(params.seed)
+    device = resolve_device(params.device)
+    ae, _, _ = load_autoencoder(AE_CRITIC_MODEL, net_config(params))
+    voxels = read_voxels(VOXELS)
+    split = read_table(SHAPES_TABLE).set_index("shape_id")["split"].reindex(voxels.shape_id).to_numpy()
+    z = encode(ae, torch.from_numpy(voxels.occupancy[:, None].astype(np.uint8)), device)
+
+    latents = pd.DataFrame({"shape_id": voxels.shape_id, "split": split, "z": list(z.astype(np.float32))})
+    write_table(latents, LATENTS)
+
+    xy = tsne_2d(z, params.embed.perplexity, params.seed)
+    tsne = pd.DataFrame({"shape_id": voxels.shape_id, "split": split, "x": xy[:, 0], "y": xy[:, 1]})
+    TSNE_CSV.parent.mkdir(parents=True, exist_ok=True)
+    tsne.to_csv(TSNE_CSV, index=False)
+    scatter_2d(xy, split, TSNE_PNG, f"t-SNE of AE-Critic latents ({len(z)} shapes)")
+    log.info("embed: %d latents of size %d, t-SNE written", len(z), z.shape[1])

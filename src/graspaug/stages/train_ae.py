@@ -1,0 +1,102 @@
+"""Stage ``train_ae``: AutoEncoder (phase 1) then AE-Critic (phase 2) on the train split.
+
+Outputs: ``models/ae.pt``, ``models/ae_critic.pt``, DVCLive logs in
+``metrics/train_ae/{ae,ae_critic}/``, summary ``metrics/train_ae.json``.
+"""
+from __future__ import annotations
+
+import dataclasses
+import json
+import logging
+import time
+from pathlib import Path
+
+import numpy as np
+import torch
+
+from graspaug.config import Params
+from graspaug.io.atomic import atomic_path
+from graspaug.io.checkpoints import save_autoencoder
+from graspaug.io.tables import read_table
+from graspaug.io.voxels import read_voxels
+from graspaug.nets.ae_critic import AEConfig, AutoEncoder, Critic
+from graspaug.stages.ingest import SHAPES_TABLE
+from graspaug.stages.voxelize import VOXELS
+from graspaug.training.autoencoder import AETrainConfig, reconstruction_iou, resolve_device, train_ae_critic, train_autoencoder
+
+log = logging.getLogger(__name__)
+
+AE_MODEL = Path("models/ae.pt")
+AE_CRITIC_MODEL = Path("models/ae_critic.pt")
+LIVE_DIR = Path("metrics/train_ae")
+SUMMARY = Path("metrics/train_ae.json")
+
+
+def net_config(params: Params) -> AEConfig:
+    """The network's settings from params (resolution from ``voxelize``)."""
+    return AEConfig(resolution=params.voxelize.resolution, z_dim=params.ae.z_dim, base_width=params.ae.base_width, top_width=params.ae.top_width)
+
+
+def train_config(params: Params) -> AETrainConfig:
+    a = params.ae
+    return AETrainConfig(a.batch_size, a.epochs_ae, a.epochs_critic, a.lr_ae, a.lr_ae_critic, a.lr_critic, a.gamma, a.lam, a.flips)
+
+
+def split_voxels(params: Params) -> dict[str, torch.Tensor]:
+    """(N, 1, R, R, R) uint8 grids per split, in the voxel file's order."""
+    voxels = read_voxels(VOXELS)
+    split = read_table(SHAPES_TABLE).set_index("shape_id")["split"]
+    labels = split.reindex(voxels.shape_id).to_numpy()
+    grids = torch.from_numpy(voxels.occupancy[:, None].astype(np.uint8))
+    return {name: grids[labels == name] for name in ("train", "test")}
+
+
+def run(params: Params) -> None:
+    from dvclive import Live
+
+    start = time.perf_counter()
+    torch.manual_seed(params.seed)
+    gen = torch.Generator().manual_seed(params.seed)
+    device = resolve_device(params.device)
+    cfg, tcfg = net_config(params), train_config(params)
+    data = split_voxels(params)
+    train, test = data["train"], data["test"]
+    log.info("train_ae: %d train / %d test shapes at %d³ on %s, widths %s", len(train), len(test), cfg.resolution, device, cfg.widths)
+
+    ae = AutoEncoder(cfg)
+    summary: dict[str, float] = {"n_train": len(train), "n_test": len(test)}
+
+    def logger(live: Live, model: AutoEncoder):
+        def on_epoch(epoch: int, metrics: dict[str, float]) -> None:
+            for key, value in metrics.items():
+                live.log_metric(key, value)
+            live.log_metric("iou_train", reconstruction_iou(model, train[:256], device))  # a fixed subset, for speed
+            live.log_metric("iou_test", reconstruction_iou(model, test, device))
+            live.next_step()
+
+        return on_epoch
+
+    with Live(str(LIVE_DIR / "ae"), dvcyaml=False, save_dvc_exp=False) as live:
+        t0 = time.perf_counter()
+        summary["ae_shapes_per_s"] = train_autoencoder(ae, train, tcfg, device, gen, logger(live, ae))
+        summary["ae_train_s"] = time.perf_counter() - t0
+    summary["ae_iou_test"] = reconstruction_iou(ae, test, device)
+    summary["ae_iou_train"] = reconstruction_iou(ae, train, device)
+    save_autoencoder(AE_MODEL, ae, None, dataclasses.asdict(tcfg))
+
+    critic = Critic(cfg)
+    with Live(str(LIVE_DIR / "ae_critic"), dvcyaml=False, save_dvc_exp=False) as live:
+        t0 = time.perf_counter()
+        summary["ae_critic_shapes_per_s"] = train_ae_critic(ae, critic, train, tcfg, device, gen, logger(live, ae))
+        summary["ae_critic_train_s"] = time.perf_counter() - t0
+    summary["ae_critic_iou_test"] = reconstruction_iou(ae, test, device)
+    summary["ae_critic_iou_train"] = reconstruction_iou(ae, train, device)
+    save_autoencoder(AE_CRITIC_MODEL, ae, critic, dataclasses.asdict(tcfg))
+
+    summary["train_s"] = time.perf_counter() - start
+    with atomic_path(SUMMARY) as tmp:
+        tmp.write_text(json.dumps({k: round(float(v), 5) for k, v in summary.items()}, indent=2) + "\n")
+    log.info(
+        "train_ae: test IoU AE %.3f, AE-Critic %.3f; %.0f s (%.1f / %.1f shapes/s)",
+        summary["ae_iou_test"], summary["ae_critic_iou_test"], summary["train_s"], summary["ae_shapes_per_s"], summary["ae_critic_shapes_per_s"],
+    )
