@@ -68,3 +68,10 @@ def test_cli_help_lists_stages_and_explains_params():
     assert sub.exit_code == 0
     for key in ("max_faces", "surface_resolution", "size_rule", "test_fraction", "source"):
         assert key in sub.output
+
+
+def test_paper_profile_loads_with_the_paper_sizes(repo_root):
+    params = load_params(repo_root / "profiles/paper.yaml")
+    assert params.voxelize.resolution == 64
+    assert (params.ae.base_width, params.ae.top_width, params.ae.z_dim) == (64, 512, 128)
+    assert params.ingest.test_fraction == pytest.approx(363 / 1363, abs=1e-4)

@@ -1,6 +1,7 @@
 """``graspaug``: one command per pipeline stage (``dvc.yaml`` calls these)."""
 from __future__ import annotations
 
+import importlib
 import logging
 import sys
 from pathlib import Path
@@ -41,62 +42,50 @@ def _run(stage_run, params: Params) -> None:
         raise typer.Exit(code=1) from None
 
 
-@app.command(
-    help="Load the shape corpus, reject broken meshes with a reason, rebuild one closed outer surface "
+def stage_command(name: str, help: str) -> None:
+    """Register ``graspaug <name>``: load params, run ``graspaug.stages.<module>.run``."""
+    module = name.replace("-", "_")
+
+    def command(params: Path = ParamsOption) -> None:
+        stage = importlib.import_module(f"graspaug.stages.{module}")
+        _run(stage.run, _load(params))
+
+    app.command(name=name, help=help)(command)
+
+
+stage_command(
+    "ingest",
+    "Load the shape corpus, reject broken meshes with a reason, rebuild one closed outer surface "
     "per shape, center and scale it, and split train/test.\n\n"
     "Writes `data/shapes/<shape_id>.ply`, `data/shapes.parquet`, `data/rejects.parquet`.\n\n"
     f"Params `data`:\n\n{describe(DataParams)}\n\nParams `ingest`:\n\n{describe(IngestParams)}\n\n"
-    "Also `seed` (split) and `n_jobs`."
+    "Also `seed` (split) and `n_jobs`.",
 )
-def ingest(params: Path = ParamsOption) -> None:
-    from graspaug.stages import ingest as stage
-
-    _run(stage.run, _load(params))
-
-
-@app.command(
-    help="Voxelize every shape's closed surface into a solid R×R×R occupancy grid (voxel centers "
+stage_command(
+    "voxelize",
+    "Voxelize every shape's closed surface into a solid R×R×R occupancy grid (voxel centers "
     "inside the surface), scaled to fit with a margin; pitch and origin are kept to go back to meters.\n\n"
-    f"Writes `data/voxels.npz`.\n\nParams `voxelize`:\n\n{describe(VoxelizeParams)}\n\nAlso `n_jobs`."
+    f"Writes `data/voxels.npz`.\n\nParams `voxelize`:\n\n{describe(VoxelizeParams)}\n\nAlso `n_jobs`.",
 )
-def voxelize(params: Path = ParamsOption) -> None:
-    from graspaug.stages import voxelize as stage
-
-    _run(stage.run, _load(params))
-
-
-@app.command(
-    help="Train the AutoEncoder (phase 1, binary cross-entropy) and then the AE-Critic (phase 2, eqs. (1)-(2) "
+stage_command(
+    "train-ae",
+    "Train the AutoEncoder (phase 1, binary cross-entropy) and then the AE-Critic (phase 2, eqs. (1)-(2) "
     "of the paper) on the train split's voxel grids; test shapes stay unseen.\n\n"
     "Writes `models/ae.pt`, `models/ae_critic.pt`, DVCLive logs in `metrics/train_ae/`, and `metrics/train_ae.json` "
     f"(test/train reconstruction IoU, time, shapes/s).\n\nParams `ae`:\n\n{describe(AEParams)}\n\n"
-    "Also `voxelize.resolution`, `seed`, `device`."
+    "Also `voxelize.resolution`, `seed`, `device`.",
 )
-def train_ae(params: Path = ParamsOption) -> None:
-    from graspaug.stages import train_ae as stage
-
-    _run(stage.run, _load(params))
-
-
-@app.command(
-    help="Encode every shape with the AE-Critic: `data/latents.parquet` (shape_id, split, z) and a 2-D t-SNE map "
-    f"(`reports/embed/tsne.csv`, `.png`).\n\nParams `embed`:\n\n{describe(EmbedParams)}"
+stage_command(
+    "embed",
+    "Encode every shape with the AE-Critic: `data/latents.parquet` (shape_id, split, z) and a 2-D t-SNE map "
+    f"(`reports/embed/tsne.csv`, `.png`).\n\nParams `embed`:\n\n{describe(EmbedParams)}",
 )
-def embed(params: Path = ParamsOption) -> None:
-    from graspaug.stages import embed as stage
-
-    _run(stage.run, _load(params))
-
-
-@app.command(
-    help="The paper's critic study: decode interpolations of random train pairs with the AE and the AE-Critic, "
+stage_command(
+    "critic-eval",
+    "The paper's critic study: decode interpolations of random train pairs with the AE and the AE-Critic, "
     "cluster each with DBSCAN, report the mean outlier percentage per α (`metrics/critic_eval.json`) with plots "
-    f"in `reports/critic_eval/`.\n\nParams `critic_eval`:\n\n{describe(CriticEvalParams)}"
+    f"in `reports/critic_eval/`.\n\nParams `critic_eval`:\n\n{describe(CriticEvalParams)}",
 )
-def critic_eval(params: Path = ParamsOption) -> None:
-    from graspaug.stages import critic_eval as stage
-
-    _run(stage.run, _load(params))
 
 
 def main() -> None:

@@ -116,7 +116,7 @@ class Critic(nn.Module):
 
 
 class AutoEncoder(nn.Module):
-    """Encoder + Decoder; ``interpolate`` decodes ``α z_a + (1 − α) z_b``... see its doc."""
+    """Encoder + Decoder: (B, 1, R, R, R) occupancy → (B, 1, R, R, R) logits."""
 
     def __init__(self, cfg: AEConfig):
         super().__init__()

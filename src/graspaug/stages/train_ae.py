@@ -39,7 +39,10 @@ def net_config(params: Params) -> AEConfig:
 
 def train_config(params: Params) -> AETrainConfig:
     a = params.ae
-    return AETrainConfig(a.batch_size, a.epochs_ae, a.epochs_critic, a.lr_ae, a.lr_ae_critic, a.lr_critic, a.gamma, a.lam, a.flips)
+    return AETrainConfig(
+        batch_size=a.batch_size, epochs_ae=a.epochs_ae, epochs_critic=a.epochs_critic, critic_warmup=a.critic_warmup,
+        lr_ae=a.lr_ae, lr_ae_critic=a.lr_ae_critic, lr_critic=a.lr_critic, gamma=a.gamma, lam=a.lam, flips=a.flips,
+    )
 
 
 def split_voxels(params: Params) -> dict[str, torch.Tensor]:
@@ -70,7 +73,7 @@ def run(params: Params) -> None:
         def on_epoch(epoch: int, metrics: dict[str, float]) -> None:
             for key, value in metrics.items():
                 live.log_metric(key, value)
-            live.log_metric("iou_train", reconstruction_iou(model, train[:256], device))  # a fixed subset, for speed
+            live.log_metric("iou_train", reconstruction_iou(model, train[:128], device))  # a fixed subset, for speed
             live.log_metric("iou_test", reconstruction_iou(model, test, device))
             live.next_step()
 

@@ -22,6 +22,7 @@ class AETrainConfig:
     batch_size: int = 32
     epochs_ae: int = 20  # phase 1: plain AE, BCE
     epochs_critic: int = 10  # phase 2: AE-Critic from phase 1
+    critic_warmup: int = 1  # first phase-2 epochs that train only the critic (a random critic would push the AE around)
     lr_ae: float = 1e-3  # phase 1 Adam (paper)
     lr_ae_critic: float = 1e-4  # phase 2 AE Adam (paper)
     lr_critic: float = 1e-3  # phase 2 critic Adam (paper)
@@ -85,6 +86,9 @@ def train_autoencoder(ae: AutoEncoder, voxels: torch.Tensor, cfg: AETrainConfig,
 def train_ae_critic(ae: AutoEncoder, critic: Critic, voxels: torch.Tensor, cfg: AETrainConfig, device: torch.device, gen: torch.Generator, on_epoch: EpochCallback | None = None) -> float:
     """Phase 2: critic on eq. (1) with Adam(lr_critic), AE on eq. (2) with Adam(lr_ae_critic).
 
+    The first ``critic_warmup`` epochs train only the critic, so the AE's eq. (2) term
+    starts from a critic that has learned something rather than from random outputs.
+
     Each batch: x̂ = AE(x); a partner for every shape from a permutation of the batch;
     α ~ U[0, 0.5]; x̂_α = decode((1 − α) z + α z_partner). Returns shapes/s.
     """
@@ -107,14 +111,17 @@ def train_ae_critic(ae: AutoEncoder, critic: Critic, voxels: torch.Tensor, cfg: 
             partner = torch.randperm(b, generator=gen).to(device)
             alpha = (0.5 * torch.rand(b, generator=gen)).to(device)
 
-            z = ae.encoder(x)
-            recon = ae.decoder(z)
-            x_alpha = torch.sigmoid(ae.interpolate(z, z[partner], alpha))
-            c_interp = critic(x_alpha)
-            loss_ae, bce, reg = autoencoder_loss(recon, x, c_interp, cfg.lam)  # eq. (2)
-            opt_ae.zero_grad(set_to_none=True)
-            loss_ae.backward()
-            opt_ae.step()
+            train_ae = epoch >= cfg.critic_warmup
+            with torch.set_grad_enabled(train_ae):
+                z = ae.encoder(x)
+                recon = ae.decoder(z)
+                x_alpha = torch.sigmoid(ae.interpolate(z, z[partner], alpha))
+                c_interp = critic(x_alpha)
+                loss_ae, bce, reg = autoencoder_loss(recon, x, c_interp, cfg.lam)  # eq. (2)
+            if train_ae:
+                opt_ae.zero_grad(set_to_none=True)
+                loss_ae.backward()
+                opt_ae.step()
 
             loss_c = critic_loss(critic, x, torch.sigmoid(recon), x_alpha, alpha, cfg.gamma)  # eq. (1)
             opt_c.zero_grad(set_to_none=True)
