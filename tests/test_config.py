@@ -29,6 +29,10 @@ def test_repo_params_load_and_match_the_dataclass_defaults(repo_root):
         ({"device": "tpu"}, "device: must be one of auto, cpu, cuda; got 'tpu'"),
         ({"data": {"source": "folder"}}, "data.path: required when data.source is folder"),
         ({"data": 3}, "data.: expected a mapping"),
+        ({"n_jobs": 0}, "n_jobs: must be >= 1, or -1 for all cores; got 0"),
+        ({"ae": {"lambda": -1}}, "ae.lambda: must be >= 0; got -1"),
+        ({"critic_eval": {"alphas": [0.1, 0.104]}}, "critic_eval.alphas: weights must differ in the first two decimals"),
+        ({"critic_eval": {"alphas": [0.1, 1.5]}}, "critic_eval.alphas: must be a non-empty list of weights in [0, 1]"),
     ],
 )
 def test_bad_params_name_the_key(raw, message):

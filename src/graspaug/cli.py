@@ -33,7 +33,7 @@ def _load(path: Path) -> Params:
 
 def _run(stage_run, params: Params) -> None:
     from graspaug.io.checkpoints import CheckpointMismatch
-    from graspaug.stages.ingest import StageError
+    from graspaug.stages import StageError
 
     try:
         stage_run(params)

@@ -107,7 +107,7 @@ class CriticEvalParams:
 class Params:
     """All parameters of the pipeline."""
 
-    seed: int = param(0, "Seeds every random choice of every stage.", ge=0)
+    seed: int = param(0, "Seeds every random choice: the split, network initialisation and batches, critic-study pairs, t-SNE.", ge=0)
     device: str = param("auto", "Torch device: `auto` (CUDA when present), `cpu` or `cuda`.", choices=("auto", "cpu", "cuda"))
     n_jobs: int = param(2, "Worker processes for per-shape loops (-1: all cores).", ge=-1)
     data: DataParams = field(default_factory=DataParams)
@@ -195,9 +195,13 @@ def parse_params(raw: Any) -> Params:
     params = _build(Params, raw, "")
     if params.data.source == "folder" and not params.data.path:
         raise ParamsError("data.path: required when data.source is folder")
+    if params.n_jobs == 0:
+        raise ParamsError("n_jobs: must be >= 1, or -1 for all cores; got 0")
     alphas = params.critic_eval.alphas
     if not alphas or not all(0 <= a <= 1 for a in alphas):
         raise ParamsError(f"critic_eval.alphas: must be a non-empty list of weights in [0, 1]; got {list(alphas)}")
+    if len({f"{a:.2f}" for a in alphas}) != len(alphas):
+        raise ParamsError(f"critic_eval.alphas: weights must differ in the first two decimals (they name the metrics); got {list(alphas)}")
     return params
 
 

@@ -17,6 +17,8 @@ def write_broken_corpus(folder):
     (folder / "truncated.ply").write_bytes(box_ply[: len(box_ply) // 2])
     (folder / "nan.obj").write_text("v nan 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 1 3 4\nf 1 4 2\nf 2 4 3\n")
     (folder / "triangle.obj").write_text("v 0 0 0\nv 0.05 0 0\nv 0 0.05 0\nf 1 2 3\n")
+    # a flat sheet tilted against every axis: flat along its own principal directions
+    (folder / "tilted.obj").write_text("v 0 0 0\nv 0.05 0 0.01\nv 0 0.05 0.02\nv 0.05 0.05 0.03\nf 1 2 3\nf 2 4 3\n")
     (folder / "empty.stl").write_bytes(b"")
     trimesh.creation.icosphere(subdivisions=6, radius=0.03).export(folder / "huge.ply")  # 81,920 faces
     (folder / "points.ply").write_text("ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nend_header\n0 0 0\n1 0 0\n0 1 0\n")
@@ -25,6 +27,7 @@ def write_broken_corpus(folder):
         "truncated": "unreadable",
         "nan": "non-finite vertex coordinates",
         "triangle": "degenerate: flat",
+        "tilted": "degenerate: flat",
         "empty": "empty file",
         "huge": "too many faces: 81920 > max_faces=50000",
         "points": "not a mesh",
@@ -33,7 +36,9 @@ def write_broken_corpus(folder):
 
 def test_every_broken_kind_is_rejected_with_its_reason(tmp_path):
     expected = write_broken_corpus(tmp_path / "broken")
-    for source in folder_sources(tmp_path / "broken"):
+    sources = folder_sources(tmp_path / "broken")
+    assert sorted(s.path.stem for s in sources) == sorted(expected)
+    for source in sources:
         stem = source.path.stem
         with pytest.raises(MeshRejected) as exc:
             load_shape(source.path, max_faces=50_000)
@@ -81,7 +86,7 @@ def test_folder_ids_are_stable_and_unique(tmp_path):
     assert [s.name for s in folder_sources(tmp_path)][2] == "folder:b/c/bowl.ply"
 
 
-def test_a_watertight_single_body_keeps_its_triangles(tmp_path):
+def test_a_convex_body_is_rebuilt_as_one_part_and_sized(tmp_path):
     from graspaug.config import IngestParams
     from graspaug.geometry.prepare import prepare_shape
     from graspaug.stages.ingest import surface_settings
@@ -89,7 +94,23 @@ def test_a_watertight_single_body_keeps_its_triangles(tmp_path):
     path = tmp_path / "box.stl"
     trimesh.creation.box(extents=(0.1, 0.06, 0.03)).export(path)
     loaded = load_shape(path)
-    assert loaded.parts  # one closed convex body counts as one convex part
+    assert len(loaded.parts) == 1  # one closed convex body counts as one convex part
     prepared = prepare_shape(loaded, surface_settings(IngestParams(size_rule="mid", size_m=0.06)))
     assert np.allclose(sorted(prepared.mesh.extents), [0.03, 0.06, 0.1], atol=1e-3)
     assert np.allclose(prepared.mesh.center_mass, 0, atol=1e-6)
+
+
+def test_a_closed_non_convex_body_keeps_its_triangles(tmp_path):
+    from graspaug.config import IngestParams
+    from graspaug.geometry.prepare import prepare_shape
+    from graspaug.stages.ingest import surface_settings
+
+    torus = trimesh.creation.torus(major_radius=0.04, minor_radius=0.012)
+    path = tmp_path / "ring.ply"
+    torus.export(path)
+    loaded = load_shape(path)
+    assert loaded.parts == []
+    prepared = prepare_shape(loaded, surface_settings(IngestParams()))
+    assert len(prepared.mesh.faces) == len(torus.faces) < IngestParams().face_budget
+    scale = prepared.normalization.scale
+    assert np.allclose(np.sort(prepared.mesh.vertices, axis=0), np.sort(torus.vertices * scale + prepared.normalization.offset, axis=0), atol=1e-9)

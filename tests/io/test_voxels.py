@@ -20,6 +20,7 @@ def test_roundtrip_and_identical_bytes_for_identical_arrays(tmp_path):
     write_voxels(voxels, tmp_path / "b.npz")
     assert (tmp_path / "a.npz").read_bytes() == (tmp_path / "b.npz").read_bytes()
     assert not [p for p in tmp_path.iterdir() if p.name.startswith(".")]  # no temporaries left
+    assert (tmp_path / "a.npz").stat().st_mode & 0o044 == 0o044  # readable by others, like any file (umask 022)
 
 
 def test_an_interrupted_write_leaves_the_old_file(tmp_path):

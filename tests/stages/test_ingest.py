@@ -100,7 +100,7 @@ def test_too_few_shapes_fails_clearly_and_writes_nothing(tmp_path, corpus_params
     params["ingest"]["min_shapes"] = 6
     result = run_stage(tmp_path, "ingest", params)
     assert result.exit_code == 1
-    assert "error: only 5 of 12 shapes are usable, ingest.min_shapes=6" in result.output
+    assert "error: only 5 of 13 shapes are usable, ingest.min_shapes=6" in result.output
     assert not (tmp_path / "data/shapes.parquet").exists()
     assert not (tmp_path / "data/shapes").exists()
     assert not [p for p in (tmp_path / "data").iterdir() if p.name.startswith(".")]

@@ -58,9 +58,13 @@ def test_ae_critic_phase_reports_its_losses_and_trains_the_critic():
     cfg = AEConfig(resolution=16, z_dim=16, base_width=4, top_width=16)
     ae, critic = AutoEncoder(cfg), Critic(cfg)
     seen = []
-    tcfg = AETrainConfig(batch_size=8, epochs_ae=0, epochs_critic=3)
+    before = {k: v.clone() for k, v in critic.state_dict().items()}
+    ae_before = {k: v.clone() for k, v in ae.state_dict().items()}
+    tcfg = AETrainConfig(batch_size=8, epochs_ae=0, epochs_critic=3, critic_warmup=1)
     rate = train_ae_critic(ae, critic, x, tcfg, CPU, torch.Generator().manual_seed(0), lambda e, m: seen.append(m))
     assert rate > 0 and len(seen) == 3
+    assert not torch.equal(before["head.weight"], critic.state_dict()["head.weight"])
+    assert not torch.equal(ae_before["encoder.fc.weight"], ae.state_dict()["encoder.fc.weight"])
     assert set(seen[0]) == {"loss_recon", "loss_reg", "loss_critic", "critic_real", "critic_interp"}
     assert all(np.isfinite(v) for m in seen for v in m.values())
 
@@ -71,7 +75,12 @@ def test_checkpoint_roundtrip_and_mismatch(tmp_path):
     save_autoencoder(tmp_path / "m.pt", ae, critic, {"lr_ae": 1e-3})
     back, back_critic, params = load_autoencoder(tmp_path / "m.pt", cfg)
     assert params == {"lr_ae": 1e-3} and back_critic is not None
+    for mine, theirs in ((ae, back), (critic, back_critic)):
+        a, b = mine.state_dict(), theirs.state_dict()
+        assert a.keys() == b.keys() and all(torch.equal(a[k], b[k]) for k in a)
     x = primitive_grids(16)
     assert np.array_equal(encode(ae, x, CPU), encode(back, x, CPU))
+    save_autoencoder(tmp_path / "again.pt", ae, critic, {"lr_ae": 1e-3})
+    assert (tmp_path / "m.pt").read_bytes() == (tmp_path / "again.pt").read_bytes()  # same weights, same bytes
     with pytest.raises(CheckpointMismatch, match=r"trained with resolution=16 \(params: 32\)"):
         load_autoencoder(tmp_path / "m.pt", AEConfig(resolution=32, z_dim=16, base_width=4, top_width=16))

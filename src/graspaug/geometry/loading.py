@@ -109,9 +109,10 @@ def load_shape(path: str | os.PathLike, unit_scale: float = 1.0, max_faces: int 
     mesh.remove_unreferenced_vertices()
     if len(mesh.faces) == 0 or not mesh.area > 0:
         raise MeshRejected("degenerate: zero surface area")
-    extents = mesh.extents
-    if extents.min() <= _FLAT_RATIO * extents.max():
-        raise MeshRejected(f"degenerate: flat, extents {np.array2string(extents, precision=4)} m")
+    # flat along the mesh's own principal directions (a tilted sheet too), not just x, y, z
+    spread = np.linalg.svd(mesh.vertices - mesh.vertices.mean(axis=0), compute_uv=False)
+    if len(spread) < 3 or spread[2] <= _FLAT_RATIO * spread[0]:
+        raise MeshRejected(f"degenerate: flat, extents {np.array2string(mesh.extents, precision=4)} m")
 
     parts: list[ConvexPart] = []
     if all(p.is_watertight and p.is_convex for p in pieces):

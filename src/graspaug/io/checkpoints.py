@@ -26,14 +26,13 @@ def save_autoencoder(path: str | os.PathLike, ae: AutoEncoder, critic: Critic | 
     state = {
         "format": "graspaug.autoencoder/1",
         "config": dataclasses.asdict(ae.cfg),
-        "resolution": ae.cfg.resolution,
         "train_params": dict(train_params),
         "autoencoder": {k: v.detach().cpu() for k, v in ae.state_dict().items()},
     }
     if critic is not None:
         state["critic"] = {k: v.detach().cpu() for k, v in critic.state_dict().items()}
-    with atomic_path(path) as tmp:
-        torch.save(state, tmp)
+    with atomic_path(path) as tmp, open(tmp, "wb") as f:
+        torch.save(state, f)  # a file object: archive names do not depend on the temporary's name
 
 
 def load_autoencoder(path: str | os.PathLike, expected: AEConfig) -> tuple[AutoEncoder, Critic | None, dict[str, Any]]:

@@ -14,6 +14,12 @@ def write_table(df: pd.DataFrame, path: str | os.PathLike) -> None:
         df.to_parquet(tmp, index=False)
 
 
+def write_csv(df: pd.DataFrame, path: str | os.PathLike) -> None:
+    """Write ``df`` as CSV (no index), e.g. the data behind a ``dvc plots`` plot."""
+    with atomic_path(path) as tmp:
+        df.to_csv(tmp, index=False)
+
+
 def read_table(path: str | os.PathLike) -> pd.DataFrame:
     """Read a parquet table written by :func:`write_table`."""
     return pd.read_parquet(path)

@@ -85,10 +85,10 @@ class Decoder(nn.Module):
         w = cfg.widths
         self.top = w[-1]
         self.fc = nn.Linear(cfg.z_dim, w[-1] * 4**3)
-        up_widths = w[-2::-1] if len(w) > 1 else []  # e.g. 128 → 64 → 32 → 16
+        up_widths = w[-2::-1]  # e.g. 128 → 64 → 32 → 16 (R >= 8 gives at least one)
         layers: list[nn.Module] = [nn.BatchNorm3d(w[-1]), nn.ReLU(inplace=True)]
-        layers += _same(w[-1], up_widths[0] if up_widths else w[-1])
-        c = up_widths[0] if up_widths else w[-1]
+        layers += _same(w[-1], up_widths[0])
+        c = up_widths[0]
         for i in range(cfg.n_down):
             last = i == cfg.n_down - 1
             c_out = 1 if last else up_widths[i + 1]

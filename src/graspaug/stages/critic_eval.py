@@ -14,13 +14,14 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
-import torch
 
 from graspaug.config import Params
 from graspaug.geometry.clusters import largest_cluster, outlier_percentage
 from graspaug.io.atomic import atomic_path
 from graspaug.io.checkpoints import load_autoencoder
+from graspaug.io.tables import write_csv
 from graspaug.plots import lines, voxel_rows
+from graspaug.stages import StageError
 from graspaug.stages.train_ae import AE_CRITIC_MODEL, AE_MODEL, net_config, split_voxels
 from graspaug.training.autoencoder import decode, encode, resolve_device
 
@@ -48,39 +49,44 @@ def interpolate(z: np.ndarray, pairs: np.ndarray, alphas: np.ndarray) -> np.ndar
 
 def run(params: Params) -> None:
     cfg = params.critic_eval
-    torch.manual_seed(params.seed)
     device = resolve_device(params.device)
-    train = split_voxels(params)["train"]
+    train = split_voxels()["train"]
     pairs = random_pairs(len(train), cfg.n_shapes, cfg.n_pairs, np.random.default_rng(params.seed))
+    if len(pairs) == 0:
+        raise StageError(f"critic_eval needs at least 2 train shapes, the split has {len(train)}")
     alphas = np.asarray(cfg.alphas, dtype=np.float32)
     seq_alphas = np.linspace(0, 1, 7, dtype=np.float32)
     examples = pairs[: cfg.n_examples]
 
-    table, rows, row_labels = {}, [], []
-    decoded_examples = {}
+    outlier_pct: dict[str, dict[str, float | None]] = {}
+    empty_grids: dict[str, int] = {}
+    sequences = {}
     for name, path in MODELS.items():
         ae, _, _ = load_autoencoder(path, net_config(params))
         z = encode(ae, train, device)
         grids = decode(ae, interpolate(z, pairs, alphas).reshape(-1, z.shape[1]), device) > cfg.threshold
         pct = np.array([outlier_percentage(g) for g in grids]).reshape(len(pairs), len(alphas))
-        table[name] = {f"{a:.2f}": float(np.nanmean(pct[:, i])) if np.isfinite(pct[:, i]).any() else None for i, a in enumerate(alphas)}
-        table[f"{name}_empty"] = int(np.isnan(pct).sum())
-        decoded_examples[name] = decode(ae, interpolate(z, examples, seq_alphas).reshape(-1, z.shape[1]), device).reshape(len(examples), len(seq_alphas), *train.shape[2:]) > cfg.threshold
+        outlier_pct[name] = {f"{a:.2f}": float(np.nanmean(pct[:, i])) if np.isfinite(pct[:, i]).any() else None for i, a in enumerate(cfg.alphas)}
+        empty_grids[name] = int(np.isnan(pct).sum())
+        seq = decode(ae, interpolate(z, examples, seq_alphas).reshape(-1, z.shape[1]), device) > cfg.threshold
+        sequences[name] = seq.reshape(len(examples), len(seq_alphas), *seq.shape[1:])
 
-    for p in range(len(examples)):
-        for name, label in (("ae", "AE"), ("ae_critic", "AE-Critic")):
-            rows.append([(g, largest_cluster(g)) for g in decoded_examples[name][p]])
-            row_labels.append(f"pair {p + 1} {label}")
-
-    result = {"n_pairs": int(len(pairs)), "n_decoded_per_model": int(len(pairs) * len(alphas)), "outlier_pct": {k: v for k, v in table.items() if not k.endswith("_empty")},
-              "empty_grids": {k[: -len("_empty")]: v for k, v in table.items() if k.endswith("_empty")}}
+    result = {"n_pairs": int(len(pairs)), "n_decoded_per_model": int(len(pairs) * len(alphas)), "outlier_pct": outlier_pct, "empty_grids": empty_grids}
     with atomic_path(METRICS) as tmp:
         tmp.write_text(json.dumps(result, indent=2) + "\n")
-    long = pd.DataFrame([{"alpha": float(a), "model": m, "outlier_pct": result["outlier_pct"][m][f"{a:.2f}"]} for m in MODELS for a in alphas])
-    OUTLIERS_CSV.parent.mkdir(parents=True, exist_ok=True)
-    long.to_csv(OUTLIERS_CSV, index=False)
-    lines(alphas, {m: long[long.model == m].outlier_pct.to_numpy() for m in MODELS}, OUTLIERS_PNG, "interpolation weight α", "mean outlier voxels (%)", f"Outliers of decoded interpolations ({len(pairs)} pairs)")
+    # one row per α, one column per model, so `dvc plots` draws one line per model
+    wide = pd.DataFrame({"alpha": list(cfg.alphas), **{m: [outlier_pct[m][f"{a:.2f}"] for a in cfg.alphas] for m in MODELS}})
+    write_csv(wide, OUTLIERS_CSV)
+    lines(list(cfg.alphas), {m: wide[m].to_numpy(dtype=float) for m in MODELS}, OUTLIERS_PNG, "interpolation weight α", "mean outlier voxels (%)", f"Outliers of decoded interpolations ({len(pairs)} pairs)")
+
+    rows, row_labels = [], []
+    for p in range(len(examples)):
+        for name, label in (("ae", "AE"), ("ae_critic", "AE-Critic")):
+            rows.append([(g, largest_cluster(g)) for g in sequences[name][p]])
+            row_labels.append(f"pair {p + 1} {label}")
     voxel_rows(rows, row_labels, [f"α={a:.2f}" for a in seq_alphas], EXAMPLES_PNG, "Interpolations: AE (upper) vs AE-Critic (lower); outliers red")
-    log.info("critic_eval: outlier %% by α %s — AE %s, AE-Critic %s", list(result["outlier_pct"]["ae"]),
-             [round(v, 2) if v is not None else None for v in result["outlier_pct"]["ae"].values()],
-             [round(v, 2) if v is not None else None for v in result["outlier_pct"]["ae_critic"].values()])
+
+    def fmt(values):
+        return [None if v is None else round(v, 2) for v in values.values()]
+
+    log.info("critic_eval: outlier %% at α %s: AE %s, AE-Critic %s", list(outlier_pct["ae"]), fmt(outlier_pct["ae"]), fmt(outlier_pct["ae_critic"]))

@@ -10,16 +10,12 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
-import torch
 
 from graspaug.config import Params
 from graspaug.io.checkpoints import load_autoencoder
-from graspaug.io.tables import read_table, write_table
-from graspaug.io.voxels import read_voxels
+from graspaug.io.tables import write_csv, write_table
 from graspaug.plots import scatter_2d
-from graspaug.stages.ingest import SHAPES_TABLE
-from graspaug.stages.train_ae import AE_CRITIC_MODEL, net_config
-from graspaug.stages.voxelize import VOXELS
+from graspaug.stages.train_ae import AE_CRITIC_MODEL, load_grids, net_config
 from graspaug.training.autoencoder import encode, resolve_device
 
 log = logging.getLogger(__name__)
@@ -40,19 +36,15 @@ def tsne_2d(z: np.ndarray, perplexity: float, seed: int) -> np.ndarray:
 
 
 def run(params: Params) -> None:
-    torch.manual_seed(params.seed)
     device = resolve_device(params.device)
     ae, _, _ = load_autoencoder(AE_CRITIC_MODEL, net_config(params))
-    voxels = read_voxels(VOXELS)
-    split = read_table(SHAPES_TABLE).set_index("shape_id")["split"].reindex(voxels.shape_id).to_numpy()
-    z = encode(ae, torch.from_numpy(voxels.occupancy[:, None].astype(np.uint8)), device)
+    shape_ids, split, grids = load_grids()
+    z = encode(ae, grids, device)
 
-    latents = pd.DataFrame({"shape_id": voxels.shape_id, "split": split, "z": list(z.astype(np.float32))})
+    latents = pd.DataFrame({"shape_id": shape_ids, "split": split, "z": list(z.astype(np.float32))})
     write_table(latents, LATENTS)
 
     xy = tsne_2d(z, params.embed.perplexity, params.seed)
-    tsne = pd.DataFrame({"shape_id": voxels.shape_id, "split": split, "x": xy[:, 0], "y": xy[:, 1]})
-    TSNE_CSV.parent.mkdir(parents=True, exist_ok=True)
-    tsne.to_csv(TSNE_CSV, index=False)
+    write_csv(pd.DataFrame({"shape_id": shape_ids, "split": split, "x": xy[:, 0], "y": xy[:, 1]}), TSNE_CSV)
     scatter_2d(xy, split, TSNE_PNG, f"t-SNE of AE-Critic latents ({len(z)} shapes)")
     log.info("embed: %d latents of size %d, t-SNE written", len(z), z.shape[1])

@@ -19,16 +19,13 @@ from graspaug.io.atomic import atomic_path
 from graspaug.io.meshes import mesh_path, write_mesh
 from graspaug.io.sources import Source, folder_sources, pybullet_sources
 from graspaug.io.tables import write_table
+from graspaug.stages import StageError
 
 log = logging.getLogger(__name__)
 
 SHAPES_DIR = Path("data/shapes")
 SHAPES_TABLE = Path("data/shapes.parquet")
 REJECTS_TABLE = Path("data/rejects.parquet")
-
-
-class StageError(RuntimeError):
-    """The stage cannot produce valid outputs; the message says why."""
 
 
 def _ingest_one(source: Source, max_faces: int, max_file_mb: float, settings: SurfaceSettings, out_dir: Path) -> dict:

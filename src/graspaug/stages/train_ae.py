@@ -8,6 +8,7 @@ from __future__ import annotations
 import dataclasses
 import json
 import logging
+import math
 import time
 from pathlib import Path
 
@@ -20,6 +21,7 @@ from graspaug.io.checkpoints import save_autoencoder
 from graspaug.io.tables import read_table
 from graspaug.io.voxels import read_voxels
 from graspaug.nets.ae_critic import AEConfig, AutoEncoder, Critic
+from graspaug.stages import StageError
 from graspaug.stages.ingest import SHAPES_TABLE
 from graspaug.stages.voxelize import VOXELS
 from graspaug.training.autoencoder import AETrainConfig, reconstruction_iou, resolve_device, train_ae_critic, train_autoencoder
@@ -45,12 +47,17 @@ def train_config(params: Params) -> AETrainConfig:
     )
 
 
-def split_voxels(params: Params) -> dict[str, torch.Tensor]:
-    """(N, 1, R, R, R) uint8 grids per split, in the voxel file's order."""
+def load_grids() -> tuple[np.ndarray, np.ndarray, torch.Tensor]:
+    """Every shape's ``shape_id``, ``split`` and (N, 1, R, R, R) uint8 grid, in the voxel file's order."""
     voxels = read_voxels(VOXELS)
     split = read_table(SHAPES_TABLE).set_index("shape_id")["split"]
     labels = split.reindex(voxels.shape_id).to_numpy()
-    grids = torch.from_numpy(voxels.occupancy[:, None].astype(np.uint8))
+    return voxels.shape_id, labels, torch.from_numpy(voxels.occupancy[:, None].astype(np.uint8))
+
+
+def split_voxels() -> dict[str, torch.Tensor]:
+    """(N, 1, R, R, R) uint8 grids per split, in the voxel file's order."""
+    _, labels, grids = load_grids()
     return {name: grids[labels == name] for name in ("train", "test")}
 
 
@@ -62,8 +69,10 @@ def run(params: Params) -> None:
     gen = torch.Generator().manual_seed(params.seed)
     device = resolve_device(params.device)
     cfg, tcfg = net_config(params), train_config(params)
-    data = split_voxels(params)
+    data = split_voxels()
     train, test = data["train"], data["test"]
+    if len(train) < 2:
+        raise StageError(f"train_ae needs at least 2 train shapes, the split has {len(train)}")
     log.info("train_ae: %d train / %d test shapes at %d³ on %s, widths %s", len(train), len(test), cfg.resolution, device, cfg.widths)
 
     ae = AutoEncoder(cfg)
@@ -98,7 +107,8 @@ def run(params: Params) -> None:
 
     summary["train_s"] = time.perf_counter() - start
     with atomic_path(SUMMARY) as tmp:
-        tmp.write_text(json.dumps({k: round(float(v), 5) for k, v in summary.items()}, indent=2) + "\n")
+        # NaN (e.g. IoU of an empty test split) is not JSON: write null
+        tmp.write_text(json.dumps({k: round(float(v), 5) if math.isfinite(v) else None for k, v in summary.items()}, indent=2) + "\n")
     log.info(
         "train_ae: test IoU AE %.3f, AE-Critic %.3f; %.0f s (%.1f / %.1f shapes/s)",
         summary["ae_iou_test"], summary["ae_critic_iou_test"], summary["train_s"], summary["ae_shapes_per_s"], summary["ae_critic_shapes_per_s"],

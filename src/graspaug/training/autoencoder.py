@@ -155,6 +155,9 @@ def decode(ae: AutoEncoder, z: np.ndarray, device: torch.device, batch_size: int
     """(N, R, R, R) float32 occupancy probabilities of (N, z_dim) latents (eval mode)."""
     ae.eval().to(device)
     zt = torch.as_tensor(np.asarray(z, dtype=np.float32))
+    if len(zt) == 0:
+        r = ae.cfg.resolution
+        return np.zeros((0, r, r, r), np.float32)
     out = [torch.sigmoid(ae.decoder(zt[i : i + batch_size].to(device))).cpu() for i in range(0, len(zt), batch_size)]
     return torch.cat(out)[:, 0].numpy()
 
