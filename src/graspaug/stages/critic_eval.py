@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import json
 import logging
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -22,15 +21,12 @@ from graspaug.io.checkpoints import load_autoencoder
 from graspaug.io.tables import write_csv
 from graspaug.plots import lines, voxel_rows
 from graspaug.stages import StageError
-from graspaug.stages.train_ae import AE_CRITIC_MODEL, AE_MODEL, net_config, split_voxels
+from graspaug.paths import AE_CRITIC_MODEL, AE_MODEL, CRITIC_EVAL_METRICS, INTERPOLATIONS_PNG, OUTLIERS_CSV, OUTLIERS_PNG
+from graspaug.stages.train_ae import net_config, split_voxels
 from graspaug.training.autoencoder import decode, encode, resolve_device
 
 log = logging.getLogger(__name__)
 
-METRICS = Path("metrics/critic_eval.json")
-OUTLIERS_CSV = Path("reports/critic_eval/outliers.csv")
-OUTLIERS_PNG = Path("reports/critic_eval/outliers.png")
-EXAMPLES_PNG = Path("reports/critic_eval/interpolations.png")
 MODELS = {"ae": AE_MODEL, "ae_critic": AE_CRITIC_MODEL}
 
 
@@ -72,7 +68,7 @@ def run(params: Params) -> None:
         sequences[name] = seq.reshape(len(examples), len(seq_alphas), *seq.shape[1:])
 
     result = {"n_pairs": int(len(pairs)), "n_decoded_per_model": int(len(pairs) * len(alphas)), "outlier_pct": outlier_pct, "empty_grids": empty_grids}
-    with atomic_path(METRICS) as tmp:
+    with atomic_path(CRITIC_EVAL_METRICS) as tmp:
         tmp.write_text(json.dumps(result, indent=2) + "\n")
     # one row per α, one column per model, so `dvc plots` draws one line per model
     wide = pd.DataFrame({"alpha": list(cfg.alphas), **{m: [outlier_pct[m][f"{a:.2f}"] for a in cfg.alphas] for m in MODELS}})
@@ -84,7 +80,7 @@ def run(params: Params) -> None:
         for name, label in (("ae", "AE"), ("ae_critic", "AE-Critic")):
             rows.append([(g, largest_cluster(g)) for g in sequences[name][p]])
             row_labels.append(f"pair {p + 1} {label}")
-    voxel_rows(rows, row_labels, [f"α={a:.2f}" for a in seq_alphas], EXAMPLES_PNG, "Interpolations: AE (upper) vs AE-Critic (lower); outliers red")
+    voxel_rows(rows, row_labels, [f"α={a:.2f}" for a in seq_alphas], INTERPOLATIONS_PNG, "Interpolations: AE (upper) vs AE-Critic (lower); outliers red")
 
     def fmt(values):
         return [None if v is None else round(v, 2) for v in values.values()]

@@ -6,7 +6,6 @@ Outputs: ``data/latents.parquet`` (``shape_id``, ``split``, ``z``: 128 float32),
 from __future__ import annotations
 
 import logging
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -15,14 +14,11 @@ from graspaug.config import Params
 from graspaug.io.checkpoints import load_autoencoder
 from graspaug.io.tables import write_csv, write_table
 from graspaug.plots import scatter_2d
-from graspaug.stages.train_ae import AE_CRITIC_MODEL, load_grids, net_config
+from graspaug.paths import AE_CRITIC_MODEL, LATENTS, TSNE_CSV, TSNE_PNG
+from graspaug.stages.train_ae import load_grids, net_config
 from graspaug.training.autoencoder import encode, resolve_device
 
 log = logging.getLogger(__name__)
-
-LATENTS = Path("data/latents.parquet")
-TSNE_CSV = Path("reports/embed/tsne.csv")
-TSNE_PNG = Path("reports/embed/tsne.png")
 
 
 def tsne_2d(z: np.ndarray, perplexity: float, seed: int) -> np.ndarray:

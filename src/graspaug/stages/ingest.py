@@ -19,13 +19,10 @@ from graspaug.io.atomic import atomic_path
 from graspaug.io.meshes import mesh_path, write_mesh
 from graspaug.io.sources import Source, folder_sources, pybullet_sources
 from graspaug.io.tables import write_table
+from graspaug.paths import REJECTS_TABLE, SHAPES_DIR, SHAPES_TABLE
 from graspaug.stages import StageError
 
 log = logging.getLogger(__name__)
-
-SHAPES_DIR = Path("data/shapes")
-SHAPES_TABLE = Path("data/shapes.parquet")
-REJECTS_TABLE = Path("data/rejects.parquet")
 
 
 def _ingest_one(source: Source, max_faces: int, max_file_mb: float, settings: SurfaceSettings, out_dir: Path) -> dict:

@@ -10,7 +10,6 @@ import json
 import logging
 import math
 import time
-from pathlib import Path
 
 import numpy as np
 import torch
@@ -21,17 +20,11 @@ from graspaug.io.checkpoints import save_autoencoder
 from graspaug.io.tables import read_table
 from graspaug.io.voxels import read_voxels
 from graspaug.nets.ae_critic import AEConfig, AutoEncoder, Critic
+from graspaug.paths import AE_CRITIC_MODEL, AE_MODEL, SHAPES_TABLE, TRAIN_AE_LIVE, TRAIN_AE_SUMMARY, VOXELS
 from graspaug.stages import StageError
-from graspaug.stages.ingest import SHAPES_TABLE
-from graspaug.stages.voxelize import VOXELS
 from graspaug.training.autoencoder import AETrainConfig, reconstruction_iou, resolve_device, train_ae_critic, train_autoencoder
 
 log = logging.getLogger(__name__)
-
-AE_MODEL = Path("models/ae.pt")
-AE_CRITIC_MODEL = Path("models/ae_critic.pt")
-LIVE_DIR = Path("metrics/train_ae")
-SUMMARY = Path("metrics/train_ae.json")
 
 
 def net_config(params: Params) -> AEConfig:
@@ -88,7 +81,7 @@ def run(params: Params) -> None:
 
         return on_epoch
 
-    with Live(str(LIVE_DIR / "ae"), dvcyaml=False, save_dvc_exp=False) as live:
+    with Live(str(TRAIN_AE_LIVE / "ae"), dvcyaml=False, save_dvc_exp=False) as live:
         t0 = time.perf_counter()
         summary["ae_shapes_per_s"] = train_autoencoder(ae, train, tcfg, device, gen, logger(live, ae))
         summary["ae_train_s"] = time.perf_counter() - t0
@@ -97,7 +90,7 @@ def run(params: Params) -> None:
     save_autoencoder(AE_MODEL, ae, None, dataclasses.asdict(tcfg))
 
     critic = Critic(cfg)
-    with Live(str(LIVE_DIR / "ae_critic"), dvcyaml=False, save_dvc_exp=False) as live:
+    with Live(str(TRAIN_AE_LIVE / "ae_critic"), dvcyaml=False, save_dvc_exp=False) as live:
         t0 = time.perf_counter()
         summary["ae_critic_shapes_per_s"] = train_ae_critic(ae, critic, train, tcfg, device, gen, logger(live, ae))
         summary["ae_critic_train_s"] = time.perf_counter() - t0
@@ -106,7 +99,7 @@ def run(params: Params) -> None:
     save_autoencoder(AE_CRITIC_MODEL, ae, critic, dataclasses.asdict(tcfg))
 
     summary["train_s"] = time.perf_counter() - start
-    with atomic_path(SUMMARY) as tmp:
+    with atomic_path(TRAIN_AE_SUMMARY) as tmp:
         # NaN (e.g. IoU of an empty test split) is not JSON: write null
         tmp.write_text(json.dumps({k: round(float(v), 5) if math.isfinite(v) else None for k, v in summary.items()}, indent=2) + "\n")
     log.info(

@@ -12,11 +12,9 @@ from graspaug.geometry.voxelize import fit_grid, voxelize_solid
 from graspaug.io.meshes import mesh_path, read_mesh
 from graspaug.io.tables import read_table
 from graspaug.io.voxels import VoxelSet, write_voxels
-from graspaug.stages.ingest import SHAPES_DIR, SHAPES_TABLE
+from graspaug.paths import SHAPES_DIR, SHAPES_TABLE, VOXELS
 
 log = logging.getLogger(__name__)
-
-VOXELS = Path("data/voxels.npz")
 
 
 def voxelize_file(path: Path, resolution: int, margin: int) -> tuple[np.ndarray, float, np.ndarray]:
