@@ -1,6 +1,4 @@
 """Loading real and broken mesh files; every broken kind gets its reason."""
-import struct
-
 import numpy as np
 import pytest
 import trimesh

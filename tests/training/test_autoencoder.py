@@ -11,6 +11,16 @@ from graspaug.training.autoencoder import AETrainConfig, encode, reconstruction_
 CPU = torch.device("cpu")
 
 
+def train_settings(**overrides) -> AETrainConfig:
+    """The default ``ae`` params' training settings with a few changed."""
+    from dataclasses import replace
+
+    from graspaug.config import Params
+    from graspaug.stages.train_ae import train_config
+
+    return replace(train_config(Params()), **overrides)
+
+
 def primitive_grids(resolution: int) -> torch.Tensor:
     """Eight real solid shapes voxelized with the project's voxelizer: (8, 1, R, R, R) uint8."""
     c = trimesh.creation
@@ -27,7 +37,7 @@ def test_a_tiny_model_overfits_eight_shapes():
     torch.manual_seed(0)
     x = primitive_grids(16)
     ae = AutoEncoder(AEConfig(resolution=16, z_dim=32, base_width=8, top_width=32))
-    cfg = AETrainConfig(batch_size=8, epochs_ae=150, epochs_critic=0, lr_ae=3e-3, flips=False)
+    cfg = train_settings(batch_size=8, epochs_ae=150, epochs_critic=0, lr_ae=3e-3, flips=False)
     train_autoencoder(ae, x, cfg, CPU, torch.Generator().manual_seed(0))
     assert reconstruction_iou(ae, x, CPU) > 0.9
 
@@ -37,7 +47,7 @@ def _train_twice_state(seed: int) -> dict[str, torch.Tensor]:
     x = primitive_grids(16)
     cfg = AEConfig(resolution=16, z_dim=16, base_width=4, top_width=16)
     ae, critic = AutoEncoder(cfg), Critic(cfg)
-    tcfg = AETrainConfig(batch_size=4, epochs_ae=2, epochs_critic=2)
+    tcfg = train_settings(batch_size=4, epochs_ae=2, epochs_critic=2)
     gen = torch.Generator().manual_seed(seed)
     train_autoencoder(ae, x, tcfg, CPU, gen)
     train_ae_critic(ae, critic, x, tcfg, CPU, gen)
@@ -60,7 +70,7 @@ def test_ae_critic_phase_reports_its_losses_and_trains_the_critic():
     seen = []
     before = {k: v.clone() for k, v in critic.state_dict().items()}
     ae_before = {k: v.clone() for k, v in ae.state_dict().items()}
-    tcfg = AETrainConfig(batch_size=8, epochs_ae=0, epochs_critic=3, critic_warmup=1)
+    tcfg = train_settings(batch_size=8, epochs_ae=0, epochs_critic=3, critic_warmup=1)
     rate = train_ae_critic(ae, critic, x, tcfg, CPU, torch.Generator().manual_seed(0), lambda e, m: seen.append(m))
     assert rate > 0 and len(seen) == 3
     assert not torch.equal(before["head.weight"], critic.state_dict()["head.weight"])

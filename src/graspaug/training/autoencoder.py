@@ -19,16 +19,18 @@ from graspaug.nets.ae_critic import AutoEncoder, Critic, autoencoder_loss, criti
 
 @dataclass(frozen=True)
 class AETrainConfig:
-    batch_size: int = 32
-    epochs_ae: int = 20  # phase 1: plain AE, BCE
-    epochs_critic: int = 10  # phase 2: AE-Critic from phase 1
-    critic_warmup: int = 1  # first phase-2 epochs that train only the critic (a random critic would push the AE around)
-    lr_ae: float = 1e-3  # phase 1 Adam (paper)
-    lr_ae_critic: float = 1e-4  # phase 2 AE Adam (paper)
-    lr_critic: float = 1e-3  # phase 2 critic Adam (paper)
-    gamma: float = 0.2  # eq. (1), ACAI default
-    lam: float = 0.5  # λ of eq. (2), ACAI default
-    flips: bool = True  # random axis flips of training grids (shape, not pose, is learned)
+    """Training settings; the ``ae`` params section holds their defaults and meaning."""
+
+    batch_size: int
+    epochs_ae: int  # phase 1: plain AE, BCE
+    epochs_critic: int  # phase 2: AE-Critic from phase 1
+    critic_warmup: int  # first phase-2 epochs that train only the critic (a random critic would push the AE around)
+    lr_ae: float  # phase 1 Adam
+    lr_ae_critic: float  # phase 2 AE Adam
+    lr_critic: float  # phase 2 critic Adam
+    gamma: float  # γ of eq. (1)
+    lam: float  # λ of eq. (2)
+    flips: bool  # random axis flips of training grids (shape, not pose, is learned)
 
 
 EpochCallback = Callable[[int, dict[str, float]], None]
