@@ -20,6 +20,8 @@ TINY = {
     "voxelize": {"resolution": 16},
     "ae": {"base_width": 4, "top_width": 16, "z_dim": 16, "batch_size": 8, "epochs_ae": 1, "epochs_critic": 1},
     "critic_eval": {"n_shapes": 10, "n_pairs": 3, "n_examples": 2},
+    "grasps": {"n_grasps": 8, "n_samples": 4},
+    "score": {"k": 3, "bins": 5},
 }
 
 
@@ -98,3 +100,28 @@ def test_dvc_repro_critic_eval_and_embed(tiny_repo):
     assert set(latents.split) == {"train", "test"}
     shown = run(["dvc", "metrics", "show", "--json"], work, env)
     assert "ae_critic_iou_test" in shown.stdout
+
+
+def test_dvc_repro_score(tiny_repo):
+    import json
+
+    work, env = tiny_repo
+    run(["dvc", "repro", "score"], work, env)
+    shapes = pd.read_parquet(work / "data/shapes.parquet")
+    grasps = pd.read_parquet(work / "data/grasps/original.parquet")
+    assert set(grasps.shape_id) <= set(shapes.shape_id) and len(grasps) > 0
+    assert grasps.groupby("shape_id").size().max() <= 8
+    scores = pd.read_parquet(work / "data/scores.parquet")
+    assert list(scores.columns[:5]) == ["shape_id", "split", "rarity", "graspness", "n_grasps"]
+    assert list(scores.shape_id) == list(shapes.shape_id)
+    assert scores.rarity.gt(0).all() and scores.graspness.between(0, 1).all()
+    per_shape = grasps.groupby("shape_id").success.mean().reindex(scores.shape_id).fillna(0).to_numpy()
+    np.testing.assert_allclose(scores.graspness, per_shape)
+    for name in ("graspness_hist", "rarity_hist", "grasp_examples"):
+        assert (work / f"reports/score/{name}.png").stat().st_size > 0
+    hist = pd.read_csv(work / "reports/score/graspness_hist.csv")
+    assert hist.shapes.sum() == (scores.split == "train").sum()
+    summary = json.loads((work / "metrics/score.json").read_text())
+    assert summary["n_train"] == (scores.split == "train").sum()
+    shown = run(["dvc", "metrics", "show", "--json"], work, env)
+    assert "success_share" in shown.stdout and "graspness_train_mean" in shown.stdout

@@ -8,7 +8,10 @@ from pathlib import Path
 
 import typer
 
-from graspaug.config import AEParams, CriticEvalParams, DataParams, EmbedParams, IngestParams, Params, ParamsError, VoxelizeParams, describe, load_params
+from graspaug.config import (
+    AEParams, CriticEvalParams, DataParams, EmbedParams, GraspsParams, IngestParams, Params, ParamsError, ScoreParams, VoxelizeParams,
+    describe, load_params,
+)
 
 app = typer.Typer(
     help="graspaug: augment a grasp planner's training objects with generated shapes.\n\n"
@@ -87,6 +90,32 @@ stage_command(
     f"in `reports/critic_eval/`.\n\nParams `critic_eval`:\n\n{describe(CriticEvalParams)}",
 )
 
+
+
+@app.command(
+    name="grasps",
+    help="Sample antipodal grasps on every shape of a corpus (Dex-Net's sampler, Franka Panda opening) and label "
+    "each with robust Ferrari-Canny: the mean ε over perturbed grasp poses, object poses and friction.\n\n"
+    "Writes `data/grasps/<corpus>.parquet` (one row per grasp) and `metrics/grasps/<corpus>.json`. "
+    "A shape without any grasp gets no rows and a warning with the reason.\n\n"
+    f"Params `grasps`:\n\n{describe(GraspsParams)}\n\nAlso `seed` and `n_jobs`.",
+)
+def grasps_command(
+    corpus: str = typer.Option("original", "--corpus", "-c", help="Which shapes: `original` (ingested corpus)."),
+    params: Path = ParamsOption,
+) -> None:
+    from graspaug.stages import grasps
+
+    _run(lambda p: grasps.run(p, corpus), _load(params))
+
+
+stage_command(
+    "score",
+    "Score every original shape: rarity (eq. (3)-(4) of the paper on the AE-Critic latents, relative to the "
+    "train split) and graspness (share of its grasps with robust ε above the threshold).\n\n"
+    "Writes `data/scores.parquet`, `metrics/score.json`, and histograms and a grasp picture in `reports/score/`.\n\n"
+    f"Params `score`:\n\n{describe(ScoreParams)}\n\nAlso `grasps.threshold` (for labels).",
+)
 
 def main() -> None:
     app()

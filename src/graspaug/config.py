@@ -104,10 +104,42 @@ class CriticEvalParams:
 
 
 @dataclass(frozen=True)
+class GraspsParams:
+    """Antipodal grasps on every shape, labelled by robust Ferrari-Canny (Dex-Net 2.0)."""
+
+    n_grasps: int = param(100, "Grasps sampled per shape (Dex-Net 2.0: up to 100; EGAD: 100).", ge=1)
+    threshold: float = param(0.002, "A grasp succeeds when its robust ε exceeds this (Dex-Net 2.0, with the torque scaling and object size below).", ge=0)
+    friction_coef: float = param(0.5, "Friction coefficient μ for sampling and quality (Dex-Net: 0.5); also the mean of the perturbed μ.", gt=0, le=1)
+    cone_faces: int = param(8, "Faces of the polyhedral friction cone (Dex-Net: 8).", ge=3, le=32)
+    torque_scaling: float = param(1000.0, "s in the wrench [f; s·τ] (1/m). With s = 1000, soft fingers bound ε by π r² μ s = 0.039 and 0.002 splits grasps as in Dex-Net 2.0.", gt=0)
+    max_width: float = param(0.08, "Gripper opening in m (Franka Panda: 0.08).", gt=0)
+    finger_radius: float = param(0.005, "Soft-finger contact radius in m for the torsion columns (Dex-Net: 0.005).", ge=0)
+    min_contact_dist: float = param(0.0025, "Contacts closer than this (m) are rejected (Dex-Net: 2.5 mm).", ge=0)
+    coverage_dist: float = param(0.0025, "Grasp centers closer than this (m) to a kept one are dropped (EGAD: 2.5 mm; 0 disables).", ge=0)
+    tries_per_point: int = param(2, "Grasp axes drawn per sampled surface point (Dex-Net: 2).", ge=1)
+    oversample: int = param(5, "Candidates per missing grasp in the first round; doubles each round (Dex-Net: 5).", ge=1)
+    max_rounds: int = param(5, "Sampling rounds before giving up on a shape (Dex-Net: 5-10).", ge=1)
+    n_samples: int = param(25, "Perturbed samples per grasp in the robust metric (Dex-Net: 25).", ge=1)
+    center_sigma: float = param(0.005, "Std of the grasp center perturbation in m.", ge=0)
+    axis_sigma: float = param(0.001, "Std of the grasp axis rotation in rad.", ge=0)
+    object_translation_sigma: float = param(0.01, "Std of the object translation in m.", ge=0)
+    object_rotation_sigma: float = param(0.01, "Std of the object rotation in rad.", ge=0)
+    friction_sigma: float = param(0.1, "Std of the perturbed friction coefficient (truncated to [0, 1]).", ge=0)
+
+
+@dataclass(frozen=True)
+class ScoreParams:
+    """Rarity (eq. 3-4 on AE-Critic latents) and graspness of every shape."""
+
+    k: int = param(20, "Neighbours in the rarity score, eq. (3)-(4) (scikit-learn LOF default: 20).", ge=1)
+    bins: int = param(20, "Bins of the graspness and rarity histograms.", ge=2)
+
+
+@dataclass(frozen=True)
 class Params:
     """All parameters of the pipeline."""
 
-    seed: int = param(0, "Seeds every random choice: the split, network initialisation and batches, critic-study pairs, t-SNE.", ge=0)
+    seed: int = param(0, "Seeds every random choice: the split, network initialisation and batches, critic-study pairs, t-SNE, grasp sampling and perturbations.", ge=0)
     device: str = param("auto", "Torch device: `auto` (CUDA when present), `cpu` or `cuda`.", choices=("auto", "cpu", "cuda"))
     n_jobs: int = param(2, "Worker processes for per-shape loops (-1: all cores).", ge=-1)
     data: DataParams = field(default_factory=DataParams)
@@ -116,6 +148,8 @@ class Params:
     ae: AEParams = field(default_factory=AEParams)
     embed: EmbedParams = field(default_factory=EmbedParams)
     critic_eval: CriticEvalParams = field(default_factory=CriticEvalParams)
+    grasps: GraspsParams = field(default_factory=GraspsParams)
+    score: ScoreParams = field(default_factory=ScoreParams)
 
 
 def _type_name(tp: Any) -> str:

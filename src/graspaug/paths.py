@@ -25,3 +25,23 @@ CRITIC_EVAL_METRICS = Path("metrics/critic_eval.json")
 OUTLIERS_CSV = Path("reports/critic_eval/outliers.csv")
 OUTLIERS_PNG = Path("reports/critic_eval/outliers.png")
 INTERPOLATIONS_PNG = Path("reports/critic_eval/interpolations.png")
+# grasps (one table per corpus: `dvc.yaml` runs the stage for each)
+CORPORA = {"original": (SHAPES_TABLE, SHAPES_DIR)}  # corpus -> (shape table, mesh folder)
+
+
+def grasps_table(corpus: str) -> Path:
+    return Path(f"data/grasps/{corpus}.parquet")
+
+
+def grasps_metrics(corpus: str) -> Path:
+    return Path(f"metrics/grasps/{corpus}.json")
+
+
+# score
+SCORES = Path("data/scores.parquet")
+SCORE_METRICS = Path("metrics/score.json")
+GRASPNESS_HIST_CSV = Path("reports/score/graspness_hist.csv")
+GRASPNESS_HIST_PNG = Path("reports/score/graspness_hist.png")
+RARITY_HIST_CSV = Path("reports/score/rarity_hist.csv")
+RARITY_HIST_PNG = Path("reports/score/rarity_hist.png")
+GRASP_EXAMPLES_PNG = Path("reports/score/grasp_examples.png")

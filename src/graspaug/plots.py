@@ -80,3 +80,44 @@ def voxel_rows(rows: list[list[tuple[np.ndarray, np.ndarray]]], row_labels: list
                 ax.text2D(-0.15, 0.5, row_labels[r], transform=ax.transAxes, rotation=90, va="center", fontsize=8)
     fig.suptitle(title, fontsize=10)
     _save(fig, path)
+
+
+def histogram(counts: np.ndarray, edges: np.ndarray, path: str | os.PathLike, xlabel: str, title: str) -> None:
+    """Bars of ``counts`` (B,) over bin ``edges`` (B + 1,)."""
+    plt = _pyplot()
+    fig, ax = plt.subplots(figsize=(6, 4))
+    ax.bar(edges[:-1], counts, width=np.diff(edges), align="edge", edgecolor="white", color="tab:blue")
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel("shapes")
+    ax.set_title(title)
+    ax.grid(alpha=0.3, axis="y")
+    _save(fig, path)
+
+
+def grasps_on_shapes(shapes: list[tuple[np.ndarray, np.ndarray]], segments: list[np.ndarray], qualities: list[np.ndarray], titles: list[str], path: str | os.PathLike, vmax: float, threshold: float) -> None:
+    """Shapes side by side with their grasps drawn as contact-to-contact segments.
+
+    shapes : per shape ``(vertices (V, 3) m, faces (F, 3))``
+    segments : per shape (G, 2, 3) contact pairs, m
+    qualities : per shape (G,) robust ε, colored red (0) to green (``vmax``); the colorbar marks ``threshold``
+    """
+    plt = _pyplot()
+    from matplotlib.colors import Normalize
+    from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection
+
+    norm = Normalize(0.0, vmax)
+    cmap = plt.get_cmap("RdYlGn")
+    fig = plt.figure(figsize=(4.5 * len(shapes), 4.8))
+    for i, ((vertices, faces), seg, q, title) in enumerate(zip(shapes, segments, qualities, titles)):
+        ax = fig.add_subplot(1, len(shapes), i + 1, projection="3d")
+        ax.add_collection3d(Poly3DCollection(vertices[faces], facecolor=(0.75, 0.75, 0.8, 0.25), edgecolor="none"))
+        ax.add_collection3d(Line3DCollection(seg, colors=cmap(norm(q)), linewidths=1.6))
+        half = 0.5 * np.ptp(vertices, axis=0).max()
+        mid = 0.5 * (vertices.max(axis=0) + vertices.min(axis=0))
+        ax.set(xlim=(mid[0] - half, mid[0] + half), ylim=(mid[1] - half, mid[1] + half), zlim=(mid[2] - half, mid[2] + half))
+        ax.set_box_aspect((1, 1, 1))
+        ax.set_axis_off()
+        ax.set_title(title, fontsize=10)
+    bar = fig.colorbar(plt.cm.ScalarMappable(norm=norm, cmap=cmap), ax=fig.axes, shrink=0.6, label="robust ε")
+    bar.ax.axhline(threshold, color="black", linewidth=1.5)
+    _save(fig, path)

@@ -23,3 +23,11 @@ def write_csv(df: pd.DataFrame, path: str | os.PathLike) -> None:
 def read_table(path: str | os.PathLike) -> pd.DataFrame:
     """Read a parquet table written by :func:`write_table`."""
     return pd.read_parquet(path)
+
+
+def write_json(obj: object, path: str | os.PathLike) -> None:
+    """Write ``obj`` as indented JSON, e.g. a stage's metrics for ``dvc metrics``."""
+    import json
+
+    with atomic_path(path) as tmp:
+        tmp.write_text(json.dumps(obj, indent=2) + "\n")
