@@ -50,7 +50,7 @@ def square_cone_grasp(mu, finger_radius, torque_scaling, half_gap):
     """Two contacts on the z axis at ±half_gap, pushing toward each other, 4-sided cones."""
     p1, p2 = np.array([[0, 0, -half_gap]]), np.array([[0, 0, half_gap]])
     n1, n2 = np.array([[0, 0, -1.0]]), np.array([[0, 0, 1.0]])
-    return grasp_wrenches(p1, n1, p2, n2, np.array([[0, 0, 1.0]]), np.zeros(3), mu, torque_scaling, finger_radius, cone_faces=4)
+    return grasp_wrenches(p1, n1, p2, n2, np.array([[0, 0, 1.0]]), np.zeros(3), mu, torque_scaling, finger_radius, cone_faces=4)[:2]
 
 
 @pytest.mark.parametrize("mu", [0.3, 0.5, 0.8])
@@ -82,7 +82,7 @@ def test_hard_fingers_and_missing_contact_give_zero():
     assert ferrari_canny(wrenches)[0] == 0.0 and ferrari_canny_qhull(wrenches[0]) == 0.0
     # contact 2 pushed sideways (normal ⟂ push): it contributes nothing
     p1, p2 = np.array([[0, 0, -0.01]]), np.array([[0, 0, 0.01]])
-    wrenches, slips = grasp_wrenches(p1, np.array([[0, 0, -1.0]]), p2, np.array([[1.0, 0, 0]]), np.array([[0, 0, 1.0]]), np.zeros(3), 0.5, 1000.0, 0.005)
+    wrenches, slips, _ = grasp_wrenches(p1, np.array([[0, 0, -1.0]]), p2, np.array([[1.0, 0, 0]]), np.array([[0, 0, 1.0]]), np.zeros(3), 0.5, 1000.0, 0.005)
     assert slips[0]
     assert ferrari_canny(wrenches)[0] == 0.0 and ferrari_canny_qhull(wrenches[0]) == 0.0
 
@@ -107,8 +107,9 @@ def test_zero_outside_force_closure_positive_inside():
     from graspaug.grasping.contacts import close_fingers
 
     c = close_fingers(mesh, centers, axes, PANDA.max_width)
-    wrenches, slips = grasp_wrenches(c.p1, c.n1, c.p2, c.n2, axes, mesh.center_mass, 0.5, 1000.0, 0.005)
+    wrenches, slips, inside = grasp_wrenches(c.p1, c.n1, c.p2, c.n2, axes, mesh.center_mass, 0.5, 1000.0, 0.005)
     assert list(slips) == [False, False, False, True, True, True]
+    assert list(inside) == [True, True, True, False, False, False]
     fast = ferrari_canny(wrenches)
     assert np.all(fast[3:] == 0.0) and np.all(fast[:3] > 0)
     assert [ferrari_canny_qhull(w) for w in wrenches[3:]] == [0.0, 0.0, 0.0]
@@ -167,24 +168,26 @@ def perturbed_grasp_wrenches(n, seed):
         c = close_fingers(mesh, centers, axes, 0.08)
         f = c.found
         mu = np.clip(rng.normal(0.5, 0.1, f.sum()), 0, 1)
-        w, slips = grasp_wrenches(c.p1[f], c.n1[f], c.p2[f], c.n2[f], axes[f], mesh.center_mass, mu, 1000.0, 0.005)
-        out.append(w)
-    return np.concatenate(out)
+        w, _, inside = grasp_wrenches(c.p1[f], c.n1[f], c.p2[f], c.n2[f], axes[f], mesh.center_mass, mu, 1000.0, 0.005)
+        out.append((w, inside))
+    return np.concatenate([w for w, _ in out]), np.concatenate([i for _, i in out])
 
 
 def test_fast_epsilon_equals_qhull_on_grasp_wrenches():
-    wrenches = perturbed_grasp_wrenches(150, seed=0)
+    wrenches, inside = perturbed_grasp_wrenches(150, seed=0)
     # symmetric, degenerate ones too: exactly antipodal contacts on the sphere and box faces
     mesh = trimesh.creation.box((0.05, 0.04, 0.07))
     from graspaug.grasping.contacts import close_fingers
 
     c = close_fingers(mesh, np.zeros((3, 3)), np.eye(3), 0.08)
-    sym, _ = grasp_wrenches(c.p1, c.n1, c.p2, c.n2, np.eye(3), mesh.center_mass, 0.5, 1000.0, 0.005)
-    wrenches = np.concatenate([wrenches, sym])
-    fast = ferrari_canny(wrenches)
+    sym, _, sym_inside = grasp_wrenches(c.p1, c.n1, c.p2, c.n2, np.eye(3), mesh.center_mass, 0.5, 1000.0, 0.005)
+    wrenches, inside = np.concatenate([wrenches, sym]), np.concatenate([inside, sym_inside])
     plain = np.array([ferrari_canny_qhull(w) for w in wrenches])
     assert (plain > 0).mean() > 0.2 and (plain == 0).mean() > 0.1  # both kinds are tested
-    np.testing.assert_allclose(fast, plain, rtol=0, atol=1e-9)
+    # the geometric force-closure test never vouches for a set whose origin is not inside
+    assert inside.sum() > 100 and np.all(plain[inside] > 0)
+    np.testing.assert_allclose(ferrari_canny(wrenches), plain, rtol=0, atol=1e-9)  # origin checked for every set
+    np.testing.assert_allclose(ferrari_canny(wrenches, inside), plain, rtol=0, atol=1e-9)  # checked where not vouched for
 
 
 def test_qhull_epsilon_matches_support_function_and_lp():

@@ -53,6 +53,6 @@ def test_plain_reference_gives_the_same_robust_quality():
     centers, axes = grasps_across(mesh, 8, 3)
     ours = robust_ferrari_canny(mesh, centers, axes, PANDA, QUALITY, NOISE, np.random.default_rng(4))
     plain = robust_ferrari_canny(mesh, centers, axes, PANDA, QUALITY, NOISE, np.random.default_rng(4),
-                                 epsilon=lambda w: np.array([ferrari_canny_qhull(x) for x in w]))
+                                 epsilon=lambda w, inside: np.array([ferrari_canny_qhull(x) for x in w]))
     np.testing.assert_allclose(ours, plain, atol=1e-9)
     assert ours[0].max() > 0.002

@@ -38,7 +38,7 @@ class Perturbations:
     friction_sigma: float
 
 
-Epsilon = Callable[[np.ndarray], np.ndarray]
+Epsilon = Callable[[np.ndarray, np.ndarray], np.ndarray]  # (wrench sets, origin known inside) -> ε
 
 
 def grasp_epsilon(
@@ -62,12 +62,12 @@ def grasp_epsilon(
     if not ok.any():
         return out
     mu = np.broadcast_to(np.asarray(friction_coef, dtype=float), (len(centers),))[ok]
-    wrenches, slips = grasp_wrenches(
+    wrenches, slips, inside = grasp_wrenches(
         contacts.p1[ok], contacts.n1[ok], contacts.p2[ok], contacts.n2[ok], np.asarray(axes, dtype=float)[ok],
         np.asarray(mesh.center_mass), mu, quality.torque_scaling, gripper.finger_radius, quality.cone_faces, x_axis,
     )
     eps = np.zeros(len(wrenches))
-    eps[~slips] = epsilon(wrenches[~slips])
+    eps[~slips] = epsilon(wrenches[~slips], inside[~slips])
     out[ok] = eps
     return out
 
