@@ -107,6 +107,12 @@ def grasps_on_shapes(shapes: list[tuple[np.ndarray, np.ndarray]], segments: list
 
     norm = Normalize(0.0, vmax)
     cmap = plt.get_cmap("RdYlGn")
+    if not shapes:
+        fig, ax = plt.subplots(figsize=(4.5, 2))
+        ax.text(0.5, 0.5, "no shape with grasps", ha="center", va="center")
+        ax.set_axis_off()
+        _save(fig, path)
+        return
     fig = plt.figure(figsize=(4.5 * len(shapes), 4.8))
     for i, ((vertices, faces), seg, q, title) in enumerate(zip(shapes, segments, qualities, titles)):
         ax = fig.add_subplot(1, len(shapes), i + 1, projection="3d")

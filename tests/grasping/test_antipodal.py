@@ -1,4 +1,6 @@
 """The antipodal sampler on real closed meshes: every grasp it returns passes Dex-Net's tests."""
+import dataclasses
+
 import numpy as np
 import pytest
 import trimesh
@@ -10,7 +12,8 @@ from graspaug.grasping.contacts import close_fingers
 from graspaug.grasping.gripper import ParallelJawGripper
 from graspaug.stages.ingest import surface_settings
 
-SETTINGS = AntipodalSettings(n_grasps=40, friction_coef=0.5, tries_per_point=2, oversample=5, max_rounds=5, min_contact_dist=0.0025, coverage_dist=0.0025)
+SETTINGS = AntipodalSettings(n_grasps=40, friction_coef=0.5, tries_per_point=2, oversample=5, max_rounds=5, max_surface_points=100,
+                             min_contact_dist=0.0025, coverage_dist=0.0025)
 PANDA = ParallelJawGripper()
 
 
@@ -36,15 +39,23 @@ def on_surface(mesh, points, tol=1e-9):
 def check_grasps(mesh, grasps, settings, gripper):
     assert 0 < len(grasps) <= settings.n_grasps
     np.testing.assert_allclose(np.linalg.norm(grasps.axis, axis=1), 1.0, atol=1e-12)
-    assert np.all(grasps.width >= settings.min_contact_dist) and np.all(grasps.width <= gripper.max_width)
-    np.testing.assert_allclose(grasps.width, np.linalg.norm(grasps.p2 - grasps.p1, axis=1))
-    assert force_closure(grasps.p1, grasps.n1, grasps.p2, grasps.n2, settings.friction_coef).all()
+    line = grasps.p2 - grasps.p1
+    width = np.linalg.norm(line, axis=1)
+    assert np.all(width >= settings.min_contact_dist) and np.all(width <= gripper.max_width)
+    # force closure, measured: both inward normals within atan(μ) of the contact line
+    for normal, direction in ((-grasps.n1, line), (-grasps.n2, -line)):
+        angle = np.degrees(np.arccos(np.clip(np.einsum("ij,ij->i", normal, direction) / width, -1, 1)))
+        assert angle.max() <= np.degrees(np.arctan(settings.friction_coef)) + 1e-9
+    # the contacts lie on the grasp axis, jaw 1 before jaw 2
+    np.testing.assert_allclose(line / width[:, None], grasps.axis, atol=1e-9)
     for p in (grasps.p1, grasps.p2):  # contacts lie on the surface
         assert on_surface(mesh, p).all()
     # the jaws closing on the grasp's center and axis find exactly these contacts
     again = close_fingers(mesh, grasps.center, grasps.axis, gripper.max_width)
     assert again.found.all()
     np.testing.assert_allclose(again.p1, grasps.p1, atol=1e-12)
+    np.testing.assert_allclose(again.p2, grasps.p2, atol=1e-12)
+    np.testing.assert_allclose(again.n2, grasps.n2, atol=1e-12)
     if settings.coverage_dist > 0:
         d = np.linalg.norm(grasps.center[:, None] - grasps.center[None], axis=2)
         assert d[np.triu_indices(len(d), 1)].min() >= settings.coverage_dist
@@ -86,7 +97,7 @@ def test_object_wider_than_the_gripper_gives_no_grasps():
 def test_narrow_gripper_and_no_coverage_rejection():
     mesh = trimesh.creation.box((0.02, 0.05, 0.06))
     narrow = ParallelJawGripper(max_width=0.03)
-    settings = AntipodalSettings(25, 0.5, 2, 5, 5, 0.0025, 0.0)
+    settings = dataclasses.replace(SETTINGS, n_grasps=25, coverage_dist=0.0)
     grasps = sample_antipodal_grasps(mesh, narrow, settings, np.random.default_rng(0))
     check_grasps(mesh, grasps, settings, narrow)
     # only across the 2 cm side, at most atan(μ) off its normal
@@ -96,3 +107,13 @@ def test_narrow_gripper_and_no_coverage_rejection():
 def test_gripper_rejects_impossible_widths():
     with pytest.raises(ValueError, match="min_width < max_width"):
         ParallelJawGripper(max_width=0.02, min_width=0.03)
+
+
+def test_force_closure_test_by_hand():
+    """Contacts on the x axis; contact 2's normal tilted by 20 deg (inside atan 0.5 = 26.6)
+    or 30 deg (outside)."""
+    p1, p2, n1 = np.array([[0.0, 0, 0]]), np.array([[0.02, 0, 0]]), np.array([[-1.0, 0, 0]])
+    for degrees, expected in ((20, True), (30, False)):
+        a = np.radians(degrees)
+        n2 = np.array([[np.cos(a), np.sin(a), 0.0]])
+        assert force_closure(p1, n1, p2, n2, 0.5)[0] == expected

@@ -80,6 +80,8 @@ def test_known_value_worked_by_hand(mu):
 def test_hard_fingers_and_missing_contact_give_zero():
     wrenches, _ = square_cone_grasp(0.5, 0.0, 1000.0, 0.001)  # no torsion: flat wrench set
     assert ferrari_canny(wrenches)[0] == 0.0 and ferrari_canny_qhull(wrenches[0]) == 0.0
+    with pytest.raises(ValueError, match="inside must be"):
+        ferrari_canny(wrenches, np.ones(3, dtype=bool))
     # contact 2 pushed sideways (normal ⟂ push): it contributes nothing
     p1, p2 = np.array([[0, 0, -0.01]]), np.array([[0, 0, 0.01]])
     wrenches, slips, _ = grasp_wrenches(p1, np.array([[0, 0, -1.0]]), p2, np.array([[1.0, 0, 0]]), np.array([[0, 0, 1.0]]), np.zeros(3), 0.5, 1000.0, 0.005)
@@ -153,7 +155,7 @@ def test_rigid_motion_of_object_and_grasp_keeps_epsilon():
         np.testing.assert_allclose(eps, base, rtol=5e-3, atol=1e-12)
 
 
-def perturbed_grasp_wrenches(n, seed):
+def perturbed_grasp_wrenches(n, seed, cone_faces=8):
     """Wrench sets of random grasps on an ellipsoid, a box and a sphere, random μ."""
     rng = np.random.default_rng(seed)
     meshes = [trimesh.creation.icosphere(4, 0.03), trimesh.creation.box((0.05, 0.04, 0.07)), trimesh.creation.icosphere(4, 1.0)]
@@ -168,7 +170,7 @@ def perturbed_grasp_wrenches(n, seed):
         c = close_fingers(mesh, centers, axes, 0.08)
         f = c.found
         mu = np.clip(rng.normal(0.5, 0.1, f.sum()), 0, 1)
-        w, _, inside = grasp_wrenches(c.p1[f], c.n1[f], c.p2[f], c.n2[f], axes[f], mesh.center_mass, mu, 1000.0, 0.005)
+        w, _, inside = grasp_wrenches(c.p1[f], c.n1[f], c.p2[f], c.n2[f], axes[f], mesh.center_mass, mu, 1000.0, 0.005, cone_faces)
         out.append((w, inside))
     return np.concatenate([w for w, _ in out]), np.concatenate([i for _, i in out])
 
@@ -190,6 +192,45 @@ def test_fast_epsilon_equals_qhull_on_grasp_wrenches():
     np.testing.assert_allclose(ferrari_canny(wrenches, inside), plain, rtol=0, atol=1e-9)  # checked where not vouched for
 
 
+@pytest.mark.parametrize("cone_faces", [3, 5, 12])
+def test_fast_epsilon_equals_qhull_for_other_cones(cone_faces):
+    wrenches, inside = perturbed_grasp_wrenches(40, seed=cone_faces, cone_faces=cone_faces)
+    plain = np.array([ferrari_canny_qhull(w) for w in wrenches])
+    assert (plain > 0).sum() > 10
+    np.testing.assert_allclose(ferrari_canny(wrenches, inside), plain, rtol=0, atol=1e-9)
+
+
+def boundary_distance_lp(points, direction):
+    """max λ with λ·direction in the convex hull of ``points`` (an LP, HiGHS)."""
+    n = len(points)
+    a_eq = np.zeros((7, n + 1))
+    a_eq[:6, :n], a_eq[:6, n], a_eq[6, :n] = points.T, -direction, 1.0
+    lp = linprog(c=np.r_[np.zeros(n), -1.0], A_eq=a_eq, b_eq=np.r_[np.zeros(6), 1.0], bounds=[(0, None)] * (n + 1), method="highs")
+    assert lp.status == 0
+    return -lp.fun
+
+
+def test_epsilon_of_grasp_wrenches_matches_support_function_and_lp():
+    """The same independent check on real grasp wrench sets (soft fingers, symmetric ones too)."""
+    wrenches, inside = perturbed_grasp_wrenches(20, seed=7)
+    mesh = trimesh.creation.box((0.05, 0.04, 0.07))
+    from graspaug.grasping.contacts import close_fingers
+
+    c = close_fingers(mesh, np.zeros((2, 3)), np.eye(3)[1:], 0.08)
+    sym = grasp_wrenches(c.p1, c.n1, c.p2, c.n2, np.eye(3)[1:], mesh.center_mass, 0.5, 1000.0, 0.005)
+    wrenches, inside = np.concatenate([wrenches[inside][:10], sym.points]), np.concatenate([inside[inside][:10], sym.interior])
+    eps = ferrari_canny(wrenches, inside)
+    rng = np.random.default_rng(2)
+    directions = rng.normal(size=(50_000, 6))
+    directions /= np.linalg.norm(directions, axis=1, keepdims=True)
+    for points, e in zip(wrenches, eps):
+        assert e > 0
+        assert (directions @ points.T).max(axis=1).min() >= e - 1e-12  # the ball of radius ε fits
+        hull = ConvexHull(points)
+        normal = hull.equations[np.argmin(-hull.equations[:, -1]), :6]
+        assert boundary_distance_lp(points, normal) == pytest.approx(e, rel=1e-7)  # and touches the boundary
+
+
 def test_qhull_epsilon_matches_support_function_and_lp():
     """On random wrench sets: every direction's support value is >= ε (the ball of radius ε
     fits), and an LP finds the boundary exactly at distance ε along the closest facet's normal."""
@@ -204,11 +245,7 @@ def test_qhull_epsilon_matches_support_function_and_lp():
         assert support.min() >= eps - 1e-12
         hull = ConvexHull(points)
         normal = hull.equations[np.argmin(-hull.equations[:, -1]), :6]
-        # max λ s.t. λ·normal = Σ α_i p_i, Σ α_i = 1, α >= 0
-        a_eq = np.zeros((7, 21))
-        a_eq[:6, :20], a_eq[:6, 20], a_eq[6, :20] = points.T, -normal, 1.0
-        lp = linprog(c=np.r_[np.zeros(20), -1.0], A_eq=a_eq, b_eq=np.r_[np.zeros(6), 1.0], bounds=[(0, None)] * 21, method="highs")
-        assert lp.status == 0 and -lp.fun == pytest.approx(eps, rel=1e-7)
+        assert boundary_distance_lp(points, normal) == pytest.approx(eps, rel=1e-7)
     outside = rng.normal(size=(20, 6)) + 5.0  # origin outside the hull
     assert ferrari_canny_qhull(outside) == 0.0
 

@@ -56,3 +56,27 @@ def test_plain_reference_gives_the_same_robust_quality():
                                  epsilon=lambda w, inside: np.array([ferrari_canny_qhull(x) for x in w]))
     np.testing.assert_allclose(ours, plain, atol=1e-9)
     assert ours[0].max() > 0.002
+
+
+def test_object_pose_noise_moves_the_object_rigidly():
+    """With only object-pose noise, a sample equals the grasp on the explicitly moved object.
+
+    ``perturbed_grasps`` draws center, grasp rotation, object rotation, object shift in that
+    order; redrawing them from the same seed gives the object's pose."""
+    from scipy.spatial.transform import Rotation
+
+    mesh = trimesh.creation.box((0.05, 0.04, 0.06))
+    centers, axes = grasps_across(mesh, 6, 5)
+    noise = Perturbations(1, 0.0, 0.0, 0.01, 0.05, 0.0)
+    mean, _ = robust_ferrari_canny(mesh, centers, axes, PANDA, QUALITY, noise, np.random.default_rng(9))
+    rng = np.random.default_rng(9)
+    rng.standard_normal((6, 1, 3)), rng.standard_normal((6, 1, 3))
+    rotations = Rotation.from_rotvec(0.05 * rng.standard_normal((6, 1, 3)).reshape(-1, 3))
+    shifts = 0.01 * rng.standard_normal((6, 1, 3)).reshape(-1, 3)
+    expected = []
+    for i in range(6):
+        moved = mesh.copy()
+        moved.apply_transform(np.vstack([np.c_[rotations[i].as_matrix(), shifts[i]], [0, 0, 0, 1]]))
+        expected.append(grasp_epsilon(moved, centers[i:i + 1], axes[i:i + 1], 0.5, PANDA, QUALITY, x_axis=rotations[i].apply([1.0, 0, 0]))[0])
+    np.testing.assert_allclose(mean, expected, rtol=5e-3, atol=1e-12)
+    assert not np.allclose(mean, grasp_epsilon(mesh, centers, axes, 0.5, PANDA, QUALITY), rtol=1e-3)  # the noise did something

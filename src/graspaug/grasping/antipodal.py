@@ -1,16 +1,16 @@
 """Dex-Net's antipodal grasp sampler on a closed mesh (lengths in meters).
 
-Per round: sample surface points (area-weighted), draw grasp axes inside each point's
-friction cone, find the opposite contact with the jaw that closes from ``max_width`` away,
+Per round: sample up to ``max_surface_points`` surface points (area-weighted), draw
+``tries_per_point`` grasp axes inside each point's friction cone, find the opposite contact with the jaw that closes from ``max_width`` away,
 re-find both contacts as the closing jaws meet the surface, keep grasps whose contacts are
 far enough apart and in force closure, drop grasps whose centers are closer than
 ``coverage_dist`` to a kept one; oversample ×``oversample`` and double that every round
 until ``n_grasps`` are kept or ``max_rounds`` have run, then shuffle and truncate.
 
 Unlike Dex-Net, surface points come from the exact mesh surface rather than SDF grid cells
-(so no point jitter is needed) and axes are not flipped at random: Dex-Net flips because
-SDF gradients can point the wrong way, while the normals of our closed, outward-oriented
-meshes cannot.
+(so no point jitter is needed), contact normals are the hit triangles' normals rather than
+SDF gradients, and axes are not flipped at random: Dex-Net flips because SDF gradients can
+point the wrong way, while the normals of our closed, outward-oriented meshes cannot.
 """
 from __future__ import annotations
 
@@ -33,6 +33,7 @@ class AntipodalSettings:
     tries_per_point: int
     oversample: int
     max_rounds: int
+    max_surface_points: int  # per round
     min_contact_dist: float  # m
     coverage_dist: float  # m, 0 disables coverage rejection
 
@@ -126,7 +127,7 @@ def sample_antipodal_grasps(mesh: trimesh.Trimesh, gripper: ParallelJawGripper, 
         remaining = settings.n_grasps - n_kept
         if remaining <= 0:
             break
-        n_points = int(np.ceil(multiplier * remaining / settings.tries_per_point))
+        n_points = min(settings.max_surface_points, int(np.ceil(multiplier * remaining / settings.tries_per_point)))
         new = _candidates(mesh, gripper, settings, n_points, rng)
         kept_centers = np.concatenate([g.center for g in kept]) if kept else np.zeros((0, 3))
         new = new.take(_spread(new, kept_centers, settings.coverage_dist))

@@ -7,8 +7,8 @@ faces, 8 by default), one row per wrench ``[force (N); s · torque (N·m)]``:
   in order around the cone, scaled by the normal force ``c = max(0, d · n_in)`` that the
   jaw moving along ``d`` can push with; torque ``(p - com) × f``, scaled by ``s``;
 - rows ``m .. 2m-1``: contact 2, the same;
-- rows ``2m .. 2m+3``: soft-finger torsion ``+τ1, -τ1, +τ2, -τ2`` with ``τ = π r² μ c n_in s``
-  (zero force).
+- rows ``2m .. 2m+3``: soft-finger torsion ``-τ1, -τ2, +τ1, +τ2`` with ``τ = π r² μ c n_in s``
+  (zero force), in Dex-Net's column order.
 
 ε is the distance from the origin to the boundary of the convex hull of these points (0 when
 the origin is not strictly inside or the hull is flat): the smallest facet-plane offset.
@@ -26,6 +26,11 @@ from scipy.spatial import ConvexHull, QhullError
 
 X_AXIS = np.array([1.0, 0.0, 0.0])
 TANGENT_SEARCH_STEPS = 1000  # Dex-Net's Contact3D.tangents(max_samples=1000)
+# Tolerances of the facet search, relative to the largest wrench coordinate (at least 1):
+RANK_TOL = 1e-12  # a point adds no rank if its reduced row is smaller than this
+SIDE_TOL = 1e-11  # a point this close to a plane lies on it
+PIN_TOL = 1e-12  # torsion points that pin a plane family's member this weakly pin none
+INTERIOR_MARGIN = 1e-9  # the contact line must be this far (relatively) inside both cones
 
 
 def _theta_table(steps: int) -> np.ndarray:
@@ -98,11 +103,13 @@ def grasp_wrenches(
     friction cone: ``μ d·n_in < |tangential part of d|``.
 
     ``interior`` marks grasps whose contact line ``ℓ = p2 - p1`` lies strictly inside contact 1's
-    polyhedral cone and ``-ℓ`` inside contact 2's, with both pushes and the torsion nonzero.
-    Then the origin is strictly inside the hull: a wrench direction ``u = (a, b)`` with
-    ``u · w <= 0`` for all points must have ``b ⟂ n1, n2`` (torsion comes in ± pairs), and with
-    ``g_i = a + s b × p_i`` lying in the polar of cone i, ``g_1 · ℓ = g_2 · ℓ`` forces
-    ``g_1 = g_2 = 0``, so ``b ∥ ℓ``, and ``b ⟂ n1`` with ``ℓ · n1 > 0`` gives ``u = 0``.
+    polyhedral cone and ``-ℓ`` inside contact 2's, with both pushes, μ, r and s nonzero. Then
+    the origin is strictly inside the hull. Proof: let ``u = (a, b)`` have ``u · w <= 0`` for
+    every point. Torsion comes in ± pairs, so ``b ⟂ n_in,1``. Each generator gives
+    ``f · g_i <= 0`` with ``g_i = a + s b × (p_i - com)``, i.e. ``g_i`` is in the polar of cone
+    i; ``ℓ`` inside cone 1 gives ``g_1 · ℓ <= 0`` (= 0 only if ``g_1 = 0``), ``-ℓ`` inside cone 2
+    gives ``g_2 · ℓ >= 0``; but ``g_1 - g_2 = s b × ℓ`` is ``⟂ ℓ``, so both vanish, ``b × ℓ = 0``,
+    ``b ∥ ℓ``, and ``b ⟂ n_in,1`` with ``ℓ · n_in,1 > 0`` leaves ``b = 0``, then ``a = 0``.
     """
     axis = np.asarray(axis, dtype=float)
     n = len(axis)
@@ -111,7 +118,7 @@ def grasp_wrenches(
     rows = np.empty((n, 2 * cone_faces + 4, 6))
     slips = np.zeros(n, dtype=bool)
     line = np.asarray(p2, dtype=float) - np.asarray(p1, dtype=float)
-    interior = (mu > 0) & (finger_radius > 0) & (np.linalg.norm(line, axis=1) > 0)
+    interior = (mu > 0) & (finger_radius > 0) & (torque_scaling != 0) & (np.linalg.norm(line, axis=1) > 0)
     edge_normals = phi + np.pi / cone_faces  # the cone polygon's edges, at distance μ cos(π/m)
     for k, (p, normal, push) in enumerate(((p1, n1, axis), (p2, n2, -axis))):
         in_normal = -np.asarray(normal, dtype=float)
@@ -125,7 +132,7 @@ def grasp_wrenches(
         with np.errstate(divide="ignore", invalid="ignore"):
             x, y = np.einsum("ij,ij->i", toward, t1) / height, np.einsum("ij,ij->i", toward, t2) / height
             reach = x[:, None] * np.cos(edge_normals) + y[:, None] * np.sin(edge_normals)
-            interior &= (c > 0) & (height > 0) & np.all(reach < (1 - 1e-9) * mu[:, None] * np.cos(np.pi / cone_faces), axis=1)
+            interior &= (c > 0) & (height > 0) & np.all(reach < (1 - INTERIOR_MARGIN) * mu[:, None] * np.cos(np.pi / cone_faces), axis=1)
         tangent = t1[:, None, :] * np.cos(phi)[None, :, None] + t2[:, None, :] * np.sin(phi)[None, :, None]
         cone = in_normal[:, None, :] + mu[:, None, None] * tangent  # (N, m, 3)
         torques = np.cross((np.asarray(p, dtype=float) - com)[:, None, :], cone)
@@ -133,10 +140,9 @@ def grasp_wrenches(
         rows[:, block, :3] = c[:, None, None] * cone
         rows[:, block, 3:] = torque_scaling * (c[:, None, None] * torques)
         torsion = np.pi * finger_radius**2 * mu[:, None] * (c[:, None] * in_normal) * torque_scaling
-        rows[:, 2 * cone_faces + 2 * k, :3] = 0.0
-        rows[:, 2 * cone_faces + 2 * k, 3:] = torsion
-        rows[:, 2 * cone_faces + 2 * k + 1, :3] = 0.0
-        rows[:, 2 * cone_faces + 2 * k + 1, 3:] = -torsion
+        for row, sign in ((2 * cone_faces + k, -1.0), (2 * cone_faces + 2 + k, 1.0)):  # -τ1, -τ2, +τ1, +τ2
+            rows[:, row, :3] = 0.0
+            rows[:, row, 3:] = sign * torsion
     return GraspWrenches(rows, slips, interior)
 
 
@@ -165,7 +171,7 @@ def _polygon_faces(cone_faces: int) -> tuple[np.ndarray, np.ndarray]:
     return rows, np.array([len(f) for f in faces], dtype=np.int64)
 
 
-_TORSION_PAIRS = np.array([[0, 2], [0, 3], [1, 2], [1, 3]])  # (±τ1, ±τ2) among +τ1, -τ1, +τ2, -τ2
+_TORSION_PAIRS = np.array([[0, 1], [0, 3], [2, 1], [2, 3]])  # (±τ1, ±τ2) among rows -τ1, -τ2, +τ1, +τ2
 
 
 @njit(cache=True)
@@ -258,8 +264,8 @@ def _origin_not_inside(points: np.ndarray, poly: np.ndarray, poly_n: np.ndarray,
     basis = np.empty((7, 7))
     origin = np.zeros(6)
     rank_t = _add_row(a, pivots, 0, origin, rank_tol)
-    rank_t = _add_row(a, pivots, rank_t, points[2 * m], rank_tol)
-    rank_t = _add_row(a, pivots, rank_t, points[2 * m + 2], rank_tol)
+    rank_t = _add_row(a, pivots, rank_t, points[2 * m + 2], rank_tol)  # +τ1
+    rank_t = _add_row(a, pivots, rank_t, points[2 * m + 3], rank_tol)  # +τ2
     for ai in range(poly.shape[0]):
         rank_a = rank_t
         for r in range(poly_n[ai]):
@@ -322,7 +328,7 @@ def _epsilon_inside(points: np.ndarray, poly: np.ndarray, poly_n: np.ndarray, ra
                     c0, c1, c2 = 1.0, 0.0, 0.0
                 elif q == 2:  # the member through torsion point `option`
                     c0, c1, c2 = g[option, 1], -g[option, 0], 0.0
-                    if abs(c0) + abs(c1) <= 1e-12 * (np.abs(basis[0]).max() + np.abs(basis[1]).max()):
+                    if abs(c0) + abs(c1) <= PIN_TOL * (np.abs(basis[0]).max() + np.abs(basis[1]).max()):
                         continue
                 else:  # the member through torsion pair `option`
                     u, w = _TORSION_PAIRS[option, 0], _TORSION_PAIRS[option, 1]
@@ -330,7 +336,7 @@ def _epsilon_inside(points: np.ndarray, poly: np.ndarray, poly_n: np.ndarray, ra
                     c1 = g[u, 2] * g[w, 0] - g[u, 0] * g[w, 2]
                     c2 = g[u, 0] * g[w, 1] - g[u, 1] * g[w, 0]
                     size = np.sqrt((g[u, 0] ** 2 + g[u, 1] ** 2 + g[u, 2] ** 2) * (g[w, 0] ** 2 + g[w, 1] ** 2 + g[w, 2] ** 2))
-                    if np.sqrt(c0 * c0 + c1 * c1 + c2 * c2) <= 1e-12 * size:
+                    if np.sqrt(c0 * c0 + c1 * c1 + c2 * c2) <= PIN_TOL * size:
                         continue  # the two points pin down no single plane
                 for j in range(7):
                     x[j] = c0 * basis[0, j]
@@ -352,7 +358,7 @@ def _epsilon_batch(wrenches: np.ndarray, inside: np.ndarray, poly: np.ndarray, p
     for i in range(wrenches.shape[0]):
         points = wrenches[i]
         scale = max(1.0, np.abs(points).max())
-        rank_tol, side_tol = 1e-12 * scale, 1e-11 * scale
+        rank_tol, side_tol = RANK_TOL * scale, SIDE_TOL * scale
         if not inside[i] and _origin_not_inside(points, poly, poly_n, rank_tol, side_tol):
             out[i] = 0.0
         else:
@@ -374,7 +380,9 @@ def ferrari_canny(wrenches: np.ndarray, inside: np.ndarray | None = None) -> np.
     cone_faces = (wrenches.shape[1] - 4) // 2 if wrenches.ndim == 3 else 0
     if wrenches.ndim != 3 or wrenches.shape[2] != 6 or 2 * cone_faces + 4 != wrenches.shape[1] or cone_faces < 3:
         raise ValueError(f"wrenches must be (N, 2m+4, 6) with m >= 3 cone faces, got {wrenches.shape}")
-    inside = np.zeros(len(wrenches), dtype=bool) if inside is None else np.asarray(inside, dtype=bool)
+    inside = np.zeros(len(wrenches), dtype=bool) if inside is None else np.ascontiguousarray(inside, dtype=bool)
+    if inside.shape != (len(wrenches),):
+        raise ValueError(f"inside must be ({len(wrenches)},) bool, got shape {inside.shape}")
     if cone_faces not in _FACES:
         _FACES[cone_faces] = _polygon_faces(cone_faces)
     out = np.zeros(len(wrenches))

@@ -38,7 +38,8 @@ def gripper(cfg: GraspsParams) -> ParallelJawGripper:
 def sampler_settings(cfg: GraspsParams) -> AntipodalSettings:
     return AntipodalSettings(
         n_grasps=cfg.n_grasps, friction_coef=cfg.friction_coef, tries_per_point=cfg.tries_per_point,
-        oversample=cfg.oversample, max_rounds=cfg.max_rounds, min_contact_dist=cfg.min_contact_dist, coverage_dist=cfg.coverage_dist,
+        oversample=cfg.oversample, max_rounds=cfg.max_rounds, max_surface_points=cfg.max_surface_points,
+        min_contact_dist=cfg.min_contact_dist, coverage_dist=cfg.coverage_dist,
     )
 
 
@@ -75,8 +76,8 @@ def grasps_of_shape(path: Path, shape_id: str, cfg: GraspsParams, seed: int) -> 
     columns.update(width=grasps.width, eps=eps, eps_mean=eps_mean, eps_std=eps_std, success=eps_mean > cfg.threshold)
     reason = None
     if len(grasps) == 0:
-        smallest = float(np.min(mesh.extents))
-        reason = (f"smallest extent {smallest:.3f} m is wider than the {cfg.max_width} m opening" if smallest >= cfg.max_width
+        smallest = float(np.min(mesh.bounding_box_oriented.extents))
+        reason = (f"its oriented bounding box's smallest side, {smallest:.3f} m, is wider than the {cfg.max_width} m opening" if smallest >= cfg.max_width
                   else f"no antipodal grasp passed the width and force-closure tests in {cfg.max_rounds} rounds")
     return pd.DataFrame(columns), reason
 

@@ -67,6 +67,11 @@ def example_shapes(scores: pd.DataFrame) -> list[str]:
     return list(dict.fromkeys(ranked.shape_id.iloc[picks]))
 
 
+def _rounded(value: float) -> float | None:
+    """A JSON-safe metric: NaN (e.g. a correlation with a constant column) becomes null."""
+    return round(float(value), 4) if np.isfinite(value) else None
+
+
 def run(params: Params) -> None:
     cfg = params.score
     shapes = read_table(SHAPES_TABLE)
@@ -85,6 +90,8 @@ def run(params: Params) -> None:
               f"rarity R, eq. (4), k = {cfg.k}", f"Rarity of the {len(train)} train shapes")
 
     picks = example_shapes(scores)
+    if not picks:
+        log.warning("score: no train shape has a grasp; the grasp picture is empty")
     drawn = [(read_mesh(mesh_path(SHAPES_DIR, s)), grasps[grasps.shape_id == s]) for s in picks]
     grasps_on_shapes(
         [(m.vertices, m.faces) for m, _ in drawn],
@@ -100,7 +107,7 @@ def run(params: Params) -> None:
         "train_shapes_without_success": int((train.n_success == 0).sum()),
         "rarity_train_median": round(float(train.rarity.median()), 4),
         "rarity_train_max": round(float(train.rarity.max()), 4),
-        "rarity_graspness_spearman": round(float(train[["rarity", "graspness"]].corr(method="spearman").iloc[0, 1]), 4),
+        "rarity_graspness_spearman": _rounded(train[["rarity", "graspness"]].corr(method="spearman").iloc[0, 1]),
     }
     write_json(summary, SCORE_METRICS)
     log.info("score: %d shapes; train graspness mean %.3f, rarity median %.3f", len(scores), summary["graspness_train_mean"], summary["rarity_train_median"])
