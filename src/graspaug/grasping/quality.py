@@ -13,7 +13,7 @@ faces, 8 by default), one row per wrench ``[force (N); s · torque (N·m)]``:
 ε is the distance from the origin to the boundary of the convex hull of these points (0 when
 the origin is not strictly inside or the hull is flat): the smallest facet-plane offset.
 :func:`ferrari_canny_qhull` computes it with one ``scipy.spatial.ConvexHull`` per grasp (about
-1 ms each in 6-D); :func:`ferrari_canny` gets the same value (to 1e-9) ~20x faster by trying
+1 ms each in 6-D); :func:`ferrari_canny` gets the same value (to 1e-9) 16-21x faster by trying
 only the hyperplanes that can be facets of this particular point set (:func:`_epsilon_inside`).
 """
 from __future__ import annotations
@@ -373,7 +373,7 @@ def ferrari_canny(wrenches: np.ndarray, inside: np.ndarray | None = None) -> np.
 
     ``inside`` (N,) bool may mark sets known to hold the origin strictly inside their hull
     (``GraspWrenches.interior``); the others are checked first. Equal to
-    :func:`ferrari_canny_qhull` to rounding, and compiled (numba): ~50 µs per grasp instead
+    :func:`ferrari_canny_qhull` to rounding, and compiled (numba): 50-70 µs per grasp instead
     of ~1 ms (bench/grasp_quality_speed.py).
     """
     wrenches = np.ascontiguousarray(wrenches, dtype=float)
