@@ -91,7 +91,6 @@ stage_command(
 )
 
 
-
 @app.command(
     name="grasps",
     help="Sample antipodal grasps on every shape of a corpus (Dex-Net's sampler, Franka Panda opening) and label "
@@ -116,6 +115,7 @@ stage_command(
     "Writes `data/scores.parquet`, `metrics/score.json`, and histograms and a grasp picture in `reports/score/`.\n\n"
     f"Params `score`:\n\n{describe(ScoreParams)}\n\nAlso `grasps.threshold` (for labels).",
 )
+
 
 def main() -> None:
     app()
