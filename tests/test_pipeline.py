@@ -22,6 +22,8 @@ TINY = {
     "critic_eval": {"n_shapes": 10, "n_pairs": 3, "n_examples": 2},
     "grasps": {"n_grasps": 8, "n_samples": 4},
     "score": {"k": 3, "bins": 5},
+    "generate": {"base_sizes": [4, 6], "ratios": [0.0, 0.5, 1.0, 2.0], "percentile": 50.0, "first_neighbour": 1, "extra_neighbours": 1,
+                 "min_voxels": 5, "min_main_share": 0.5, "smoothing_iterations": 3, "n_examples": 2},
 }
 
 
@@ -125,3 +127,35 @@ def test_dvc_repro_score(tiny_repo):
     assert summary["n_train"] == (scores.split == "train").sum()
     shown = run(["dvc", "metrics", "show", "--json"], work, env)
     assert "success_share" in shown.stdout and "graspness_train_mean" in shown.stdout
+
+
+def test_dvc_repro_generate_and_its_grasps(tiny_repo):
+    import json
+
+    import trimesh
+
+    work, env = tiny_repo
+    run(["dvc", "repro", "grasps_generated"], work, env)
+    shapes = pd.read_parquet(work / "data/shapes.parquet")
+    base = {b: pd.read_parquet(work / f"data/generated/{b}/base.parquet") for b in (4, 6)}
+    assert set(base[4].shape_id) < set(base[6].shape_id) <= set(shapes.shape_id[shapes.split == "train"])
+    for b in (4, 6):
+        index = pd.read_parquet(work / f"data/generated/{b}/index.parquet")
+        for pool in ("targeted", "random"):
+            part = index[index.pool == pool]
+            assert list(part.order) == list(range(2 * b))  # max ratio 2 -> 2B shapes, in order
+        assert set(index.parent_a) | set(index.parent_b) <= set(base[b].shape_id)
+        assert index.alpha.between(0, 0.5).all() and index.watertight.all()
+        assert set(index.selected_by) <= {"rarity", "graspness", "random"}
+        for shape_id in index.shape_id[:3]:
+            mesh = trimesh.load(work / f"data/generated/{b}/meshes/{shape_id}.obj", force="mesh")
+            assert mesh.is_watertight
+        summary = json.loads((work / f"metrics/generate/{b}.json").read_text())
+        assert summary["targeted"]["kept"] == summary["random"]["kept"] == 2 * b
+        rejects = pd.read_parquet(work / f"data/generated/{b}/rejects.parquet")
+        assert summary["targeted"]["tried"] + summary["random"]["tried"] == 4 * b + len(rejects)
+        grasps = pd.read_parquet(work / f"data/grasps/gen_{b}.parquet")
+        assert set(grasps.shape_id) <= set(index.shape_id)
+        assert (work / f"reports/generate/{b}/pairs.png").stat().st_size > 0
+    again = run(["dvc", "repro", "grasps_generated"], work, env)
+    assert "Running stage" not in again.stdout

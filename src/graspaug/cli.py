@@ -9,7 +9,7 @@ from pathlib import Path
 import typer
 
 from graspaug.config import (
-    AEParams, CriticEvalParams, DataParams, EmbedParams, GraspsParams, IngestParams, Params, ParamsError, ScoreParams, VoxelizeParams,
+    AEParams, CriticEvalParams, DataParams, EmbedParams, GenerateParams, GraspsParams, IngestParams, Params, ParamsError, ScoreParams, VoxelizeParams,
     describe, load_params,
 )
 
@@ -95,12 +95,13 @@ stage_command(
     name="grasps",
     help="Sample antipodal grasps on every shape of a corpus (Dex-Net's sampler, Franka Panda opening) and label "
     "each with robust Ferrari-Canny: the mean ε over perturbed grasp poses, object poses and friction.\n\n"
-    "Writes `data/grasps/<corpus>.parquet` (one row per grasp) and `metrics/grasps/<corpus>.json`. "
+    "Writes `data/grasps/<corpus>.parquet` (one row per grasp) and `metrics/grasps/<corpus>.json`; corpus "
+    "`original` is the ingested shapes, `gen_<B>` the shapes generated for base size B. "
     "A shape without any grasp gets no rows and a warning with the reason.\n\n"
     f"Params `grasps`:\n\n{describe(GraspsParams)}\n\nAlso `seed` and `n_jobs`.",
 )
 def grasps_command(
-    corpus: str = typer.Option("original", "--corpus", "-c", help="Which shapes: `original` (ingested corpus)."),
+    corpus: str = typer.Option("original", "--corpus", "-c", help="Which shapes: `original` (ingested corpus) or `gen_<B>` (generated for base size B)."),
     params: Path = ParamsOption,
 ) -> None:
     from graspaug.stages import grasps
@@ -115,6 +116,27 @@ stage_command(
     "Writes `data/scores.parquet`, `metrics/score.json`, and histograms and a grasp picture in `reports/score/`.\n\n"
     f"Params `score`:\n\n{describe(ScoreParams)}\n\nAlso `grasps.threshold` (for labels).",
 )
+
+
+
+@app.command(
+    name="generate",
+    help="Generate new shapes for one base set of B train shapes (paper Section III-C): pair its rare shapes, and "
+    "separately its graspable ones, with their N-th to (N+K)-th nearest neighbours in latent space, decode the "
+    "interpolated latents with the AE-Critic and mesh them (fill, opening, marching cubes, Humphrey smoothing); "
+    "also a random-pair pool of the same size as the baseline. Each pool holds max(ratios) × B shapes in order: "
+    "the first round(R × B) are the set for ratio R.\n\n"
+    "Writes `data/generated/<B>/` (`meshes/*.obj`, `index.parquet`, `rejects.parquet`, `base.parquet`), "
+    "`metrics/generate/<B>.json` and `reports/generate/<B>/{pairs,tsne}.png`.\n\n"
+    f"Params `generate`:\n\n{describe(GenerateParams)}\n\nAlso `score.k` (rarity on the base set), `seed`, `device`, `n_jobs`.",
+)
+def generate_command(
+    base_size: int = typer.Option(..., "--base-size", "-b", help="The base set size B (one of generate.base_sizes)."),
+    params: Path = ParamsOption,
+) -> None:
+    from graspaug.stages import generate
+
+    _run(lambda p: generate.run(p, base_size), _load(params))
 
 
 def main() -> None:

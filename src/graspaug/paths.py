@@ -25,8 +25,44 @@ CRITIC_EVAL_METRICS = Path("metrics/critic_eval.json")
 OUTLIERS_CSV = Path("reports/critic_eval/outliers.csv")
 OUTLIERS_PNG = Path("reports/critic_eval/outliers.png")
 INTERPOLATIONS_PNG = Path("reports/critic_eval/interpolations.png")
+# generate (one folder per base size B)
+def generated_dir(base_size: int) -> Path:
+    return Path(f"data/generated/{base_size}")
+
+
+def generated_index(base_size: int) -> Path:
+    return generated_dir(base_size) / "index.parquet"
+
+
+def generated_meshes(base_size: int) -> Path:
+    return generated_dir(base_size) / "meshes"
+
+
+def base_set_table(base_size: int) -> Path:
+    return generated_dir(base_size) / "base.parquet"
+
+
+def generate_metrics(base_size: int) -> Path:
+    return Path(f"metrics/generate/{base_size}.json")
+
+
+def generate_reports(base_size: int) -> Path:
+    return Path(f"reports/generate/{base_size}")
+
+
+GENERATED_SUFFIX = ".obj"
+
+
 # grasps (one table per corpus: `dvc.yaml` runs the stage for each)
-CORPORA = {"original": (SHAPES_TABLE, SHAPES_DIR)}  # corpus -> (shape table, mesh folder)
+def corpus_files(corpus: str) -> tuple[Path, Path, str] | None:
+    """(shape table, mesh folder, mesh suffix) of a corpus: ``original`` (ingested shapes) or
+    ``gen_<B>`` (the shapes generated for base size B); None for an unknown name."""
+    if corpus == "original":
+        return SHAPES_TABLE, SHAPES_DIR, ".ply"
+    if corpus.startswith("gen_") and corpus[4:].isdigit():
+        size = int(corpus[4:])
+        return generated_index(size), generated_meshes(size), GENERATED_SUFFIX
+    return None
 
 
 def grasps_table(corpus: str) -> Path:

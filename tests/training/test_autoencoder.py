@@ -41,6 +41,17 @@ def test_a_tiny_model_overfits_eight_shapes():
     train_autoencoder(ae, x, cfg, CPU, torch.Generator().manual_seed(0))
     assert reconstruction_iou(ae, x, CPU) > 0.9
 
+    # the decoded sphere latent, and a sphere-box interpolation, mesh to closed one-piece surfaces
+    from graspaug.geometry.from_voxels import clean_occupancy, mesh_from_occupancy
+    from graspaug.training.autoencoder import decode
+
+    z = encode(ae, x, CPU)
+    for latent in (z[1], 0.5 * z[1] + 0.5 * z[0]):
+        grid = clean_occupancy(decode(ae, latent[None], CPU)[0], 0.5, 1, 20, 0.9)
+        assert grid.reason is None
+        mesh = mesh_from_occupancy(grid.occupancy, 0.01, 10)
+        assert mesh.is_watertight and len(mesh.split()) == 1 and mesh.volume > 0
+
 
 def _train_twice_state(seed: int) -> dict[str, torch.Tensor]:
     torch.manual_seed(seed)

@@ -23,7 +23,7 @@ from graspaug.grasping.gripper import ParallelJawGripper
 from graspaug.grasping.robust import Perturbations, QualitySettings, grasp_epsilon, robust_ferrari_canny
 from graspaug.io.meshes import mesh_path, read_mesh
 from graspaug.io.tables import read_table, write_json, write_table
-from graspaug.paths import CORPORA, grasps_metrics, grasps_table
+from graspaug.paths import corpus_files, grasps_metrics, grasps_table
 from graspaug.stages import StageError
 
 log = logging.getLogger(__name__)
@@ -85,13 +85,14 @@ def grasps_of_shape(path: Path, shape_id: str, cfg: GraspsParams, seed: int) -> 
 def run(params: Params, corpus: str = "original") -> None:
     from graspaug.parallel import parallel_map
 
-    if corpus not in CORPORA:
-        raise StageError(f"unknown corpus {corpus!r}; known: {', '.join(CORPORA)}")
+    files = corpus_files(corpus)
+    if files is None:
+        raise StageError(f"unknown corpus {corpus!r}; known: original, gen_<base size>")
     start = time.perf_counter()
     cfg = params.grasps
-    table_path, mesh_dir = CORPORA[corpus]
+    table_path, mesh_dir, suffix = files
     shape_ids = list(read_table(table_path)["shape_id"])
-    jobs = [(mesh_path(mesh_dir.resolve(), s), s) for s in shape_ids]  # workers may have another cwd
+    jobs = [(mesh_path(mesh_dir.resolve(), s, suffix), s) for s in shape_ids]  # workers may have another cwd
     results = parallel_map(lambda job: grasps_of_shape(job[0], job[1], cfg, params.seed), jobs, params.n_jobs, f"grasps ({corpus})")
     for shape_id, (_, reason) in zip(shape_ids, results):
         if reason:

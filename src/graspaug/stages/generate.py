@@ -1,0 +1,239 @@
+"""Stage ``generate``: for one base set of B train shapes, a targeted and a random pool of new shapes.
+
+``dvc.yaml`` runs it once per base size (``generate@50`` …). The targeted pool pairs the base
+set's rare shapes, and separately its graspable ones, with their N-th … (N+K)-th nearest
+neighbours in latent space, decodes ``(1 - α) z_a + α z_b`` with the AE-Critic and meshes it
+(paper Section III-C); the random pool does the same for random pairs (the baseline the paper
+argues against). Each pool holds ``ceil(max ratio × B)`` kept shapes in order: the first
+``round(R × B)`` are the augmentation set of ratio R. A degenerate decode is rejected with its
+reason and replaced by the next candidate.
+
+Outputs, in ``data/generated/<B>/``: ``meshes/<shape_id>.obj``, ``index.parquet`` (one row
+per kept shape), ``rejects.parquet``, ``base.parquet`` (the base set with its scores); plus
+``metrics/generate/<B>.json`` and ``reports/generate/<B>/{pairs,tsne}.png``.
+"""
+from __future__ import annotations
+
+import logging
+import math
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+import trimesh
+
+from graspaug.config import GenerateParams, Params
+from graspaug.generation import Candidate, above_percentile, nested_base_sets, random_candidates, targeted_candidates
+from graspaug.geometry.from_voxels import CleanGrid, clean_occupancy, mesh_from_occupancy
+from graspaug.io.atomic import atomic_path
+from graspaug.io.checkpoints import load_autoencoder
+from graspaug.io.meshes import mesh_path, write_obj
+from graspaug.io.tables import read_table, write_json, write_table
+from graspaug.io.voxels import read_voxels
+from graspaug.paths import (
+    AE_CRITIC_MODEL, GENERATED_SUFFIX, LATENTS, SCORES, SHAPES_TABLE, VOXELS, generate_metrics, generate_reports, generated_dir,
+)
+from graspaug.plots import scatter_2d, voxel_rows
+from graspaug.scores import rarity
+from graspaug.stages import StageError
+from graspaug.stages.train_ae import net_config
+from graspaug.training.autoencoder import decode, resolve_device
+
+log = logging.getLogger(__name__)
+
+EXTRA_ALPHAS = (0.4, 0.2, 0.1, 0.05)  # added in this order when widening K cannot fill a pool
+# (then the percentile drops in steps of 5; a pool that still cannot be filled stops the stage)
+BASE_SEED = 0xBA5E  # base sets: their own stream of the seed
+
+
+@dataclass(frozen=True)
+class Decoded:
+    """One candidate's outcome: the cleaned grid and, if kept, its mesh (meters)."""
+
+    candidate: Candidate
+    grid: CleanGrid
+    mesh: trimesh.Trimesh | None
+    reason: str | None
+
+
+def pool_size(cfg: GenerateParams, base_size: int) -> int:
+    return math.ceil(max(cfg.ratios) * base_size - 1e-9)
+
+
+def mesh_decoded(probability: np.ndarray, pitch: float, cfg: GenerateParams) -> tuple[CleanGrid, trimesh.Trimesh | None, str | None]:
+    """Clean a decoded grid and mesh it; a reason instead of a mesh if it is degenerate."""
+    grid = clean_occupancy(probability, cfg.threshold, cfg.opening, cfg.min_voxels, cfg.min_main_share)
+    if grid.reason:
+        return grid, None, grid.reason
+    mesh = mesh_from_occupancy(grid.occupancy, pitch, cfg.smoothing_iterations)
+    if not mesh.is_watertight:
+        return grid, None, "surface not closed after meshing"
+    return grid, mesh, None
+
+
+def fill_pool(make: Callable[[int], list[Candidate]], needed: int, run_batch: Callable[[list[Candidate]], list[Decoded]], name: str) -> tuple[list[Decoded], list[Decoded], int]:
+    """Decode candidates in order until ``needed`` are kept, asking ``make`` for a longer list
+    when rejects use them up. Returns kept, rejected, and how many candidates were tried."""
+    kept: list[Decoded] = []
+    rejected: list[Decoded] = []
+    tried = 0
+    while len(kept) < needed:
+        missing = needed - len(kept)
+        batch = make(tried + missing)[tried : tried + missing]
+        if not batch:
+            raise StageError(f"{name} pool: only {len(kept)} of {needed} shapes after {tried} candidates; no more pairs or weights to try")
+        for outcome in run_batch(batch):
+            tried += 1
+            (rejected if outcome.reason else kept).append(outcome)
+    return kept, rejected, tried
+
+
+def widening_targeted(z: np.ndarray, rare: np.ndarray, graspable: np.ndarray, cfg: GenerateParams, notes: list[str]) -> Callable[[int], list[Candidate]]:
+    """``make(count)`` for the targeted pool: at least ``count`` candidates if at all possible.
+    Until there are enough, each step (noted) widens K by one if that adds pairs, else adds the
+    next weight of EXTRA_ALPHAS, else lowers the percentile by 5 (admitting more shapes)."""
+    state = {"k": cfg.extra_neighbours, "alphas": list(cfg.alphas), "percentile": cfg.percentile}
+
+    def candidates(k: int) -> list[Candidate]:
+        return targeted_candidates(z, rare, graspable, state["percentile"], cfg.first_neighbour, k, state["alphas"])
+
+    def make(count: int) -> list[Candidate]:
+        current = candidates(state["k"])
+        while len(current) < count:
+            wider = candidates(state["k"] + 1)
+            if len(wider) > len(current):
+                state["k"] += 1
+                notes.append(f"K widened to {state['k']} ({len(wider)} candidates, {count} wanted)")
+                current = wider
+                continue
+            extra = [a for a in EXTRA_ALPHAS if a not in state["alphas"]]
+            if extra:
+                state["alphas"].append(extra[0])
+                notes.append(f"alpha {extra[0]} added ({count} candidates wanted)")
+            elif state["percentile"] > 0:
+                state["percentile"] = max(0.0, state["percentile"] - 5.0)
+                notes.append(f"percentile lowered to {state['percentile']:g} ({count} candidates wanted)")
+            else:
+                break
+            current = candidates(state["k"])
+        return current
+
+    make.state = state  # type: ignore[attr-defined]
+    return make
+
+
+def run(params: Params, base_size: int) -> None:
+    from graspaug.parallel import parallel_map
+
+    start = time.perf_counter()
+    cfg = params.generate
+    if base_size not in cfg.base_sizes:
+        raise StageError(f"base size {base_size} is not in generate.base_sizes {list(cfg.base_sizes)}")
+    shapes = read_table(SHAPES_TABLE)
+    train_ids = shapes.shape_id[shapes.split == "train"].to_numpy()
+    if len(train_ids) < max(cfg.base_sizes):
+        raise StageError(f"generate.base_sizes: {max(cfg.base_sizes)} is larger than the {len(train_ids)} train shapes")
+    base = nested_base_sets(train_ids, sorted(cfg.base_sizes), np.random.default_rng([params.seed, BASE_SEED]))[base_size]
+    latents = read_table(LATENTS).set_index("shape_id").z
+    scores = read_table(SCORES).set_index("shape_id")
+    voxels = read_voxels(VOXELS)
+    pitch_of = dict(zip(voxels.shape_id, voxels.pitch))
+    z = np.stack(latents.loc[base].to_numpy()).astype(np.float32)
+    base_rarity = rarity(z, params.score.k)  # relative to this base set
+    graspness = scores.graspness.loc[base].to_numpy()
+    pitch = np.array([pitch_of[s] for s in base])
+
+    device = resolve_device(params.device)
+    ae, _, _ = load_autoencoder(AE_CRITIC_MODEL, net_config(params))
+
+    def run_batch(candidates: list[Candidate]) -> list[Decoded]:
+        a = np.array([c.a for c in candidates])
+        b = np.array([c.b for c in candidates])
+        alpha = np.array([c.alpha for c in candidates], dtype=np.float32)[:, None]
+        probability = decode(ae, (1 - alpha) * z[a] + alpha * z[b], device)
+        child_pitch = (1 - alpha[:, 0]) * pitch[a] + alpha[:, 0] * pitch[b]  # metric size: the parents' scales interpolated
+        out = parallel_map(lambda job: mesh_decoded(job[0], job[1], cfg), list(zip(probability, child_pitch)), params.n_jobs, f"generate {base_size}")
+        return [Decoded(c, grid, mesh, reason) for c, (grid, mesh, reason) in zip(candidates, out)]
+
+    needed = pool_size(cfg, base_size)
+    notes: list[str] = []
+    make_targeted = widening_targeted(z, base_rarity, graspness, cfg, notes)
+    targeted, targeted_rejects, targeted_tried = fill_pool(make_targeted, needed, run_batch, "targeted")
+    random_rng_seed = [params.seed, BASE_SEED, base_size]
+    make_random = lambda count: random_candidates(base_size, count, list(cfg.alphas), np.random.default_rng(random_rng_seed))  # noqa: E731
+    randoms, random_rejects, random_tried = fill_pool(make_random, needed, run_batch, "random")
+    for note in notes:
+        log.info("generate %d: %s", base_size, note)
+
+    rows, reject_rows = [], []
+    for pool, kept in (("targeted", targeted), ("random", randoms)):
+        for order, d in enumerate(kept):
+            c, m = d.candidate, d.mesh
+            za, zb = z[c.a], z[c.b]
+            rows.append({
+                "shape_id": f"gen_{base_size}_{pool[0]}{order:04d}", "base_size": base_size, "pool": pool, "order": order,
+                "parent_a": base[c.a], "parent_b": base[c.b], "alpha": c.alpha, "selected_by": c.selected_by,
+                "z": ((1 - c.alpha) * za + c.alpha * zb).astype(np.float32), "faces": len(m.faces), "vertices": len(m.vertices),
+                "watertight": bool(m.is_watertight), "one_piece": len(m.split(only_watertight=False)) == 1, "volume": float(m.volume),
+                "extent_x": m.extents[0], "extent_y": m.extents[1], "extent_z": m.extents[2], "split": "train", "origin": "generated",
+            })
+    for pool, rejects in (("targeted", targeted_rejects), ("random", random_rejects)):
+        reject_rows += [{"pool": pool, "parent_a": base[d.candidate.a], "parent_b": base[d.candidate.b], "alpha": d.candidate.alpha,
+                         "selected_by": d.candidate.selected_by, "reason": d.reason} for d in rejects]
+    index = pd.DataFrame(rows)
+    index["rarity_vs_base"] = rarity(z, params.score.k, query=np.stack(index.z.to_numpy()))
+    used = make_targeted.state  # type: ignore[attr-defined]
+    rare_group = set(above_percentile(base_rarity, used["percentile"]))
+    grasp_group = set(above_percentile(graspness, used["percentile"]))
+    base_table = pd.DataFrame({"shape_id": base, "rarity": base_rarity, "graspness": graspness,
+                               "selected_by_rarity": [i in rare_group for i in range(base_size)],
+                               "selected_by_graspness": [i in grasp_group for i in range(base_size)]})
+    with atomic_path(generated_dir(base_size), directory=True) as folder:
+        (folder / "meshes").mkdir()
+        for row, d in zip(rows, targeted + randoms):
+            write_obj(d.mesh, mesh_path(folder / "meshes", row["shape_id"], GENERATED_SUFFIX))
+        write_table(index, folder / "index.parquet")
+        write_table(pd.DataFrame(reject_rows, columns=["pool", "parent_a", "parent_b", "alpha", "selected_by", "reason"]), folder / "rejects.parquet")
+        write_table(base_table, folder / "base.parquet")
+
+    draw_examples(base, voxels, targeted, randoms, cfg.n_examples, base_size)
+    from graspaug.stages.embed import tsne_2d
+
+    xy = tsne_2d(np.concatenate([z, np.stack(index.z.to_numpy())]), params.embed.perplexity, params.seed)
+    groups = ["base"] * base_size + [f"generated ({s})" for s in index.selected_by]
+    scatter_2d(xy, groups, generate_reports(base_size) / "tsne.png", f"t-SNE of base set {base_size} and its generated shapes")
+
+    reasons = pd.Series([r["reason"].split(":")[0] for r in reject_rows], dtype=object)
+    summary = {
+        "base_size": base_size, "pool_size": needed,
+        "targeted": {"kept": len(targeted), "tried": targeted_tried, "by_rarity": int((index.selected_by == "rarity").sum()),
+                     "by_graspness": int((index.selected_by == "graspness").sum()), "k_used": used["k"],
+                     "alphas_used": used["alphas"], "percentile_used": used["percentile"]},
+        "random": {"kept": len(randoms), "tried": random_tried},
+        "rejects": {str(k): int(v) for k, v in reasons.value_counts().sort_index().items()},
+        "watertight_share": round(float(index.watertight.mean()), 4),
+        "one_piece_share": round(float(index.one_piece.mean()), 4),
+        "seconds": round(time.perf_counter() - start, 1),
+    }
+    write_json(summary, generate_metrics(base_size))
+    log.info("generate %d: %d targeted (%d tried) + %d random (%d tried) shapes, %d rejected, %.1f%% watertight, in %.1f s",
+             base_size, len(targeted), targeted_tried, len(randoms), random_tried, len(reject_rows), 100 * summary["watertight_share"], summary["seconds"])
+
+
+def draw_examples(base: np.ndarray, voxels, targeted: list[Decoded], randoms: list[Decoded], n_examples: int, base_size: int) -> None:
+    """Parent a | child | parent b, for the first targeted shapes and two random ones."""
+    row_of = {s: i for i, s in enumerate(voxels.shape_id)}
+
+    def parent(shape_id: str) -> tuple[np.ndarray, np.ndarray]:
+        grid = voxels.occupancy[row_of[shape_id]].astype(bool)
+        return grid, grid
+
+    rows, labels = [], []
+    for d in targeted[:n_examples] + randoms[:2]:
+        c = d.candidate
+        child = d.grid.occupancy
+        rows.append([parent(base[c.a]), (child, child), parent(base[c.b])])
+        labels.append(f"{c.selected_by}, α={c.alpha:g}")
+    voxel_rows(rows, labels, ["parent a", "generated", "parent b"], generate_reports(base_size) / "pairs.png", f"Generated shapes of base set {base_size}")
