@@ -2,7 +2,12 @@
 import numpy as np
 import pytest
 
-from graspaug.generation import above_percentile, nested_base_sets, neighbour_pairs, random_candidates, targeted_candidates
+from dataclasses import dataclass
+
+from graspaug.generation import (
+    Candidate, PoolExhausted, RandomStream, TargetedStream, above_percentile, fill_pool, nested_base_sets, neighbour_pairs, pool_size,
+    ratio_count, targeted_candidates,
+)
 
 # Points on a line at 0, 1, 3, 7, 12, 18: no ties, so every point's neighbour ranks are clear:
 # 0: 1 2 3 4 5 | 1: 0 2 3 4 5 | 2: 1 0 3 4 5 | 3: 2 4 1 0 5 | 4: 3 5 2 1 0 | 5: 4 3 2 1 0
@@ -10,10 +15,11 @@ LINE = np.array([[0.0], [1.0], [3.0], [7.0], [12.0], [18.0]])
 
 
 def test_neighbour_pairs_are_exactly_the_nth_to_n_plus_kth():
-    assert neighbour_pairs(LINE, 1, 0) == [(0, 1), (1, 2), (2, 3), (3, 4), (4, 5)]
-    # rank 2: 0-2 1-2 (2-0) 3-4 4-5 3-5, then rank 3: 0-3 1-3 2-3 (3-1) 2-4 2-5
-    assert neighbour_pairs(LINE, 2, 1) == [(0, 2), (1, 2), (3, 4), (4, 5), (3, 5), (0, 3), (1, 3), (2, 3), (2, 4), (2, 5)]
-    assert neighbour_pairs(LINE, 5, 3) == [(0, 5), (1, 5), (2, 5), (3, 5), (0, 4)]  # only 5 others: rank 5 is the last
+    # (shape, its neighbour); a pair met the other way round before is dropped
+    assert neighbour_pairs(LINE, 1, 0) == [(0, 1), (2, 1), (3, 2), (4, 3), (5, 4)]
+    # rank 2: 0-2 1-2 (2-0) 3-4 4-5 5-3, then rank 3: 0-3 1-3 2-3 (3-1) 4-2 5-2
+    assert neighbour_pairs(LINE, 2, 1) == [(0, 2), (1, 2), (3, 4), (4, 5), (5, 3), (0, 3), (1, 3), (2, 3), (4, 2), (5, 2)]
+    assert neighbour_pairs(LINE, 5, 3) == [(0, 5), (1, 5), (2, 5), (3, 5), (4, 0)]  # only 5 others: rank 5 is the last
     assert neighbour_pairs(LINE[:1], 1, 2) == []
 
 
@@ -41,18 +47,55 @@ def test_targeted_candidates_interleave_groups_and_weights():
     cands = targeted_candidates(z, rare, graspable, 50, 1, 0, [0.5, 0.3])
     by = [(c.selected_by, c.a, c.b, c.alpha) for c in cands]
     assert by == [
-        ("rarity", 3, 4, 0.5), ("graspness", 0, 1, 0.5), ("rarity", 4, 5, 0.5), ("graspness", 1, 2, 0.5),
-        ("rarity", 3, 4, 0.3), ("graspness", 0, 1, 0.3), ("rarity", 4, 5, 0.3), ("graspness", 1, 2, 0.3),
+        ("rarity", 3, 4, 0.5), ("graspness", 0, 1, 0.5), ("rarity", 5, 4, 0.5), ("graspness", 2, 1, 0.5),
+        ("rarity", 3, 4, 0.3), ("graspness", 0, 1, 0.3), ("rarity", 5, 4, 0.3), ("graspness", 2, 1, 0.3),
     ]
     # a shape in both groups: its pairs are not generated twice
     both = targeted_candidates(z, rare, rare, 50, 1, 0, [0.5])
-    assert [(c.selected_by, c.a, c.b) for c in both] == [("rarity", 3, 4), ("rarity", 4, 5)]
+    assert [(c.selected_by, c.a, c.b) for c in both] == [("rarity", 3, 4), ("rarity", 5, 4)]
 
 
-def test_random_candidates_are_seeded_and_prefix_stable():
-    a = random_candidates(6, 40, [0.5, 0.3], np.random.default_rng(1))
-    b = random_candidates(6, 10, [0.5, 0.3], np.random.default_rng(1))
-    assert a[:10] == b
-    pairs = [(c.a, c.b) for c in a[:15]]
-    assert len(set(pairs)) == 15 and all(i < j for i, j in pairs)  # every pair once before any repeats
-    assert len({(c.a, c.b, c.alpha) for c in a[:30]}) == 30  # a repeated pair gets the other weight
+def test_random_stream_is_seeded_distinct_and_finite():
+    a = RandomStream(6, [0.5, 0.3], np.random.default_rng(1))
+    b = RandomStream(6, [0.5, 0.3], np.random.default_rng(1))
+    assert a.items == b.items and len(a.items) == 15 * 2  # every pair, with every weight, once
+    assert len({(frozenset((c.a, c.b)), c.alpha) for c in a.items}) == 30
+    assert len({frozenset((c.a, c.b)) for c in a.items[:15]}) == 15  # all pairs before any repeats
+    assert a.take(28, 10) == a.items[28:] and a.take(30, 5) == []
+
+
+def test_ratio_sets_are_prefixes_of_the_pool():
+    assert [ratio_count(r, 25) for r in (0, 0.5, 1, 1.5, 2)] == [0, 13, 25, 38, 50]
+    assert pool_size([0.0, 0.5, 1.5], 25) == 38 and all(ratio_count(r, 25) <= 38 for r in (0.0, 0.5, 1.5))
+
+
+@dataclass
+class Outcome:
+    candidate: Candidate
+    reason: str | None
+
+
+def every_third_rejected(batch):
+    """A stand-in decoder for the pool logic: rejects the candidates whose weight-and-pair hash says so."""
+    return [Outcome(c, "empty decode" if (c.a * 7 + c.b * 3 + int(c.alpha * 10)) % 3 == 0 else None) for c in batch]
+
+
+def test_fill_pool_replaces_rejects_widens_and_keeps_prefixes():
+    rng = np.random.default_rng(4)
+    z, rare, grasp = rng.normal(size=(12, 4)), rng.random(12), rng.random(12)
+
+    def pool(needed):
+        stream = TargetedStream(z, rare, grasp, 75, 1, 0, [0.5])
+        kept, rejected = fill_pool(stream, needed, every_third_rejected)
+        return stream, kept, rejected
+
+    small_stream, small, _ = pool(4)
+    stream, kept, rejected = pool(30)
+    assert len(kept) == 30 and rejected and all(o.reason for o in rejected)
+    assert stream.notes and stream.notes[0].startswith("alpha 0.4 added")  # it had to widen, and said so
+    tried = [o.candidate for o in kept + rejected]
+    assert len({(frozenset((c.a, c.b)), c.alpha) for c in tried}) == len(tried)  # nothing decoded twice
+    assert [o.candidate for o in kept[:4]] == [o.candidate for o in small]  # the smaller pool is a prefix
+    assert stream.items[: len(small_stream.items)] == small_stream.items  # and so is the stream
+    with pytest.raises(PoolExhausted, match="no more pairs or weights"):
+        fill_pool(RandomStream(3, [0.5], np.random.default_rng(0)), 5, every_third_rejected)

@@ -145,6 +145,8 @@ def test_dvc_repro_generate_and_its_grasps(tiny_repo):
             part = index[index.pool == pool]
             assert list(part.order) == list(range(2 * b))  # max ratio 2 -> 2B shapes, in order
         assert set(index.parent_a) | set(index.parent_b) <= set(base[b].shape_id)
+        pairs = index.apply(lambda r: (r.pool, frozenset((r.parent_a, r.parent_b)), r.alpha), axis=1)
+        assert pairs.is_unique  # no shape generated twice
         assert index.alpha.between(0, 0.5).all() and index.watertight.all()
         assert set(index.selected_by) <= {"rarity", "graspness", "random"}
         for shape_id in index.shape_id[:3]:
@@ -154,8 +156,15 @@ def test_dvc_repro_generate_and_its_grasps(tiny_repo):
         assert summary["targeted"]["kept"] == summary["random"]["kept"] == 2 * b
         rejects = pd.read_parquet(work / f"data/generated/{b}/rejects.parquet")
         assert summary["targeted"]["tried"] + summary["random"]["tried"] == 4 * b + len(rejects)
+        assert sum(summary["rejects"].values()) == len(rejects)
         grasps = pd.read_parquet(work / f"data/grasps/gen_{b}.parquet")
         assert set(grasps.shape_id) <= set(index.shape_id)
         assert (work / f"reports/generate/{b}/pairs.png").stat().st_size > 0
     again = run(["dvc", "repro", "grasps_generated"], work, env)
     assert "Running stage" not in again.stdout
+    # determinism: regenerating gives the same table and the same mesh files
+    before = pd.read_parquet(work / "data/generated/6/index.parquet")
+    mesh_bytes = (work / f"data/generated/6/meshes/{before.shape_id[0]}.obj").read_bytes()
+    run(["dvc", "repro", "-f", "-s", "generate@6"], work, env)
+    pd.testing.assert_frame_equal(pd.read_parquet(work / "data/generated/6/index.parquet"), before)
+    assert (work / f"data/generated/6/meshes/{before.shape_id[0]}.obj").read_bytes() == mesh_bytes

@@ -118,7 +118,6 @@ stage_command(
 )
 
 
-
 @app.command(
     name="generate",
     help="Generate new shapes for one base set of B train shapes (paper Section III-C): pair its rare shapes, and "

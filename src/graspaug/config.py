@@ -144,8 +144,8 @@ class GenerateParams:
     ratios: list[float] = param((0.0, 0.5, 1.0, 1.5, 2.0), "Augmentation ratios generated:base (paper: 1:0 ... 1:2); each pool holds max ratio × base size shapes.")
     percentile: float = param(75.0, "Shapes above this percentile of rarity, and separately of graspness, in the base set are paired (top 25%).", ge=0, le=99)
     first_neighbour: int = param(2, "N: pair each selected shape with its N-th ... (N+K)-th nearest selected neighbours (1 = nearest; 2 avoids near-duplicates).", ge=1)
-    extra_neighbours: int = param(3, "K: see first_neighbour. Widened by one at a time (logged) if the pool would be too small.", ge=0)
-    alphas: list[float] = param((0.5, 0.3), "Interpolation weights in (0, 0.5]; 0.4, 0.2, 0.1, 0.05 are added (logged) if widening K is not enough, then the percentile drops by 5s.")
+    extra_neighbours: int = param(3, "K: see first_neighbour. Widened (logged) if a pool runs dry, see alphas.", ge=0)
+    alphas: list[float] = param((0.5, 0.3), "Interpolation weights in (0, 0.5]. If a pool runs dry, 0.4, 0.2, 0.1, 0.05 are added, then K widens, then the percentile drops by 5s (each step logged).")
     threshold: float = param(0.5, "Occupancy threshold of decoded grids.", gt=0, le=1)
     opening: int = param(1, "Binary opening iterations on the decoded solid (removes one-voxel spurs).", ge=0, le=3)
     min_voxels: int = param(100, "A decode with a largest piece smaller than this is rejected (tiny).", ge=1)
@@ -259,8 +259,8 @@ def parse_params(raw: Any) -> Params:
     gen = params.generate
     if not gen.base_sizes or any(b < 2 for b in gen.base_sizes) or len(set(gen.base_sizes)) != len(gen.base_sizes):
         raise ParamsError(f"generate.base_sizes: must be distinct sizes >= 2; got {list(gen.base_sizes)}")
-    if not gen.ratios or any(r < 0 for r in gen.ratios):
-        raise ParamsError(f"generate.ratios: must be a non-empty list of ratios >= 0; got {list(gen.ratios)}")
+    if not gen.ratios or any(r < 0 for r in gen.ratios) or max(gen.ratios) <= 0:
+        raise ParamsError(f"generate.ratios: must be ratios >= 0, the largest > 0; got {list(gen.ratios)}")
     if not gen.alphas or not all(0 < a <= 0.5 for a in gen.alphas) or len(set(gen.alphas)) != len(gen.alphas):
         raise ParamsError(f"generate.alphas: must be distinct weights in (0, 0.5]; got {list(gen.alphas)}")
     return params

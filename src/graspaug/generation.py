@@ -1,28 +1,44 @@
 """Which shapes to generate: base sets, selection by score, neighbour pairs and the pool order
 (paper Section III-C and the augmentation sets of Section IV-C/D).
 
-A pool is a list of ``Candidate`` (parent pair + interpolation weight), ordered so that its
-first ``round(R · B)`` entries are the augmentation set for ratio ``R``: sets for larger
-ratios contain those for smaller ones.
+A pool is an append-only stream of ``Candidate`` (parent pair + interpolation weight); the
+kept ones, in stream order, make the pool, whose first ``ratio_count(R, B)`` shapes are the
+augmentation set for ratio ``R``: sets for larger ratios contain those for smaller ones.
 """
 from __future__ import annotations
 
+import math
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import Protocol, TypeVar
 
 import numpy as np
 from sklearn.neighbors import NearestNeighbors
+
+EXTRA_ALPHAS = (0.4, 0.2, 0.1, 0.05)  # weights a targeted stream adds, in this order, when it runs dry
 
 
 @dataclass(frozen=True)
 class Candidate:
     """One shape to generate: parents ``a``, ``b`` (indices into the base set), weight ``alpha``
-    on ``b`` (z = (1 - α) z_a + α z_b), and what chose the pair (``rarity``, ``graspness``,
-    ``random``)."""
+    on ``b`` (z = (1 - α) z_a + α z_b, so below 0.5 the child is closer to ``a``, the selected
+    shape whose neighbour ``b`` is), and what chose the pair (``rarity``, ``graspness``, ``random``)."""
 
     a: int
     b: int
     alpha: float
     selected_by: str
+
+
+def ratio_count(ratio: float, base_size: int) -> int:
+    """Generated shapes in the augmentation set of ``ratio`` (generated : base) for a base set of
+    ``base_size``: ``R · B`` rounded half up (1:0.5 of 25 shapes is 13)."""
+    return math.floor(ratio * base_size + 0.5)
+
+
+def pool_size(ratios: Sequence[float], base_size: int) -> int:
+    """Shapes a pool needs so that every ratio's set is a prefix of it."""
+    return max(ratio_count(r, base_size) for r in ratios)
 
 
 def nested_base_sets(shape_ids: np.ndarray, sizes: list[int], rng: np.random.Generator) -> dict[int, np.ndarray]:
@@ -42,55 +58,138 @@ def above_percentile(scores: np.ndarray, percentile: float) -> np.ndarray:
 
 
 def neighbour_pairs(z: np.ndarray, first: int, extra: int) -> list[tuple[int, int]]:
-    """Unordered pairs ``(i, j)``, ``i < j``, of each point with its ``first``-th to
-    ``(first + extra)``-th nearest neighbours (Euclidean, 1 = nearest; ranks beyond the other
-    points are skipped), in order of (neighbour rank, i) with duplicates dropped."""
+    """Pairs ``(i, j)`` of each point ``i`` with its ``first``-th to ``(first + extra)``-th nearest
+    neighbours ``j`` (Euclidean, 1 = nearest; ranks beyond the other points are skipped), in
+    order of (neighbour rank, i); a pair already met the other way round is dropped."""
     n = len(z)
     last = min(first + extra, n - 1)
     if n < 2 or first > last:
         return []
     _, idx = NearestNeighbors(n_neighbors=last).fit(z).kneighbors()
-    pairs: dict[tuple[int, int], None] = {}
+    seen: set[frozenset[int]] = set()
+    pairs = []
     for rank in range(first, last + 1):
         for i in range(n):
             j = int(idx[i, rank - 1])
-            pairs.setdefault((min(i, j), max(i, j)), None)
-    return list(pairs)
+            if frozenset((i, j)) not in seen:
+                seen.add(frozenset((i, j)))
+                pairs.append((i, j))
+    return pairs
 
 
-def targeted_candidates(z: np.ndarray, rarity: np.ndarray, graspness: np.ndarray, percentile: float, first: int, extra: int, alphas: list[float]) -> list[Candidate]:
-    """The targeted pool's candidates, in pool order.
-
-    Shapes above the ``percentile`` in rarity form one group, above it in graspness another;
-    within each group, pairs of N-th to (N+K)-th nearest neighbours (latent space of the
-    group). The two groups' lists (each: every pair at the first α, then every pair at the
-    next α, …) are interleaved one by one; a pair and weight already taken is skipped."""
+def targeted_candidates(z: np.ndarray, rarity: np.ndarray, graspness: np.ndarray, percentile: float, first: int, extra: int, alphas: Sequence[float]) -> list[Candidate]:
+    """Candidates from the shapes above the ``percentile`` in rarity (one group) and in
+    graspness (another), each paired with its N-th to (N+K)-th nearest neighbours of its group
+    in latent space. The two groups' lists (each: every pair at the first α, then every pair at
+    the next α, …) are interleaved one by one; a pair and weight already taken is skipped."""
     lists = []
     for name, scores in (("rarity", rarity), ("graspness", graspness)):
         group = above_percentile(scores, percentile)
         pairs = [(int(group[i]), int(group[j])) for i, j in neighbour_pairs(z[group], first, extra)]
         lists.append([Candidate(a, b, float(alpha), name) for alpha in alphas for a, b in pairs])
     out: list[Candidate] = []
-    seen: set[tuple[int, int, float]] = set()
+    seen: set[tuple[frozenset[int], float]] = set()
     for k in range(max(len(lst) for lst in lists)):
         for lst in lists:
-            if k < len(lst) and (lst[k].a, lst[k].b, lst[k].alpha) not in seen:
-                seen.add((lst[k].a, lst[k].b, lst[k].alpha))
+            if k < len(lst) and (key := (frozenset((lst[k].a, lst[k].b)), lst[k].alpha)) not in seen:
+                seen.add(key)
                 out.append(lst[k])
     return out
 
 
-def random_candidates(n_shapes: int, count: int, alphas: list[float], rng: np.random.Generator) -> list[Candidate]:
-    """``count`` candidates from uniformly random distinct pairs of the base set (the paper's
-    "random augmentation" baseline): the pairs in a seeded order, weights cycling through
-    ``alphas``; a pair comes back (with the next weight) only after every pair was used."""
-    all_pairs = [(i, j) for i in range(n_shapes) for j in range(i + 1, n_shapes)]
-    if not all_pairs:
-        return []
-    order = rng.permutation(len(all_pairs))
-    out = []
-    for k in range(count):
-        i, j = all_pairs[order[k % len(all_pairs)]]
-        round_ = k // len(all_pairs)  # each later round shifts the weights by one
-        out.append(Candidate(i, j, float(alphas[(k % len(all_pairs) + round_) % len(alphas)]), "random"))
-    return out
+class CandidateStream:
+    """An append-only list of distinct candidates that a subclass grows on demand: what was
+    handed out stays where it was, so a pool filled for more shapes starts with the same ones."""
+
+    def __init__(self) -> None:
+        self.items: list[Candidate] = []
+        self.notes: list[str] = []  # how the stream was widened
+        self._seen: set[tuple[frozenset[int], float]] = set()
+
+    def _append(self, candidates: list[Candidate]) -> None:
+        for c in candidates:
+            key = (frozenset((c.a, c.b)), c.alpha)
+            if key not in self._seen:
+                self._seen.add(key)
+                self.items.append(c)
+
+    def _grow(self, count: int) -> None:
+        """Append candidates until there are ``count``, if the rule allows."""
+
+    def take(self, start: int, count: int) -> list[Candidate]:
+        """Candidates ``start .. start + count`` (fewer, or none, once the stream is exhausted)."""
+        if len(self.items) < start + count:
+            self._grow(start + count)
+        return self.items[start : start + count]
+
+
+class TargetedStream(CandidateStream):
+    """The targeted pool's stream (:func:`targeted_candidates`). When it runs dry it widens,
+    one step at a time, each noted: first the next weight of EXTRA_ALPHAS (near pairs stay
+    near), then K by one while a group has neighbours that far, then the percentile down by 5."""
+
+    def __init__(self, z: np.ndarray, rarity: np.ndarray, graspness: np.ndarray, percentile: float, first: int, extra: int, alphas: Sequence[float]) -> None:
+        super().__init__()
+        self.z, self.rarity, self.graspness, self.first = z, rarity, graspness, first
+        self.percentile, self.extra, self.alphas = float(percentile), extra, list(alphas)
+        self._refill()
+
+    def _refill(self) -> None:
+        self._append(targeted_candidates(self.z, self.rarity, self.graspness, self.percentile, self.first, self.extra, self.alphas))
+
+    def _grow(self, count: int) -> None:
+        while len(self.items) < count:
+            largest_group = max(len(above_percentile(s, self.percentile)) for s in (self.rarity, self.graspness))
+            extra_alphas = [a for a in EXTRA_ALPHAS if a not in self.alphas]
+            if extra_alphas:
+                self.alphas.append(extra_alphas[0])
+                self.notes.append(f"alpha {extra_alphas[0]} added ({len(self.items)} candidates, {count} wanted)")
+            elif self.first + self.extra < largest_group - 1:
+                self.extra += 1
+                self.notes.append(f"K widened to {self.extra} ({len(self.items)} candidates, {count} wanted)")
+            elif self.percentile > 0:
+                self.percentile = max(0.0, self.percentile - 5.0)
+                self.notes.append(f"percentile lowered to {self.percentile:g} ({len(self.items)} candidates, {count} wanted)")
+            else:
+                return
+            self._refill()
+
+
+class RandomStream(CandidateStream):
+    """The random pool's stream (the paper's "random augmentation" baseline): every distinct
+    pair of the base set in a seeded order, weights cycling through ``alphas``; after all
+    pairs, each pair again with the next weight, until every pair has had every weight."""
+
+    def __init__(self, n_shapes: int, alphas: Sequence[float], rng: np.random.Generator) -> None:
+        super().__init__()
+        pairs = [(i, j) for i in range(n_shapes) for j in range(i + 1, n_shapes)]
+        order = rng.permutation(len(pairs))
+        for round_ in range(len(alphas)):
+            self._append([Candidate(*pairs[p], float(alphas[(k + round_) % len(alphas)]), "random") for k, p in enumerate(order)])
+
+
+class HasReason(Protocol):
+    reason: str | None
+
+
+D = TypeVar("D", bound=HasReason)
+
+
+class PoolExhausted(RuntimeError):
+    """A pool could not be filled: every candidate the stream allows was tried."""
+
+
+def fill_pool(stream: CandidateStream, needed: int, run_batch: Callable[[list[Candidate]], list[D]]) -> tuple[list[D], list[D]]:
+    """Try the stream's candidates in order until ``needed`` are kept (``reason`` None);
+    ``run_batch`` decodes a batch. Returns the kept and the rejected, in stream order; raises
+    :class:`PoolExhausted` if the stream ends first."""
+    kept: list[D] = []
+    rejected: list[D] = []
+    while len(kept) < needed:
+        tried = len(kept) + len(rejected)
+        batch = stream.take(tried, needed - len(kept))
+        if not batch:
+            raise PoolExhausted(f"only {len(kept)} of {needed} shapes after {tried} candidates; no more pairs or weights to try")
+        for outcome in run_batch(batch):
+            (rejected if outcome.reason else kept).append(outcome)
+    return kept, rejected

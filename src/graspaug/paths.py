@@ -26,6 +26,8 @@ OUTLIERS_CSV = Path("reports/critic_eval/outliers.csv")
 OUTLIERS_PNG = Path("reports/critic_eval/outliers.png")
 INTERPOLATIONS_PNG = Path("reports/critic_eval/interpolations.png")
 # generate (one folder per base size B)
+
+
 def generated_dir(base_size: int) -> Path:
     return Path(f"data/generated/{base_size}")
 

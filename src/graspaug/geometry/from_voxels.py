@@ -1,7 +1,7 @@
 """Decoded occupancy grids → closed surface meshes in meters (paper Section III-C).
 
-Threshold, fill holes, binary opening, keep the largest 26-connected piece, marching cubes
-(Lewiner), the largest mesh component, Humphrey smoothing (Vollmer et al. 1999).
+Threshold, fill holes, binary opening, keep the largest face-connected piece, marching cubes
+(Lewiner), Humphrey smoothing (Vollmer et al. 1999).
 """
 from __future__ import annotations
 
@@ -26,7 +26,8 @@ class CleanGrid:
 
 def clean_occupancy(probability: np.ndarray, threshold: float, opening: int, min_voxels: int, min_main_share: float) -> CleanGrid:
     """Binary solid from decoded probabilities (R, R, R): ``> threshold``, holes filled, opened
-    ``opening`` times (removes one-voxel spurs), reduced to its largest 26-connected piece.
+    ``opening`` times (removes one-voxel spurs), reduced to its largest face-connected piece
+    (voxels touching only along an edge or corner would make separate surfaces).
 
     Rejected (``reason`` set) when nothing is left, fewer than ``min_voxels`` voxels are, or
     the largest piece holds less than ``min_main_share`` of them (a shape in many pieces)."""
@@ -36,7 +37,7 @@ def clean_occupancy(probability: np.ndarray, threshold: float, opening: int, min
     total = int(solid.sum())
     if total == 0:
         return CleanGrid(solid, 0.0, "empty decode")
-    labels, n = ndimage.label(solid, structure=np.ones((3, 3, 3)))
+    labels, n = ndimage.label(solid, structure=ndimage.generate_binary_structure(3, 1))
     sizes = np.bincount(labels.ravel())[1:]
     main = labels == (1 + int(np.argmax(sizes)))
     share = float(sizes.max() / total)
@@ -49,14 +50,11 @@ def clean_occupancy(probability: np.ndarray, threshold: float, opening: int, min
 
 def mesh_from_occupancy(occupancy: np.ndarray, pitch: float, smoothing_iterations: int) -> trimesh.Trimesh:
     """Closed triangle mesh (meters) of a solid grid (R, R, R) bool with voxels ``pitch`` m wide,
-    its center of mass at the origin. Marching cubes at level 0.5 on the zero-padded grid,
-    the largest connected component, ``smoothing_iterations`` of Humphrey smoothing."""
+    its center of mass at the origin: marching cubes at level 0.5 on the zero-padded grid, then
+    ``smoothing_iterations`` of Humphrey smoothing. A face-connected grid gives one piece."""
     padded = np.pad(occupancy.astype(np.float32), 1)
     vertices, faces, _, _ = marching_cubes(padded, level=0.5, method="lewiner")
     mesh = trimesh.Trimesh(vertices * pitch, faces[:, ::-1], process=True)  # skimage winds inward here
-    pieces = mesh.split(only_watertight=False)
-    if len(pieces) > 1:
-        mesh = max(pieces, key=lambda m: len(m.faces))
     if smoothing_iterations > 0:
         trimesh.smoothing.filter_humphrey(mesh, iterations=smoothing_iterations)
     if mesh.is_watertight and mesh.volume < 0:

@@ -15,9 +15,7 @@ per kept shape), ``rejects.parquet``, ``base.parquet`` (the base set with its sc
 from __future__ import annotations
 
 import logging
-import math
 import time
-from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -25,7 +23,7 @@ import pandas as pd
 import trimesh
 
 from graspaug.config import GenerateParams, Params
-from graspaug.generation import Candidate, above_percentile, nested_base_sets, random_candidates, targeted_candidates
+from graspaug.generation import Candidate, PoolExhausted, RandomStream, TargetedStream, above_percentile, fill_pool, nested_base_sets, pool_size
 from graspaug.geometry.from_voxels import CleanGrid, clean_occupancy, mesh_from_occupancy
 from graspaug.io.atomic import atomic_path
 from graspaug.io.checkpoints import load_autoencoder
@@ -43,23 +41,17 @@ from graspaug.training.autoencoder import decode, resolve_device
 
 log = logging.getLogger(__name__)
 
-EXTRA_ALPHAS = (0.4, 0.2, 0.1, 0.05)  # added in this order when widening K cannot fill a pool
-# (then the percentile drops in steps of 5; a pool that still cannot be filled stops the stage)
 BASE_SEED = 0xBA5E  # base sets: their own stream of the seed
 
 
 @dataclass(frozen=True)
 class Decoded:
-    """One candidate's outcome: the cleaned grid and, if kept, its mesh (meters)."""
+    """One candidate's outcome: the cleaned grid (bit-packed, R³ bits) and, if kept, its mesh (m)."""
 
     candidate: Candidate
-    grid: CleanGrid
+    packed_grid: np.ndarray
     mesh: trimesh.Trimesh | None
     reason: str | None
-
-
-def pool_size(cfg: GenerateParams, base_size: int) -> int:
-    return math.ceil(max(cfg.ratios) * base_size - 1e-9)
 
 
 def mesh_decoded(probability: np.ndarray, pitch: float, cfg: GenerateParams) -> tuple[CleanGrid, trimesh.Trimesh | None, str | None]:
@@ -68,60 +60,12 @@ def mesh_decoded(probability: np.ndarray, pitch: float, cfg: GenerateParams) -> 
     if grid.reason:
         return grid, None, grid.reason
     mesh = mesh_from_occupancy(grid.occupancy, pitch, cfg.smoothing_iterations)
-    if not mesh.is_watertight:
-        return grid, None, "surface not closed after meshing"
+    pieces = len(mesh.split(only_watertight=False))
+    if pieces != 1:
+        return grid, None, f"surface in {pieces} pieces after meshing"
+    if not mesh.is_volume:
+        return grid, None, "surface not a closed volume after meshing"
     return grid, mesh, None
-
-
-def fill_pool(make: Callable[[int], list[Candidate]], needed: int, run_batch: Callable[[list[Candidate]], list[Decoded]], name: str) -> tuple[list[Decoded], list[Decoded], int]:
-    """Decode candidates in order until ``needed`` are kept, asking ``make`` for a longer list
-    when rejects use them up. Returns kept, rejected, and how many candidates were tried."""
-    kept: list[Decoded] = []
-    rejected: list[Decoded] = []
-    tried = 0
-    while len(kept) < needed:
-        missing = needed - len(kept)
-        batch = make(tried + missing)[tried : tried + missing]
-        if not batch:
-            raise StageError(f"{name} pool: only {len(kept)} of {needed} shapes after {tried} candidates; no more pairs or weights to try")
-        for outcome in run_batch(batch):
-            tried += 1
-            (rejected if outcome.reason else kept).append(outcome)
-    return kept, rejected, tried
-
-
-def widening_targeted(z: np.ndarray, rare: np.ndarray, graspable: np.ndarray, cfg: GenerateParams, notes: list[str]) -> Callable[[int], list[Candidate]]:
-    """``make(count)`` for the targeted pool: at least ``count`` candidates if at all possible.
-    Until there are enough, each step (noted) widens K by one if that adds pairs, else adds the
-    next weight of EXTRA_ALPHAS, else lowers the percentile by 5 (admitting more shapes)."""
-    state = {"k": cfg.extra_neighbours, "alphas": list(cfg.alphas), "percentile": cfg.percentile}
-
-    def candidates(k: int) -> list[Candidate]:
-        return targeted_candidates(z, rare, graspable, state["percentile"], cfg.first_neighbour, k, state["alphas"])
-
-    def make(count: int) -> list[Candidate]:
-        current = candidates(state["k"])
-        while len(current) < count:
-            wider = candidates(state["k"] + 1)
-            if len(wider) > len(current):
-                state["k"] += 1
-                notes.append(f"K widened to {state['k']} ({len(wider)} candidates, {count} wanted)")
-                current = wider
-                continue
-            extra = [a for a in EXTRA_ALPHAS if a not in state["alphas"]]
-            if extra:
-                state["alphas"].append(extra[0])
-                notes.append(f"alpha {extra[0]} added ({count} candidates wanted)")
-            elif state["percentile"] > 0:
-                state["percentile"] = max(0.0, state["percentile"] - 5.0)
-                notes.append(f"percentile lowered to {state['percentile']:g} ({count} candidates wanted)")
-            else:
-                break
-            current = candidates(state["k"])
-        return current
-
-    make.state = state  # type: ignore[attr-defined]
-    return make
 
 
 def run(params: Params, base_size: int) -> None:
@@ -155,17 +99,20 @@ def run(params: Params, base_size: int) -> None:
         probability = decode(ae, (1 - alpha) * z[a] + alpha * z[b], device)
         child_pitch = (1 - alpha[:, 0]) * pitch[a] + alpha[:, 0] * pitch[b]  # metric size: the parents' scales interpolated
         out = parallel_map(lambda job: mesh_decoded(job[0], job[1], cfg), list(zip(probability, child_pitch)), params.n_jobs, f"generate {base_size}")
-        return [Decoded(c, grid, mesh, reason) for c, (grid, mesh, reason) in zip(candidates, out)]
+        return [Decoded(c, np.packbits(grid.occupancy), mesh, reason) for c, (grid, mesh, reason) in zip(candidates, out)]
 
-    needed = pool_size(cfg, base_size)
-    notes: list[str] = []
-    make_targeted = widening_targeted(z, base_rarity, graspness, cfg, notes)
-    targeted, targeted_rejects, targeted_tried = fill_pool(make_targeted, needed, run_batch, "targeted")
-    random_rng_seed = [params.seed, BASE_SEED, base_size]
-    make_random = lambda count: random_candidates(base_size, count, list(cfg.alphas), np.random.default_rng(random_rng_seed))  # noqa: E731
-    randoms, random_rejects, random_tried = fill_pool(make_random, needed, run_batch, "random")
-    for note in notes:
+    needed = pool_size(cfg.ratios, base_size)
+    targeted_stream = TargetedStream(z, base_rarity, graspness, cfg.percentile, cfg.first_neighbour, cfg.extra_neighbours, cfg.alphas)
+    random_stream = RandomStream(base_size, cfg.alphas, np.random.default_rng([params.seed, BASE_SEED, base_size]))
+    pools = {}
+    for name, stream in (("targeted", targeted_stream), ("random", random_stream)):
+        try:
+            pools[name] = fill_pool(stream, needed, run_batch)
+        except PoolExhausted as exc:
+            raise StageError(f"generate {base_size}, {name} pool: {exc}") from None
+    for note in targeted_stream.notes:
         log.info("generate %d: %s", base_size, note)
+    (targeted, targeted_rejects), (randoms, random_rejects) = pools["targeted"], pools["random"]
 
     rows, reject_rows = [], []
     for pool, kept in (("targeted", targeted), ("random", randoms)):
@@ -184,9 +131,8 @@ def run(params: Params, base_size: int) -> None:
                          "selected_by": d.candidate.selected_by, "reason": d.reason} for d in rejects]
     index = pd.DataFrame(rows)
     index["rarity_vs_base"] = rarity(z, params.score.k, query=np.stack(index.z.to_numpy()))
-    used = make_targeted.state  # type: ignore[attr-defined]
-    rare_group = set(above_percentile(base_rarity, used["percentile"]))
-    grasp_group = set(above_percentile(graspness, used["percentile"]))
+    rare_group = set(above_percentile(base_rarity, targeted_stream.percentile))
+    grasp_group = set(above_percentile(graspness, targeted_stream.percentile))
     base_table = pd.DataFrame({"shape_id": base, "rarity": base_rarity, "graspness": graspness,
                                "selected_by_rarity": [i in rare_group for i in range(base_size)],
                                "selected_by_graspness": [i in grasp_group for i in range(base_size)]})
@@ -206,20 +152,24 @@ def run(params: Params, base_size: int) -> None:
     scatter_2d(xy, groups, generate_reports(base_size) / "tsne.png", f"t-SNE of base set {base_size} and its generated shapes")
 
     reasons = pd.Series([r["reason"].split(":")[0] for r in reject_rows], dtype=object)
+    kept_share = {name: len(pools[name][0]) / (len(pools[name][0]) + len(pools[name][1])) for name in pools}
     summary = {
         "base_size": base_size, "pool_size": needed,
-        "targeted": {"kept": len(targeted), "tried": targeted_tried, "by_rarity": int((index.selected_by == "rarity").sum()),
-                     "by_graspness": int((index.selected_by == "graspness").sum()), "k_used": used["k"],
-                     "alphas_used": used["alphas"], "percentile_used": used["percentile"]},
-        "random": {"kept": len(randoms), "tried": random_tried},
+        "targeted": {"kept": len(targeted), "tried": len(targeted) + len(targeted_rejects), "kept_share": round(kept_share["targeted"], 4),
+                     "by_rarity": int((index.selected_by == "rarity").sum()), "by_graspness": int((index.selected_by == "graspness").sum()),
+                     "k_used": targeted_stream.extra, "alphas_used": targeted_stream.alphas, "percentile_used": targeted_stream.percentile,
+                     "widening": targeted_stream.notes},
+        "random": {"kept": len(randoms), "tried": len(randoms) + len(random_rejects), "kept_share": round(kept_share["random"], 4)},
         "rejects": {str(k): int(v) for k, v in reasons.value_counts().sort_index().items()},
-        "watertight_share": round(float(index.watertight.mean()), 4),
-        "one_piece_share": round(float(index.one_piece.mean()), 4),
+        "kept_watertight_one_piece_share": round(float((index.watertight & index.one_piece).mean()), 4),
         "seconds": round(time.perf_counter() - start, 1),
     }
+    for name, share in kept_share.items():
+        if share < 0.95:
+            log.warning("generate %d: only %.1f%% of the %s pool's decodes were usable meshes", base_size, 100 * share, name)
     write_json(summary, generate_metrics(base_size))
-    log.info("generate %d: %d targeted (%d tried) + %d random (%d tried) shapes, %d rejected, %.1f%% watertight, in %.1f s",
-             base_size, len(targeted), targeted_tried, len(randoms), random_tried, len(reject_rows), 100 * summary["watertight_share"], summary["seconds"])
+    log.info("generate %d: %d targeted (%d tried) + %d random (%d tried) shapes, %d rejected, in %.1f s", base_size, len(targeted),
+             summary["targeted"]["tried"], len(randoms), summary["random"]["tried"], len(reject_rows), summary["seconds"])
 
 
 def draw_examples(base: np.ndarray, voxels, targeted: list[Decoded], randoms: list[Decoded], n_examples: int, base_size: int) -> None:
@@ -231,9 +181,10 @@ def draw_examples(base: np.ndarray, voxels, targeted: list[Decoded], randoms: li
         return grid, grid
 
     rows, labels = [], []
+    resolution = voxels.occupancy.shape[1]
     for d in targeted[:n_examples] + randoms[:2]:
         c = d.candidate
-        child = d.grid.occupancy
+        child = np.unpackbits(d.packed_grid, count=resolution**3).reshape((resolution,) * 3).astype(bool)
         rows.append([parent(base[c.a]), (child, child), parent(base[c.b])])
         labels.append(f"{c.selected_by}, α={c.alpha:g}")
     voxel_rows(rows, labels, ["parent a", "generated", "parent b"], generate_reports(base_size) / "pairs.png", f"Generated shapes of base set {base_size}")
