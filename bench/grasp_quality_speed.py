@@ -25,7 +25,8 @@ from graspaug.config import GraspsParams
 from graspaug.grasping.antipodal import sample_antipodal_grasps
 from graspaug.grasping.quality import ferrari_canny, ferrari_canny_qhull
 from graspaug.grasping.robust import robust_ferrari_canny
-from graspaug.stages.grasps import gripper, perturbations, quality_settings, sampler_settings, shape_rng
+from graspaug.rng import shape_rng
+from graspaug.stages.grasps import gripper, perturbations, quality_settings, sampler_settings
 
 from _corpus import default_shapes
 

@@ -24,6 +24,7 @@ TINY = {
     "score": {"k": 3, "bins": 5},
     "generate": {"base_sizes": [4, 6], "ratios": [0.0, 0.5, 1.0, 2.0], "percentile": 50.0, "first_neighbour": 1, "extra_neighbours": 1,
                  "min_voxels": 5, "min_main_share": 0.5, "smoothing_iterations": 3, "n_examples": 2},
+    "render": {"max_poses": 2, "n_examples": 4},
 }
 
 
@@ -168,3 +169,28 @@ def test_dvc_repro_generate_and_its_grasps(tiny_repo):
     run(["dvc", "repro", "-f", "-s", "generate@6"], work, env)
     pd.testing.assert_frame_equal(pd.read_parquet(work / "data/generated/6/index.parquet"), before)
     assert (work / f"data/generated/6/meshes/{before.shape_id[0]}.obj").read_bytes() == mesh_bytes
+
+
+def test_dvc_repro_render(tiny_repo):
+    import json
+
+    from graspaug.io.gqcnn import GraspImages
+
+    work, env = tiny_repo
+    run(["dvc", "repro", "render", "render_generated"], work, env)
+    shapes = pd.read_parquet(work / "data/shapes.parquet")
+    for corpus in ("original", "gen_4", "gen_6"):
+        data = GraspImages.open(work / f"data/gqcnn/{corpus}")
+        summary = json.loads((work / f"metrics/render/{corpus}.json").read_text())
+        assert len(data) == summary["n_datapoints"] > 0
+        assert data.images().shape == (len(data), 32, 32)
+        index = data.index
+        if corpus == "original":
+            assert set(index.shape_id) <= set(shapes.shape_id) and set(index.split) == {"train", "test"}
+        else:
+            generated = pd.read_parquet(work / f"data/generated/{corpus[4:]}/index.parquet")
+            assert set(index.shape_id) <= set(generated.shape_id) and (index.base_size == int(corpus[4:])).all()
+            assert set(index.pool) <= {"targeted", "random"} and index.order.notna().all() and (index.split == "train").all()
+        assert (work / f"reports/render/{corpus}/examples.png").stat().st_size > 0
+    again = run(["dvc", "repro", "render", "render_generated"], work, env)
+    assert "Running stage" not in again.stdout

@@ -9,7 +9,8 @@ from pathlib import Path
 import typer
 
 from graspaug.config import (
-    AEParams, CriticEvalParams, DataParams, EmbedParams, GenerateParams, GraspsParams, IngestParams, Params, ParamsError, ScoreParams, VoxelizeParams,
+    AEParams, CriticEvalParams, DataParams, EmbedParams, GenerateParams, GraspsParams, IngestParams, Params, ParamsError, RenderParams, ScoreParams,
+    VoxelizeParams,
     describe, load_params,
 )
 
@@ -136,6 +137,50 @@ def generate_command(
     from graspaug.stages import generate
 
     _run(lambda p: generate.run(p, base_size), _load(params))
+
+
+@app.command(
+    name="render",
+    help="Render a Dex-Net 2.0 style grasp image dataset for a corpus: each shape in its most probable stable poses "
+    "on a table, random depth-camera views from above, and for every grasp whose jaw axis is near parallel to the "
+    "table a 96×96 crop centered on it, turned so the jaws are horizontal, averaged down to 32×32, with the "
+    "gripper depth, an approach collision check of the Panda and the label (collision free and robust ε above "
+    "the grasps threshold). Crops come from rays cast only where they are needed; they equal crops cut from "
+    "full 640×480 renders (tests/render).\n\n"
+    "Writes `data/gqcnn/<corpus>/` (.npy shards of images, z, labels, ε; `index.parquet`; `skipped.parquet`), "
+    "`metrics/render/<corpus>.json` and `reports/render/<corpus>/examples.png`.\n\n"
+    f"Params `render`:\n\n{describe(RenderParams)}\n\nAlso `grasps.max_width` (the gripper), `seed` and `n_jobs`.",
+)
+def render_command(
+    corpus: str = typer.Option("original", "--corpus", "-c", help="Which shapes: `original` (train and test) or `gen_<B>` (generated for base size B)."),
+    params: Path = ParamsOption,
+) -> None:
+    from graspaug.stages import render
+
+    _run(lambda p: render.run(p, corpus), _load(params))
+
+
+@app.command(
+    name="export-dexnet",
+    help="Export a rendered dataset in Dex-Net 2.0's tensor layout for Berkeley's gqcnn tools: "
+    "`<out>/tensors/{depth_ims_tf_table,hand_poses,robust_ferrari_canny,collision_free,obj_labels,pose_labels}_%05d.npz` "
+    "(key `arr_0`, 1000 rows per file) and `<out>/config.json`. hand_poses rows are (center row, center column, "
+    "depth z, jaw angle, row − cy, column − cx, open jaws in px); obj_labels index config.json's `obj_ids`, "
+    "pose_labels its `pose_ids`. Run from the project folder after the render stage.",
+)
+def export_dexnet_command(
+    corpus: str = typer.Argument(..., help="Rendered corpus: `original` or `gen_<B>`."),
+    out: Path = typer.Argument(..., help="Folder to create (must not exist or be empty)."),
+    rows_per_file: int = typer.Option(1000, "--rows-per-file", min=1, help="Datapoints per .npz file (Dex-Net: 1000)."),
+) -> None:
+    from graspaug.stages import StageError, render
+
+    try:
+        n = render.export_dexnet(corpus, out, rows_per_file)
+    except (StageError, FileNotFoundError, FileExistsError) as exc:
+        typer.echo(f"error: {exc}", err=True)
+        raise typer.Exit(1) from None
+    typer.echo(f"wrote {n} datapoints to {out}")
 
 
 def main() -> None:

@@ -155,6 +155,28 @@ class GenerateParams:
 
 
 @dataclass(frozen=True)
+class RenderParams:
+    """Dex-Net 2.0 style depth crops of every grasp seen from above (the GQ-CNN's data)."""
+
+    max_poses: int = param(5, "Most probable stable resting poses rendered per shape.", ge=1)
+    min_pose_probability: float = param(0.01, "Stable poses less likely than this are pruned (Dex-Net: 0.01).", ge=0, le=1)
+    images_per_pose: int = param(1, "Random camera views per stable pose (Dex-Net 2.0: 5; each view holds every table-parallel grasp).", ge=1)
+    max_grasps_per_image: int = param(0, "At most this many grasps per view, a seeded random subset (0: all).", ge=0)
+    axis_tolerance_deg: float = param(5.0, "A grasp is rendered in a pose if its jaw axis is within this angle of parallel to the table (deg).", ge=0, le=90)
+    approach_distance: float = param(0.1, "Length of the straight approach from above checked for gripper collisions (m).", ge=0)
+    camera_distance: list[float] = param((0.65, 0.75), "Range of the camera's distance to its target point on the table (m).")
+    camera_tilt_deg: list[float] = param((0.1, 5.0), "Range of the optical axis' angle from straight down (deg).")
+    object_offset: float = param(0.1, "The camera aims up to this far from the object in x and y (m), so objects sit off the image center.", ge=0)
+    image_width: int = param(640, "Depth image width (px).", ge=32)
+    image_height: int = param(480, "Depth image height (px).", ge=32)
+    focal_length: float = param(525.0, "fx = fy (px); the principal point is the image center (Primesense/D435 at 640×480: ~525).", gt=0)
+    crop_size: int = param(96, "Side of the grasp-centered crop in image pixels (Dex-Net: 96).", ge=1)
+    out_size: int = param(32, "Side of the stored crop after block averaging (Dex-Net: 32); must divide crop_size.", ge=1)
+    shard_rows: int = param(20000, "Datapoints per .npy shard.", ge=1)
+    n_examples: int = param(24, "Crops in the example picture (half positive, half negative when there are enough).", ge=2)
+
+
+@dataclass(frozen=True)
 class Params:
     """All parameters of the pipeline."""
 
@@ -170,6 +192,7 @@ class Params:
     grasps: GraspsParams = field(default_factory=GraspsParams)
     score: ScoreParams = field(default_factory=ScoreParams)
     generate: GenerateParams = field(default_factory=GenerateParams)
+    render: RenderParams = field(default_factory=RenderParams)
 
 
 def _type_name(tp: Any) -> str:
@@ -263,6 +286,12 @@ def parse_params(raw: Any) -> Params:
         raise ParamsError(f"generate.ratios: must be ratios >= 0, the largest > 0; got {list(gen.ratios)}")
     if not gen.alphas or not all(0 < a <= 0.5 for a in gen.alphas) or len(set(gen.alphas)) != len(gen.alphas):
         raise ParamsError(f"generate.alphas: must be distinct weights in (0, 0.5]; got {list(gen.alphas)}")
+    render = params.render
+    for key, values, lowest, highest in (("camera_distance", render.camera_distance, 0.01, 10.0), ("camera_tilt_deg", render.camera_tilt_deg, 0.0, 89.0)):
+        if len(values) != 2 or not lowest <= values[0] <= values[1] <= highest:
+            raise ParamsError(f"render.{key}: must be [low, high] with {lowest} <= low <= high <= {highest}; got {list(values)}")
+    if render.crop_size % render.out_size or render.crop_size < render.out_size:
+        raise ParamsError(f"render.out_size: must divide render.crop_size ({render.crop_size}); got {render.out_size}")
     return params
 
 

@@ -83,3 +83,16 @@ GRASPNESS_HIST_PNG = Path("reports/score/graspness_hist.png")
 RARITY_HIST_CSV = Path("reports/score/rarity_hist.csv")
 RARITY_HIST_PNG = Path("reports/score/rarity_hist.png")
 GRASP_EXAMPLES_PNG = Path("reports/score/grasp_examples.png")
+
+
+# render (one dataset folder per corpus)
+def gqcnn_dir(corpus: str) -> Path:
+    return Path(f"data/gqcnn/{corpus}")
+
+
+def render_metrics(corpus: str) -> Path:
+    return Path(f"metrics/render/{corpus}.json")
+
+
+def render_examples(corpus: str) -> Path:
+    return Path(f"reports/render/{corpus}/examples.png")

@@ -127,3 +127,27 @@ def grasps_on_shapes(shapes: list[tuple[np.ndarray, np.ndarray]], segments: list
     bar = fig.colorbar(plt.cm.ScalarMappable(norm=norm, cmap=cmap), ax=fig.axes, shrink=0.6, label="robust ε")
     bar.ax.axhline(threshold, color="black", linewidth=1.5)
     _save(fig, path)
+
+
+def crop_grid(images: np.ndarray, titles: Sequence[str], jaw_half_widths: Sequence[float], path: str | os.PathLike, title: str, columns: int = 6) -> None:
+    """Depth crops (n, s, s) (m) in a grid, each in its own gray scale (near = light), with its
+    title and the open jaws drawn as two vertical red ticks ``jaw_half_widths`` pixels left and
+    right of the center (the jaw axis is the crop's horizontal)."""
+    plt = _pyplot()
+    n = len(images)
+    rows = max(1, int(np.ceil(n / columns)))
+    fig, axes = plt.subplots(rows, columns, figsize=(1.9 * columns, 2.1 * rows), squeeze=False)
+    for ax in axes.ravel():
+        ax.axis("off")
+    for ax, image, label, half in zip(axes.ravel(), images, titles, jaw_half_widths):
+        size = image.shape[0]
+        center = (size - 1) / 2
+        ax.imshow(-image, cmap="gray", interpolation="nearest")
+        for side in (-1, 1):
+            ax.plot([center + side * half] * 2, [center - size / 8, center + size / 8], color="red", linewidth=1.5)
+        ax.plot([center], [center], marker="+", color="tab:blue", markersize=6)
+        ax.set_title(label, fontsize=7)
+    if n == 0:
+        axes[0, 0].text(0.5, 0.5, "no datapoints", ha="center", va="center", transform=axes[0, 0].transAxes)
+    fig.suptitle(title, fontsize=9)
+    _save(fig, path)

@@ -8,17 +8,24 @@ from dataclasses import dataclass
 class ParallelJawGripper:
     """A two-finger parallel gripper (lengths in meters).
 
-    Defaults are the Franka Emika Panda hand: 0.08 m maximum opening, fingers about 0.02 m wide
-    and 0.045 m long. ``finger_radius`` is the radius of the soft-finger contact patch used by
-    the torsional friction columns of the grasp wrench (Dex-Net's default 0.005 m).
+    Defaults are the Franka Emika Panda hand: 0.08 m maximum opening; finger and palm boxes are
+    the bounding boxes of the collision meshes in pybullet_data's ``franka_panda`` (the grasp
+    center is the URDF's ``panda_grasptarget``, 0.105 m in front of the hand). In the grasp frame
+    (x: jaw axis, z: approach) a finger spans z in [fingertip_offset - finger_length,
+    fingertip_offset]; the palm spans z in [-palm_offset - palm_size[2], -palm_offset].
+    ``finger_radius`` is the radius of the soft-finger contact patch used by the torsional
+    friction columns of the grasp wrench (Dex-Net's default 0.005 m).
     """
 
     name: str = "franka_panda"
     max_width: float = 0.08  # jaw opening (m)
     min_width: float = 0.0  # smallest closing width (m)
-    finger_width: float = 0.02  # across the jaw, perpendicular to the grasp axis (m)
-    finger_length: float = 0.045  # along the approach direction (m)
-    finger_thickness: float = 0.01  # along the grasp axis (m)
+    finger_width: float = 0.021  # across the jaw, perpendicular to the grasp axis (m)
+    finger_length: float = 0.0538  # along the approach direction (m)
+    finger_thickness: float = 0.0264  # along the grasp axis, outward from the jaw face (m)
+    fingertip_offset: float = 0.0072  # how far the fingertips reach past the grasp center (m)
+    palm_offset: float = 0.039  # distance from the grasp center back to the palm (m)
+    palm_size: tuple[float, float, float] = (0.2045, 0.0632, 0.0919)  # along the axis, across, along the approach (m)
     finger_radius: float = 0.005  # soft contact patch radius (m)
 
     def __post_init__(self) -> None:

@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import logging
 import time
-import zlib
 from pathlib import Path
 
 import numpy as np
@@ -24,6 +23,7 @@ from graspaug.grasping.robust import Perturbations, QualitySettings, grasp_epsil
 from graspaug.io.meshes import mesh_path, read_mesh
 from graspaug.io.tables import read_table, write_json, write_table
 from graspaug.paths import corpus_files, grasps_metrics, grasps_table
+from graspaug.rng import shape_rng
 from graspaug.stages import StageError
 
 log = logging.getLogger(__name__)
@@ -52,11 +52,6 @@ def perturbations(cfg: GraspsParams) -> Perturbations:
         n_samples=cfg.n_samples, center_sigma=cfg.center_sigma, axis_sigma=cfg.axis_sigma,
         object_translation_sigma=cfg.object_translation_sigma, object_rotation_sigma=cfg.object_rotation_sigma, friction_sigma=cfg.friction_sigma,
     )
-
-
-def shape_rng(seed: int, shape_id: str) -> np.random.Generator:
-    """The random stream of one shape: fixed by ``seed`` and the id, whatever the worker or order."""
-    return np.random.default_rng([seed, zlib.crc32(shape_id.encode())])
 
 
 def grasps_of_shape(path: Path, shape_id: str, cfg: GraspsParams, seed: int) -> tuple[pd.DataFrame, str | None]:

@@ -1,0 +1,152 @@
+"""One shape's Dex-Net 2.0 datapoints: stable poses × camera views × table-parallel grasps."""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import trimesh
+
+from graspaug.grasping.gripper import ParallelJawGripper
+from graspaug.render.camera import CameraPose, Intrinsics, ViewpointRanges, sample_viewpoint
+from graspaug.render.collision import CollisionChecker, approach_directions
+from graspaug.render.crops import CropGeometry, crops_by_ray_casting
+from graspaug.render.stable_poses import stable_poses
+
+COLUMNS = ("grasp_index", "pose_id", "pose_probability", "image_id", "camera_height", "camera_tilt", "center_u", "center_v", "angle", "z",
+           "width_px", "collision_free")
+
+
+@dataclass(frozen=True)
+class RenderSettings:
+    """How one shape's datapoints are made (Dex-Net 2.0's recipe by default).
+
+    ``max_poses`` most probable stable poses with probability >= ``min_pose_probability``;
+    ``images_per_pose`` random camera views of each; in each view every grasp whose jaw axis is
+    within ``axis_tolerance_deg`` of parallel to the table (at most ``max_grasps_per_image``,
+    a seeded random subset; 0: all), approached from above over ``approach_distance`` (m).
+    """
+
+    max_poses: int = 5
+    min_pose_probability: float = 0.01
+    images_per_pose: int = 2
+    max_grasps_per_image: int = 0
+    axis_tolerance_deg: float = 5.0
+    approach_distance: float = 0.1
+    viewpoints: ViewpointRanges = field(default_factory=ViewpointRanges)
+    intrinsics: Intrinsics = field(default_factory=Intrinsics)
+    crop: CropGeometry = field(default_factory=CropGeometry)
+
+
+@dataclass(frozen=True)
+class ShapeDatapoints:
+    """``images`` (D, out, out) float32 depth crops (m); ``columns``: name → (D,) array, per
+    :data:`COLUMNS` (``grasp_index`` indexes the grasps passed in; ``angle`` in radians is the
+    jaw axis's direction in the full image; ``z`` (m) the grasp center's camera depth;
+    ``camera_tilt`` in degrees); ``n_poses`` stable poses used; ``n_rays`` rays cast."""
+
+    images: np.ndarray
+    columns: dict[str, np.ndarray]
+    n_poses: int
+    n_rays: int
+
+    def __len__(self) -> int:
+        return len(self.images)
+
+
+def grasp_image_geometry(camera: CameraPose, intrinsics: Intrinsics, centers: np.ndarray, axes: np.ndarray, opening: float) -> dict[str, np.ndarray]:
+    """Image center (u, v), jaw direction angle (rad), depth z (m) and jaw opening in pixels of
+    grasps with table-frame ``centers`` and unit ``axes`` (G, 3)."""
+    center_cam = camera.to_camera(centers)
+    uv = intrinsics.project(center_cam)
+    ends = [intrinsics.project(camera.to_camera(centers + sign * axes * opening / 2)) for sign in (-1.0, 1.0)]
+    jaw = ends[1] - ends[0]
+    return {"center_u": uv[:, 0], "center_v": uv[:, 1], "angle": np.arctan2(jaw[:, 1], jaw[:, 0]), "z": center_cam[:, 2],
+            "width_px": np.linalg.norm(jaw, axis=1)}
+
+
+@dataclass(frozen=True)
+class Scene:
+    """One camera view of the object in one stable pose, with the grasps it shows.
+
+    ``pose`` (4, 4) places the object (its own frame) on the table; ``grasp_index`` (G,) indexes
+    the grasps passed to :func:`plan_scenes`; ``centers`` / ``axes`` (G, 3) are those grasps in
+    the table frame; ``image`` holds their image geometry (:func:`grasp_image_geometry`)."""
+
+    pose_id: int
+    pose: np.ndarray
+    probability: float
+    image_id: int
+    camera: CameraPose
+    grasp_index: np.ndarray
+    centers: np.ndarray
+    axes: np.ndarray
+    image: dict[str, np.ndarray]
+
+
+def plan_scenes(mesh: trimesh.Trimesh, centers: np.ndarray, axes: np.ndarray, opening: float, settings: RenderSettings,
+                rng: np.random.Generator) -> tuple[list[Scene], int]:
+    """The scenes of one object (``mesh`` in meters, its own frame) for grasps with ``centers``
+    and unit jaw ``axes`` (N, 3) in that frame, and the number of stable poses used. A grasp
+    appears in a pose's views if its jaw axis is within the tolerance of parallel to the table
+    and its center falls inside the image; views without such grasps are left out."""
+    centers = np.asarray(centers, dtype=float).reshape(-1, 3)
+    axes = np.asarray(axes, dtype=float).reshape(-1, 3)
+    poses = stable_poses(mesh)
+    keep = np.flatnonzero(poses.probabilities >= settings.min_pose_probability)[: settings.max_poses]
+    limit = np.sin(np.radians(settings.axis_tolerance_deg))
+    intrinsics = settings.intrinsics
+    scenes = []
+    for pose_id in keep:
+        pose = poses.transforms[pose_id]
+        rotation, translation = pose[:3, :3], pose[:3, 3]
+        pose_axes = axes @ rotation.T
+        aligned = np.flatnonzero(np.abs(pose_axes[:, 2]) <= limit)
+        if len(aligned) == 0:
+            continue
+        pose_centers = centers[aligned] @ rotation.T + translation
+        pose_axes = pose_axes[aligned]
+        for image_id in range(settings.images_per_pose):
+            camera = sample_viewpoint(settings.viewpoints, rng)
+            chosen = np.arange(len(aligned))
+            if 0 < settings.max_grasps_per_image < len(chosen):
+                chosen = np.sort(rng.choice(chosen, settings.max_grasps_per_image, replace=False))
+            image = grasp_image_geometry(camera, intrinsics, pose_centers[chosen], pose_axes[chosen], opening)
+            inside = (image["center_u"] >= 0) & (image["center_u"] <= intrinsics.width - 1) & (image["center_v"] >= 0) & (image["center_v"] <= intrinsics.height - 1)
+            if not inside.any():
+                continue
+            chosen = chosen[inside]
+            scenes.append(Scene(pose_id=int(pose_id), pose=pose, probability=float(poses.probabilities[pose_id]),
+                                image_id=int(pose_id) * settings.images_per_pose + image_id, camera=camera, grasp_index=aligned[chosen],
+                                centers=pose_centers[chosen], axes=pose_axes[chosen], image={k: v[inside] for k, v in image.items()}))
+    return scenes, len(keep)
+
+
+def render_shape(mesh: trimesh.Trimesh, centers: np.ndarray, axes: np.ndarray, gripper: ParallelJawGripper, settings: RenderSettings,
+                 rng: np.random.Generator) -> ShapeDatapoints:
+    """Datapoints of one object (``mesh`` in meters, its own frame) for grasps with ``centers``
+    and unit jaw ``axes`` (N, 3) in that frame: a crop, image geometry and approach collision
+    check for every grasp of every scene of :func:`plan_scenes`."""
+    scenes, n_poses = plan_scenes(mesh, centers, axes, gripper.max_width, settings, rng)
+    checker = CollisionChecker(mesh, gripper, settings.approach_distance) if scenes else None
+    images, rows, n_rays = [], {name: [] for name in COLUMNS}, 0
+    for scene in scenes:
+        crops, rays = crops_by_ray_casting(mesh, scene.camera, settings.intrinsics, np.stack([scene.image["center_u"], scene.image["center_v"]], axis=1),
+                                           scene.image["angle"], settings.crop, pose=scene.pose)
+        n_rays += rays
+        images.append(crops)
+        count = len(scene.grasp_index)
+        rows["grasp_index"].append(scene.grasp_index)
+        rows["pose_id"].append(np.full(count, scene.pose_id))
+        rows["pose_probability"].append(np.full(count, scene.probability))
+        rows["image_id"].append(np.full(count, scene.image_id))
+        rows["camera_height"].append(np.full(count, scene.camera.height))
+        rows["camera_tilt"].append(np.full(count, np.degrees(scene.camera.tilt)))
+        for name, values in scene.image.items():
+            rows[name].append(values)
+        rows["collision_free"].append(checker.collision_free(scene.centers, scene.axes, approach_directions(scene.axes), pose=scene.pose))
+    if not images:
+        out = settings.crop.out_size
+        empty = {name: np.zeros(0, dtype=bool if name == "collision_free" else int if name in ("grasp_index", "pose_id", "image_id") else float)
+                 for name in COLUMNS}
+        return ShapeDatapoints(np.zeros((0, out, out), np.float32), empty, n_poses, n_rays)
+    return ShapeDatapoints(np.concatenate(images), {name: np.concatenate(parts) for name, parts in rows.items()}, n_poses, n_rays)
