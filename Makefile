@@ -26,7 +26,7 @@ test: install
 	$(BIN)/python -m pytest -n 2 --dist loadfile -q
 
 bench: install
-	cd bench && ../$(BIN)/python voxelize_speed.py && ../$(BIN)/python voxelize_accuracy.py && ../$(BIN)/python grasp_quality_speed.py
+	cd bench && ../$(BIN)/python voxelize_speed.py && ../$(BIN)/python voxelize_accuracy.py && ../$(BIN)/python grasp_quality_speed.py && ../$(BIN)/python render_speed.py
 
 clean-venv:
 	rm -rf $(VENV)

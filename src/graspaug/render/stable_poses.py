@@ -51,7 +51,8 @@ def _topple_targets(hull: trimesh.Trimesh, center: np.ndarray) -> np.ndarray:
     triangles, normals = hull.triangles, hull.face_normals
     n_faces = len(triangles)
     projected = center - np.einsum("ij,ij->i", normals, center - triangles[:, 0])[:, None] * normals
-    barycentric = trimesh.triangles.points_to_barycentric(triangles, projected)
+    with np.errstate(divide="ignore", invalid="ignore"):  # sliver hull triangles give NaN: not toppling, as in trimesh
+        barycentric = trimesh.triangles.points_to_barycentric(triangles, projected)
     target = np.arange(n_faces)
     unstable = np.any(barycentric < 0, axis=1)
 
