@@ -68,9 +68,9 @@ def main() -> None:
     with PybulletDepthScene() as pybullet_scene:
         placed = None
         for mesh, scene in jobs:
-            if placed is not (mesh, scene.pose_id):
+            if placed != (id(mesh), scene.pose_id):
                 pybullet_scene.place(mesh, scene.pose)  # set-up, not timed
-                placed = (mesh, scene.pose_id)
+                placed = (id(mesh), scene.pose_id)
             start = time.perf_counter()
             image = pybullet_scene.depth(scene.camera, settings.intrinsics)
             reference.append(crops_from_depth_image(image, *grasp_pixels(scene), settings.crop))

@@ -163,10 +163,11 @@ def render_command(
 @app.command(
     name="export-dexnet",
     help="Export a rendered dataset in Dex-Net 2.0's tensor layout for Berkeley's gqcnn tools: "
-    "`<out>/tensors/{depth_ims_tf_table,hand_poses,robust_ferrari_canny,collision_free,obj_labels,pose_labels}_%05d.npz` "
-    "(key `arr_0`, 1000 rows per file) and `<out>/config.json`. hand_poses rows are (center row, center column, "
-    "depth z, jaw angle, row − cy, column − cx, open jaws in px); obj_labels index config.json's `obj_ids`, "
-    "pose_labels its `pose_ids`. Run from the project folder after the render stage.",
+    "`<out>/tensors/{depth_ims_tf_table,hand_poses,robust_ferrari_canny,collision_free,obj_labels,pose_labels,image_labels}_%05d.npz` "
+    "(key `arr_0`, 1000 rows per file) and `<out>/config.json`. As in Dex-Net, robust_ferrari_canny is 0 for "
+    "colliding grasps (so `metric > threshold` is the label); robust_ferrari_canny_raw keeps the robust ε. hand_poses "
+    "rows are (center row, center column, depth z, jaw angle, row − cy, column − cx, open jaws in px); obj_labels "
+    "index config.json's `obj_ids`, pose_labels its `pose_ids`. Run from the project folder after the render stage.",
 )
 def export_dexnet_command(
     corpus: str = typer.Argument(..., help="Rendered corpus: `original` or `gen_<B>`."),

@@ -73,3 +73,22 @@ def test_no_grasps_or_no_table_parallel_grasp_gives_no_datapoints():
     upright = render_shape(mesh, centers[4:], axes[4:], HAND, RenderSettings(), np.random.default_rng(0))
     assert len(upright) == 0 and upright.n_poses == 5  # max_poses
     assert set(upright.columns) == set(empty.columns)
+
+
+def test_crops_that_would_leave_the_image_are_not_rendered():
+    from graspaug.render.camera import ViewpointRanges
+    from graspaug.render.dataset import crop_inside_image, plan_scenes
+
+    mesh, centers, axes = box_grasps()
+    settings = RenderSettings(max_poses=6, images_per_pose=40, viewpoints=ViewpointRanges(object_offset=0.3))
+    scenes, _ = plan_scenes(mesh, centers, axes, HAND.max_width, settings, np.random.default_rng(0))
+    shown = sum(len(s.grasp_index) for s in scenes)
+    centered = RenderSettings(max_poses=6, images_per_pose=40, viewpoints=ViewpointRanges(object_offset=0.0))
+    all_shown = sum(len(s.grasp_index) for s in plan_scenes(mesh, centers, axes, HAND.max_width, centered, np.random.default_rng(0))[0])
+    # with the object up to 0.3 m off the image center, many crops would cross the border
+    assert 0 < shown < 0.9 * all_shown
+    for scene in scenes:
+        u, v, angle = scene.image["center_u"], scene.image["center_v"], scene.image["angle"]
+        assert crop_inside_image(u, v, angle, settings.crop, settings.intrinsics).all()
+        reach = 47.5 * (np.abs(np.cos(angle)) + np.abs(np.sin(angle)))
+        assert np.all((u - reach >= 0) & (u + reach <= 639) & (v - reach >= 0) & (v + reach <= 479))

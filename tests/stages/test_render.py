@@ -53,7 +53,8 @@ def test_render_writes_shards_index_metrics_and_a_dexnet_export(tmp_path, monkey
     np.testing.assert_allclose(merged.eps, merged.eps_mean)
     assert (index.label == (index.collision_free & (index.eps > 0.002))).all()
     assert (index.split == index.shape_id.map(shapes.set_index("shape_id").split)).all()
-    assert index.origin.eq("original").all() and index.base_size.isna().all()
+    assert index.origin.eq("original").all() and index.base_size.isna().all() and index.pool.isna().all()
+    assert str(index.pool.dtype) == "string"  # the same column type as in generated corpora
     np.testing.assert_array_equal(data.read("labels"), index.label.to_numpy())
     np.testing.assert_allclose(data.read("z"), index.z, rtol=1e-6)
     np.testing.assert_allclose(data.read("eps"), index.eps, rtol=1e-6)
@@ -84,8 +85,14 @@ def test_render_writes_shards_index_metrics_and_a_dexnet_export(tmp_path, monkey
     hand_poses = read_tensor_field(out, "hand_poses")
     np.testing.assert_allclose(hand_poses[:, [0, 1, 2, 3, 6]], index[["center_v", "center_u", "z", "angle", "width_px"]], rtol=1e-6)
     np.testing.assert_allclose(hand_poses[:, 4], index.center_v - 239.5, atol=1e-4)
-    np.testing.assert_allclose(read_tensor_field(out, "robust_ferrari_canny"), index.eps, rtol=1e-6)
+    # Dex-Net's convention: the metric is 0 for colliding grasps, so `metric > threshold` is our label
+    metric = read_tensor_field(out, "robust_ferrari_canny")
+    np.testing.assert_allclose(metric, np.where(index.collision_free, index.eps, 0.0), rtol=1e-6)
+    np.testing.assert_array_equal(metric > 0.002, index.label)
+    np.testing.assert_allclose(read_tensor_field(out, "robust_ferrari_canny_raw"), index.eps, rtol=1e-6)
     np.testing.assert_array_equal(read_tensor_field(out, "collision_free"), index.collision_free.astype(np.uint8))
+    image_labels = read_tensor_field(out, "image_labels")
+    assert len(np.unique(image_labels)) == index.groupby(["shape_id", "pose_id", "image_id"]).ngroups
     obj_ids = np.array(config["obj_ids"])
     np.testing.assert_array_equal(obj_ids[read_tensor_field(out, "obj_labels")], index.shape_id)
     pose_ids = np.array(config["pose_ids"])
@@ -104,3 +111,16 @@ def test_render_params_are_checked(tmp_path):
     (tmp_path / "params.yaml").write_text("render:\n  out_size: 40\n")
     result = CliRunner().invoke(app, ["render", "--params", str(tmp_path / "params.yaml")])
     assert result.exit_code == 2 and "render.out_size: must divide render.crop_size (96)" in result.output
+
+
+def test_a_mesh_that_cannot_be_rendered_is_skipped_with_its_reason(tmp_path):
+    from graspaug.grasping.gripper import ParallelJawGripper
+    from graspaug.render.dataset import RenderSettings
+    from graspaug.stages.render import render_one
+
+    flat = trimesh.Trimesh(vertices=[[0, 0, 0], [0.05, 0, 0], [0, 0.05, 0]], faces=[[0, 1, 2]])  # no volume, no hull
+    flat.export(tmp_path / "flat.ply")
+    data, reason = render_one(tmp_path / "flat.ply", "flat", np.zeros((1, 3)), np.array([[1.0, 0, 0]]), RenderSettings(), ParallelJawGripper(), 0)
+    assert data is None and reason.startswith("rendering failed: ")
+    data, reason = render_one(tmp_path / "missing.ply", "missing", np.zeros((1, 3)), np.array([[1.0, 0, 0]]), RenderSettings(), ParallelJawGripper(), 0)
+    assert data is None and reason.startswith("mesh could not be read")

@@ -83,12 +83,19 @@ class Scene:
     image: dict[str, np.ndarray]
 
 
+def crop_inside_image(u: np.ndarray, v: np.ndarray, angle: np.ndarray, crop: CropGeometry, intrinsics: Intrinsics) -> np.ndarray:
+    """(G,) bool: the crop around each grasp center (u, v) turned by ``angle`` reads only pixels
+    of the image (so it is the crop a real camera image gives, without border padding)."""
+    reach = (crop.crop_size - 1) / 2 * (np.abs(np.cos(angle)) + np.abs(np.sin(angle))) + 1
+    return (u - reach >= 0) & (u + reach <= intrinsics.width - 1) & (v - reach >= 0) & (v + reach <= intrinsics.height - 1)
+
+
 def plan_scenes(mesh: trimesh.Trimesh, centers: np.ndarray, axes: np.ndarray, opening: float, settings: RenderSettings,
                 rng: np.random.Generator) -> tuple[list[Scene], int]:
     """The scenes of one object (``mesh`` in meters, its own frame) for grasps with ``centers``
     and unit jaw ``axes`` (N, 3) in that frame, and the number of stable poses used. A grasp
     appears in a pose's views if its jaw axis is within the tolerance of parallel to the table
-    and its center falls inside the image; views without such grasps are left out."""
+    and its whole (rotated) crop lies inside the image; views without such grasps are left out."""
     centers = np.asarray(centers, dtype=float).reshape(-1, 3)
     axes = np.asarray(axes, dtype=float).reshape(-1, 3)
     poses = stable_poses(mesh)
@@ -107,17 +114,15 @@ def plan_scenes(mesh: trimesh.Trimesh, centers: np.ndarray, axes: np.ndarray, op
         pose_axes = pose_axes[aligned]
         for image_id in range(settings.images_per_pose):
             camera = sample_viewpoint(settings.viewpoints, rng)
-            chosen = np.arange(len(aligned))
+            image = grasp_image_geometry(camera, intrinsics, pose_centers, pose_axes, opening)
+            chosen = np.flatnonzero(crop_inside_image(image["center_u"], image["center_v"], image["angle"], settings.crop, intrinsics))
             if 0 < settings.max_grasps_per_image < len(chosen):
                 chosen = np.sort(rng.choice(chosen, settings.max_grasps_per_image, replace=False))
-            image = grasp_image_geometry(camera, intrinsics, pose_centers[chosen], pose_axes[chosen], opening)
-            inside = (image["center_u"] >= 0) & (image["center_u"] <= intrinsics.width - 1) & (image["center_v"] >= 0) & (image["center_v"] <= intrinsics.height - 1)
-            if not inside.any():
+            if len(chosen) == 0:
                 continue
-            chosen = chosen[inside]
             scenes.append(Scene(pose_id=int(pose_id), pose=pose, probability=float(poses.probabilities[pose_id]),
                                 image_id=int(pose_id) * settings.images_per_pose + image_id, camera=camera, grasp_index=aligned[chosen],
-                                centers=pose_centers[chosen], axes=pose_axes[chosen], image={k: v[inside] for k, v in image.items()}))
+                                centers=pose_centers[chosen], axes=pose_axes[chosen], image={k: v[chosen] for k, v in image.items()}))
     return scenes, len(keep)
 
 

@@ -46,8 +46,9 @@ def _landing_probabilities(triangles: np.ndarray, center: np.ndarray) -> np.ndar
     return np.arctan(np.sqrt(np.clip(product, 0.0, None))) / np.pi
 
 
-def _topple_targets(hull: trimesh.Trimesh, center: np.ndarray) -> np.ndarray:
-    """For each hull triangle, the triangle it topples to (itself when it is a resting one)."""
+def _topple_targets(hull: trimesh.Trimesh, center: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """For each hull triangle, the triangle it topples to (itself when it is a resting one),
+    and which triangles rest (hold the projected center of mass)."""
     triangles, normals = hull.triangles, hull.face_normals
     n_faces = len(triangles)
     projected = center - np.einsum("ij,ij->i", normals, center - triangles[:, 0])[:, None] * normals
@@ -71,10 +72,10 @@ def _topple_targets(hull: trimesh.Trimesh, center: np.ndarray) -> np.ndarray:
     order = np.lexsort((~beyond, face))  # per face, the first edge the projected center lies beyond
     face, neighbour = face[order], neighbour[order]
     if len(face) == 0:
-        return target
+        return target, ~unstable
     first = np.r_[True, face[1:] != face[:-1]]
     target[face[first]] = neighbour[first]
-    return target
+    return target, ~unstable
 
 
 def stable_poses(mesh: trimesh.Trimesh, center_of_mass: np.ndarray | None = None) -> StablePoses:
@@ -83,15 +84,14 @@ def stable_poses(mesh: trimesh.Trimesh, center_of_mass: np.ndarray | None = None
     hull = mesh.convex_hull
     center = np.asarray(mesh.center_mass if center_of_mass is None else center_of_mass, dtype=float)
     prior = _landing_probabilities(hull.triangles, center)
-    target = _topple_targets(hull, center)
-    for _ in range(len(target)):  # follow topples until each face points at a resting one
+    target, rests = _topple_targets(hull, center)
+    for _ in range(len(target)):  # follow topples (pointer doubling) until each chain ends
         nxt = target[target]
         if np.array_equal(nxt, target):
             break
         target = nxt
-    resting = target[target] == target
-    resting_face = target[resting]
-    mass = np.bincount(resting_face, weights=prior[resting], minlength=len(target))
+    lands = rests[target]  # chains that end on a resting face; a loop of toppling faces does not
+    mass = np.bincount(target[lands], weights=prior[lands], minlength=len(target))
 
     faces = np.flatnonzero(mass > 0)
     keys = np.round(hull.face_normals[faces], 3)

@@ -64,7 +64,10 @@ def render_one(path: Path, shape_id: str, centers: np.ndarray, axes: np.ndarray,
         mesh = read_mesh(path)
     except Exception as exc:  # a broken file is skipped with its reason, not fatal
         return None, f"mesh could not be read: {exc}"
-    data = render_shape(mesh, centers, axes, hand, settings, shape_rng(seed, shape_id, "render"))
+    try:
+        data = render_shape(mesh, centers, axes, hand, settings, shape_rng(seed, shape_id, "render"))
+    except Exception as exc:  # a degenerate mesh (no hull, no volume) is skipped with its reason
+        return None, f"rendering failed: {type(exc).__name__}: {exc}"
     if len(data) == 0:
         return None, (f"none of its {len(centers)} grasps has its jaw axis within {settings.axis_tolerance_deg} deg of the table "
                       f"in its {data.n_poses} stable poses")
@@ -89,6 +92,7 @@ def run(params: Params, corpus: str = "original") -> None:
             shapes[column] = None
     shapes["base_size"] = shapes["base_size"].astype("Int64")
     shapes["order"] = shapes["order"].astype("Int64")
+    shapes["pool"] = shapes["pool"].astype("string")  # same column types for every corpus
     grasps = read_table(grasps_table(corpus))
     by_shape = {shape_id: rows for shape_id, rows in grasps.groupby("shape_id", sort=False)}
     empty = grasps.iloc[:0]
@@ -123,6 +127,7 @@ def run(params: Params, corpus: str = "original") -> None:
     index = pd.concat(parts, ignore_index=True)
     for column in ("base_size", "order"):
         index[column] = index[column].astype("Int64")
+    index["pool"] = index["pool"].astype("string")
     images = np.concatenate(images)
     camera = settings.intrinsics
     dataset_info = {
@@ -183,19 +188,24 @@ def export_dexnet(corpus: str, out: str | Path, rows_per_file: int = 1000) -> in
     obj_ids, obj_labels = np.unique(index.shape_id.to_numpy(), return_inverse=True)
     pose_keys = index.shape_id + ":" + index.pose_id.astype(str)
     pose_ids, pose_labels = np.unique(pose_keys.to_numpy(), return_inverse=True)
+    _, image_labels = np.unique((pose_keys + ":" + index.image_id.astype(str)).to_numpy(), return_inverse=True)
     cx, cy = info["intrinsics"]["cx"], info["intrinsics"]["cy"]
     hand_poses = np.stack([index.center_v, index.center_u, index.z, index.angle, index.center_v - cy, index.center_u - cx, index.width_px], axis=1)
     fields = {
         "depth_ims_tf_table": data.images()[..., None],
         "hand_poses": hand_poses.astype(np.float32),
-        "robust_ferrari_canny": index.eps.to_numpy(np.float32),
+        # Dex-Net stores each metric times collision_free, and gqcnn labels by the metric alone
+        "robust_ferrari_canny": (index.eps * index.collision_free).to_numpy(np.float32),
+        "robust_ferrari_canny_raw": index.eps.to_numpy(np.float32),
         "collision_free": index.collision_free.to_numpy(np.uint8),
         "obj_labels": obj_labels.astype(np.uint32),
         "pose_labels": pose_labels.astype(np.uint32),
+        "image_labels": image_labels.astype(np.uint32),
     }
     extra = {"source": f"graspaug render ({corpus})", "dataset": info, "obj_ids": obj_ids.tolist(), "pose_ids": pose_ids.tolist(),
              "hand_poses_columns": ["center_row", "center_col", "depth", "angle", "center_row_minus_cy", "center_col_minus_cx", "width_px"],
-             "label_rule": f"robust_ferrari_canny > {info['grasps_threshold']} and collision_free"}
+             "label_rule": f"robust_ferrari_canny > {info['grasps_threshold']} (robust_ferrari_canny is 0 for colliding grasps, as in Dex-Net; "
+                           "robust_ferrari_canny_raw keeps the robust epsilon before that)"}
     with atomic_path(out, directory=True) as folder:
         write_tensor_dataset(folder, fields, rows_per_file, extra)
     return len(index)
