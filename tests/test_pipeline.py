@@ -25,6 +25,7 @@ TINY = {
     "generate": {"base_sizes": [4, 6], "ratios": [0.0, 0.5, 1.0, 2.0], "percentile": 50.0, "first_neighbour": 1, "extra_neighbours": 1,
                  "min_voxels": 5, "min_main_share": 0.5, "smoothing_iterations": 3, "n_examples": 2},
     "render": {"max_poses": 2, "n_examples": 4},
+    "gqcnn": {"filters": 4, "fc": 16, "pose_fc": 4, "steps": 6, "log_every": 3, "random_base_sizes": [6], "random_ratios": [1.0]},
 }
 
 
@@ -193,4 +194,32 @@ def test_dvc_repro_render(tiny_repo):
             assert set(index.pool) <= {"targeted", "random"} and index.order.notna().all() and (index.split == "train").all()
         assert (work / f"reports/render/{corpus}/examples.png").stat().st_size > 0
     again = run(["dvc", "repro", "render", "render_generated"], work, env)
+    assert "Running stage" not in again.stdout
+
+
+def test_dvc_repro_gqcnn_matrix_and_report(tiny_repo):
+    import json
+
+    work, env = tiny_repo
+    run(["dvc", "repro", "report"], work, env)
+    names = [f"targeted/{b}-{r}-s0" for b in (4, 6) for r in (0.0, 0.5, 1.0, 2.0)] + ["random/6-1.0-s0"]
+    for name in names:
+        summary = json.loads((work / f"metrics/gqcnn/{name}.json").read_text())
+        assert set(summary["test"]) == {"ap", "accuracy", "roc_auc", "positive_share", "datapoints"}
+        assert summary["steps"] == 6 and summary["test"]["datapoints"] > 0
+        folder = work / f"models/gqcnn/{name}"
+        assert np.load(folder / "test_predictions.npy").shape == (summary["test"]["datapoints"],)
+        assert (work / f"metrics/gqcnn/{name}/plots/metrics/loss.tsv").exists()  # DVCLive curves, every 3 steps
+    with_generated = json.loads((work / "metrics/gqcnn/targeted/6-2.0-s0.json").read_text())["train"]
+    assert with_generated["generated_shapes_asked"] == 12 and with_generated["base_shapes"] <= 6
+    ap = json.loads((work / "metrics/ap.json").read_text())
+    assert set(ap["ap"]["targeted"]) == {"4", "6"} and set(ap["ap"]["targeted"]["6"]) == {"0", "0.5", "1", "2"}
+    assert set(ap["ap"]["random"]["6"]) == {"0", "1"}  # ratio 0 is shared with the targeted curve
+    report = (work / "reports/gqcnn/report.md").read_text()
+    assert "| targeted | 4 |" in report and "| random | 6 |" in report and "## What the numbers say" in report
+    for picture in ("ap_vs_ratio", "improvement_by_score", "tsne_graspness"):
+        assert (work / f"reports/gqcnn/{picture}.png").stat().st_size > 0
+    shown = run(["dvc", "metrics", "show", "--json"], work, env)
+    assert "metrics/gqcnn/targeted/6-2.0-s0.json" in shown.stdout
+    again = run(["dvc", "repro", "report"], work, env)
     assert "Running stage" not in again.stdout

@@ -177,6 +177,33 @@ class RenderParams:
 
 
 @dataclass(frozen=True)
+class GQCNNParams:
+    """GQ-CNN networks per base size × augmentation ratio (paper Section IV-C) and their training."""
+
+    filters: int = param(16, "Channels of each conv layer (Dex-Net 2.0 / paper profile: 64).", ge=1)
+    fc: int = param(128, "Width of fc3 and fc4 (Dex-Net: 1024).", ge=1)
+    pose_fc: int = param(16, "Width of the gripper-depth layer pc1 (Dex-Net: 16).", ge=1)
+    pool_after_conv2: bool = param(True, "Max pool after conv2_2 (Dex-Net's 2018 config; 2017: none).")
+    steps: int = param(800, "SGD steps per network, the same for every training set (the budget rule).", ge=1)
+    batch_size: int = param(64, "Datapoints per step (Dex-Net: 64-128).", ge=2)
+    lr: float = param(0.01, "SGD learning rate (Dex-Net: 0.01).", gt=0)
+    momentum: float = param(0.9, "SGD momentum (Dex-Net: 0.9).", ge=0, le=1)
+    lr_decay: float = param(0.95, "Learning rate factor every decay_steps steps (Dex-Net: 0.95).", gt=0, le=1)
+    decay_steps: int = param(50, "Steps between learning-rate decays (Dex-Net: ~0.66 epoch).", ge=1)
+    weight_decay: float = param(5e-4, "L2 weight decay (Dex-Net: 5e-4).", ge=0)
+    gamma_shape: float = param(1000.0, "Multiplicative image noise ~ Gamma(k, 1/k) per image (Dex-Net: k = 1000; 0: off).", ge=0)
+    gp_prob: float = param(0.5, "Chance of adding smooth Gaussian-process noise to an image (Dex-Net: 0.5).", ge=0, le=1)
+    gp_sigma: float = param(0.005, "Its standard deviation (m) (Dex-Net: 0.005).", ge=0)
+    gp_grid: int = param(8, "Its grid side before upsampling to the image (Dex-Net: 8 for 32 px).", ge=1)
+    symmetrize: bool = param(True, "Turn images 180° and flip them about either axis at random (Dex-Net).")
+    val_fraction: float = param(0.1, "Share of the training views (whole images) held out for the validation curves.", ge=0, le=0.5)
+    log_every: int = param(100, "Steps between DVCLive points (loss, train/val accuracy, val AP).", ge=1)
+    seeds: list[int] = param((0,), "Training seeds; each network is trained once per seed (study profile: 0, 1, 2).")
+    random_base_sizes: list[int] = param((200,), "Base sizes that also get random-pair augmentation networks (the baseline).")
+    random_ratios: list[float] = param((0.5, 1.0, 1.5, 2.0), "Their ratios (ratio 0 is the same network as the targeted one).")
+
+
+@dataclass(frozen=True)
 class Params:
     """All parameters of the pipeline."""
 
@@ -193,6 +220,7 @@ class Params:
     score: ScoreParams = field(default_factory=ScoreParams)
     generate: GenerateParams = field(default_factory=GenerateParams)
     render: RenderParams = field(default_factory=RenderParams)
+    gqcnn: GQCNNParams = field(default_factory=GQCNNParams)
 
 
 def _type_name(tp: Any) -> str:
@@ -290,6 +318,13 @@ def parse_params(raw: Any) -> Params:
     for key, values, lowest, highest in (("camera_distance", render.camera_distance, 0.01, 10.0), ("camera_tilt_deg", render.camera_tilt_deg, 0.0, 89.0)):
         if len(values) != 2 or not lowest <= values[0] <= values[1] <= highest:
             raise ParamsError(f"render.{key}: must be [low, high] with {lowest} <= low <= high <= {highest}; got {list(values)}")
+    net = params.gqcnn
+    if not net.seeds or len(set(net.seeds)) != len(net.seeds) or min(net.seeds) < 0:
+        raise ParamsError(f"gqcnn.seeds: must be distinct seeds >= 0; got {list(net.seeds)}")
+    if not set(net.random_base_sizes) <= set(gen.base_sizes):
+        raise ParamsError(f"gqcnn.random_base_sizes: must be among generate.base_sizes {list(gen.base_sizes)}; got {list(net.random_base_sizes)}")
+    if not set(net.random_ratios) <= set(gen.ratios) or 0.0 in net.random_ratios:
+        raise ParamsError(f"gqcnn.random_ratios: must be nonzero ratios among generate.ratios {list(gen.ratios)}; got {list(net.random_ratios)}")
     if render.crop_size % render.out_size or render.crop_size < render.out_size:
         raise ParamsError(f"render.out_size: must divide render.crop_size ({render.crop_size}); got {render.out_size}")
     return params

@@ -96,3 +96,25 @@ def render_metrics(corpus: str) -> Path:
 
 def render_examples(corpus: str) -> Path:
     return Path(f"reports/render/{corpus}/examples.png")
+
+
+# train_gqcnn (one network per pool × base size × ratio × seed) and report
+def gqcnn_name(base_size: int, ratio: float, seed: int) -> str:
+    """``<B>-<R>-s<seed>``, R written as DVC writes the float from params.yaml (``0.5``, ``1.0``)."""
+    return f"{base_size}-{float(ratio)}-s{seed}"
+
+
+def gqcnn_model_dir(pool: str, base_size: int, ratio: float, seed: int) -> Path:
+    return Path(f"models/gqcnn/{pool}/{gqcnn_name(base_size, ratio, seed)}")
+
+
+def gqcnn_metrics(pool: str, base_size: int, ratio: float, seed: int) -> Path:
+    return Path(f"metrics/gqcnn/{pool}/{gqcnn_name(base_size, ratio, seed)}.json")
+
+
+def gqcnn_live(pool: str, base_size: int, ratio: float, seed: int) -> Path:
+    return Path(f"metrics/gqcnn/{pool}/{gqcnn_name(base_size, ratio, seed)}")
+
+
+AP_METRICS = Path("metrics/ap.json")
+REPORT_DIR = Path("reports/gqcnn")

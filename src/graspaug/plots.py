@@ -151,3 +151,69 @@ def crop_grid(images: np.ndarray, titles: Sequence[str], jaw_half_widths: Sequen
         axes[0, 0].text(0.5, 0.5, "no datapoints", ha="center", va="center", transform=axes[0, 0].transAxes)
     fig.suptitle(title, fontsize=9)
     _save(fig, path)
+
+
+def ap_vs_ratio(curves: dict[str, tuple[Sequence[float], Sequence[float], Sequence[float]]], path: str | os.PathLike, title: str) -> None:
+    """AP over augmentation ratio, one line per label with error bars: label → (ratios, mean, std)
+    (the paper's Fig. 7). Labels containing "random" are drawn dashed."""
+    plt = _pyplot()
+    fig, ax = plt.subplots(figsize=(6.4, 4.2))
+    for label, (ratios, mean, std) in curves.items():
+        ax.errorbar(ratios, mean, yerr=std, marker="o", capsize=3, linestyle="--" if "random" in label else "-", label=label)
+    ax.set_xlabel("augmentation ratio R (generated : base)")
+    ax.set_ylabel("test Average Precision")
+    ax.set_title(title, fontsize=9)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    _save(fig, path)
+
+
+def improvement_by_interval(panels: list[dict], path: str | os.PathLike, title: str) -> None:
+    """The paper's Fig. 8: per panel (a score: rarity or graspness), normalized histograms of
+    the selected and the generated shapes and the mean per-object AP improvement of test
+    objects in each score interval. Each panel: ``name``, ``edges`` (bins + 1), ``selected``,
+    ``generated`` (score arrays), ``improvement`` (mean per bin, NaN where empty), ``objects`` (per bin)."""
+    plt = _pyplot()
+    fig, axes = plt.subplots(1, len(panels), figsize=(6 * len(panels), 4.2), squeeze=False)
+    for ax, panel in zip(axes[0], panels):
+        edges = np.asarray(panel["edges"])
+        centers, width = (edges[:-1] + edges[1:]) / 2, np.diff(edges)
+        for name, values, color in (("selected", panel["selected"], "tab:orange"), ("generated", panel["generated"], "tab:green")):
+            counts, _ = np.histogram(np.clip(values, edges[0], edges[-1]), bins=edges)
+            share = counts / max(counts.sum(), 1)
+            ax.bar(centers, share, width=width * 0.9, alpha=0.45, color=color, label=f"{name} shapes ({len(values)})")
+        ax.set_xlabel(panel["name"])
+        ax.set_ylabel("share of shapes")
+        twin = ax.twinx()
+        improvement = np.asarray(panel["improvement"], dtype=float)
+        twin.plot(centers, improvement, marker="o", color="tab:blue", label="mean AP improvement of test objects")
+        for x, y, n in zip(centers, improvement, panel["objects"]):
+            if np.isfinite(y):
+                twin.annotate(str(n), (x, y), textcoords="offset points", xytext=(0, 5), ha="center", fontsize=7, color="tab:blue")
+        twin.axhline(0, color="gray", linewidth=0.8)
+        twin.set_ylabel("per-object AP improvement")
+        lines, labels = ax.get_legend_handles_labels()
+        more, more_labels = twin.get_legend_handles_labels()
+        ax.legend(lines + more, labels + more_labels, fontsize=7, loc="upper right")
+    fig.suptitle(title, fontsize=9)
+    _save(fig, path)
+
+
+def scatter_colored(xy: np.ndarray, values: np.ndarray, markers: Sequence[str], path: str | os.PathLike, title: str, colorbar: str) -> None:
+    """(N, 2) points colored by ``values``, one marker style per group in ``markers`` (the paper's Fig. 1)."""
+    plt = _pyplot()
+    fig, ax = plt.subplots(figsize=(6.5, 6))
+    markers = np.asarray(markers)
+    styles = ["o", "^", "s", "D"]
+    art = None
+    for style, name in zip(styles, sorted(set(markers))):
+        sel = markers == name
+        art = ax.scatter(xy[sel, 0], xy[sel, 1], c=values[sel], s=10 if style == "o" else 16, marker=style, cmap="viridis",
+                         vmin=float(np.nanmin(values)), vmax=float(np.nanmax(values)), label=f"{name} ({sel.sum()})", edgecolors="none")
+    if art is not None:
+        fig.colorbar(art, ax=ax, label=colorbar)
+    ax.set_title(title, fontsize=9)
+    ax.set_xticks([])
+    ax.set_yticks([])
+    ax.legend(fontsize=8)
+    _save(fig, path)

@@ -58,3 +58,13 @@ def load_autoencoder(path: str | os.PathLike, expected: AEConfig) -> tuple[AutoE
         critic = Critic(saved)
         critic.load_state_dict(state["critic"])
     return ae, critic, state["train_params"]
+
+
+def load_gqcnn(path: str | os.PathLike):
+    """A trained GQ-CNN from ``models/gqcnn/<pool>/<B>-<R>-s<seed>/model.pt``, on the CPU, in eval mode."""
+    from graspaug.nets.gqcnn import GQCNN, GQCNNConfig
+
+    saved = torch.load(path, map_location="cpu", weights_only=True)
+    net = GQCNN(GQCNNConfig(**saved["config"]))
+    net.load_state_dict(saved["state_dict"])
+    return net.eval()

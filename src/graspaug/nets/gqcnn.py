@@ -1,0 +1,88 @@
+"""Grasp Quality CNN (Dex-Net 2.0, Mahler et al. 2017): P(success | depth crop, gripper depth).
+
+    image 1×32×32 ─ conv1_1 7×7 ─ conv1_2 5×5 ─ LRN ─ maxpool 2 ─ conv2_1 3×3 ─ conv2_2 3×3 ─ LRN
+                  [─ maxpool 2 (2018 config)] ─ fc3 (1024) ─┐
+    gripper depth z ─ pc1 (16) ─────────────────────────────┴─ fc4 (1024) ─ fc5 (2 logits)
+
+ReLU after every layer but fc5, SAME padding, LRN over 5 channels (TF depth radius 2,
+α 2e-5, β 0.75, bias 1), weights ~ N(0, 2 / fan_in). fc4 sums fc3 and pc1 through their own
+weights (Dex-Net's merge). Paper widths: 64 filters, fc3 = fc4 = 1024; the CPU default is
+narrower (``GQCNNConfig``). Inputs are normalized by the training set's statistics, kept in
+the model (``image_mean``, ``image_std``, ``z_mean``, ``z_std``) so a saved model takes raw
+depths in meters.
+"""
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+
+import torch
+import torch.nn.functional as F
+from torch import nn
+
+
+@dataclass(frozen=True)
+class GQCNNConfig:
+    image_size: int = 32  # crop side (px)
+    filters: int = 64  # channels of each conv layer (Dex-Net: 64)
+    fc: int = 1024  # width of fc3 and fc4 (Dex-Net: 1024)
+    pose_fc: int = 16  # width of pc1 (Dex-Net: 16)
+    pool_after_conv2: bool = True  # the 2018 config's second max pool (2017: none)
+
+    def __post_init__(self) -> None:
+        if self.image_size % (4 if self.pool_after_conv2 else 2):
+            raise ValueError(f"image_size {self.image_size} must be divisible by the pooling")
+        if min(self.filters, self.fc, self.pose_fc) < 1:
+            raise ValueError(f"layer widths must be >= 1, got {self}")
+
+
+class GQCNN(nn.Module):
+    def __init__(self, config: GQCNNConfig = GQCNNConfig()) -> None:
+        super().__init__()
+        self.config = config
+        c = config.filters
+        self.conv1_1 = nn.Conv2d(1, c, 7, padding="same")
+        self.conv1_2 = nn.Conv2d(c, c, 5, padding="same")
+        self.conv2_1 = nn.Conv2d(c, c, 3, padding="same")
+        self.conv2_2 = nn.Conv2d(c, c, 3, padding="same")
+        # torch divides alpha by the window (5), TF's tf.nn.lrn does not: 2e-5 * 5
+        self.lrn = nn.LocalResponseNorm(size=5, alpha=2e-5 * 5, beta=0.75, k=1.0)
+        side = config.image_size // (4 if config.pool_after_conv2 else 2)
+        self.fc3 = nn.Linear(c * side * side, config.fc)
+        self.pc1 = nn.Linear(1, config.pose_fc)
+        self.fc4_image = nn.Linear(config.fc, config.fc)
+        self.fc4_pose = nn.Linear(config.pose_fc, config.fc, bias=False)
+        self.fc5 = nn.Linear(config.fc, 2)
+        for module in self.modules():
+            if isinstance(module, (nn.Conv2d, nn.Linear)):
+                nn.init.kaiming_normal_(module.weight, nonlinearity="relu")  # std sqrt(2 / fan_in)
+                if module.bias is not None:
+                    nn.init.zeros_(module.bias)
+        for name in ("image_mean", "image_std", "z_mean", "z_std"):
+            self.register_buffer(name, torch.tensor(0.0 if name.endswith("mean") else 1.0))
+
+    def set_normalization(self, image_mean: float, image_std: float, z_mean: float, z_std: float) -> None:
+        """Scalar statistics of the training images and gripper depths (m)."""
+        for name, value in (("image_mean", image_mean), ("image_std", image_std), ("z_mean", z_mean), ("z_std", z_std)):
+            getattr(self, name).fill_(float(value))
+
+    def forward(self, images: torch.Tensor, z: torch.Tensor) -> torch.Tensor:
+        """Logits (N, 2) [failure, success] for depth crops (N, 1, S, S) and gripper depths (N,), meters."""
+        x = (images - self.image_mean) / self.image_std
+        x = F.relu(self.conv1_1(x))
+        x = self.lrn(F.relu(self.conv1_2(x)))
+        x = F.max_pool2d(x, 2)
+        x = F.relu(self.conv2_1(x))
+        x = self.lrn(F.relu(self.conv2_2(x)))
+        if self.config.pool_after_conv2:
+            x = F.max_pool2d(x, 2)
+        x = F.relu(self.fc3(x.flatten(1)))
+        p = F.relu(self.pc1(((z - self.z_mean) / self.z_std).reshape(-1, 1)))
+        x = F.relu(self.fc4_image(x) + self.fc4_pose(p))
+        return self.fc5(x)
+
+    def success_probability(self, images: torch.Tensor, z: torch.Tensor) -> torch.Tensor:
+        """P(success) (N,) = softmax of the logits, second class."""
+        return torch.softmax(self.forward(images, z), dim=1)[:, 1]
+
+    def describe(self) -> dict:
+        return {**asdict(self.config), "parameters": sum(p.numel() for p in self.parameters())}

@@ -1,0 +1,206 @@
+"""Stage ``report``: the paper's GQ-CNN experiment in one table, three figures and plain words.
+
+Reads every trained network (``models/gqcnn/<pool>/<B>-<R>-s<seed>/``: summary and test
+predictions) that params ask for. Writes ``metrics/ap.json`` (test AP mean / std / n per
+pool, base size and ratio; the best ratio per base size; targeted minus random),
+``reports/gqcnn/ap_table.csv`` and, in ``reports/gqcnn/``: ``report.md``, ``ap_vs_ratio.png``
+(Fig. 7), ``improvement_by_score.png`` (Fig. 8: per-object AP improvement of the largest base
+size's best ratio over ratio 0, by rarity and graspness interval, with the histograms of the
+selected and generated shapes) and ``tsne_graspness.png`` (Fig. 1: t-SNE of the original
+train and generated latents, colored by graspness).
+"""
+from __future__ import annotations
+
+import json
+import logging
+
+import numpy as np
+import pandas as pd
+from sklearn.metrics import average_precision_score
+
+from graspaug.config import Params
+from graspaug.generation import ratio_count
+from graspaug.io.atomic import atomic_path
+from graspaug.io.tables import read_table, write_csv, write_json
+from graspaug.paths import AP_METRICS, LATENTS, REPORT_DIR, SCORES, base_set_table, generated_index, gqcnn_dir, gqcnn_model_dir, grasps_table
+from graspaug.stages import StageError
+
+log = logging.getLogger(__name__)
+
+
+def variants(params: Params) -> list[tuple[str, int, float, int]]:
+    """(pool, base size, ratio, seed) of every network params ask for."""
+    cfg, gen = params.gqcnn, params.generate
+    out = [("targeted", b, float(r), s) for b in gen.base_sizes for r in gen.ratios for s in cfg.seeds]
+    out += [("random", b, float(r), s) for b in cfg.random_base_sizes for r in cfg.random_ratios for s in cfg.seeds]
+    return out
+
+
+def collect(params: Params) -> pd.DataFrame:
+    """One row per network: pool, base_size, ratio, seed, ap, accuracy, roc_auc."""
+    rows = []
+    for pool, base, ratio, seed in variants(params):
+        path = gqcnn_model_dir(pool, base, ratio, seed) / "summary.json"
+        if not path.exists():
+            raise StageError(f"{path} is missing: run `dvc repro train_gqcnn train_gqcnn_random` first")
+        test = json.loads(path.read_text())["test"]
+        rows.append({"pool": pool, "base_size": base, "ratio": ratio, "seed": seed, "ap": test["ap"], "accuracy": test["accuracy"], "roc_auc": test["roc_auc"]})
+    return pd.DataFrame(rows)
+
+
+def ap_table(runs: pd.DataFrame) -> pd.DataFrame:
+    """Mean, standard deviation (over seeds; NaN for one seed) and count of test AP per pool,
+    base size and ratio. The random curve shares ratio 0 (no generated shapes) with targeted."""
+    zero = runs[(runs.pool == "targeted") & (runs.ratio == 0.0) & runs.base_size.isin(runs.base_size[runs.pool == "random"])]
+    runs = pd.concat([runs, zero.assign(pool="random")], ignore_index=True)
+    table = runs.groupby(["pool", "base_size", "ratio"]).ap.agg(ap_mean="mean", ap_std="std", n="count").reset_index()
+    return table.sort_values(["pool", "base_size", "ratio"], ascending=[False, True, True], ignore_index=True)
+
+
+def verdicts(table: pd.DataFrame) -> tuple[dict, list[str]]:
+    """Best ratio per base size and whether augmentation / targeting beat the seed spread, as
+    numbers and as sentences."""
+    summary, words = {}, []
+    targeted = table[table.pool == "targeted"]
+    for base, rows in targeted.groupby("base_size"):
+        rows = rows.dropna(subset=["ap_mean"])
+        if rows.empty or not (rows.ratio == 0.0).any():
+            words.append(f"B = {base}: no test AP (the test set needs both labels).")
+            continue
+        best = rows.loc[rows.ap_mean.idxmax()]
+        zero = rows[rows.ratio == 0.0].iloc[0]
+        gain = float(best.ap_mean - zero.ap_mean)
+        spread = float(np.nanmax([best.ap_std, zero.ap_std])) if int(best.n) > 1 else float("nan")
+        beyond = bool(np.isfinite(spread) and gain > spread)
+        summary[str(base)] = {"best_ratio": float(best.ratio), "best_ap": float(best.ap_mean), "ap_ratio_0": float(zero.ap_mean),
+                              "gain": gain, "seed_spread": spread if np.isfinite(spread) else None, "beyond_seed_spread": beyond}
+        if best.ratio == 0.0:
+            words.append(f"B = {base}: no augmentation ratio beat training on the {base} base shapes alone (AP {zero.ap_mean:.4f}).")
+        elif not np.isfinite(spread):
+            words.append(f"B = {base}: the best ratio is 1:{best.ratio:g} (AP {best.ap_mean:.4f} vs {zero.ap_mean:.4f} at 1:0, +{gain:.4f}); "
+                         "with one seed there is no seed spread to compare the gain with, so this is not evidence of an improvement.")
+        else:
+            words.append(f"B = {base}: the best ratio is 1:{best.ratio:g} (AP {best.ap_mean:.4f} vs {zero.ap_mean:.4f} at 1:0, +{gain:.4f}); "
+                         f"the seed spread (largest std of the two, n = {int(best.n)}) is {spread:.4f}, so the gain is "
+                         f"{'larger than' if beyond else 'within'} the spread{'' if beyond else ': not an improvement we can claim'}.")
+    random = table[table.pool == "random"]
+    for base, rows in random.groupby("base_size"):
+        merged = rows.merge(targeted[targeted.base_size == base], on="ratio", suffixes=("_random", "_targeted"))
+        merged = merged[merged.ratio > 0]
+        diffs = merged.ap_mean_targeted - merged.ap_mean_random
+        spread = np.nanmax(np.r_[merged.ap_std_targeted, merged.ap_std_random]) if (merged.n_targeted > 1).all() else float("nan")
+        wins = int((diffs > 0).sum())
+        clear = int((diffs > spread).sum()) if np.isfinite(spread) else 0
+        summary[f"targeted_vs_random_{base}"] = {"ratios": merged.ratio.tolist(), "targeted_minus_random": diffs.round(5).tolist(),
+                                                  "targeted_higher": wins, "beyond_seed_spread": clear}
+        words.append(f"Targeted vs random augmentation at B = {base}: targeted has the higher AP at {wins} of {len(merged)} ratios "
+                     f"(differences {', '.join(f'{d:+.4f}' for d in diffs)}); "
+                     + (f"{clear} of them exceed the seed spread ({spread:.4f})." if np.isfinite(spread) else "one seed, so no spread to judge them by."))
+    return summary, words
+
+
+def per_object_ap(labels: np.ndarray, probability: np.ndarray, shape_ids: np.ndarray) -> pd.Series:
+    """AP per test object (those with both classes among their datapoints)."""
+    frame = pd.DataFrame({"label": labels.astype(int), "p": probability, "shape_id": shape_ids})
+    values = {s: average_precision_score(g.label, g.p) for s, g in frame.groupby("shape_id") if 0 < g.label.sum() < len(g)}
+    return pd.Series(values, dtype=float)
+
+
+def mean_predictions(pool: str, base: int, ratio: float, seeds) -> tuple[np.ndarray, np.ndarray]:
+    """Test predictions averaged over seeds, and their rows in the original index."""
+    folders = [gqcnn_model_dir(pool, base, ratio, s) for s in seeds]
+    rows = np.load(folders[0] / "test_rows.npy")
+    return np.mean([np.load(f / "test_predictions.npy") for f in folders], axis=0), rows
+
+
+def run(params: Params) -> None:
+    from graspaug.plots import ap_vs_ratio, improvement_by_interval, scatter_colored
+
+    runs = collect(params)
+    if runs.ap.isna().all():
+        log.warning("report: the test set has only one class, so no network has an AP")
+    table = ap_table(runs)
+    summary, words = verdicts(table)
+    write_csv(table, REPORT_DIR / "ap_table.csv")
+
+    curves = {}
+    for (pool, base), rows in table.groupby(["pool", "base_size"], sort=False):
+        curves[f"B = {base}, {pool}"] = (rows.ratio.to_numpy(), rows.ap_mean.to_numpy(), np.nan_to_num(rows.ap_std.to_numpy()))
+    ap_vs_ratio(curves, REPORT_DIR / "ap_vs_ratio.png", f"Test AP vs augmentation ratio (seeds: {list(params.gqcnn.seeds)}; error bars: std over seeds)")
+
+    # Fig. 8: the largest base size, its best targeted ratio against ratio 0
+    base = max(params.generate.base_sizes)
+    best = summary.get(str(base), {}).get("best_ratio", 0.0)
+    compare = best if best > 0 else max(params.generate.ratios)
+    index = read_table(gqcnn_dir("original") / "index.parquet")
+    after, rows = mean_predictions("targeted", base, compare, params.gqcnn.seeds)
+    before, _ = mean_predictions("targeted", base, 0.0, params.gqcnn.seeds)
+    labels, shape_ids = index.label.to_numpy()[rows], index.shape_id.to_numpy()[rows]
+    improvement = (per_object_ap(labels, after, shape_ids) - per_object_ap(labels, before, shape_ids)).dropna()
+    scores = read_table(SCORES).set_index("shape_id")
+    base_set = read_table(base_set_table(base))
+    generated = read_table(generated_index(base))
+    generated = generated[(generated.pool == "targeted") & (generated.order < ratio_count(compare, base))]
+    grasps = read_table(grasps_table(f"gen_{base}"))
+    generated_graspness = grasps.groupby("shape_id").success.mean().reindex(generated.shape_id).fillna(0.0).to_numpy()
+    panels = []
+    for name, selected, made in (("rarity", base_set.rarity[base_set.selected_by_rarity], generated.rarity_vs_base),
+                                 ("graspness", base_set.graspness[base_set.selected_by_graspness], pd.Series(generated_graspness))):
+        test_values = scores.loc[improvement.index, name].to_numpy()
+        values = np.concatenate([selected, made, test_values])
+        edges = np.linspace(0.0 if name == "graspness" else float(np.min(values)), float(np.quantile(values, 0.99)) + 1e-9, 9)
+        bins = np.clip(np.digitize(test_values, edges) - 1, 0, len(edges) - 2)
+        means = [float(improvement.to_numpy()[bins == b].mean()) if (bins == b).any() else np.nan for b in range(len(edges) - 1)]
+        panels.append({"name": name, "edges": edges, "selected": np.asarray(selected), "generated": np.asarray(made), "improvement": means,
+                       "objects": [int((bins == b).sum()) for b in range(len(edges) - 1)]})
+    improvement_by_interval(panels, REPORT_DIR / "improvement_by_score.png",
+                            f"B = {base}: per-object test AP, ratio 1:{compare:g} minus 1:0 ({len(improvement)} test objects with both labels)")
+    summary["per_object"] = {"base_size": base, "ratio": compare, "objects": int(len(improvement)),
+                             "mean_improvement": round(float(improvement.mean()), 5) if len(improvement) else None,
+                             "improved_share": round(float((improvement > 0).mean()), 4) if len(improvement) else None}
+
+    # Fig. 1: t-SNE of original train and generated latents by graspness
+    from sklearn.manifold import TSNE
+
+    latents = read_table(LATENTS)
+    train = latents[latents.split == "train"]
+    z = np.concatenate([np.stack(train.z.to_numpy()), np.stack(generated.z.to_numpy())])
+    graspness = np.concatenate([scores.loc[train.shape_id, "graspness"].to_numpy(), generated_graspness])
+    groups = ["original train"] * len(train) + [f"generated (B = {base}, targeted)"] * len(generated)
+    xy = TSNE(n_components=2, perplexity=min(params.embed.perplexity, (len(z) - 1) / 3), init="pca", random_state=params.seed).fit_transform(z)
+    scatter_colored(xy, graspness, groups, REPORT_DIR / "tsne_graspness.png", "t-SNE of the AE-Critic latents, colored by graspness (paper Fig. 1)", "graspness")
+
+    ap = {pool: {str(b): {f"{r:g}": {"mean": None if np.isnan(m) else round(m, 5), "std": None if np.isnan(s) else round(s, 5), "n": int(n)}
+                          for r, m, s, n in zip(rows.ratio, rows.ap_mean, rows.ap_std, rows.n)}
+                 for b, rows in frame.groupby("base_size")} for pool, frame in table.groupby("pool")}
+    write_json({"ap": ap, "summary": summary, "seeds": list(params.gqcnn.seeds)}, AP_METRICS)
+    write_markdown(table, words, summary, params)
+    for line in words:
+        log.info("report: %s", line)
+
+
+def write_markdown(table: pd.DataFrame, words: list[str], summary: dict, params: Params) -> None:
+    lines = ["# GQ-CNN augmentation experiment", "",
+             f"Test Average Precision on every test-split grasp of the original corpus; mean ± std over seeds {list(params.gqcnn.seeds)} "
+             f"({params.gqcnn.steps} SGD steps per network). Paper (Fig. 7): best ratios 1:0.5, 1:1.5, 1:2 for B = 50, 100, 200.", ""]
+    ratios = sorted(table.ratio.unique())
+    lines.append("| pool | B | " + " | ".join(f"1:{r:g}" for r in ratios) + " | best |")
+    lines.append("|---|---|" + "---|" * (len(ratios) + 1))
+    for (pool, base), rows in table.groupby(["pool", "base_size"], sort=False):
+        cells = []
+        for r in ratios:
+            row = rows[rows.ratio == r]
+            if row.empty:
+                cells.append("")
+            else:
+                m, s = row.ap_mean.iloc[0], row.ap_std.iloc[0]
+                cells.append("-" if np.isnan(m) else f"{m:.4f}" + ("" if np.isnan(s) else f" ± {s:.4f}"))
+        best = f"1:{rows.loc[rows.ap_mean.idxmax(), 'ratio']:g}" if rows.ap_mean.notna().any() else "-"
+        lines.append(f"| {pool} | {base} | " + " | ".join(cells) + f" | {best} |")
+    lines += ["", "## What the numbers say", ""] + [f"- {w}" for w in words]
+    per = summary["per_object"]
+    lines += [f"- Per object (B = {per['base_size']}, 1:{per['ratio']:g} vs 1:0): mean AP change {per['mean_improvement']}, "
+              f"improved on {per['improved_share']} of {per['objects']} test objects with both labels.", "",
+              "![AP vs ratio](ap_vs_ratio.png)", "", "![Per-object improvement](improvement_by_score.png)", "", "![t-SNE](tsne_graspness.png)", ""]
+    with atomic_path(REPORT_DIR / "report.md") as tmp:
+        tmp.write_text("\n".join(lines))

@@ -1,0 +1,140 @@
+"""Stage ``train_gqcnn``: one GQ-CNN for one base size B, augmentation ratio R, pool and seed.
+
+Training set: the rendered datapoints of the B base shapes (``data/gqcnn/original``, shapes
+of ``data/generated/B/base.parquet``) plus those of the first round(R × B) shapes of B's
+``targeted`` (or ``random``) pool (``data/gqcnn/gen_B``); a ``val_fraction`` of its views is
+held out for the validation curves. Test set: every test-split datapoint of
+``data/gqcnn/original``. Budget rule: ``gqcnn.steps`` SGD steps for every variant.
+
+Outputs: ``models/gqcnn/<pool>/<B>-<R>-s<seed>/`` (``model.pt``: config, weights, training
+summary; ``test_predictions.npy``: P(success) per test datapoint, in index order),
+``metrics/gqcnn/<pool>/<B>-<R>-s<seed>.json`` (test AP, accuracy, ROC AUC; stable keys for
+``dvc metrics diff``) and the DVCLive curves in ``metrics/gqcnn/<pool>/<B>-<R>-s<seed>/``.
+"""
+from __future__ import annotations
+
+import dataclasses
+import json
+import logging
+import time
+
+import numpy as np
+import torch
+
+from graspaug.config import GQCNNParams, Params
+from graspaug.generation import ratio_count
+from graspaug.io.atomic import atomic_path
+from graspaug.io.gqcnn import GraspImages
+from graspaug.io.tables import read_table, write_json
+from graspaug.nets.gqcnn import GQCNN, GQCNNConfig
+from graspaug.paths import base_set_table, gqcnn_dir, gqcnn_live, gqcnn_metrics, gqcnn_model_dir
+from graspaug.stages import StageError
+from graspaug.training.autoencoder import resolve_device
+from graspaug.training.gqcnn import GraspArrays, NoiseSettings, TrainSettings, classification_metrics, predict, train_gqcnn
+
+log = logging.getLogger(__name__)
+
+POOLS = ("targeted", "random")
+
+
+def network_config(cfg: GQCNNParams, image_size: int) -> GQCNNConfig:
+    return GQCNNConfig(image_size=image_size, filters=cfg.filters, fc=cfg.fc, pose_fc=cfg.pose_fc, pool_after_conv2=cfg.pool_after_conv2)
+
+
+def train_settings(cfg: GQCNNParams) -> TrainSettings:
+    return TrainSettings(
+        steps=cfg.steps, batch_size=cfg.batch_size, lr=cfg.lr, momentum=cfg.momentum, lr_decay=cfg.lr_decay, decay_steps=cfg.decay_steps,
+        weight_decay=cfg.weight_decay, log_every=cfg.log_every,
+        noise=NoiseSettings(gamma_shape=cfg.gamma_shape, gp_prob=cfg.gp_prob, gp_sigma=cfg.gp_sigma, gp_grid=cfg.gp_grid, symmetrize=cfg.symmetrize),
+    )
+
+
+def _arrays(data: GraspImages, rows: np.ndarray) -> GraspArrays:
+    return GraspArrays(data.images(rows), data.read("z", rows), data.read("labels", rows))
+
+
+def training_set(base_size: int, ratio: float, pool: str) -> tuple[GraspArrays, np.ndarray, dict]:
+    """The datapoints of the base shapes and of the first round(R·B) shapes of the pool, their
+    view keys (for the validation split) and counts."""
+    base = set(read_table(base_set_table(base_size)).shape_id)
+    original = GraspImages.open(gqcnn_dir("original"))
+    rows = np.flatnonzero(original.index.shape_id.isin(base).to_numpy())
+    parts = [_arrays(original, rows)]
+    keys = [("o:" + original.index.shape_id.iloc[rows] + ":" + original.index.image_id.iloc[rows].astype(str)).to_numpy()]
+    n_generated, generated_shapes = ratio_count(ratio, base_size), 0
+    if n_generated:
+        generated = GraspImages.open(gqcnn_dir(f"gen_{base_size}"))
+        index = generated.index
+        gen_rows = np.flatnonzero(((index.pool == pool) & (index.order < n_generated)).to_numpy())
+        parts.append(_arrays(generated, gen_rows))
+        keys.append(("g:" + index.shape_id.iloc[gen_rows] + ":" + index.image_id.iloc[gen_rows].astype(str)).to_numpy())
+        generated_shapes = int(index.shape_id.iloc[gen_rows].nunique())
+    data = GraspArrays(*(np.concatenate([getattr(p, f) for p in parts]) for f in ("images", "z", "labels")))
+    info = {"base_shapes": int(original.index.shape_id.iloc[rows].nunique()), "generated_shapes_asked": n_generated,
+            "generated_shapes": generated_shapes, "datapoints": len(data), "positive_share": round(float(data.labels.mean()), 4) if len(data) else None}
+    return data, np.concatenate(keys), info
+
+
+def test_set() -> tuple[GraspArrays, np.ndarray]:
+    """Every test-split datapoint of the original corpus and its row in the index."""
+    original = GraspImages.open(gqcnn_dir("original"))
+    rows = np.flatnonzero((original.index.split == "test").to_numpy())
+    return _arrays(original, rows), rows
+
+
+def run(params: Params, base_size: int, ratio: float, pool: str = "targeted", seed: int = 0) -> None:
+    cfg = params.gqcnn
+    if pool not in POOLS:
+        raise StageError(f"unknown pool {pool!r}; known: {', '.join(POOLS)}")
+    if base_size not in params.generate.base_sizes:
+        raise StageError(f"base size {base_size} is not in generate.base_sizes {list(params.generate.base_sizes)}")
+    if float(ratio) not in params.generate.ratios:
+        raise StageError(f"ratio {ratio} is not in generate.ratios {list(params.generate.ratios)}")
+    start = time.perf_counter()
+    device = resolve_device(params.device)
+    train, keys, info = training_set(base_size, ratio, pool)
+    if len(train) < 2:
+        raise StageError(f"training set of {base_size}-{ratio} ({pool}) has {len(train)} datapoints; render the corpora first")
+    if train.labels.min() == train.labels.max():
+        log.warning("train_gqcnn %s %d-%s: all %d training datapoints have label %d; the network cannot learn to rank",
+                    pool, base_size, ratio, len(train), int(train.labels[0]))
+    views = np.unique(keys)
+    rng = np.random.default_rng([params.seed, seed, base_size, int(round(ratio * 1000))])
+    held_out = rng.choice(views, int(round(cfg.val_fraction * len(views))), replace=False)
+    is_val = np.isin(keys, held_out)
+    val, fit = train.subset(np.flatnonzero(is_val)), train.subset(np.flatnonzero(~is_val))
+    test, test_rows = test_set()
+
+    torch.manual_seed(params.seed * 1_000_003 + seed)
+    net = GQCNN(network_config(cfg, train.images.shape[1]))
+    gen = torch.Generator().manual_seed(params.seed * 1_000_003 + seed + 1)
+    from dvclive import Live
+
+    live_dir = gqcnn_live(pool, base_size, ratio, seed)
+    log.info("train_gqcnn %s %d-%s seed %d: %d train / %d val datapoints (%d base + %d generated shapes), %d test, %s on %s",
+             pool, base_size, ratio, seed, len(fit), len(val), info["base_shapes"], info["generated_shapes"], len(test), net.describe(), device)
+    with Live(str(live_dir), dvcyaml=False, save_dvc_exp=False) as live:
+        def on_log(step: int, metrics: dict[str, float]) -> None:
+            for name, value in metrics.items():
+                live.log_metric(name, value)
+            live.next_step()
+
+        speed = train_gqcnn(net, fit, val if len(val) else None, train_settings(cfg), device, gen, on_log)
+    probability = predict(net, test, device)
+    scores = classification_metrics(test.labels, probability)
+    summary = {
+        "pool": pool, "base_size": base_size, "ratio": float(ratio), "seed": seed,
+        "test": {k: (round(v, 5) if isinstance(v, float) else v) for k, v in scores.items()},
+        "train": {**info, "fit_datapoints": len(fit), "val_datapoints": len(val)},
+        "steps": cfg.steps, "batch_size": cfg.batch_size, "parameters": net.describe()["parameters"],
+        "samples_per_second": round(speed["samples_per_second"], 1), "seconds": round(time.perf_counter() - start, 1),
+    }
+    with atomic_path(gqcnn_model_dir(pool, base_size, ratio, seed), directory=True) as folder:
+        torch.save({"config": dataclasses.asdict(net.config), "state_dict": net.state_dict(), "summary": summary}, folder / "model.pt")
+        np.save(folder / "test_predictions.npy", probability)
+        np.save(folder / "test_rows.npy", test_rows)
+        (folder / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
+    write_json(summary, gqcnn_metrics(pool, base_size, ratio, seed))
+    log.info("train_gqcnn %s %d-%s seed %d: test AP %.4f, accuracy %.4f, ROC AUC %.4f; %.0f samples/s, %.1f s", pool, base_size, ratio, seed,
+             scores["ap"] or float("nan"), scores["accuracy"], scores["roc_auc"] or float("nan"), speed["samples_per_second"], summary["seconds"])
+

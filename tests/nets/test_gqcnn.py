@@ -1,0 +1,35 @@
+"""The GQ-CNN network: shapes, layer sizes, normalization kept in the model."""
+import pytest
+import torch
+
+from graspaug.nets.gqcnn import GQCNN, GQCNNConfig
+
+
+@pytest.mark.parametrize("pool", [True, False])
+def test_output_shapes_and_layer_sizes(pool):
+    net = GQCNN(GQCNNConfig(filters=8, fc=32, pose_fc=4, pool_after_conv2=pool))
+    logits = net(torch.rand(5, 1, 32, 32) + 0.5, torch.rand(5) + 0.5)
+    assert logits.shape == (5, 2)
+    side = 8 if pool else 16
+    assert net.fc3.in_features == 8 * side * side and net.fc3.out_features == 32
+    assert net.pc1.out_features == 4 and net.fc4_pose.in_features == 4 and net.fc5.out_features == 2
+    p = net.success_probability(torch.rand(3, 1, 32, 32), torch.rand(3))
+    assert p.shape == (3,) and torch.all((p >= 0) & (p <= 1))
+
+
+def test_dexnet_widths_and_normalization_in_the_model():
+    net = GQCNN()  # Dex-Net 2.0 (2018 config) widths
+    assert [net.conv1_1.kernel_size, net.conv1_2.kernel_size, net.conv2_1.kernel_size] == [(7, 7), (5, 5), (3, 3)]
+    assert net.conv1_1.out_channels == 64 and net.fc3.out_features == 1024 and net.fc4_image.out_features == 1024
+    assert net.lrn.size == 5 and net.lrn.alpha == pytest.approx(1e-4) and net.lrn.beta == 0.75
+    images, z = torch.rand(4, 1, 32, 32) * 0.05 + 0.65, torch.rand(4) * 0.05 + 0.65
+    before = net(images, z)
+    net.set_normalization(0.7, 0.02, 0.68, 0.03)
+    assert not torch.allclose(before, net(images, z))
+    state = net.state_dict()
+    assert float(state["image_mean"]) == pytest.approx(0.7) and float(state["z_std"]) == pytest.approx(0.03)
+    again = GQCNN()
+    again.load_state_dict(state)
+    assert torch.allclose(again(images, z), net(images, z))
+    with pytest.raises(ValueError, match="divisible"):
+        GQCNNConfig(image_size=30)

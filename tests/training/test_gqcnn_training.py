@@ -1,0 +1,69 @@
+"""Training a GQ-CNN: metrics, noise, and learning a separable toy set."""
+import numpy as np
+import pytest
+import torch
+
+from graspaug.nets.gqcnn import GQCNN, GQCNNConfig
+from graspaug.training.gqcnn import GraspArrays, NoiseSettings, TrainSettings, augment, classification_metrics, predict, train_gqcnn
+
+
+def test_average_precision_matches_a_hand_computed_case():
+    # ranked: 1 (pos), 0.8 (neg), 0.7 (pos), 0.1 (neg): precision at the positives 1/1 and 2/3
+    scores = classification_metrics(np.array([1, 0, 1, 0]), np.array([0.9, 0.8, 0.7, 0.1]))
+    assert scores["ap"] == pytest.approx((1 + 2 / 3) / 2)
+    assert scores["accuracy"] == pytest.approx(0.75)  # 0.8 > 0.5 is the one mistake
+    assert scores["roc_auc"] == pytest.approx(0.75)  # 3 of 4 (pos, neg) pairs ordered right
+    assert scores["positive_share"] == 0.5 and scores["datapoints"] == 4
+    one_class = classification_metrics(np.zeros(3), np.array([0.1, 0.2, 0.3]))
+    assert one_class["ap"] is None and one_class["roc_auc"] is None
+
+
+def test_augmentation_noise_and_symmetries():
+    gen = torch.Generator().manual_seed(0)
+    images = torch.rand(400, 1, 32, 32) * 0.1 + 0.6
+    z = torch.rand(400) * 0.1 + 0.6
+    sym, same_z = augment(images, z, NoiseSettings(gamma_shape=0, gp_prob=0, symmetrize=True), gen)
+    torch.testing.assert_close(same_z, z)
+    # turns and flips only move pixels
+    torch.testing.assert_close(sym.flatten(1).sort(dim=1).values, images.flatten(1).sort(dim=1).values)
+    assert 0.7 < (sym != images).flatten(1).any(1).float().mean() < 0.95  # 1 - 1/8 of the images change
+    scaled, scaled_z = augment(torch.ones(4000, 1, 4, 4), torch.full((4000,), 2.0), NoiseSettings(gamma_shape=1000, gp_prob=0, symmetrize=False), gen)
+    scaled = scaled[:, 0, 0, 0]
+    assert float(scaled.mean()) == pytest.approx(1.0, abs=0.003) and float(scaled.std()) == pytest.approx(1000**-0.5, rel=0.1)
+    torch.testing.assert_close(scaled_z, 2 * scaled)  # image and gripper depth scaled together
+    field, _ = augment(torch.zeros(2000, 1, 32, 32), torch.zeros(2000), NoiseSettings(gamma_shape=0, gp_prob=0.5, gp_sigma=0.005, symmetrize=False), gen)
+    noisy = field.flatten(1).abs().amax(1) > 0
+    assert 0.45 < float(noisy.float().mean()) < 0.55
+    assert 0.003 < float(field[noisy].std()) < 0.006  # the grid's sigma, smoothed by the upsampling
+    a = augment(images, z, NoiseSettings(), torch.Generator().manual_seed(3))
+    b = augment(images, z, NoiseSettings(), torch.Generator().manual_seed(3))
+    torch.testing.assert_close(a, b)
+
+
+def toy_set(n: int, rng: np.random.Generator) -> GraspArrays:
+    """Positives: an object (2 cm nearer than the table) under the gripper; negatives: the
+    object off to one side. Table depth, object size and position vary."""
+    images = np.full((n, 32, 32), 0.7, np.float32) + rng.uniform(-0.02, 0.02, (n, 1, 1)).astype(np.float32)
+    labels = rng.random(n) < 0.3
+    for i in range(n):
+        half = rng.integers(3, 6)
+        cx = 16 if labels[i] else rng.choice([5, 27])
+        cy = 16 + rng.integers(-3, 4)
+        images[i, cy - half : cy + half, cx - half : cx + half] -= 0.02
+    return GraspArrays(images, (images[:, 16, 16] + 0.01).astype(np.float32), labels.astype(np.uint8))
+
+
+def test_a_tiny_gqcnn_learns_a_separable_toy_set():
+    rng = np.random.default_rng(0)
+    train, test = toy_set(1500, rng), toy_set(500, rng)
+    torch.manual_seed(0)
+    net = GQCNN(GQCNNConfig(filters=8, fc=32, pose_fc=4))
+    logged = []
+    settings = TrainSettings(steps=150, batch_size=32, lr=0.01, decay_steps=50, log_every=50)
+    speed = train_gqcnn(net, train, test, settings, torch.device("cpu"), torch.Generator().manual_seed(0), lambda step, m: logged.append((step, m)))
+    assert [step for step, _ in logged] == [50, 100, 150]
+    assert set(logged[0][1]) == {"loss", "train_accuracy", "lr", "val_accuracy", "val_ap"}
+    assert logged[-1][1]["loss"] < logged[0][1]["loss"]
+    scores = classification_metrics(test.labels, predict(net, test, torch.device("cpu")))
+    assert scores["ap"] > 0.95
+    assert speed["samples_per_second"] > 0
