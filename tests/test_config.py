@@ -79,3 +79,13 @@ def test_paper_profile_loads_with_the_paper_sizes(repo_root):
     assert params.voxelize.resolution == 64
     assert (params.ae.base_width, params.ae.top_width, params.ae.z_dim) == (64, 512, 128)
     assert params.ingest.test_fraction == pytest.approx(363 / 1363, abs=1e-4)
+
+
+def test_study_profile_is_the_defaults_with_three_seeds(repo_root):
+    import dataclasses
+
+    study, default = load_params(repo_root / "profiles/study.yaml"), load_params(repo_root / "params.yaml")
+    assert study.gqcnn.seeds == (0, 1, 2) and default.gqcnn.seeds == (0,)
+    assert dataclasses.replace(study, gqcnn=dataclasses.replace(study.gqcnn, seeds=(0,))) == default
+    paper = load_params(repo_root / "profiles/paper.yaml")
+    assert (paper.gqcnn.filters, paper.gqcnn.fc) == (64, 1024) and len(paper.gqcnn.seeds) >= 3

@@ -20,11 +20,11 @@ TINY = {
     "voxelize": {"resolution": 16},
     "ae": {"base_width": 4, "top_width": 16, "z_dim": 16, "batch_size": 8, "epochs_ae": 1, "epochs_critic": 1},
     "critic_eval": {"n_shapes": 10, "n_pairs": 3, "n_examples": 2},
-    "grasps": {"n_grasps": 8, "n_samples": 4},
+    "grasps": {"n_grasps": 8, "n_samples": 4, "threshold": 0.0005},  # a low threshold: positives in a tiny test set
     "score": {"k": 3, "bins": 5},
     "generate": {"base_sizes": [4, 6], "ratios": [0.0, 0.5, 1.0, 2.0], "percentile": 50.0, "first_neighbour": 1, "extra_neighbours": 1,
                  "min_voxels": 5, "min_main_share": 0.5, "smoothing_iterations": 3, "n_examples": 2},
-    "render": {"max_poses": 2, "n_examples": 4},
+    "render": {"max_poses": 2, "n_examples": 4, "axis_tolerance_deg": 45.0, "images_per_pose": 2},
     "gqcnn": {"filters": 4, "fc": 16, "pose_fc": 4, "steps": 6, "log_every": 3, "random_base_sizes": [6], "random_ratios": [1.0]},
 }
 
@@ -214,6 +214,8 @@ def test_dvc_repro_gqcnn_matrix_and_report(tiny_repo):
     assert with_generated["generated_shapes_asked"] == 12 and with_generated["base_shapes"] <= 6
     ap = json.loads((work / "metrics/ap.json").read_text())
     assert set(ap["ap"]["targeted"]) == {"4", "6"} and set(ap["ap"]["targeted"]["6"]) == {"0", "0.5", "1", "2"}
+    assert all(0 < cell["mean"] <= 1 and cell["n"] == 1 for cell in ap["ap"]["targeted"]["6"].values())  # both labels in the test set
+    assert ap["summary"]["6"]["best_ratio"] in (0.0, 0.5, 1.0, 2.0) and "beyond_seed_spread" in ap["summary"]["6"]
     assert set(ap["ap"]["random"]["6"]) == {"0", "1"}  # ratio 0 is shared with the targeted curve
     report = (work / "reports/gqcnn/report.md").read_text()
     assert "| targeted | 4 |" in report and "| random | 6 |" in report and "## What the numbers say" in report

@@ -180,16 +180,16 @@ class RenderParams:
 class GQCNNParams:
     """GQ-CNN networks per base size × augmentation ratio (paper Section IV-C) and their training."""
 
-    filters: int = param(16, "Channels of each conv layer (Dex-Net 2.0 / paper profile: 64).", ge=1)
-    fc: int = param(128, "Width of fc3 and fc4 (Dex-Net: 1024).", ge=1)
+    filters: int = param(8, "Channels of each conv layer (Dex-Net 2.0 / paper profile: 64; 8 fits the CPU budget).", ge=1)
+    fc: int = param(64, "Width of fc3 and fc4 (Dex-Net: 1024).", ge=1)
     pose_fc: int = param(16, "Width of the gripper-depth layer pc1 (Dex-Net: 16).", ge=1)
     pool_after_conv2: bool = param(True, "Max pool after conv2_2 (Dex-Net's 2018 config; 2017: none).")
-    steps: int = param(800, "SGD steps per network, the same for every training set (the budget rule).", ge=1)
+    steps: int = param(400, "SGD steps per network, the same for every training set (the budget rule).", ge=1)
     batch_size: int = param(64, "Datapoints per step (Dex-Net: 64-128).", ge=2)
     lr: float = param(0.01, "SGD learning rate (Dex-Net: 0.01).", gt=0)
     momentum: float = param(0.9, "SGD momentum (Dex-Net: 0.9).", ge=0, le=1)
     lr_decay: float = param(0.95, "Learning rate factor every decay_steps steps (Dex-Net: 0.95).", gt=0, le=1)
-    decay_steps: int = param(50, "Steps between learning-rate decays (Dex-Net: ~0.66 epoch).", ge=1)
+    decay_steps: int = param(100, "Steps between learning-rate decays (Dex-Net: ~0.66 epoch).", ge=1)
     weight_decay: float = param(5e-4, "L2 weight decay (Dex-Net: 5e-4).", ge=0)
     gamma_shape: float = param(1000.0, "Multiplicative image noise ~ Gamma(k, 1/k) per image (Dex-Net: k = 1000; 0: off).", ge=0)
     gp_prob: float = param(0.5, "Chance of adding smooth Gaussian-process noise to an image (Dex-Net: 0.5).", ge=0, le=1)

@@ -21,7 +21,7 @@ def test_dexnet_widths_and_normalization_in_the_model():
     net = GQCNN()  # Dex-Net 2.0 (2018 config) widths
     assert [net.conv1_1.kernel_size, net.conv1_2.kernel_size, net.conv2_1.kernel_size] == [(7, 7), (5, 5), (3, 3)]
     assert net.conv1_1.out_channels == 64 and net.fc3.out_features == 1024 and net.fc4_image.out_features == 1024
-    assert net.lrn.size == 5 and net.lrn.alpha == pytest.approx(1e-4) and net.lrn.beta == 0.75
+    assert net.lrn.size == 5 and net.lrn.alpha == pytest.approx(1e-4) and net.lrn.beta == 0.75 and net.lrn.k == 1.0
     images, z = torch.rand(4, 1, 32, 32) * 0.05 + 0.65, torch.rand(4) * 0.05 + 0.65
     before = net(images, z)
     net.set_normalization(0.7, 0.02, 0.68, 0.03)
@@ -33,3 +33,12 @@ def test_dexnet_widths_and_normalization_in_the_model():
     assert torch.allclose(again(images, z), net(images, z))
     with pytest.raises(ValueError, match="divisible"):
         GQCNNConfig(image_size=30)
+
+
+@pytest.mark.parametrize("size", [3, 4, 5])
+def test_local_response_norm_equals_torchs(size):
+    from graspaug.nets.gqcnn import LocalResponseNorm
+
+    x = torch.randn(3, 7, 5, 6, dtype=torch.float64)
+    expected = torch.nn.LocalResponseNorm(size, alpha=0.3, beta=0.75, k=1.0)(x)
+    torch.testing.assert_close(LocalResponseNorm(size, alpha=0.3, beta=0.75, k=1.0)(x), expected, rtol=1e-12, atol=1e-12)

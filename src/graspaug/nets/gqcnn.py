@@ -35,6 +35,25 @@ class GQCNNConfig:
             raise ValueError(f"layer widths must be >= 1, got {self}")
 
 
+class LocalResponseNorm(nn.Module):
+    """``x / (k + alpha / size * sum of x² over the size nearest channels) ** beta``, the same
+    function as ``torch.nn.LocalResponseNorm`` (a test checks it). The channel window sum is a
+    1×1 convolution with a 0/1 band matrix, several times faster on the CPU than torch's
+    pooling of a 5-D copy."""
+
+    def __init__(self, size: int, alpha: float, beta: float, k: float) -> None:
+        super().__init__()
+        self.size, self.alpha, self.beta, self.k = size, alpha, beta, k
+
+    def forward(self, x: torch.Tensor) -> torch.Tensor:
+        channels = x.shape[1]
+        offset = torch.arange(channels, device=x.device)
+        diff = offset[None, :] - offset[:, None]  # input channel - output channel
+        band = ((diff >= -(self.size // 2)) & (diff <= (self.size - 1) // 2)).to(x.dtype)
+        window = F.conv2d(x * x, band.view(channels, channels, 1, 1))
+        return x * (self.k + self.alpha / self.size * window).pow(-self.beta)
+
+
 class GQCNN(nn.Module):
     def __init__(self, config: GQCNNConfig = GQCNNConfig()) -> None:
         super().__init__()
@@ -45,7 +64,7 @@ class GQCNN(nn.Module):
         self.conv2_1 = nn.Conv2d(c, c, 3, padding="same")
         self.conv2_2 = nn.Conv2d(c, c, 3, padding="same")
         # torch divides alpha by the window (5), TF's tf.nn.lrn does not: 2e-5 * 5
-        self.lrn = nn.LocalResponseNorm(size=5, alpha=2e-5 * 5, beta=0.75, k=1.0)
+        self.lrn = LocalResponseNorm(size=5, alpha=2e-5 * 5, beta=0.75, k=1.0)
         side = config.image_size // (4 if config.pool_after_conv2 else 2)
         self.fc3 = nn.Linear(c * side * side, config.fc)
         self.pc1 = nn.Linear(1, config.pose_fc)

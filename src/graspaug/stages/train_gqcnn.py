@@ -115,9 +115,10 @@ def run(params: Params, base_size: int, ratio: float, pool: str = "targeted", se
              pool, base_size, ratio, seed, len(fit), len(val), info["base_shapes"], info["generated_shapes"], len(test), net.describe(), device)
     with Live(str(live_dir), dvcyaml=False, save_dvc_exp=False) as live:
         def on_log(step: int, metrics: dict[str, float]) -> None:
+            live.step = step  # x axis: SGD steps
             for name, value in metrics.items():
                 live.log_metric(name, value)
-            live.next_step()
+            live.make_summary()
 
         speed = train_gqcnn(net, fit, val if len(val) else None, train_settings(cfg), device, gen, on_log)
     probability = predict(net, test, device)
