@@ -191,12 +191,12 @@ class GQCNNParams:
     lr_decay: float = param(0.95, "Learning rate factor every decay_steps steps (Dex-Net: 0.95).", gt=0, le=1)
     decay_steps: int = param(100, "Steps between learning-rate decays (Dex-Net: ~0.66 epoch).", ge=1)
     weight_decay: float = param(5e-4, "L2 weight decay (Dex-Net: 5e-4).", ge=0)
-    gamma_shape: float = param(1000.0, "Multiplicative image noise ~ Gamma(k, 1/k) per image (Dex-Net: k = 1000; 0: off).", ge=0)
+    gamma_shape: float = param(1000.0, "Multiplicative noise ~ Gamma(k, 1/k) per image (Dex-Net: k = 1000; 0: off); unlike Dex-Net it scales the gripper depth too, so the object's height relative to the gripper keeps its meaning.", ge=0)
     gp_prob: float = param(0.5, "Chance of adding smooth Gaussian-process noise to an image (Dex-Net: 0.5).", ge=0, le=1)
     gp_sigma: float = param(0.005, "Its standard deviation (m) (Dex-Net: 0.005).", ge=0)
     gp_grid: int = param(8, "Its grid side before upsampling to the image (Dex-Net: 8 for 32 px).", ge=1)
     symmetrize: bool = param(True, "Turn images 180° and flip them about either axis at random (Dex-Net).")
-    val_fraction: float = param(0.1, "Share of the training views (whole images) held out for the validation curves.", ge=0, le=0.5)
+    val_fraction: float = param(0.1, "Share of the training views (whole images) held out for the validation curves; a view is held out or not by a hash of its id and the seed, the same for every ratio and pool.", ge=0, le=0.5)
     log_every: int = param(100, "Steps between DVCLive points (loss, train/val accuracy, val AP).", ge=1)
     seeds: list[int] = param((0,), "Training seeds; each network is trained once per seed (study profile: 0, 1, 2).")
     random_base_sizes: list[int] = param((200,), "Base sizes that also get random-pair augmentation networks (the baseline).")
@@ -298,6 +298,10 @@ def _build(cls: type, raw: Any, prefix: str) -> Any:
 def parse_params(raw: Any) -> Params:
     """Typed :class:`Params` from a parsed params.yaml mapping; raises :class:`ParamsError`."""
     params = _build(Params, raw, "")
+    for section, key in (("generate", "ratios"), ("gqcnn", "random_ratios")):
+        written = ((raw or {}).get(section) or {}).get(key) or []
+        if any(isinstance(value, int) for value in written):
+            raise ParamsError(f"{section}.{key}: write every ratio as a float (1.0, not 1): DVC names the networks' folders after them; got {written}")
     if params.data.source == "folder" and not params.data.path:
         raise ParamsError("data.path: required when data.source is folder")
     if params.n_jobs == 0:

@@ -76,6 +76,9 @@ class GQCNN(nn.Module):
                 nn.init.kaiming_normal_(module.weight, nonlinearity="relu")  # std sqrt(2 / fan_in)
                 if module.bias is not None:
                     nn.init.zeros_(module.bias)
+        # fc4 is one layer over [fc3, pc1] in Dex-Net: one std sqrt(2 / (fc + pose_fc)) for both parts
+        for part in (self.fc4_image, self.fc4_pose):
+            nn.init.normal_(part.weight, std=(2.0 / (config.fc + config.pose_fc)) ** 0.5)
         for name in ("image_mean", "image_std", "z_mean", "z_std"):
             self.register_buffer(name, torch.tensor(0.0 if name.endswith("mean") else 1.0))
 

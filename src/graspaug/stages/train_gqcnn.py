@@ -7,7 +7,8 @@ held out for the validation curves. Test set: every test-split datapoint of
 ``data/gqcnn/original``. Budget rule: ``gqcnn.steps`` SGD steps for every variant.
 
 Outputs: ``models/gqcnn/<pool>/<B>-<R>-s<seed>/`` (``model.pt``: config, weights, training
-summary; ``test_predictions.npy``: P(success) per test datapoint, in index order),
+summary; ``summary.json``; ``timing.json``: seconds and samples/s; ``test_predictions.npy``:
+P(success) per test datapoint and ``test_rows.npy``: their rows in the original index),
 ``metrics/gqcnn/<pool>/<B>-<R>-s<seed>.json`` (test AP, accuracy, ROC AUC; stable keys for
 ``dvc metrics diff``) and the DVCLive curves in ``metrics/gqcnn/<pool>/<B>-<R>-s<seed>/``.
 """
@@ -17,6 +18,7 @@ import dataclasses
 import json
 import logging
 import time
+import zlib
 
 import numpy as np
 import torch
@@ -75,6 +77,16 @@ def training_set(base_size: int, ratio: float, pool: str) -> tuple[GraspArrays, 
     return data, np.concatenate(keys), info
 
 
+def held_out_views(keys: np.ndarray, fraction: float, *seeds: int) -> np.ndarray:
+    """(N,) bool: datapoints whose view (key) is held out for validation. Decided per view by a
+    hash of the seeds and the key, so a base shape's view is held out (or not) alike for every
+    ratio and pool: variants differ only by the generated shapes they add."""
+    prefix = ":".join(map(str, seeds)) + ":"
+    unique, inverse = np.unique(keys, return_inverse=True)
+    chosen = np.array([zlib.crc32((prefix + key).encode()) / 2**32 < fraction for key in unique], dtype=bool)
+    return chosen[inverse] if len(unique) else np.zeros(len(keys), dtype=bool)
+
+
 def test_set() -> tuple[GraspArrays, np.ndarray]:
     """Every test-split datapoint of the original corpus and its row in the index."""
     original = GraspImages.open(gqcnn_dir("original"))
@@ -98,10 +110,7 @@ def run(params: Params, base_size: int, ratio: float, pool: str = "targeted", se
     if train.labels.min() == train.labels.max():
         log.warning("train_gqcnn %s %d-%s: all %d training datapoints have label %d; the network cannot learn to rank",
                     pool, base_size, ratio, len(train), int(train.labels[0]))
-    views = np.unique(keys)
-    rng = np.random.default_rng([params.seed, seed, base_size, int(round(ratio * 1000))])
-    held_out = rng.choice(views, int(round(cfg.val_fraction * len(views))), replace=False)
-    is_val = np.isin(keys, held_out)
+    is_val = held_out_views(keys, cfg.val_fraction, params.seed, seed)
     val, fit = train.subset(np.flatnonzero(is_val)), train.subset(np.flatnonzero(~is_val))
     test, test_rows = test_set()
 
@@ -118,24 +127,24 @@ def run(params: Params, base_size: int, ratio: float, pool: str = "targeted", se
             live.step = step  # x axis: SGD steps
             for name, value in metrics.items():
                 live.log_metric(name, value)
-            live.make_summary()
 
         speed = train_gqcnn(net, fit, val if len(val) else None, train_settings(cfg), device, gen, on_log)
     probability = predict(net, test, device)
     scores = classification_metrics(test.labels, probability)
-    summary = {
+    summary = {  # the metrics file: stable keys, no timings (they would show in every `dvc metrics diff`)
         "pool": pool, "base_size": base_size, "ratio": float(ratio), "seed": seed,
         "test": {k: (round(v, 5) if isinstance(v, float) else v) for k, v in scores.items()},
         "train": {**info, "fit_datapoints": len(fit), "val_datapoints": len(val)},
         "steps": cfg.steps, "batch_size": cfg.batch_size, "parameters": net.describe()["parameters"],
-        "samples_per_second": round(speed["samples_per_second"], 1), "seconds": round(time.perf_counter() - start, 1),
     }
+    timing = {"samples_per_second": round(speed["samples_per_second"], 1), "seconds": round(time.perf_counter() - start, 1)}
     with atomic_path(gqcnn_model_dir(pool, base_size, ratio, seed), directory=True) as folder:
         torch.save({"config": dataclasses.asdict(net.config), "state_dict": net.state_dict(), "summary": summary}, folder / "model.pt")
+        (folder / "timing.json").write_text(json.dumps(timing) + "\n")
         np.save(folder / "test_predictions.npy", probability)
         np.save(folder / "test_rows.npy", test_rows)
         (folder / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
     write_json(summary, gqcnn_metrics(pool, base_size, ratio, seed))
     log.info("train_gqcnn %s %d-%s seed %d: test AP %.4f, accuracy %.4f, ROC AUC %.4f; %.0f samples/s, %.1f s", pool, base_size, ratio, seed,
-             scores["ap"] or float("nan"), scores["accuracy"], scores["roc_auc"] or float("nan"), speed["samples_per_second"], summary["seconds"])
+             scores["ap"] or float("nan"), scores["accuracy"], scores["roc_auc"] or float("nan"), timing["samples_per_second"], timing["seconds"])
 
