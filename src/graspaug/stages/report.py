@@ -78,8 +78,9 @@ def verdicts(runs: pd.DataFrame, table: pd.DataFrame) -> tuple[dict, list[str]]:
     targeting, beat the seed-to-seed variation: the per-seed paired gain must exceed twice its
     standard error (about a t-test at 5%; it needs at least two seeds)."""
     summary, words = {}, []
-    targeted = table[table.pool == "targeted"].dropna(subset=["ap_mean"])
+    targeted = table[table.pool == "targeted"]
     for base, rows in targeted.groupby("base_size"):
+        rows = rows.dropna(subset=["ap_mean"])
         if not (rows.ratio == 0.0).any():
             words.append(f"B = {base}: no test AP at ratio 0 (the test set needs both labels).")
             continue
@@ -107,6 +108,9 @@ def verdicts(runs: pd.DataFrame, table: pd.DataFrame) -> tuple[dict, list[str]]:
         beyond = sum(g["beyond_2se"] for g in gains.values())
         summary[f"targeted_vs_random_{base}"] = {f"{r:g}": {k: (round(v, 5) if isinstance(v, float) else v) for k, v in g.items()} for r, g in gains.items()}
         seeds = max((g["n"] for g in gains.values()), default=0)
+        if seeds == 0:
+            words.append(f"Targeted vs random augmentation at B = {base}: no test AP to compare (the test set needs both labels).")
+            continue
         words.append(f"Targeted vs random augmentation at B = {base}: targeted has the higher test AP at {higher} of {len(ratios)} ratios "
                      "(AP differences " + ", ".join(f"1:{r:g} {g['mean']:+.4f}" for r, g in gains.items()) + "); "
                      + (f"{beyond} of them by more than twice the standard error over {seeds} seeds." if seeds > 1
