@@ -194,8 +194,9 @@ def improvement_by_interval(panels: list[dict], path: str | os.PathLike, title: 
         twin.set_ylabel("per-object AP improvement")
         lines, labels = ax.get_legend_handles_labels()
         more, more_labels = twin.get_legend_handles_labels()
-        ax.legend(lines + more, labels + more_labels, fontsize=7, loc="upper right")
+        ax.legend(lines + more, labels + more_labels, fontsize=7, loc="upper left")
     fig.suptitle(title, fontsize=9)
+    fig.subplots_adjust(wspace=0.45)
     _save(fig, path)
 
 
