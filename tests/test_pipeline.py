@@ -213,6 +213,7 @@ def test_dvc_repro_gqcnn_matrix_and_report(tiny_repo):
     with_generated = json.loads((work / "metrics/gqcnn/targeted/6-2.0-s0.json").read_text())["train"]
     assert with_generated["generated_shapes_asked"] == 12 and with_generated["base_shapes"] <= 6
     ap = json.loads((work / "metrics/ap.json").read_text())
+    report = (work / "reports/gqcnn/report.md").read_text()
     assert set(ap["ap"]["targeted"]) == {"4", "6"} and set(ap["ap"]["targeted"]["6"]) == {"0", "0.5", "1", "2"}
     index = pd.read_parquet(work / "data/gqcnn/original/index.parquet")
     test_labels = index.label[index.split == "test"]
@@ -227,7 +228,6 @@ def test_dvc_repro_gqcnn_matrix_and_report(tiny_repo):
     train_positive = json.loads((work / "metrics/gqcnn/targeted/6-2.0-s0.json").read_text())["train"]["positive_share"]
     assert 0 < train_positive < 1  # the tiny params give the networks both labels to learn from
     assert set(ap["ap"]["random"]["6"]) == {"0", "1"}  # ratio 0 is shared with the targeted curve
-    report = (work / "reports/gqcnn/report.md").read_text()
     assert "| targeted | 4 |" in report and "| random | 6 |" in report and "## What the numbers say" in report
     for picture in ("ap_vs_ratio", "improvement_by_score", "tsne_graspness"):
         assert (work / f"reports/gqcnn/{picture}.png").stat().st_size > 0
