@@ -3,3 +3,13 @@
 
 class StageError(RuntimeError):
     """A stage cannot produce valid outputs; the message says why (the CLI prints it, exit code 1)."""
+
+
+def corpus_paths(corpus: str):
+    """(shape table, mesh folder, mesh suffix) of a corpus name, or a StageError naming the known ones."""
+    from graspaug.paths import corpus_files
+
+    files = corpus_files(corpus)
+    if files is None:
+        raise StageError(f"unknown corpus {corpus!r}; known: original, gen_<base size>")
+    return files

@@ -22,9 +22,9 @@ from graspaug.grasping.gripper import ParallelJawGripper
 from graspaug.grasping.robust import Perturbations, QualitySettings, grasp_epsilon, robust_ferrari_canny
 from graspaug.io.meshes import mesh_path, read_mesh
 from graspaug.io.tables import read_table, write_json, write_table
-from graspaug.paths import corpus_files, grasps_metrics, grasps_table
+from graspaug.paths import grasps_metrics, grasps_table
 from graspaug.rng import shape_rng
-from graspaug.stages import StageError
+from graspaug.stages import corpus_paths
 
 log = logging.getLogger(__name__)
 
@@ -80,9 +80,7 @@ def grasps_of_shape(path: Path, shape_id: str, cfg: GraspsParams, seed: int) -> 
 def run(params: Params, corpus: str = "original") -> None:
     from graspaug.parallel import parallel_map
 
-    files = corpus_files(corpus)
-    if files is None:
-        raise StageError(f"unknown corpus {corpus!r}; known: original, gen_<base size>")
+    files = corpus_paths(corpus)
     start = time.perf_counter()
     cfg = params.grasps
     table_path, mesh_dir, suffix = files

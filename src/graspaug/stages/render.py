@@ -32,12 +32,12 @@ from graspaug.io.dexnet import write_tensor_dataset
 from graspaug.io.gqcnn import GraspImages, write_grasp_images
 from graspaug.io.meshes import mesh_path, read_mesh
 from graspaug.io.tables import read_table, write_json
-from graspaug.paths import corpus_files, gqcnn_dir, grasps_table, render_examples, render_metrics
+from graspaug.paths import gqcnn_dir, grasps_table, render_examples, render_metrics
 from graspaug.render.camera import Intrinsics, ViewpointRanges
 from graspaug.render.crops import CropGeometry
 from graspaug.render.dataset import RenderSettings, ShapeDatapoints, render_shape
 from graspaug.rng import shape_rng
-from graspaug.stages import StageError
+from graspaug.stages import StageError, corpus_paths
 from graspaug.stages.grasps import gripper
 
 log = logging.getLogger(__name__)
@@ -78,9 +78,7 @@ def run(params: Params, corpus: str = "original") -> None:
     from graspaug.parallel import parallel_map
     from graspaug.plots import crop_grid
 
-    files = corpus_files(corpus)
-    if files is None:
-        raise StageError(f"unknown corpus {corpus!r}; known: original, gen_<base size>")
+    files = corpus_paths(corpus)
     start = time.perf_counter()
     cfg = params.render
     settings = render_settings(cfg)
