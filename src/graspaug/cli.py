@@ -10,7 +10,7 @@ import typer
 
 from graspaug.config import (
     AEParams, CriticEvalParams, DataParams, EmbedParams, GenerateParams, GQCNNParams, GraspsParams, IngestParams, Params, ParamsError, RenderParams, ScoreParams,
-    VoxelizeParams,
+    SimParams, VoxelizeParams,
     describe, load_params,
 )
 
@@ -216,6 +216,17 @@ stage_command(
     "did augmentation beat the seed spread, did targeted beat random.\n\n"
     "Writes `metrics/ap.json`, `reports/gqcnn/{report.md,ap_table.csv,ap_vs_ratio.png,improvement_by_score.png,tsne_graspness.png}`.\n\n"
     "Reads params `generate.base_sizes`, `generate.ratios`, `gqcnn.seeds`, `gqcnn.random_base_sizes`, `gqcnn.random_ratios`, `embed.perplexity`, `seed`.",
+)
+
+stage_command(
+    "sim",
+    "Simulated robot trials (paper Section IV-E): a pybullet Franka Panda picks each object (eight everyday objects of "
+    "pybullet_data and `sim.n_test_objects` held-out test shapes, dropped from seeded poses) from the table into a bin, "
+    "with grasps planned on an overhead depth image by the GQ-CNN: antipodal seeds on depth edges, cross-entropy "
+    "refinement. Arms: `before` (B-0) and `after` (B at the report's best ratio), the same drops for both.\n\n"
+    "Writes `metrics/sim.json` (success per arm and object, 95% Wilson intervals, paired McNemar test) and `reports/sim/` "
+    "(`report.md`, `trials.csv`, `success.csv/.png`, `objects.csv`, `timing.json`, `trials/<arm>-<object>.png`).\n\n"
+    f"Params `sim`:\n\n{describe(SimParams)}",
 )
 
 

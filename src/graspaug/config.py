@@ -204,6 +204,38 @@ class GQCNNParams:
 
 
 @dataclass(frozen=True)
+class SimParams:
+    """Simulated Panda pick-and-place trials before and after augmentation (paper Section IV-E)."""
+
+    objects: list[str] = param(("mug", "duck", "teddy", "bunny", "torus", "cube", "cylinder", "prism"), "Everyday objects of pybullet_data to pick (any of mug, duck, teddy, bunny, torus, cube, cylinder, prism).")
+    n_test_objects: int = param(2, "Held-out test shapes (test split of data/shapes, a seeded choice) picked as well.", ge=0)
+    attempts: int = param(10, "Attempts per object and arm (paper: 10); each attempt drops the object anew from a seeded pose, the same for both arms.", ge=1)
+    base_size: int = param(200, "Base size B of the two networks compared: B-0 (before) and B at the report's best ratio (after).", ge=2)
+    object_mass: float = param(0.1, "Mass of every object (kg; the random_urdfs objects weigh 0.1).", gt=0)
+    object_friction: float = param(0.5, "Lateral friction of the objects (pybullet multiplies it by the partner's: fingers, table).", gt=0)
+    finger_friction: float = param(1.0, "Lateral friction of the finger pads.", gt=0)
+    table_friction: float = param(0.8, "Lateral friction of the table.", gt=0)
+    grip_force: float = param(20.0, "Closing force limit per finger (N; the URDF's effort limit is 20).", gt=0)
+    camera_height: float = param(0.65, "Depth camera height above the table, looking straight down (m; paper: 0.65).", gt=0.1)
+    image_width: int = param(640, "Depth image width (px).", ge=128)
+    image_height: int = param(480, "Depth image height (px).", ge=128)
+    focal_length: float = param(525.0, "fx = fy (px); the principal point is the image center.", gt=0)
+    drop_offset: float = param(0.05, "Objects are dropped up to this far from the table center in x and y, in a random orientation (m).", ge=0, le=0.15)
+    seed_samples: int = param(250, "Antipodal seed grasps per image (Dex-Net: 100-250).", ge=1)
+    cem_iters: int = param(3, "Cross-entropy iterations (Dex-Net: 3).", ge=0)
+    elite_fraction: float = param(0.25, "Share of the best grasps refit each iteration (Dex-Net: 0.25).", gt=0, le=1)
+    gmm_components: int = param(3, "Gaussian mixture components at most; fewer when ceil(0.4 × elites) is smaller.", ge=1)
+    gmm_samples: int = param(50, "Grasps drawn from the mixture per iteration (Dex-Net: 50).", ge=1)
+    friction_coef: float = param(0.8, "Friction coefficient of the antipodality test on depth edges (Dex-Net: 0.8).", gt=0)
+    depth_grad_thresh: float = param(0.0025, "Depth gradient (m per px) that marks an edge pixel (Dex-Net: 0.0025).", gt=0)
+    min_dist_from_boundary: int = param(45, "Edge pixels this close to the image border are ignored (px; Dex-Net: 45).", ge=0)
+    min_depth_offset: float = param(0.005, "Grasp depth below the surface between the jaws, lowest (m; Dex-Net: 0.005).", ge=0)
+    max_depth_offset: float = param(0.04, "... and highest (m; Dex-Net: 0.04).", ge=0)
+    n_pictures: int = param(3, "Trials per arm (first attempts of the first objects) drawn with their depth image, grasp and pick frames.", ge=0)
+    vhacd_resolution: int = param(100000, "V-HACD voxel resolution of the convex decompositions (cached per mesh in ~/.cache/graspaug/sim or $GRASPAUG_CACHE).", ge=10000)
+
+
+@dataclass(frozen=True)
 class Params:
     """All parameters of the pipeline."""
 
@@ -221,6 +253,7 @@ class Params:
     generate: GenerateParams = field(default_factory=GenerateParams)
     render: RenderParams = field(default_factory=RenderParams)
     gqcnn: GQCNNParams = field(default_factory=GQCNNParams)
+    sim: SimParams = field(default_factory=SimParams)
 
 
 def _type_name(tp: Any) -> str:
@@ -331,6 +364,18 @@ def parse_params(raw: Any) -> Params:
         raise ParamsError(f"gqcnn.random_ratios: must be nonzero ratios among generate.ratios {list(gen.ratios)}; got {list(net.random_ratios)}")
     if render.crop_size % render.out_size or render.crop_size < render.out_size:
         raise ParamsError(f"render.out_size: must divide render.crop_size ({render.crop_size}); got {render.out_size}")
+    sim = params.sim
+    from graspaug.sim.catalog import EVERYDAY_OBJECTS
+
+    unknown = [name for name in sim.objects if name not in EVERYDAY_OBJECTS]
+    if unknown or len(set(sim.objects)) != len(sim.objects):
+        raise ParamsError(f"sim.objects: must be distinct names among {', '.join(EVERYDAY_OBJECTS)}; got {list(sim.objects)}")
+    if not sim.objects and sim.n_test_objects == 0:
+        raise ParamsError("sim.objects: no objects to pick (sim.objects is empty and sim.n_test_objects is 0)")
+    if sim.base_size not in gen.base_sizes:
+        raise ParamsError(f"sim.base_size: must be one of generate.base_sizes {list(gen.base_sizes)}; got {sim.base_size}")
+    if sim.min_depth_offset > sim.max_depth_offset:
+        raise ParamsError(f"sim.max_depth_offset: must be >= sim.min_depth_offset ({sim.min_depth_offset}); got {sim.max_depth_offset}")
     return params
 
 

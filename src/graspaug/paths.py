@@ -118,3 +118,6 @@ def gqcnn_live(pool: str, base_size: int, ratio: float, seed: int) -> Path:
 
 AP_METRICS = Path("metrics/ap.json")
 REPORT_DIR = Path("reports/gqcnn")
+# sim
+SIM_METRICS = Path("metrics/sim.json")
+SIM_REPORT_DIR = Path("reports/sim")

@@ -218,3 +218,47 @@ def scatter_colored(xy: np.ndarray, values: np.ndarray, markers: Sequence[str], 
     ax.set_yticks([])
     ax.legend(fontsize=8)
     _save(fig, path)
+
+
+def success_bars(names: Sequence[str], arms: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]], path: str | os.PathLike, title: str) -> None:
+    """Grouped bars of success rate per object and arm; ``arms[label] = (rate, low, high)``,
+    each (len(names),), drawn with the interval as error bars."""
+    plt = _pyplot()
+    fig, ax = plt.subplots(figsize=(max(6.0, 0.9 * len(names) + 2), 4))
+    x = np.arange(len(names))
+    width = 0.8 / max(1, len(arms))
+    for i, (label, (rate, low, high)) in enumerate(arms.items()):
+        rate, low, high = (np.asarray(a, dtype=float) for a in (rate, low, high))
+        ax.bar(x + (i - (len(arms) - 1) / 2) * width, rate, width, yerr=[rate - low, high - rate], capsize=3, label=label)
+    ax.set_xticks(x)
+    ax.set_xticklabels(names, rotation=30, ha="right")
+    ax.set_ylim(0, 1.05)
+    ax.set_ylabel("grasp success rate")
+    ax.set_title(title)
+    ax.legend()
+    _save(fig, path)
+
+
+def pick_story(depth: np.ndarray, jaw: np.ndarray | None, window: tuple[int, int, int, int], frames: Sequence[tuple[str, np.ndarray]],
+               path: str | os.PathLike, title: str) -> None:
+    """One trial: the depth image (m) inside ``window`` = (u0, v0, u1, v1) px with the chosen
+    grasp's jaw segment ``jaw`` (2, 2) as (u, v) rows drawn, then the RGB pick frames."""
+    plt = _pyplot()
+    panels = 1 + len(frames)
+    fig, axes = plt.subplots(1, panels, figsize=(2.9 * panels, 2.9), layout="constrained")
+    axes = np.atleast_1d(axes)
+    u0, v0, u1, v1 = window
+    shown = axes[0].imshow(depth[v0:v1, u0:u1], cmap="viridis", extent=(u0 - 0.5, u1 - 0.5, v1 - 0.5, v0 - 0.5))
+    if jaw is not None:
+        axes[0].plot(jaw[:, 0], jaw[:, 1], "r-", lw=2)
+        axes[0].plot(jaw[:, 0], jaw[:, 1], "ro", ms=4)
+    fig.colorbar(shown, ax=axes[0], location="bottom", fraction=0.05, pad=0.02, label="depth (m)")
+    axes[0].set_title("depth image + grasp", fontsize=8)
+    for ax, (label, frame) in zip(axes[1:], frames):
+        ax.imshow(frame)
+        ax.set_title(label, fontsize=8)
+    for ax in axes:
+        ax.set_xticks([])
+        ax.set_yticks([])
+    fig.suptitle(title, fontsize=9)
+    _save(fig, path)

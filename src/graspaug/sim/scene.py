@@ -1,0 +1,140 @@
+"""The pick-and-place cell: a table, the Panda beside it, a bin, a depth camera straight above.
+
+Table frame: the table top is z = 0, objects are dropped around the origin, the camera looks
+straight down at the origin from ``camera_height``; the robot's base stands at ``robot_base``
+and the bin (pybullet_data's ``tray/traybox.urdf``, scaled) at ``bin_position``, both outside
+the camera's view. One :class:`PickScene` is one pybullet DIRECT client; a trial builds a fresh
+one so that the same seed always gives the same physics.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pybullet
+import pybullet_data
+
+from graspaug.render.camera import CameraPose, Intrinsics, look_at
+from graspaug.render.pybullet_depth import depth_from_zbuffer, projection_matrix, view_matrix
+from graspaug.sim.objects import SimObject
+from graspaug.sim.panda import HandSettings, Panda
+
+
+@dataclass(frozen=True)
+class CellLayout:
+    """Where things stand (m) and how the world steps."""
+
+    camera_height: float = 0.65
+    intrinsics: Intrinsics = Intrinsics()
+    table_size: tuple[float, float] = (1.2, 1.2)
+    table_friction: float = 0.8
+    robot_base: tuple[float, float, float] = (-0.6, 0.0, 0.0)
+    bin_position: tuple[float, float, float] = (-0.25, 0.5, 0.0)
+    bin_scale: float = 0.5  # traybox is 0.6 × 0.6 × 0.15 m at scale 1
+    time_step: float = 1 / 240
+    gravity: float = 9.81
+
+    @property
+    def bin_half_extent(self) -> float:
+        """Half the inner width of the bin (m)."""
+        return 0.29 * self.bin_scale
+
+    @property
+    def bin_height(self) -> float:
+        return 0.15 * self.bin_scale
+
+    @property
+    def camera(self) -> CameraPose:
+        return look_at(np.array([0.0, 0.0, self.camera_height]), np.zeros(3))
+
+
+class PickScene:
+    """A fresh physics world with the cell of ``layout`` and a Panda with ``hand``."""
+
+    near, far = 0.05, 3.0  # depth camera clipping planes (m)
+
+    def __init__(self, layout: CellLayout = CellLayout(), hand: HandSettings = HandSettings()) -> None:
+        self.layout = layout
+        self.client = pybullet.connect(pybullet.DIRECT)
+        c = self.client
+        pybullet.setGravity(0, 0, -layout.gravity, physicsClientId=c)
+        pybullet.setTimeStep(layout.time_step, physicsClientId=c)
+        half = [layout.table_size[0] / 2, layout.table_size[1] / 2, 0.025]
+        table = pybullet.createCollisionShape(pybullet.GEOM_BOX, halfExtents=half, physicsClientId=c)
+        table_visual = pybullet.createVisualShape(pybullet.GEOM_BOX, halfExtents=half, rgbaColor=[0.8, 0.7, 0.55, 1], physicsClientId=c)
+        self.table = pybullet.createMultiBody(0, table, table_visual, basePosition=[0, 0, -0.025], physicsClientId=c)
+        pybullet.changeDynamics(self.table, -1, lateralFriction=layout.table_friction, physicsClientId=c)
+        self.bin = pybullet.loadURDF(f"{pybullet_data.getDataPath()}/tray/traybox.urdf", basePosition=list(layout.bin_position),
+                                     globalScaling=layout.bin_scale, useFixedBase=True, physicsClientId=c)
+        self.robot = Panda(c, layout.robot_base, hand, layout.time_step)
+        self.object: int | None = None
+
+    # --- the object --------------------------------------------------------------------------
+    def add_object(self, obj: SimObject, position, orientation) -> int:
+        """Put ``obj`` at ``position`` (3,) m with quaternion ``orientation`` (x, y, z, w)."""
+        c = self.client
+        collision = pybullet.createCollisionShape(pybullet.GEOM_MESH, fileName=str(obj.collision), physicsClientId=c)
+        visual = pybullet.createVisualShape(pybullet.GEOM_MESH, fileName=str(obj.visual), rgbaColor=[0.3, 0.5, 0.8, 1],
+                                            physicsClientId=c)
+        self.object = pybullet.createMultiBody(obj.mass, collision, visual, basePosition=list(position),
+                                               baseOrientation=list(orientation), physicsClientId=c)
+        pybullet.changeDynamics(self.object, -1, lateralFriction=obj.lateral_friction, spinningFriction=obj.spinning_friction,
+                                rollingFriction=obj.rolling_friction, physicsClientId=c)
+        return self.object
+
+    def object_pose(self) -> tuple[np.ndarray, np.ndarray]:
+        position, orientation = pybullet.getBasePositionAndOrientation(self.object, physicsClientId=self.client)
+        return np.array(position), np.array(orientation)
+
+    def object_speed(self) -> float:
+        """Largest of the object's linear (m/s) and angular (rad/s × 0.05 m) speeds."""
+        linear, angular = pybullet.getBaseVelocity(self.object, physicsClientId=self.client)
+        return max(float(np.linalg.norm(linear)), 0.05 * float(np.linalg.norm(angular)))
+
+    def object_bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        low, high = pybullet.getAABB(self.object, physicsClientId=self.client)
+        return np.array(low), np.array(high)
+
+    def settle(self, max_time: float = 2.0, speed: float = 0.005) -> float:
+        """Step until the object moves slower than ``speed`` or ``max_time`` s pass; the time taken."""
+        steps = int(round(max_time / self.layout.time_step))
+        for i in range(steps):
+            self.robot.step(1)
+            if i % 12 == 11 and self.object_speed() < speed:
+                return (i + 1) * self.layout.time_step
+        return max_time
+
+    def object_in_bin(self) -> bool:
+        """Whether the object's center lies inside the bin's walls, below its rim."""
+        position, _ = self.object_pose()
+        offset = position[:2] - np.asarray(self.layout.bin_position[:2])
+        return bool(np.all(np.abs(offset) < self.layout.bin_half_extent) and position[2] < self.layout.bin_position[2] + self.layout.bin_height)
+
+    def object_touches_robot(self) -> bool:
+        return len(pybullet.getContactPoints(self.object, self.robot.body, physicsClientId=self.client)) > 0
+
+    # --- sensing -----------------------------------------------------------------------------
+    def depth_image(self) -> np.ndarray:
+        """The overhead camera's depth image (H, W) float64 m (TinyRenderer z-buffer → metric)."""
+        k = self.layout.intrinsics
+        _, _, _, zbuffer, _ = pybullet.getCameraImage(
+            k.width, k.height, view_matrix(self.layout.camera), projection_matrix(k, self.near, self.far),
+            renderer=pybullet.ER_TINY_RENDERER, flags=pybullet.ER_NO_SEGMENTATION_MASK, physicsClientId=self.client)
+        return depth_from_zbuffer(np.reshape(zbuffer, (k.height, k.width)), self.near, self.far)
+
+    def color_frame(self, width: int = 320, height: int = 240) -> np.ndarray:
+        """An RGB picture (height, width, 3) uint8 of the cell from the front-left, for the reports."""
+        view = pybullet.computeViewMatrix([0.35, -0.55, 0.45], [-0.15, 0.2, 0.08], [0, 0, 1])
+        projection = pybullet.computeProjectionMatrixFOV(45, width / height, 0.05, 5.0)
+        _, _, rgba, _, _ = pybullet.getCameraImage(width, height, view, projection, renderer=pybullet.ER_TINY_RENDERER,
+                                                   flags=pybullet.ER_NO_SEGMENTATION_MASK, physicsClientId=self.client)
+        return np.reshape(np.asarray(rgba, dtype=np.uint8), (height, width, 4))[..., :3]
+
+    def close(self) -> None:
+        pybullet.disconnect(physicsClientId=self.client)
+
+    def __enter__(self) -> PickScene:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()

@@ -1,0 +1,134 @@
+"""One pick-and-place attempt: drop the object, look, plan, pick, carry to the bin, release.
+
+A trial runs in a fresh :class:`~graspaug.sim.scene.PickScene` so that its outcome depends only
+on the object, the drop seed and the grasp: the same seed gives the same drop (and the same
+depth image) to every planner. The grasp comes from a planner callable (depth image → image
+grasp) or, for scripted tests, directly as a table-frame pose.
+"""
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from graspaug.render.camera import CameraPose, Intrinsics
+from graspaug.sim.objects import SimObject
+from graspaug.sim.panda import FINGER_OPEN, HandSettings
+from graspaug.sim.policy import ImageGrasps, PlannedGrasp, grasp_in_table_frame
+from graspaug.sim.scene import CellLayout, PickScene
+
+OUTCOMES = ("success", "no_grasp", "not_lifted", "dropped", "outside_bin")
+
+
+@dataclass(frozen=True)
+class TrialSettings:
+    """The motion script (m, s)."""
+
+    drop_offset: float = 0.05  # drop point uniform in ±offset around the table origin (x and y)
+    drop_clearance: float = 0.02  # gap between the table and the object's lowest point at release
+    settle_time: float = 2.0  # at most this long for the object to come to rest
+    pregrasp_height: float = 0.15  # above the grasp center
+    lift_height: float = 0.2
+    carry_height: float = 0.25  # grasp center above the bin floor when released
+    carry_speed: float = 0.5  # m/s
+    release_time: float = 1.0  # after opening, before the bin check
+
+
+@dataclass
+class TrialResult:
+    """What happened; ``frames`` (RGB uint8) and ``depth`` only when recorded."""
+
+    outcome: str
+    success: bool
+    drop_position: tuple[float, float, float]
+    grasp_center: tuple[float, float, float] | None = None  # table frame (m)
+    jaw_angle: float | None = None  # rad, from the table's x axis
+    image_grasp: dict | None = None  # u, v, angle, depth, width_px
+    quality: float | None = None  # GQ-CNN P(success)
+    planning_time: float | None = None  # s
+    candidates: int = 0
+    depth: np.ndarray | None = None
+    frames: list[tuple[str, np.ndarray]] = field(default_factory=list)
+
+
+def random_orientation(rng: np.random.Generator) -> np.ndarray:
+    """A uniformly random unit quaternion (x, y, z, w)."""
+    q = rng.normal(size=4)
+    return q / np.linalg.norm(q)
+
+
+Planner = Callable[[np.ndarray, CameraPose, Intrinsics], "PlannedGrasp | None"]
+
+
+ScriptedGrasp = Callable[[np.ndarray, np.ndarray], "tuple[np.ndarray, float]"]
+
+
+def run_trial(obj: SimObject, drop_seed: int, planner: Planner | None = None, scripted: ScriptedGrasp | None = None,
+              layout: CellLayout = CellLayout(), hand: HandSettings = HandSettings(), settings: TrialSettings = TrialSettings(),
+              record: bool = False) -> TrialResult:
+    """Drop ``obj`` at the pose drawn from ``drop_seed``, then pick it with ``planner``'s grasp
+    (or the ``scripted`` one: the object's resting position (3,) m and quaternion (x, y, z, w)
+    → table-frame grasp center (3,) m and jaw angle rad) and carry it to the bin."""
+    rng = np.random.default_rng(drop_seed)
+    with PickScene(layout, hand) as scene:
+        xy = rng.uniform(-settings.drop_offset, settings.drop_offset, size=2)
+        orientation = random_orientation(rng)
+        scene.add_object(obj, [xy[0], xy[1], 1.0], orientation)  # high up to measure its extent in that orientation
+        low, _ = scene.object_bounds()
+        drop = np.array([xy[0], xy[1], 1.0 - low[2] + settings.drop_clearance])
+        import pybullet  # noqa: PLC0415 - only here, to move the body once
+
+        pybullet.resetBasePositionAndOrientation(scene.object, drop.tolist(), orientation.tolist(), physicsClientId=scene.client)
+        scene.settle(settings.settle_time)
+        result = TrialResult(outcome="no_grasp", success=False, drop_position=tuple(float(x) for x in drop))
+        frames = result.frames
+        if record:
+            frames.append(("object dropped", scene.color_frame()))
+        if scripted is None:
+            depth = scene.depth_image()
+            if record:
+                result.depth = depth
+            planned = planner(depth, layout.camera, layout.intrinsics) if planner is not None else None
+            if planned is None:
+                return result
+            g: ImageGrasps = planned.grasp
+            centers, angles = grasp_in_table_frame(g, layout.camera, layout.intrinsics)
+            center, jaw_angle = centers[0], float(angles[0])
+            result.image_grasp = {"u": float(g.centers[0, 0]), "v": float(g.centers[0, 1]), "angle": float(g.angles[0]),
+                                  "depth": float(g.depths[0]), "width_px": float(g.widths[0])}
+            result.quality, result.planning_time, result.candidates = planned.quality, planned.planning_time, planned.candidates
+        else:
+            center, jaw_angle = scripted(*scene.object_pose())
+            center, jaw_angle = np.asarray(center, dtype=float), float(jaw_angle)
+        result.grasp_center, result.jaw_angle = tuple(float(x) for x in center), jaw_angle
+        start_height = scene.object_pose()[0][2]
+
+        robot = scene.robot
+        robot.place_hand(center + [0, 0, settings.pregrasp_height], jaw_angle)
+        robot.step(int(0.1 / layout.time_step))
+        if record:
+            frames.append(("pre-grasp", scene.color_frame()))
+        robot.move_line(center, jaw_angle)
+        robot.set_fingers(0.0)
+        if record:
+            frames.append(("closed", scene.color_frame()))
+        robot.move_line(center + [0, 0, settings.lift_height], jaw_angle)
+        lifted = scene.object_pose()[0][2] > start_height + 0.5 * settings.lift_height and scene.object_touches_robot()
+        if record:
+            frames.append(("lifted", scene.color_frame()))
+        if not lifted:
+            result.outcome = "not_lifted"
+            return result
+        above_bin = np.array([layout.bin_position[0], layout.bin_position[1], layout.bin_position[2] + settings.carry_height])
+        robot.move_line(above_bin, jaw_angle, speed=settings.carry_speed)
+        held = scene.object_touches_robot()
+        if record:
+            frames.append(("over the bin", scene.color_frame()))
+        robot.set_fingers(2 * FINGER_OPEN)
+        robot.step(int(settings.release_time / layout.time_step))
+        if record:
+            frames.append(("released", scene.color_frame()))
+        result.success = scene.object_in_bin()
+        result.outcome = "success" if result.success else ("outside_bin" if held else "dropped")
+        return result

@@ -1,0 +1,291 @@
+"""Stage ``sim``: simulated Panda pick-and-place trials with the GQ-CNN before and after augmentation.
+
+Arms: ``before`` = the targeted network of base size ``sim.base_size`` at ratio 0, ``after`` =
+the same base size at the best ratio of ``metrics/ap.json`` (first training seed). Every object
+(the everyday objects of ``sim.objects`` and ``sim.n_test_objects`` held-out test shapes) is
+dropped ``sim.attempts`` times from seeded poses, the same for both arms; each arm plans one
+grasp per drop on the overhead depth image and the Panda tries to put the object in the bin.
+
+Writes ``metrics/sim.json`` (success per arm and object with 95 % Wilson intervals, the paired
+McNemar test), ``reports/sim/`` (``report.md``, ``trials.csv`` one row per attempt,
+``success.csv``/``success.png`` per object, ``objects.csv``, ``timing.json`` planning and stage
+times, ``trials/<arm>-<object>.png`` depth image with the grasp and pick frames).
+"""
+from __future__ import annotations
+
+import functools
+import json
+import logging
+import time
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+from graspaug.config import Params
+from graspaug.io.atomic import atomic_path
+from graspaug.io.tables import read_table, write_csv, write_json
+from graspaug.parallel import parallel_map
+from graspaug.paths import AP_METRICS, SHAPES_DIR, SHAPES_TABLE, SIM_METRICS, SIM_REPORT_DIR, gqcnn_model_dir
+from graspaug.render.camera import Intrinsics
+from graspaug.rng import shape_rng
+from graspaug.stages import StageError
+
+log = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True)
+class ObjectJob:
+    """One object's attempts in one arm (a worker's unit of work)."""
+
+    arm: str
+    model: str  # path of model.pt
+    name: str
+    kind: str  # everyday | test_shape
+    sim_object: object  # graspaug.sim.objects.SimObject
+    drop_seeds: tuple[int, ...]
+    plan_seeds: tuple[int, ...]
+    record: bool
+
+
+def arms(params: Params) -> dict[str, tuple[float, str]]:
+    """Arm → (ratio, model path), from the report's best ratio for ``sim.base_size``."""
+    if not AP_METRICS.exists():
+        raise StageError(f"{AP_METRICS} is missing: run `dvc repro report` first")
+    summary = json.loads(AP_METRICS.read_text()).get("summary", {}).get(str(params.sim.base_size))
+    if summary is None:
+        raise StageError(f"{AP_METRICS} has no summary for base size {params.sim.base_size} (sim.base_size)")
+    seed = params.gqcnn.seeds[0]
+    out = {"before": (0.0, gqcnn_model_dir("targeted", params.sim.base_size, 0.0, seed) / "model.pt"),
+           "after": (float(summary["best_ratio"]), gqcnn_model_dir("targeted", params.sim.base_size, summary["best_ratio"], seed) / "model.pt")}
+    for _, path in out.values():
+        if not path.exists():
+            raise StageError(f"{path} is missing: run `dvc repro train_gqcnn` first")
+    return {arm: (ratio, str(path)) for arm, (ratio, path) in out.items()}
+
+
+def test_shape_ids(params: Params) -> list[str]:
+    """The held-out shapes picked in the trials: a seeded choice from the test split."""
+    if params.sim.n_test_objects == 0:
+        return []
+    shapes = read_table(SHAPES_TABLE)
+    test = sorted(shapes.shape_id[shapes.split == "test"])
+    if len(test) < params.sim.n_test_objects:
+        raise StageError(f"sim.n_test_objects = {params.sim.n_test_objects} but the test split has {len(test)} shapes")
+    chosen = shape_rng(params.seed, "sim", "test-objects").choice(len(test), size=params.sim.n_test_objects, replace=False)
+    return [test[i] for i in sorted(chosen)]
+
+
+def prepare_objects(params: Params):
+    """(name, kind, SimObject, extents) for every object, decompositions cached."""
+    from graspaug.io.meshes import mesh_path, read_mesh
+    from graspaug.sim.objects import default_cache_dir, everyday_mesh, prepare_object
+
+    cfg, cache = params.sim, default_cache_dir()
+    meshes = [(name, "everyday", everyday_mesh(name)) for name in cfg.objects]
+    meshes += [(shape_id, "test_shape", read_mesh(mesh_path(SHAPES_DIR, shape_id))) for shape_id in test_shape_ids(params)]
+    return [(name, kind, prepare_object(name, mesh, cache, cfg.object_mass, cfg.object_friction, cfg.vhacd_resolution), mesh.extents)
+            for name, kind, mesh in meshes]
+
+
+def settings(params: Params):
+    """The library settings that params.sim describes."""
+    from graspaug.sim.panda import HandSettings
+    from graspaug.sim.policy import CEMSettings, SamplerSettings
+    from graspaug.sim.scene import CellLayout
+
+    cfg = params.sim
+    intrinsics = Intrinsics(width=cfg.image_width, height=cfg.image_height, fx=cfg.focal_length, fy=cfg.focal_length,
+                            cx=(cfg.image_width - 1) / 2, cy=(cfg.image_height - 1) / 2)
+    layout = CellLayout(camera_height=cfg.camera_height, intrinsics=intrinsics, table_friction=cfg.table_friction)
+    hand = HandSettings(grip_force=cfg.grip_force, finger_friction=cfg.finger_friction)
+    sampler = SamplerSettings(friction_coef=cfg.friction_coef, depth_grad_thresh=cfg.depth_grad_thresh,
+                              min_dist_from_boundary=cfg.min_dist_from_boundary, min_depth_offset=cfg.min_depth_offset,
+                              max_depth_offset=cfg.max_depth_offset, max_width=params.grasps.max_width)
+    cem = CEMSettings(num_seed_samples=cfg.seed_samples, num_iters=cfg.cem_iters, elite_fraction=cfg.elite_fraction,
+                      gmm_components=cfg.gmm_components, num_gmm_samples=cfg.gmm_samples)
+    return layout, hand, sampler, cem
+
+
+@functools.lru_cache(maxsize=4)
+def _policy(model: str, layout, sampler, cem, crop_size: int, out_size: int):
+    import torch
+
+    from graspaug.io.checkpoints import load_gqcnn
+    from graspaug.render.crops import CropGeometry
+    from graspaug.sim.policy import CrossEntropyGraspPolicy
+
+    torch.set_num_threads(1)
+    return CrossEntropyGraspPolicy(load_gqcnn(model), layout.intrinsics, sampler, cem, CropGeometry(crop_size, out_size))
+
+
+def run_object(job: ObjectJob, layout, hand, sampler, cem, crop_size: int, out_size: int) -> list[dict]:
+    """Every attempt of one object in one arm: a row per attempt (plus depth and frames for the
+    first attempt when ``job.record``)."""
+    from graspaug.sim.trials import run_trial
+
+    policy = _policy(job.model, layout, sampler, cem, crop_size, out_size)
+    rows = []
+    for attempt, (drop_seed, plan_seed) in enumerate(zip(job.drop_seeds, job.plan_seeds)):
+        rng = np.random.default_rng(plan_seed)
+        record = job.record and attempt == 0
+        result = run_trial(job.sim_object, drop_seed, planner=lambda depth, camera, k: policy.plan(depth, rng), layout=layout,
+                           hand=hand, record=record)
+        g = result.image_grasp or {}
+        rows.append({
+            "arm": job.arm, "object": job.name, "kind": job.kind, "attempt": attempt, "drop_seed": drop_seed,
+            "outcome": result.outcome, "success": result.success, "quality": result.quality, "candidates": result.candidates,
+            "u": g.get("u"), "v": g.get("v"), "angle": g.get("angle"), "depth": g.get("depth"), "width_px": g.get("width_px"),
+            "grasp_x": None if result.grasp_center is None else result.grasp_center[0],
+            "grasp_y": None if result.grasp_center is None else result.grasp_center[1],
+            "grasp_z": None if result.grasp_center is None else result.grasp_center[2],
+            "jaw_angle": result.jaw_angle, "planning_time": result.planning_time,
+            "_depth": result.depth, "_frames": result.frames,
+        })
+    return rows
+
+
+def rate_summary(outcomes: pd.Series) -> dict:
+    from graspaug.sim.stats import wilson_interval
+
+    k, n = int(outcomes.sum()), int(len(outcomes))
+    low, high = wilson_interval(k, n)
+    return {"successes": k, "attempts": n, "success_rate": round(k / n, 5) if n else None, "wilson_low": round(low, 5), "wilson_high": round(high, 5)}
+
+
+def _picture(row: dict, ratio: float, path) -> None:
+    from graspaug.plots import pick_story
+
+    depth = row["_depth"]
+    h, w = depth.shape
+    jaw = None
+    if row["u"] is not None:
+        half = 0.5 * row["width_px"] * np.array([np.cos(row["angle"]), np.sin(row["angle"])])
+        center = np.array([row["u"], row["v"]])
+        jaw = np.stack([center - half, center + half])
+        cu, cv = int(round(row["u"])), int(round(row["v"]))
+    else:
+        cu, cv = w // 2, h // 2
+    r = 80
+    u0, v0 = int(np.clip(cu - r, 0, w - 2 * r)), int(np.clip(cv - r, 0, h - 2 * r))
+    quality = "no grasp found" if row["quality"] is None else f"Q = {row['quality']:.3f}"
+    title = f"{row['object']}, arm {row['arm']} (ratio {ratio:g}), attempt 0: {quality} → {row['outcome']}"
+    pick_story(depth, jaw, (u0, v0, u0 + 2 * r, v0 + 2 * r), row["_frames"], path, title)
+
+
+def report_text(metrics: dict, trials: pd.DataFrame) -> str:
+    before, after, test = metrics["arms"]["before"], metrics["arms"]["after"], metrics["paired"]
+    diff = metrics["difference"]
+    lines = [
+        "# Simulated robot trials: GQ-CNN before vs after augmentation",
+        "",
+        f"Franka Panda in pybullet, overhead depth camera {metrics['setup']['camera_height']} m above the table, "
+        f"{metrics['setup']['objects']} objects × {metrics['setup']['attempts']} seeded drops, the same drops for both arms. "
+        "Success = the object ends inside the bin.",
+        "",
+        "| arm | network | successes | rate | 95% Wilson interval |",
+        "|---|---|---|---|---|",
+    ]
+    for arm in ("before", "after"):
+        a = metrics["arms"][arm]
+        lines.append(f"| {arm} | B = {metrics['setup']['base_size']}, ratio {a['ratio']:g} | {a['successes']}/{a['attempts']} | "
+                     f"{a['success_rate']:.2f} | [{a['wilson_low']:.2f}, {a['wilson_high']:.2f}] |")
+    lines += ["", "| object | kind | before | after |", "|---|---|---|---|"]
+    for name, row in metrics["per_object"].items():
+        b, a = row["before"], row["after"]
+        lines.append(f"| {name} | {row['kind']} | {b['successes']}/{b['attempts']} | {a['successes']}/{a['attempts']} |")
+    counts = trials.groupby(["arm", "outcome"]).size().unstack(fill_value=0)
+    lines += ["", "Outcomes (no_grasp: no antipodal pair on the image; not_lifted: the object stayed on the table; "
+              "dropped: lost on the way; outside_bin: released but not in the bin):", "",
+              "| arm | " + " | ".join(counts.columns) + " |", "|---|" + "---|" * len(counts.columns)]
+    for arm, row in counts.iterrows():
+        lines.append(f"| {arm} | " + " | ".join(str(int(v)) for v in row) + " |")
+    lines += ["", "## Verdict", ""]
+    if metrics["same_network"]:
+        lines.append(f"The report's best ratio for B = {metrics['setup']['base_size']} is 0, so \"after\" is the same network as "
+                     "\"before\": augmentation brought nothing to test here.")
+    else:
+        word = "rose" if diff > 0 else ("fell" if diff < 0 else "did not change")
+        lines.append(f"The success rate {word} after augmentation ({before['success_rate']:.2f} → {after['success_rate']:.2f}, {diff:+.2f}). "
+                     f"On the same drops \"after\" alone succeeded {test['only_after']} times and \"before\" alone "
+                     f"{test['only_before']} times (exact McNemar p = {test['p_value']:.3g}).")
+        if test["p_value"] >= 0.05:
+            lines.append("The difference is within chance at the 5% level: no evidence either way.")
+        elif diff > 0:
+            lines.append("Augmentation helped the simulated robot beyond chance (5% level).")
+        else:
+            lines.append("Augmentation made the simulated robot worse, beyond chance (5% level); the paper's 68% → 86% "
+                         "(real Panda) does not reproduce here.")
+    return "\n".join(lines) + "\n"
+
+
+def run(params: Params) -> None:
+    from graspaug.plots import success_bars
+    from graspaug.sim.stats import paired_test
+
+    start = time.perf_counter()
+    cfg = params.sim
+    arm_models = arms(params)
+    objects = prepare_objects(params)
+    layout, hand, sampler, cem = settings(params)
+    jobs = []
+    for index, (name, kind, sim_object, _) in enumerate(objects):
+        drop_seeds = tuple(int(shape_rng(params.seed, name, f"sim-drop-{a}").integers(2**31 - 1)) for a in range(cfg.attempts))
+        plan_seeds = tuple(int(shape_rng(params.seed, name, f"sim-plan-{a}").integers(2**31 - 1)) for a in range(cfg.attempts))
+        for arm, (_, model) in arm_models.items():
+            jobs.append(ObjectJob(arm, model, name, kind, sim_object, drop_seeds, plan_seeds, index < cfg.n_pictures))
+    log.info("sim: %d objects × %d attempts × %d arms (after = ratio %g)", len(objects), cfg.attempts, len(arm_models), arm_models["after"][0])
+    work = functools.partial(run_object, layout=layout, hand=hand, sampler=sampler, cem=cem, crop_size=params.render.crop_size,
+                             out_size=params.render.out_size)
+    rows = [row for rows in parallel_map(work, jobs, params.n_jobs, "sim") for row in rows]
+    trials = pd.DataFrame([{k: v for k, v in row.items() if not k.startswith("_")} for row in rows])
+    trials["ratio"] = trials.arm.map({arm: ratio for arm, (ratio, _) in arm_models.items()})
+
+    metrics = {
+        "setup": {"base_size": cfg.base_size, "objects": len(objects), "attempts": cfg.attempts, "camera_height": cfg.camera_height,
+                  "model_seed": params.gqcnn.seeds[0]},
+        "arms": {arm: {"ratio": ratio, **rate_summary(trials.success[trials.arm == arm])} for arm, (ratio, _) in arm_models.items()},
+        "per_object": {},
+    }
+    for name, kind, _, _ in objects:
+        sel = trials.object == name
+        metrics["per_object"][name] = {"kind": kind, **{arm: rate_summary(trials.success[sel & (trials.arm == arm)]) for arm in arm_models}}
+    paired = trials.pivot_table(index=["object", "attempt"], columns="arm", values="success", aggfunc="first")
+    metrics["paired"] = paired_test(paired["before"].to_numpy(bool), paired["after"].to_numpy(bool))
+    metrics["difference"] = round(metrics["arms"]["after"]["success_rate"] - metrics["arms"]["before"]["success_rate"], 5)
+    metrics["same_network"] = arm_models["before"][1] == arm_models["after"][1]
+
+    planning = trials.planning_time.dropna()
+    timing = {"planning_time_mean": float(planning.mean()) if len(planning) else None,
+              "planning_time_median": float(planning.median()) if len(planning) else None,
+              "planning_time_max": float(planning.max()) if len(planning) else None,
+              "planning_time_by_arm": {arm: float(trials.planning_time[trials.arm == arm].mean()) for arm in arm_models},
+              "trials": int(len(trials)), "stage_seconds": None}
+
+    with atomic_path(SIM_REPORT_DIR, directory=True) as out:
+        write_csv(trials.drop(columns=["planning_time"]), out / "trials.csv")
+        write_csv(pd.DataFrame([{"object": name, "kind": kind, "extent_x": e[0], "extent_y": e[1], "extent_z": e[2],
+                                 "mass": cfg.object_mass, "friction": cfg.object_friction,
+                                 "convex_hulls": ("\n" + so.collision.read_text()).count("\no "), "collision_file": str(so.collision)}
+                                for name, kind, so, e in objects]), out / "objects.csv")
+        per_object = pd.DataFrame([{"object": name, **{arm: row[arm]["success_rate"] for arm in arm_models}}
+                                   for name, row in metrics["per_object"].items()])
+        write_csv(per_object, out / "success.csv")
+        names = [*metrics["per_object"], "all"]
+        bars = {}
+        for arm, (ratio, _) in arm_models.items():
+            stats = [metrics["per_object"][n][arm] for n in names[:-1]] + [metrics["arms"][arm]]
+            bars[f"{arm} (ratio {ratio:g})"] = tuple(np.array([s[key] for s in stats]) for key in ("success_rate", "wilson_low", "wilson_high"))
+        success_bars(names, bars, out / "success.png", f"Pick success per object, B = {cfg.base_size} (95% Wilson intervals)")
+        (out / "trials").mkdir()
+        for row in rows:
+            if row["_depth"] is not None:
+                _picture(row, arm_models[row["arm"]][0], out / "trials" / f"{row['arm']}-{row['object']}.png")
+        (out / "report.md").write_text(report_text(metrics, trials))
+        timing["stage_seconds"] = round(time.perf_counter() - start, 1)
+        write_json(timing, out / "timing.json")
+    write_json(metrics, SIM_METRICS)
+    b, a = metrics["arms"]["before"], metrics["arms"]["after"]
+    log.info("sim: before %d/%d (%.2f), after %d/%d (%.2f), McNemar p = %.3f; planning %.3f s per grasp (max %.3f); %.0f s",
+             b["successes"], b["attempts"], b["success_rate"], a["successes"], a["attempts"], a["success_rate"], metrics["paired"]["p_value"],
+             timing["planning_time_mean"] or 0, timing["planning_time_max"] or 0, time.perf_counter() - start)
