@@ -33,6 +33,11 @@ def test_repo_params_load_and_match_the_dataclass_defaults(repo_root):
         ({"ae": {"lambda": -1}}, "ae.lambda: must be >= 0; got -1"),
         ({"critic_eval": {"alphas": [0.1, 0.104]}}, "critic_eval.alphas: weights must differ in the first two decimals"),
         ({"critic_eval": {"alphas": [0.1, 1.5]}}, "critic_eval.alphas: must be a non-empty list of weights in [0, 1]"),
+        ({"sim": {"objects": ["mug", "teapot"]}}, "sim.objects: must be distinct names among mug, duck,"),
+        ({"sim": {"objects": [], "n_test_objects": 0}}, "sim.objects: no objects to pick"),
+        ({"sim": {"base_size": 300}}, "sim.base_size: must be one of generate.base_sizes [50, 100, 200]; got 300"),
+        ({"sim": {"min_depth_offset": 0.05}}, "sim.max_depth_offset: must be >= sim.min_depth_offset (0.05); got 0.04"),
+        ({"sim": {"attempts": 0}}, "sim.attempts: must be >= 1; got 0"),
     ],
 )
 def test_bad_params_name_the_key(raw, message):
@@ -79,6 +84,7 @@ def test_paper_profile_loads_with_the_paper_sizes(repo_root):
     assert params.voxelize.resolution == 64
     assert (params.ae.base_width, params.ae.top_width, params.ae.z_dim) == (64, 512, 128)
     assert params.ingest.test_fraction == pytest.approx(363 / 1363, abs=1e-4)
+    assert (len(params.sim.objects), params.sim.n_test_objects, params.sim.attempts) == (8, 0, 10)  # 8 objects x 10 attempts
 
 
 def test_study_profile_is_the_defaults_with_three_seeds(repo_root):

@@ -26,6 +26,7 @@ TINY = {
                  "min_voxels": 5, "min_main_share": 0.5, "smoothing_iterations": 3, "n_examples": 2},
     "render": {"max_poses": 2, "n_examples": 4, "axis_tolerance_deg": 45.0, "images_per_pose": 2},
     "gqcnn": {"filters": 4, "fc": 16, "pose_fc": 4, "steps": 6, "log_every": 3, "random_base_sizes": [6], "random_ratios": [1.0]},
+    "sim": {"objects": ["cube"], "n_test_objects": 1, "attempts": 2, "base_size": 6, "seed_samples": 100, "n_pictures": 1},
 }
 
 
@@ -234,4 +235,35 @@ def test_dvc_repro_gqcnn_matrix_and_report(tiny_repo):
     shown = run(["dvc", "metrics", "show", "--json"], work, env)
     assert "metrics/gqcnn/targeted/6-2.0-s0.json" in shown.stdout
     again = run(["dvc", "repro", "report"], work, env)
+    assert "Running stage" not in again.stdout
+
+
+def test_dvc_repro_sim(tiny_repo, tmp_path):
+    import json
+
+    work, env = tiny_repo
+    env = {**env, "GRASPAUG_CACHE": str(tmp_path / "cache")}
+    run(["dvc", "repro", "sim"], work, env)
+    metrics = json.loads((work / "metrics/sim.json").read_text())
+    ap = json.loads((work / "metrics/ap.json").read_text())
+    after_ratio = ap["summary"]["6"]["best_ratio"] if "6" in ap["summary"] else 2.0  # no test AP: the largest ratio
+    assert metrics["arms"]["before"]["ratio"] == 0.0 and metrics["arms"]["after"]["ratio"] == after_ratio
+    assert metrics["setup"]["after_ratio_from_report"] == ("6" in ap["summary"])
+    for arm in ("before", "after"):
+        a = metrics["arms"][arm]
+        assert a["attempts"] == 4 and 0 <= a["successes"] <= 4
+        assert a["wilson_low"] <= a["success_rate"] <= a["wilson_high"]
+    trials = pd.read_csv(work / "reports/sim/trials.csv")
+    assert len(trials) == 8 and set(trials.object) == {"cube", metrics["setup"]["test_shapes"][0]}
+    # the same seeded drops for both arms
+    drops = trials.pivot_table(index=["object", "attempt"], columns="arm", values="drop_seed")
+    assert (drops["before"] == drops["after"]).all()
+    assert set(trials.outcome) <= {"success", "no_grasp", "not_lifted", "dropped", "outside_bin"}
+    assert (trials.success == (trials.outcome == "success")).all()
+    timing = json.loads((work / "reports/sim/timing.json").read_text())
+    assert timing["trials"] == 8 and timing["planning_time_max"] > 0
+    assert "## Verdict" in (work / "reports/sim/report.md").read_text()
+    for picture in ("success.png", "trials/before-cube.png", "trials/after-cube.png"):
+        assert (work / "reports/sim" / picture).stat().st_size > 0
+    again = run(["dvc", "repro", "sim"], work, env)
     assert "Running stage" not in again.stdout

@@ -48,20 +48,25 @@ class ObjectJob:
     record: bool
 
 
-def arms(params: Params) -> dict[str, tuple[float, str]]:
-    """Arm → (ratio, model path), from the report's best ratio for ``sim.base_size``."""
+def arms(params: Params) -> tuple[dict[str, tuple[float, str]], bool]:
+    """Arm → (ratio, model path): ratio 0 and the report's best ratio for ``sim.base_size``, and
+    whether the ratio came from the report. When the report has no test AP for that base size (a
+    test set with one label), "after" is the largest ratio, with a warning."""
     if not AP_METRICS.exists():
         raise StageError(f"{AP_METRICS} is missing: run `dvc repro report` first")
-    summary = json.loads(AP_METRICS.read_text()).get("summary", {}).get(str(params.sim.base_size))
+    base = params.sim.base_size
+    summary = json.loads(AP_METRICS.read_text()).get("summary", {}).get(str(base))
     if summary is None:
-        raise StageError(f"{AP_METRICS} has no summary for base size {params.sim.base_size} (sim.base_size)")
+        best = float(max(params.generate.ratios))
+        log.warning("sim: %s has no test AP for base size %d; comparing ratio 0 with the largest ratio %g", AP_METRICS, base, best)
+    else:
+        best = float(summary["best_ratio"])
     seed = params.gqcnn.seeds[0]
-    out = {"before": (0.0, gqcnn_model_dir("targeted", params.sim.base_size, 0.0, seed) / "model.pt"),
-           "after": (float(summary["best_ratio"]), gqcnn_model_dir("targeted", params.sim.base_size, summary["best_ratio"], seed) / "model.pt")}
+    out = {arm: (ratio, gqcnn_model_dir("targeted", base, ratio, seed) / "model.pt") for arm, ratio in (("before", 0.0), ("after", best))}
     for _, path in out.values():
         if not path.exists():
             raise StageError(f"{path} is missing: run `dvc repro train_gqcnn` first")
-    return {arm: (ratio, str(path)) for arm, (ratio, path) in out.items()}
+    return {arm: (ratio, str(path)) for arm, (ratio, path) in out.items()}, summary is not None
 
 
 def test_shape_ids(params: Params) -> list[str]:
@@ -225,7 +230,7 @@ def run(params: Params) -> None:
 
     start = time.perf_counter()
     cfg = params.sim
-    arm_models = arms(params)
+    arm_models, from_report = arms(params)
     objects = prepare_objects(params)
     layout, hand, sampler, cem = settings(params)
     jobs = []
@@ -242,7 +247,8 @@ def run(params: Params) -> None:
     trials["ratio"] = trials.arm.map({arm: ratio for arm, (ratio, _) in arm_models.items()})
 
     metrics = {
-        "setup": {"base_size": cfg.base_size, "objects": len(objects), "attempts": cfg.attempts, "camera_height": cfg.camera_height,
+        "setup": {"base_size": cfg.base_size, "after_ratio_from_report": from_report, "objects": len(objects), "attempts": cfg.attempts,
+                  "test_shapes": [name for name, kind, _, _ in objects if kind == "test_shape"], "camera_height": cfg.camera_height,
                   "model_seed": params.gqcnn.seeds[0]},
         "arms": {arm: {"ratio": ratio, **rate_summary(trials.success[trials.arm == arm])} for arm, (ratio, _) in arm_models.items()},
         "per_object": {},
