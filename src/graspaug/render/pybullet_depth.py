@@ -44,6 +44,15 @@ def depth_from_zbuffer(zbuffer: np.ndarray, near: float, far: float) -> np.ndarr
     return far * near / (far - (far - near) * np.asarray(zbuffer, dtype=float))
 
 
+def render_depth(client: int, camera: CameraPose, intrinsics: Intrinsics, near: float, far: float) -> np.ndarray:
+    """The depth image (height, width) float64 (m) that ``camera`` sees in pybullet ``client``
+    (TinyRenderer, clipping planes ``near`` and ``far`` m)."""
+    _, _, _, zbuffer, _ = pybullet.getCameraImage(
+        intrinsics.width, intrinsics.height, view_matrix(camera), projection_matrix(intrinsics, near, far),
+        renderer=pybullet.ER_TINY_RENDERER, flags=pybullet.ER_NO_SEGMENTATION_MASK, physicsClientId=client)
+    return depth_from_zbuffer(np.reshape(zbuffer, (intrinsics.height, intrinsics.width)), near, far)
+
+
 class PybulletDepthScene:
     """One object on a table in a pybullet DIRECT client, rendered by its software TinyRenderer.
 
@@ -70,10 +79,7 @@ class PybulletDepthScene:
 
     def depth(self, camera: CameraPose, intrinsics: Intrinsics) -> np.ndarray:
         """The depth image (height, width) float64 (m) that ``camera`` sees."""
-        _, _, _, zbuffer, _ = pybullet.getCameraImage(
-            intrinsics.width, intrinsics.height, view_matrix(camera), projection_matrix(intrinsics, self.near, self.far),
-            renderer=pybullet.ER_TINY_RENDERER, flags=pybullet.ER_NO_SEGMENTATION_MASK, physicsClientId=self.client)
-        return depth_from_zbuffer(np.reshape(zbuffer, (intrinsics.height, intrinsics.width)), self.near, self.far)
+        return render_depth(self.client, camera, intrinsics, self.near, self.far)
 
     def close(self) -> None:
         pybullet.disconnect(physicsClientId=self.client)

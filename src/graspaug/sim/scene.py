@@ -15,7 +15,7 @@ import pybullet
 import pybullet_data
 
 from graspaug.render.camera import CameraPose, Intrinsics, look_at
-from graspaug.render.pybullet_depth import depth_from_zbuffer, projection_matrix, view_matrix
+from graspaug.render.pybullet_depth import render_depth
 from graspaug.sim.objects import SimObject
 from graspaug.sim.panda import HandSettings, Panda
 
@@ -82,6 +82,10 @@ class PickScene:
                                 rollingFriction=obj.rolling_friction, physicsClientId=c)
         return self.object
 
+    def move_object(self, position, orientation) -> None:
+        """Put the object at ``position`` (3,) m with quaternion (x, y, z, w) at once, at rest."""
+        pybullet.resetBasePositionAndOrientation(self.object, list(position), list(orientation), physicsClientId=self.client)
+
     def object_pose(self) -> tuple[np.ndarray, np.ndarray]:
         position, orientation = pybullet.getBasePositionAndOrientation(self.object, physicsClientId=self.client)
         return np.array(position), np.array(orientation)
@@ -116,11 +120,7 @@ class PickScene:
     # --- sensing -----------------------------------------------------------------------------
     def depth_image(self) -> np.ndarray:
         """The overhead camera's depth image (H, W) float64 m (TinyRenderer z-buffer → metric)."""
-        k = self.layout.intrinsics
-        _, _, _, zbuffer, _ = pybullet.getCameraImage(
-            k.width, k.height, view_matrix(self.layout.camera), projection_matrix(k, self.near, self.far),
-            renderer=pybullet.ER_TINY_RENDERER, flags=pybullet.ER_NO_SEGMENTATION_MASK, physicsClientId=self.client)
-        return depth_from_zbuffer(np.reshape(zbuffer, (k.height, k.width)), self.near, self.far)
+        return render_depth(self.client, self.layout.camera, self.layout.intrinsics, self.near, self.far)
 
     def color_frame(self, width: int = 320, height: int = 240) -> np.ndarray:
         """An RGB picture (height, width, 3) uint8 of the cell from the front-left, for the reports."""

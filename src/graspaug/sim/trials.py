@@ -77,9 +77,7 @@ def run_trial(obj: SimObject, drop_seed: int, planner: Planner | None = None, sc
         scene.add_object(obj, [xy[0], xy[1], 1.0], orientation)  # high up to measure its extent in that orientation
         low, _ = scene.object_bounds()
         drop = np.array([xy[0], xy[1], 1.0 - low[2] + settings.drop_clearance])
-        import pybullet  # noqa: PLC0415 - only here, to move the body once
-
-        pybullet.resetBasePositionAndOrientation(scene.object, drop.tolist(), orientation.tolist(), physicsClientId=scene.client)
+        scene.move_object(drop, orientation)
         scene.settle(settings.settle_time)
         result = TrialResult(outcome="no_grasp", success=False, drop_position=tuple(float(x) for x in drop))
         frames = result.frames
