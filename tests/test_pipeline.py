@@ -26,7 +26,7 @@ TINY = {
                  "min_voxels": 5, "min_main_share": 0.5, "smoothing_iterations": 3, "n_examples": 2},
     "render": {"max_poses": 2, "n_examples": 4, "axis_tolerance_deg": 45.0, "images_per_pose": 2},
     "gqcnn": {"filters": 4, "fc": 16, "pose_fc": 4, "steps": 6, "log_every": 3, "random_base_sizes": [6], "random_ratios": [1.0]},
-    "sim": {"objects": ["cube"], "n_test_objects": 1, "attempts": 2, "base_size": 6, "seed_samples": 100, "n_pictures": 1},
+    "sim": {"objects": ["cube"], "n_test_objects": 1, "attempts": 2, "base_size": 6, "seed_samples": 100, "n_pictures": 1, "antipodal_arm": True},
 }
 
 
@@ -248,14 +248,20 @@ def test_dvc_repro_sim(tiny_repo, tmp_path):
     ap = json.loads((work / "metrics/ap.json").read_text())
     after_ratio = ap["summary"]["6"]["best_ratio"] if "6" in ap["summary"] else 2.0  # no test AP: the largest ratio
     assert metrics["arms"]["before"]["ratio"] == 0.0 and metrics["arms"]["after"]["ratio"] == after_ratio
-    assert metrics["setup"]["after_ratio_from_report"] == ("6" in ap["summary"])
+    assert metrics["setup"]["after_ratio_from_report"] == ("6" in ap["summary"]) and metrics["setup"]["model_seeds"] == [0]
+    assert metrics["per_seed"]["0"]["before"] == {k: v for k, v in metrics["arms"]["before"].items() if k != "ratio"}
     for arm in ("before", "after"):
         a = metrics["arms"][arm]
         assert a["attempts"] == 4 and 0 <= a["successes"] <= 4
         assert a["wilson_low"] <= a["success_rate"] <= a["wilson_high"]
+    assert metrics["antipodal_reference"]["attempts"] == 4  # the reference arm without a network
     trials = pd.read_csv(work / "reports/sim/trials.csv")
-    assert len(trials) == 8 and set(trials.object) == {"cube", metrics["setup"]["test_shapes"][0]}
+    assert len(trials) == 12 and set(trials.object) == {"cube", metrics["setup"]["test_shapes"][0]}
+    planned = (trials.arm != "antipodal") & (trials.outcome != "no_grasp")
+    assert trials.quality[trials.arm == "antipodal"].isna().all() and trials.quality[planned].notna().all()
+    trials = trials[trials.arm != "antipodal"]
     # the same seeded drops for both arms
+    assert set(trials.seed) == {0}
     drops = trials.pivot_table(index=["object", "attempt"], columns="arm", values="drop_seed")
     assert (drops["before"] == drops["after"]).all()
     assert set(trials.outcome) <= {"success", "no_grasp", "not_lifted", "dropped", "outside_bin"}
@@ -263,7 +269,7 @@ def test_dvc_repro_sim(tiny_repo, tmp_path):
     timing = json.loads((work / "reports/sim/timing.json").read_text())
     assert timing["trials"] == 8 and timing["planning_time_max"] > 0
     assert "## Verdict" in (work / "reports/sim/report.md").read_text()
-    for picture in ("success.png", "trials/before-cube.png", "trials/after-cube.png"):
+    for picture in ("success.png", "trials/before-cube.png", "trials/after-cube.png", "trials/antipodal-cube.png"):
         assert (work / "reports/sim" / picture).stat().st_size > 0
     again = run(["dvc", "repro", "sim"], work, env)
     assert "Running stage" not in again.stdout

@@ -231,6 +231,7 @@ class SimParams:
     min_dist_from_boundary: int = param(45, "Edge pixels this close to the image border are ignored (px; Dex-Net: 45).", ge=0)
     min_depth_offset: float = param(0.005, "Grasp depth below the surface between the jaws, lowest (m; Dex-Net: 0.005).", ge=0)
     max_depth_offset: float = param(0.04, "... and highest (m; Dex-Net: 0.04).", ge=0)
+    antipodal_arm: bool = param(False, "Also run the reference arm `antipodal`: a random antipodal seed grasp, no network (how much the GQ-CNN adds).")
     n_pictures: int = param(3, "Trials per arm (first attempts of the first objects) drawn with their depth image, grasp and pick frames.", ge=0)
     vhacd_resolution: int = param(100000, "V-HACD voxel resolution of the convex decompositions (cached per mesh in ~/.cache/graspaug/sim or $GRASPAUG_CACHE).", ge=10000)
 

@@ -232,10 +232,11 @@ def success_bars(names: Sequence[str], arms: dict[str, tuple[np.ndarray, np.ndar
         ax.bar(x + (i - (len(arms) - 1) / 2) * width, rate, width, yerr=[rate - low, high - rate], capsize=3, label=label)
     ax.set_xticks(x)
     ax.set_xticklabels(names, rotation=30, ha="right")
-    ax.set_ylim(0, 1.05)
+    ax.set_ylim(0, 1.25)
+    ax.set_yticks(np.linspace(0, 1, 6))
     ax.set_ylabel("grasp success rate")
     ax.set_title(title)
-    ax.legend()
+    ax.legend(loc="upper center", ncol=len(arms), fontsize=8)
     _save(fig, path)
 
 

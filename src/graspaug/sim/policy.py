@@ -197,6 +197,21 @@ class CrossEntropyGraspPolicy:
                             candidates=scored)
 
 
+class RandomAntipodalPolicy:
+    """The reference without a network: one antipodal seed grasp of the image, drawn at random
+    (quality NaN)."""
+
+    def __init__(self, intrinsics: Intrinsics, sampler: SamplerSettings = SamplerSettings()) -> None:
+        self.intrinsics, self.sampler = intrinsics, sampler
+
+    def plan(self, depth: np.ndarray, rng: np.random.Generator) -> PlannedGrasp | None:
+        start = time.perf_counter()
+        grasps = sample_antipodal_grasps(depth, self.intrinsics, self.sampler, 1, rng)
+        if len(grasps) == 0:
+            return None
+        return PlannedGrasp(grasp=grasps, quality=float("nan"), planning_time=time.perf_counter() - start, candidates=1)
+
+
 def grasp_in_table_frame(grasps: ImageGrasps, camera: CameraPose, intrinsics: Intrinsics) -> tuple[np.ndarray, np.ndarray]:
     """Grasp centers (N, 3) m and jaw angles (N,) rad (in the table plane, from the table's x
     axis) of image grasps seen by ``camera``: the center pixel deprojected at the grasp depth,
