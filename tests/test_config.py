@@ -30,6 +30,8 @@ def test_repo_params_load_and_match_the_dataclass_defaults(repo_root):
         ({"data": {"source": "folder"}}, "data.path: required when data.source is folder"),
         ({"data": 3}, "data.: expected a mapping"),
         ({"n_jobs": 0}, "n_jobs: must be >= 1, or -1 for all cores; got 0"),
+        ({"executor": "dask"}, "scheduler: required when executor is dask"),
+        ({"executor": "ray"}, "executor: must be one of joblib, dask; got 'ray'"),
         ({"ae": {"lambda": -1}}, "ae.lambda: must be >= 0; got -1"),
         ({"critic_eval": {"alphas": [0.1, 0.104]}}, "critic_eval.alphas: weights must differ in the first two decimals"),
         ({"critic_eval": {"alphas": [0.1, 1.5]}}, "critic_eval.alphas: must be a non-empty list of weights in [0, 1]"),

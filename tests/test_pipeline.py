@@ -1,4 +1,4 @@
-"""Real ``dvc repro`` in a temporary copy of the repository, on tiny params."""
+"""Real ``dvc repro`` in a temporary copy of the repository, on the tiny profile (``profiles/tiny.yaml``)."""
 import os
 import shutil
 import subprocess
@@ -8,27 +8,10 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
-import yaml
 
 from graspaug.io.voxels import read_voxels
 
 pytestmark = pytest.mark.slow
-
-TINY = {
-    "data": {"limit": 20},
-    "ingest": {"surface_resolution": 48, "finest_surface_resolution": 48, "face_budget": 2000, "min_shapes": 5},
-    "voxelize": {"resolution": 16},
-    "ae": {"base_width": 4, "top_width": 16, "z_dim": 16, "batch_size": 8, "epochs_ae": 1, "epochs_critic": 1},
-    "critic_eval": {"n_shapes": 10, "n_pairs": 3, "n_examples": 2},
-    "grasps": {"n_grasps": 8, "n_samples": 4, "threshold": 0.0005},  # a low threshold: positives in a tiny test set
-    "score": {"k": 3, "bins": 5},
-    "generate": {"base_sizes": [4, 6], "ratios": [0.0, 0.5, 1.0, 2.0], "percentile": 50.0, "first_neighbour": 1, "extra_neighbours": 1,
-                 "min_voxels": 5, "min_main_share": 0.5, "smoothing_iterations": 3, "n_examples": 2},
-    "render": {"max_poses": 2, "n_examples": 4, "axis_tolerance_deg": 45.0, "images_per_pose": 2},
-    "gqcnn": {"filters": 4, "fc": 16, "pose_fc": 4, "steps": 6, "log_every": 3, "random_base_sizes": [6], "random_ratios": [1.0]},
-    "sim": {"objects": ["cube"], "n_test_objects": 1, "attempts": 2, "base_size": 6, "seed_samples": 100, "n_pictures": 1, "antipodal_arm": True},
-}
-
 
 def copy_repo(src: Path, dst: Path) -> None:
     """The files a user's clone has (tracked by git), without outputs or caches."""
@@ -38,13 +21,6 @@ def copy_repo(src: Path, dst: Path) -> None:
             continue
         (dst / rel).parent.mkdir(parents=True, exist_ok=True)
         shutil.copy2(src / rel, dst / rel)
-
-
-def set_params(path: Path, overrides: dict) -> None:
-    params = yaml.safe_load(path.read_text())
-    for section, values in overrides.items():
-        params[section].update(values)
-    path.write_text(yaml.safe_dump(params, sort_keys=False))
 
 
 def run(cmd, cwd, env):
@@ -57,7 +33,7 @@ def run(cmd, cwd, env):
 def tiny_repo(repo_root, tmp_path_factory):
     work = tmp_path_factory.mktemp("repo")
     copy_repo(repo_root, work)
-    set_params(work / "params.yaml", TINY)
+    shutil.copy(work / "profiles/tiny.yaml", work / "params.yaml")
     env = {**os.environ, "DVC_NO_ANALYTICS": "1", "PATH": f"{Path(sys.executable).parent}{os.pathsep}{os.environ['PATH']}",
            "GIT_AUTHOR_NAME": "test", "GIT_AUTHOR_EMAIL": "test@example.com", "GIT_COMMITTER_NAME": "test", "GIT_COMMITTER_EMAIL": "test@example.com"}
     run(["git", "init", "-q"], work, env)
@@ -271,5 +247,72 @@ def test_dvc_repro_sim(tiny_repo, tmp_path):
     assert "## Verdict" in (work / "reports/sim/report.md").read_text()
     for picture in ("success.png", "trials/before-cube.png", "trials/after-cube.png", "trials/antipodal-cube.png"):
         assert (work / "reports/sim" / picture).stat().st_size > 0
+    again = run(["dvc", "repro", "sim"], work, env)
+    assert "Running stage" not in again.stdout
+
+
+def test_queued_two_point_sweep_lines_up_metrics(tiny_repo):
+    """`dvc exp run --queue -S` twice, `dvc queue start`, then `dvc exp show` / `dvc metrics diff`."""
+    import json
+    import time
+
+    work, env = tiny_repo
+    run(["dvc", "repro", "sim"], work, env)  # the baseline is complete (no-op after the tests above)
+    run(["git", "add", "-A"], work, env)
+    run(["git", "commit", "-q", "-m", "baseline"], work, env)
+    for force in (10.0, 40.0):
+        run(["dvc", "exp", "run", "--queue", "-S", f"sim.grip_force={force}", "--name", f"grip-{int(force)}"], work, env)
+    run(["dvc", "queue", "start", "-j", "1"], work, env)
+    deadline = time.time() + 600
+    while time.time() < deadline:
+        status = run(["dvc", "queue", "status"], work, env).stdout
+        if "Queued" not in status and "Running" not in status:
+            break
+        time.sleep(3)
+    assert status.count("Success") == 2, status
+    shown = json.loads(run(["dvc", "exp", "show", "--json"], work, env).stdout)
+    experiments = {}
+    for commit in shown:
+        for exp in commit.get("experiments") or []:
+            for rev in exp.get("revs") or []:
+                data = rev["data"]
+                experiments[rev.get("name") or data.get("name")] = data
+    assert {"grip-10", "grip-40"} <= set(experiments), list(experiments)
+    for name, force in (("grip-10", 10.0), ("grip-40", 40.0)):
+        data = experiments[name]
+        assert data["params"]["params.yaml"]["data"]["sim"]["grip_force"] == force
+        sim = data["metrics"]["metrics/sim.json"]["data"]
+        ap = data["metrics"]["metrics/ap.json"]["data"]
+        assert sim["arms"]["before"]["attempts"] == 4 and "ap" in ap
+    diff = run(["dvc", "metrics", "diff", "grip-10", "grip-40", "--json"], work, env).stdout
+    assert "metrics/sim.json" in json.loads(diff) or json.loads(diff) == {}  # same numbers are possible on 4 attempts
+    run(["dvc", "queue", "stop"], work, env)
+
+
+def test_killed_stage_leaves_no_output_and_repro_completes(tiny_repo):
+    """SIGKILL `dvc repro ingest` while it writes meshes: no half-written output is taken as valid,
+    and the next `dvc repro` writes the same outputs as before."""
+    import signal
+    import time
+
+    work, env = tiny_repo
+    before = pd.read_parquet(work / "data/shapes.parquet")
+    process = subprocess.Popen(["dvc", "repro", "-f", "-s", "ingest"], cwd=work, env=env, stdout=subprocess.DEVNULL,
+                               stderr=subprocess.DEVNULL, start_new_session=True)
+    partial = []
+    deadline = time.time() + 120
+    while time.time() < deadline and process.poll() is None:
+        partial = [p for p in (work / "data").glob(".shapes.tmp-*") if p.is_dir() and len(list(p.iterdir())) >= 3]
+        if partial:
+            os.killpg(process.pid, signal.SIGKILL)
+            break
+        time.sleep(0.01)
+    process.wait()
+    assert partial, "the stage finished before any mesh was written; nothing was killed"
+    assert not (work / "data/shapes").exists()  # DVC removed the old output; the half-written one is only a .tmp sibling
+    assert "ingest" in run(["dvc", "status", "ingest"], work, env).stdout  # the stage is not taken as up to date
+    run(["dvc", "repro", "sim"], work, env)
+    assert not list((work / "data").glob(".shapes.tmp-*"))  # the leftover is gone
+    pd.testing.assert_frame_equal(pd.read_parquet(work / "data/shapes.parquet"), before)
     again = run(["dvc", "repro", "sim"], work, env)
     assert "Running stage" not in again.stdout

@@ -243,6 +243,8 @@ class Params:
     seed: int = param(0, "Seeds every random choice: the split, network initialisation and batches, critic-study pairs, t-SNE, grasp sampling and perturbations.", ge=0)
     device: str = param("auto", "Torch device: `auto` (CUDA when present), `cpu` or `cuda`.", choices=("auto", "cpu", "cuda"))
     n_jobs: int = param(2, "Worker processes for per-shape loops (-1: all cores).", ge=-1)
+    executor: str = param("joblib", "Where per-shape loops (ingest, voxelize, grasps, generate, render, sim) run: `joblib` (n_jobs local processes) or `dask` (the Dask cluster at `scheduler`; needs `pip install 'graspaug[dask]'` and workers that see the project at the same path).", choices=("joblib", "dask"))
+    scheduler: str | None = param(None, "Dask scheduler address when executor is `dask`, e.g. tcp://10.0.0.5:8786.")
     data: DataParams = field(default_factory=DataParams)
     ingest: IngestParams = field(default_factory=IngestParams)
     voxelize: VoxelizeParams = field(default_factory=VoxelizeParams)
@@ -255,6 +257,13 @@ class Params:
     render: RenderParams = field(default_factory=RenderParams)
     gqcnn: GQCNNParams = field(default_factory=GQCNNParams)
     sim: SimParams = field(default_factory=SimParams)
+
+    @property
+    def workers(self):
+        """Where per-shape loops run (``graspaug.parallel.Workers``); not a DVC param: results do not depend on it."""
+        from graspaug.parallel import Workers
+
+        return Workers(n_jobs=self.n_jobs, executor=self.executor, scheduler=self.scheduler)
 
 
 def _type_name(tp: Any) -> str:
@@ -340,6 +349,8 @@ def parse_params(raw: Any) -> Params:
         raise ParamsError("data.path: required when data.source is folder")
     if params.n_jobs == 0:
         raise ParamsError("n_jobs: must be >= 1, or -1 for all cores; got 0")
+    if params.executor == "dask" and not params.scheduler:
+        raise ParamsError("scheduler: required when executor is dask (e.g. tcp://10.0.0.5:8786)")
     alphas = params.critic_eval.alphas
     if not alphas or not all(0 <= a <= 1 for a in alphas):
         raise ParamsError(f"critic_eval.alphas: must be a non-empty list of weights in [0, 1]; got {list(alphas)}")

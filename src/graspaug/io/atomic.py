@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import contextlib
+import glob
 import os
 import shutil
 import tempfile
@@ -9,15 +10,28 @@ from collections.abc import Iterator
 from pathlib import Path
 
 
+def remove_stale_temporaries(path: str | os.PathLike) -> None:
+    """Delete the ``.tmp-*`` siblings of ``path`` that a killed writer left behind (DVC runs one
+    stage at a time per workspace, so no other writer of ``path`` is alive)."""
+    path = Path(path)
+    for stale in path.parent.glob(f".{glob.escape(path.name)}.tmp-*"):
+        if stale.is_dir():
+            shutil.rmtree(stale, ignore_errors=True)
+        else:
+            stale.unlink(missing_ok=True)
+
+
 @contextlib.contextmanager
 def atomic_path(path: str | os.PathLike, directory: bool = False) -> Iterator[Path]:
     """Yield a temporary sibling of ``path`` to write into; move it over ``path`` on success.
 
     If the block raises (or the process dies) the final name is untouched and the
-    temporary is removed (or left as a ``.tmp-*`` sibling that no reader takes).
+    temporary is removed (or, if the process was killed, left as a ``.tmp-*`` sibling that no
+    reader takes and the next write of ``path`` removes).
     """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
+    remove_stale_temporaries(path)
     if directory:
         tmp = Path(tempfile.mkdtemp(prefix=f".{path.name}.tmp-", dir=path.parent))
     else:

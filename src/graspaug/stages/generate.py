@@ -98,7 +98,7 @@ def run(params: Params, base_size: int) -> None:
         alpha = np.array([c.alpha for c in candidates], dtype=np.float32)[:, None]
         probability = decode(ae, (1 - alpha) * z[a] + alpha * z[b], device)
         child_pitch = (1 - alpha[:, 0]) * pitch[a] + alpha[:, 0] * pitch[b]  # metric size: the parents' scales interpolated
-        out = parallel_map(lambda job: mesh_decoded(job[0], job[1], cfg), list(zip(probability, child_pitch)), params.n_jobs, f"generate {base_size}")
+        out = parallel_map(lambda job: mesh_decoded(job[0], job[1], cfg), list(zip(probability, child_pitch)), params.workers, f"generate {base_size}")
         return [Decoded(c, np.packbits(grid.occupancy), mesh, reason) for c, (grid, mesh, reason) in zip(candidates, out)]
 
     needed = pool_size(cfg.ratios, base_size)

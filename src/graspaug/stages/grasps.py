@@ -86,7 +86,7 @@ def run(params: Params, corpus: str = "original") -> None:
     table_path, mesh_dir, suffix = files
     shape_ids = list(read_table(table_path)["shape_id"])
     jobs = [(mesh_path(mesh_dir.resolve(), s, suffix), s) for s in shape_ids]  # workers may have another cwd
-    results = parallel_map(lambda job: grasps_of_shape(job[0], job[1], cfg, params.seed), jobs, params.n_jobs, f"grasps ({corpus})")
+    results = parallel_map(lambda job: grasps_of_shape(job[0], job[1], cfg, params.seed), jobs, params.workers, f"grasps ({corpus})")
     for shape_id, (_, reason) in zip(shape_ids, results):
         if reason:
             log.warning("grasps: %s has no grasp: %s", shape_id, reason)

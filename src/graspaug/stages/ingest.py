@@ -97,7 +97,7 @@ def run(params: Params) -> None:
 
     with atomic_path(SHAPES_DIR, directory=True) as tmp_dir:
         tmp_dir = tmp_dir.resolve()  # worker processes may have another working directory
-        rows = parallel_map(lambda s: _ingest_one(s, cfg.max_faces, cfg.max_file_mb, settings, tmp_dir), sources, params.n_jobs, "ingest")
+        rows = parallel_map(lambda s: _ingest_one(s, cfg.max_faces, cfg.max_file_mb, settings, tmp_dir), sources, params.workers, "ingest")
         shapes = pd.DataFrame([r for r in rows if r.pop("ok")])
         rejects = pd.DataFrame([r for r in rows if "reason" in r], columns=["shape_id", "source", "source_sha256", "reason"])
         if len(shapes) < cfg.min_shapes:

@@ -99,7 +99,7 @@ def run(params: Params, corpus: str = "original") -> None:
         rows = by_shape.get(shape_id, empty)
         jobs.append((mesh_path(mesh_dir.resolve(), shape_id, suffix), shape_id, rows[["center_x", "center_y", "center_z"]].to_numpy(),
                      rows[["axis_x", "axis_y", "axis_z"]].to_numpy()))
-    results = parallel_map(lambda job: render_one(*job, settings, hand, params.seed), jobs, params.n_jobs, f"render ({corpus})")
+    results = parallel_map(lambda job: render_one(*job, settings, hand, params.seed), jobs, params.workers, f"render ({corpus})")
 
     images, parts, skipped, n_rays, n_poses = [], [], [], 0, []
     for shape, (data, reason) in zip(shapes.itertuples(index=False), results):

@@ -285,7 +285,7 @@ def run(params: Params) -> None:
              len(model_seeds), ratios["after"])
     work = functools.partial(run_object, layout=layout, hand=hand, sampler=sampler, cem=cem, crop_size=params.render.crop_size,
                              out_size=params.render.out_size)
-    rows = [row for rows in parallel_map(work, jobs, params.n_jobs, "sim") for row in rows]
+    rows = [row for rows in parallel_map(work, jobs, params.workers, "sim") for row in rows]
     trials = pd.DataFrame([{k: v for k, v in row.items() if not k.startswith("_")} for row in rows])
     trials["ratio"] = trials.arm.map(ratios)
     reference = trials[trials.arm == "antipodal"]

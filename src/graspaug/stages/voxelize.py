@@ -32,7 +32,7 @@ def run(params: Params) -> None:
     cfg = params.voxelize
     shape_ids = list(read_table(SHAPES_TABLE)["shape_id"])
     paths = [mesh_path(SHAPES_DIR.resolve(), s) for s in shape_ids]  # workers may have another cwd
-    out = parallel_map(lambda p: voxelize_file(p, cfg.resolution, cfg.margin), paths, params.n_jobs, "voxelize")
+    out = parallel_map(lambda p: voxelize_file(p, cfg.resolution, cfg.margin), paths, params.workers, "voxelize")
     voxels = VoxelSet(
         shape_id=np.array(shape_ids),
         occupancy=np.stack([o[0] for o in out]),

@@ -1,0 +1,63 @@
+"""Per-shape stages on a real Dask distributed cluster give what the local joblib run gives."""
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from graspaug.config import load_params
+from graspaug.parallel import Workers, parallel_map
+
+
+def square(x: int) -> int:
+    return x * x
+
+
+def test_workers_check_their_settings():
+    with pytest.raises(ValueError, match="needs a scheduler address"):
+        Workers(executor="dask")
+    with pytest.raises(ValueError, match="joblib or dask"):
+        Workers(executor="ray")
+
+
+def test_local_processes_keep_order():
+    assert parallel_map(square, list(range(20)), Workers(n_jobs=2), "squares") == [x * x for x in range(20)]
+
+
+def worker_address(_: int) -> str:
+    from distributed import get_worker
+
+    return get_worker().address
+
+
+def run_ingest_and_voxelize(folder, params, monkeypatch) -> tuple[pd.DataFrame, dict, dict]:
+    from graspaug.io.voxels import read_voxels
+    from graspaug.stages import ingest, voxelize
+
+    monkeypatch.chdir(folder)
+    ingest.run(params)
+    voxelize.run(params)
+    shapes = pd.read_parquet(folder / "data/shapes.parquet")
+    meshes = {p.name: p.read_bytes() for p in sorted((folder / "data/shapes").iterdir())}
+    voxels = read_voxels(folder / "data/voxels.npz")
+    return shapes, meshes, {"occupancy": voxels.occupancy, "ids": np.asarray(voxels.shape_id), "origin": voxels.origin}
+
+
+def test_stages_on_a_dask_cluster_equal_the_local_run(repo_root, tmp_path, monkeypatch):
+    distributed = pytest.importorskip("distributed")
+    tiny = load_params(repo_root / "profiles/tiny.yaml")
+    params = dataclasses.replace(tiny, data=dataclasses.replace(tiny.data, limit=6), ingest=dataclasses.replace(tiny.ingest, min_shapes=2))
+    (tmp_path / "local").mkdir()
+    (tmp_path / "cluster").mkdir()
+    local = run_ingest_and_voxelize(tmp_path / "local", params, monkeypatch)
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
+        on_cluster = dataclasses.replace(params, executor="dask", scheduler=cluster.scheduler_address)
+        remote = run_ingest_and_voxelize(tmp_path / "cluster", on_cluster, monkeypatch)
+        ran_on = set(parallel_map(worker_address, list(range(8)), on_cluster.workers, "where"))
+        assert ran_on and ran_on <= set(cluster.scheduler_info["workers"])  # the calls ran on the cluster's workers
+    pd.testing.assert_frame_equal(local[0], remote[0])
+    assert len(local[1]) == 6 and local[1] == remote[1]  # byte-identical meshes
+    for key in local[2]:
+        assert np.array_equal(local[2][key], remote[2][key])
