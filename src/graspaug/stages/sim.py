@@ -322,7 +322,7 @@ def run(params: Params) -> None:
         write_csv(pd.concat([trials, reference]).drop(columns=["planning_time"]), out / "trials.csv")
         write_csv(pd.DataFrame([{"object": name, "kind": kind, "extent_x": e[0], "extent_y": e[1], "extent_z": e[2],
                                  "mass": cfg.object_mass, "friction": cfg.object_friction,
-                                 "convex_hulls": ("\n" + so.collision.read_text()).count("\no "), "collision_file": str(so.collision)}
+                                 "convex_hulls": ("\n" + so.collision.read_text()).count("\no "), "collision_file": so.collision.name}
                                 for name, kind, so, e in objects]), out / "objects.csv")
         per_object = pd.DataFrame([{"object": name, **{arm: row[arm]["success_rate"] for arm in [*ratios, "antipodal"] if arm in row}}
                                    for name, row in metrics["per_object"].items()])
