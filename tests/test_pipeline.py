@@ -257,6 +257,7 @@ def test_queued_two_point_sweep_lines_up_metrics(tiny_repo):
     import time
 
     work, env = tiny_repo
+    env = {**env, "GRASPAUG_CACHE": str(work.parent / "sweep-cache")}
     run(["dvc", "repro", "sim"], work, env)  # the baseline is complete (no-op after the tests above)
     run(["git", "add", "-A"], work, env)
     run(["git", "commit", "-q", "-m", "baseline"], work, env)
@@ -284,8 +285,10 @@ def test_queued_two_point_sweep_lines_up_metrics(tiny_repo):
         sim = data["metrics"]["metrics/sim.json"]["data"]
         ap = data["metrics"]["metrics/ap.json"]["data"]
         assert sim["arms"]["before"]["attempts"] == 4 and "ap" in ap
-    diff = run(["dvc", "metrics", "diff", "grip-10", "grip-40", "--json"], work, env).stdout
-    assert "metrics/sim.json" in json.loads(diff) or json.loads(diff) == {}  # same numbers are possible on 4 attempts
+    changed = json.loads(run(["dvc", "params", "diff", "grip-10", "grip-40", "--json"], work, env).stdout)
+    assert changed["params.yaml"] == {"sim.grip_force": {"old": 10.0, "new": 40.0}}
+    diff = json.loads(run(["dvc", "metrics", "diff", "grip-10", "grip-40", "--json", "--all"], work, env).stdout)
+    assert diff["metrics/sim.json"]["arms.before.attempts"] == {"old": 4, "new": 4, "diff": 0}  # --all lines up every metric
     run(["dvc", "queue", "stop"], work, env)
 
 

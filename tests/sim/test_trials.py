@@ -67,3 +67,26 @@ def test_planned_pick_same_seed_same_outcome(duck):
     assert first.depth[v, u] < layout.camera_height - 0.005
     assert [label for label, _ in first.frames] == ["object dropped", "pre-grasp", "closed", "lifted", "over the bin", "released"][: len(first.frames)]
     assert all(frame.shape == (240, 320, 3) for _, frame in first.frames)
+
+
+def test_jaw_angle_convention_on_a_long_bar(sim_cache):
+    """A 3 × 12 × 3 cm bar: closing across its width lifts it, closing along its length (wider than
+    the 8 cm opening) cannot. A jaw angle off by 90° or a flipped axis would swap the outcomes."""
+    import trimesh
+
+    from graspaug.sim.objects import prepare_object
+
+    bar = prepare_object("bar", trimesh.creation.box(extents=[0.03, 0.12, 0.03]), sim_cache, mass=0.1, lateral_friction=0.5)
+
+    def jaws(axis_index):
+        def scripted(position, quaternion):
+            axes = np.array(pybullet.getMatrixFromQuaternion(quaternion)).reshape(3, 3).T  # rows: body axes in the table frame
+            long_axis = axes[1]  # the bar's 12 cm axis lies flat whatever face it rests on
+            across = np.array([-long_axis[1], long_axis[0], 0.0])
+            axis = across if axis_index == "across" else long_axis
+            return np.asarray(position), float(np.arctan2(axis[1], axis[0]))
+        return scripted
+
+    assert run_trial(bar, drop_seed=2, scripted=jaws("across")).outcome == "success"
+    assert run_trial(bar, drop_seed=2, scripted=jaws("along")).outcome == "not_lifted"
+

@@ -92,8 +92,10 @@ def default_cache_dir() -> Path:
 
 def prepare_object(name: str, mesh: trimesh.Trimesh, cache_dir: Path, mass: float, lateral_friction: float,
                    resolution: int = 100_000) -> SimObject:
-    """Write ``mesh`` (m), centered on its center of mass, to the cache as
-    ``<name>-<sha256>.obj``, decompose it, and return the :class:`SimObject` for the trials."""
+    """Write ``mesh`` (m) to the cache as ``<name>-<sha256>.obj``, decompose it, and return the
+    :class:`SimObject` for the trials. The mesh is centered on its center of mass when it is a
+    closed volume, else on its bounding-box center (several pybullet_data meshes are open); the
+    body's center of mass is that origin."""
     mesh = mesh.copy()
     mesh.apply_translation(-mesh.center_mass if mesh.is_volume else -mesh.bounds.mean(axis=0))
     cache_dir = Path(cache_dir)

@@ -102,8 +102,8 @@ def sample_antipodal_grasps(depth: np.ndarray, intrinsics: Intrinsics, settings:
     grad_v, grad_u = np.gradient(depth)
     magnitude = np.hypot(grad_u, grad_v)
     edges = magnitude > settings.depth_grad_thresh
-    b = settings.min_dist_from_boundary
-    edges[:b], edges[-b:], edges[:, :b], edges[:, -b:] = False, False, False, False
+    b, (h, w) = settings.min_dist_from_boundary, depth.shape
+    edges[:b], edges[h - b:], edges[:, :b], edges[:, w - b:] = False, False, False, False
     v, u = np.nonzero(edges)
     empty = ImageGrasps(np.zeros((0, 2)), np.zeros(0), np.zeros(0), np.zeros(0))
     if len(u) < 2:

@@ -17,6 +17,7 @@ from __future__ import annotations
 import functools
 import json
 import logging
+import os
 import time
 from dataclasses import dataclass
 
@@ -118,8 +119,17 @@ def settings(params: Params):
     return layout, hand, sampler, cem
 
 
-@functools.lru_cache(maxsize=4)
 def _policy(model: str | None, layout, sampler, cem, crop_size: int, out_size: int):
+    """The planner for ``model``, loaded once per worker process and file version."""
+    if model is None:
+        return _cached_policy(None, None, layout, sampler, cem, crop_size, out_size)
+    path = os.path.abspath(model)
+    stat = os.stat(path)
+    return _cached_policy(path, (stat.st_mtime_ns, stat.st_size), layout, sampler, cem, crop_size, out_size)
+
+
+@functools.lru_cache(maxsize=4)
+def _cached_policy(model: str | None, version, layout, sampler, cem, crop_size: int, out_size: int):
     from graspaug.sim.policy import RandomAntipodalPolicy
 
     if model is None:
@@ -134,18 +144,19 @@ def _policy(model: str | None, layout, sampler, cem, crop_size: int, out_size: i
     return CrossEntropyGraspPolicy(load_gqcnn(model), layout.intrinsics, sampler, cem, CropGeometry(crop_size, out_size))
 
 
-def run_object(job: ObjectJob, layout, hand, sampler, cem, crop_size: int, out_size: int) -> list[dict]:
+def run_object(job: ObjectJob, layout, hand, sampler, cem, crop_size: int, out_size: int, trial_settings=None) -> list[dict]:
     """Every attempt of one object in one arm: a row per attempt (plus depth and frames for the
     first attempt when ``job.record``)."""
-    from graspaug.sim.trials import run_trial
+    from graspaug.sim.trials import TrialSettings, run_trial
 
+    trial_settings = trial_settings or TrialSettings()
     policy = _policy(job.model, layout, sampler, cem, crop_size, out_size)
     rows = []
     for attempt, (drop_seed, plan_seed) in enumerate(zip(job.drop_seeds, job.plan_seeds)):
         rng = np.random.default_rng(plan_seed)
         record = job.record and attempt == 0
         result = run_trial(job.sim_object, drop_seed, planner=lambda depth, camera, k: policy.plan(depth, rng), layout=layout,
-                           hand=hand, record=record)
+                           hand=hand, settings=trial_settings, record=record)
         g = result.image_grasp or {}
         rows.append({
             "arm": job.arm, "seed": job.seed, "object": job.name, "kind": job.kind, "attempt": attempt, "drop_seed": drop_seed,
@@ -181,12 +192,17 @@ def _picture(row: dict, ratio: float | None, path) -> None:
         cu, cv = int(round(row["u"])), int(round(row["v"]))
     else:
         cu, cv = w // 2, h // 2
-    r = 80
+    r = min(80, h // 2, w // 2)
     u0, v0 = int(np.clip(cu - r, 0, w - 2 * r)), int(np.clip(cv - r, 0, h - 2 * r))
     quality = "no grasp found" if row["quality"] is None else ("random" if np.isnan(row["quality"]) else f"Q = {row['quality']:.3f}")
     network = "random antipodal grasp, no network" if ratio is None else f"ratio {ratio:g}, training seed {row['seed']}"
     title = f"{row['object']}, arm {row['arm']} ({network}), attempt 0: {quality} → {row['outcome']}"
     pick_story(depth, jaw, (u0, v0, u0 + 2 * r, v0 + 2 * r), row["_frames"], path, title)
+
+
+def _mean_or_none(values: pd.Series) -> float | None:
+    values = values.dropna()
+    return float(values.mean()) if len(values) else None
 
 
 def compare(trials: pd.DataFrame) -> dict:
@@ -196,6 +212,8 @@ def compare(trials: pd.DataFrame) -> dict:
 
     out = {arm: rate_summary(trials.success[trials.arm == arm]) for arm in ("before", "after")}
     paired = trials.pivot_table(index=["seed", "object", "attempt"], columns="arm", values="success", aggfunc="first")
+    if paired.isna().any().any():
+        raise StageError("sim: an attempt is missing from one arm; the arms cannot be paired")
     out["difference"] = round(out["after"]["success_rate"] - out["before"]["success_rate"], 5)
     out["paired"] = paired_test(paired["before"].to_numpy(bool), paired["after"].to_numpy(bool))
     return out
@@ -283,8 +301,10 @@ def run(params: Params) -> None:
             jobs.append(ObjectJob("antipodal", -1, None, name, kind, sim_object, drop_seeds, plan_seeds, index < cfg.n_pictures))
     log.info("sim: %d objects × %d attempts × 2 arms × %d training seeds (after = ratio %g)", len(objects), cfg.attempts,
              len(model_seeds), ratios["after"])
+    from graspaug.sim.trials import TrialSettings
+
     work = functools.partial(run_object, layout=layout, hand=hand, sampler=sampler, cem=cem, crop_size=params.render.crop_size,
-                             out_size=params.render.out_size)
+                             out_size=params.render.out_size, trial_settings=TrialSettings(drop_offset=cfg.drop_offset))
     rows = [row for rows in parallel_map(work, jobs, params.workers, "sim") for row in rows]
     trials = pd.DataFrame([{k: v for k, v in row.items() if not k.startswith("_")} for row in rows])
     trials["ratio"] = trials.arm.map(ratios)
@@ -315,7 +335,7 @@ def run(params: Params) -> None:
     timing = {"planning_time_mean": float(planning.mean()) if len(planning) else None,
               "planning_time_median": float(planning.median()) if len(planning) else None,
               "planning_time_max": float(planning.max()) if len(planning) else None,
-              "planning_time_by_arm": {arm: float(trials.planning_time[trials.arm == arm].mean()) for arm in ratios},
+              "planning_time_by_arm": {arm: _mean_or_none(trials.planning_time[trials.arm == arm]) for arm in ratios},
               "trials": int(len(trials)), "stage_seconds": None}
 
     with atomic_path(SIM_REPORT_DIR, directory=True) as out:
