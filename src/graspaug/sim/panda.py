@@ -63,10 +63,6 @@ class Panda:
     def arm_angles(self) -> np.ndarray:
         return np.array([s[0] for s in pybullet.getJointStates(self.body, ARM_JOINTS, physicsClientId=self.client)])
 
-    def finger_gap(self) -> float:
-        """Distance between the jaws (m)."""
-        return float(sum(s[0] for s in pybullet.getJointStates(self.body, FINGER_JOINTS, physicsClientId=self.client)))
-
     def grasp_pose(self) -> tuple[np.ndarray, np.ndarray]:
         """Position (3,) m and quaternion (x, y, z, w) of the grasp center link."""
         state = pybullet.getLinkState(self.body, GRASP_TARGET_LINK, computeForwardKinematics=True, physicsClientId=self.client)
