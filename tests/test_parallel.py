@@ -7,7 +7,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from graspaug.config import load_params
+from graspaug.profiles import profile_params
 from graspaug.parallel import Workers, parallel_map
 
 
@@ -47,13 +47,13 @@ def run_ingest_and_voxelize(folder, params, monkeypatch) -> tuple[pd.DataFrame, 
 
 def test_stages_on_a_dask_cluster_equal_the_local_run(repo_root, tmp_path, monkeypatch):
     distributed = pytest.importorskip("distributed")
-    tiny = load_params(repo_root / "profiles/tiny.yaml")
-    params = dataclasses.replace(tiny, data=dataclasses.replace(tiny.data, limit=6), ingest=dataclasses.replace(tiny.ingest, min_shapes=2))
+    tiny = profile_params("tiny", repo_root / "profiles")
+    params = tiny.model_copy(update={"data": dataclasses.replace(tiny.data, limit=6), "ingest": dataclasses.replace(tiny.ingest, min_shapes=2)})
     (tmp_path / "local").mkdir()
     (tmp_path / "cluster").mkdir()
     local = run_ingest_and_voxelize(tmp_path / "local", params, monkeypatch)
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
-        on_cluster = dataclasses.replace(params, executor="dask", scheduler=cluster.scheduler_address)
+        on_cluster = params.model_copy(update={"executor": "dask", "scheduler": cluster.scheduler_address})
         remote = run_ingest_and_voxelize(tmp_path / "cluster", on_cluster, monkeypatch)
         ran_on = set(parallel_map(worker_address, list(range(8)), on_cluster.workers, "where"))
         assert ran_on and ran_on <= set(cluster.scheduler_info["workers"])  # the calls ran on the cluster's workers

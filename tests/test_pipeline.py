@@ -33,7 +33,7 @@ def run(cmd, cwd, env):
 def tiny_repo(repo_root, tmp_path_factory):
     work = tmp_path_factory.mktemp("repo")
     copy_repo(repo_root, work)
-    shutil.copy(work / "profiles/tiny.yaml", work / "params.yaml")
+    run([str(Path(sys.executable).parent / "graspaug"), "profile", "tiny"], work, {**os.environ})  # the documented way to apply a profile
     env = {**os.environ, "DVC_NO_ANALYTICS": "1", "PATH": f"{Path(sys.executable).parent}{os.pathsep}{os.environ['PATH']}",
            "GIT_AUTHOR_NAME": "test", "GIT_AUTHOR_EMAIL": "test@example.com", "GIT_COMMITTER_NAME": "test", "GIT_COMMITTER_EMAIL": "test@example.com"}
     run(["git", "init", "-q"], work, env)
@@ -75,7 +75,8 @@ def test_dvc_repro_critic_eval_and_embed(tiny_repo):
     assert set(result["outlier_pct"]) == {"ae", "ae_critic"}
     assert list(result["outlier_pct"]["ae"]) == ["0.00", "0.10", "0.20", "0.30", "0.40", "0.50"]
     summary = json.loads((work / "metrics/train_ae.json").read_text())
-    assert 0 <= summary["ae_iou_test"] <= 1 and summary["ae_shapes_per_s"] > 0
+    assert 0 <= summary["ae_iou_test"] <= 1 and "ae_shapes_per_s" not in summary  # results only: timings go to reports/timing
+    assert json.loads((work / "reports/timing/train_ae.json").read_text())["ae_shapes_per_s"] > 0
     latents = pd.read_parquet(work / "data/latents.parquet")
     assert len(latents) == 20 and len(latents.z[0]) == 16
     assert set(latents.split) == {"train", "test"}
@@ -264,7 +265,7 @@ def test_queued_two_point_sweep_lines_up_metrics(tiny_repo):
     run(["git", "add", "-A"], work, env)
     run(["git", "commit", "-q", "-m", "baseline"], work, env)
     for force in (10.0, 40.0):
-        run(["dvc", "exp", "run", "--queue", "-S", f"sim.grip_force={force}", "--name", f"grip-{int(force)}"], work, env)
+        run(["dvc", "exp", "run", "--queue", "-S", f"sim.hand.grip_force={force}", "--name", f"grip-{int(force)}"], work, env)
     run(["dvc", "queue", "start", "-j", "1"], work, env)
     deadline = time.time() + 600
     while time.time() < deadline:
@@ -283,13 +284,13 @@ def test_queued_two_point_sweep_lines_up_metrics(tiny_repo):
     assert {"grip-10", "grip-40"} <= set(experiments), list(experiments)
     for name, force in (("grip-10", 10.0), ("grip-40", 40.0)):
         data = experiments[name]
-        assert data["params"]["params.yaml"]["data"]["sim"]["grip_force"] == force
+        assert data["params"]["params.yaml"]["data"]["sim"]["hand"]["grip_force"] == force
         sim = data["metrics"]["metrics/sim.json"]["data"]
         ap = data["metrics"]["metrics/ap.json"]["data"]
         assert sim["arms"]["before"]["attempts"] == 4 and "ap" in ap
     changed = json.loads(run(["dvc", "params", "diff", "grip-10", "grip-40", "--json"], work, env).stdout)
-    assert list(changed["params.yaml"]) == ["sim.grip_force"]
-    assert (changed["params.yaml"]["sim.grip_force"]["old"], changed["params.yaml"]["sim.grip_force"]["new"]) == (10.0, 40.0)
+    assert list(changed["params.yaml"]) == ["sim.hand.grip_force"]
+    assert (changed["params.yaml"]["sim.hand.grip_force"]["old"], changed["params.yaml"]["sim.hand.grip_force"]["new"]) == (10.0, 40.0)
     diff = json.loads(run(["dvc", "metrics", "diff", "grip-10", "grip-40", "--json", "--all"], work, env).stdout)
     assert diff["metrics/sim.json"]["arms.before.attempts"] == {"old": 4, "new": 4, "diff": 0}  # --all lines up every metric
     run(["dvc", "queue", "stop"], work, env)

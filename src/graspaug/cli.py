@@ -9,10 +9,11 @@ from pathlib import Path
 import typer
 
 from graspaug.config import (
-    AEParams, CriticEvalParams, DataParams, EmbedParams, GenerateParams, GQCNNParams, GraspsParams, IngestParams, Params, ParamsError, RenderParams, ScoreParams,
-    SimParams, VoxelizeParams,
-    describe, load_params,
+    AEParams, CriticEvalParams, EmbedParams, GenerateParams, GQCNNParams, GraspsParams, IngestParams, Params, ParamsError, RenderParams, ScoreParams,
+    SimParams, VoxelizeParams, load_params,
 )
+from graspaug.io.settings import CorpusSettings
+from graspaug.settings import describe
 
 app = typer.Typer(
     help="graspaug: augment a grasp planner's training objects with generated shapes.\n\n"
@@ -36,8 +37,7 @@ def _load(path: Path) -> Params:
 
 
 def _run(stage_run, params: Params) -> None:
-    from graspaug.io.checkpoints import CheckpointMismatch
-    from graspaug.stages import StageError
+    from graspaug.errors import CheckpointMismatch, StageError
 
     try:
         stage_run(params)
@@ -62,33 +62,33 @@ stage_command(
     "Load the shape corpus, reject broken meshes with a reason, rebuild one closed outer surface "
     "per shape, center and scale it, and split train/test.\n\n"
     "Writes `data/shapes/<shape_id>.ply`, `data/shapes.parquet`, `data/rejects.parquet`.\n\n"
-    f"Params `data`:\n\n{describe(DataParams)}\n\nParams `ingest`:\n\n{describe(IngestParams)}\n\n"
+    f"Params `data`:\n\n{describe(CorpusSettings, 'data.')}\n\nParams `ingest`:\n\n{describe(IngestParams, 'ingest.')}\n\n"
     "Also `seed` (split) and `n_jobs`.",
 )
 stage_command(
     "voxelize",
     "Voxelize every shape's closed surface into a solid R×R×R occupancy grid (voxel centers "
     "inside the surface), scaled to fit with a margin; pitch and origin are kept to go back to meters.\n\n"
-    f"Writes `data/voxels.npz`.\n\nParams `voxelize`:\n\n{describe(VoxelizeParams)}\n\nAlso `n_jobs`.",
+    f"Writes `data/voxels.npz`.\n\nParams `voxelize`:\n\n{describe(VoxelizeParams, 'voxelize.')}\n\nAlso `n_jobs`.",
 )
 stage_command(
     "train-ae",
     "Train the AutoEncoder (phase 1, binary cross-entropy) and then the AE-Critic (phase 2, eqs. (1)-(2) "
     "of the paper) on the train split's voxel grids; test shapes stay unseen.\n\n"
     "Writes `models/ae.pt`, `models/ae_critic.pt`, DVCLive logs in `metrics/train_ae/`, and `metrics/train_ae.json` "
-    f"(test/train reconstruction IoU, time, shapes/s).\n\nParams `ae`:\n\n{describe(AEParams)}\n\n"
-    "Also `voxelize.resolution`, `seed`, `device`.",
+    f"(test/train reconstruction IoU, time, shapes/s).\n\nParams `ae`:\n\n{describe(AEParams, 'ae.')}\n\n"
+    "Also `seed`, `device`.",
 )
 stage_command(
     "embed",
     "Encode every shape with the AE-Critic: `data/latents.parquet` (shape_id, split, z) and a 2-D t-SNE map "
-    f"(`reports/embed/tsne.csv`, `.png`).\n\nParams `embed`:\n\n{describe(EmbedParams)}",
+    f"(`reports/embed/tsne.csv`, `.png`).\n\nParams `embed`:\n\n{describe(EmbedParams, 'embed.')}",
 )
 stage_command(
     "critic-eval",
     "The paper's critic study: decode interpolations of random train pairs with the AE and the AE-Critic, "
     "cluster each with DBSCAN, report the mean outlier percentage per α (`metrics/critic_eval.json`) with plots "
-    f"in `reports/critic_eval/`.\n\nParams `critic_eval`:\n\n{describe(CriticEvalParams)}",
+    f"in `reports/critic_eval/`.\n\nParams `critic_eval`:\n\n{describe(CriticEvalParams, 'critic_eval.')}",
 )
 
 
@@ -99,7 +99,7 @@ stage_command(
     "Writes `data/grasps/<corpus>.parquet` (one row per grasp) and `metrics/grasps/<corpus>.json`; corpus "
     "`original` is the ingested shapes, `gen_<B>` the shapes generated for base size B. "
     "A shape without any grasp gets no rows and a warning with the reason.\n\n"
-    f"Params `grasps`:\n\n{describe(GraspsParams)}\n\nAlso `seed` and `n_jobs`.",
+    f"Params `grasps`:\n\n{describe(GraspsParams, 'grasps.')}\n\nAlso `seed` and `n_jobs`.",
 )
 def grasps_command(
     corpus: str = typer.Option("original", "--corpus", "-c", help="Which shapes: `original` (ingested corpus) or `gen_<B>` (generated for base size B)."),
@@ -115,7 +115,7 @@ stage_command(
     "Score every original shape: rarity (eq. (3)-(4) of the paper on the AE-Critic latents, relative to the "
     "train split) and graspness (share of its grasps with robust ε above the threshold).\n\n"
     "Writes `data/scores.parquet`, `metrics/score.json`, and histograms and a grasp picture in `reports/score/`.\n\n"
-    f"Params `score`:\n\n{describe(ScoreParams)}\n\nAlso `grasps.threshold` (for labels).",
+    f"Params `score`:\n\n{describe(ScoreParams, 'score.')}\n\nAlso `grasps.threshold` (for labels).",
 )
 
 
@@ -128,7 +128,7 @@ stage_command(
     "the first round(R × B) are the set for ratio R.\n\n"
     "Writes `data/generated/<B>/` (`meshes/*.obj`, `index.parquet`, `rejects.parquet`, `base.parquet`), "
     "`metrics/generate/<B>.json` and `reports/generate/<B>/{pairs,tsne}.png`.\n\n"
-    f"Params `generate`:\n\n{describe(GenerateParams)}\n\nAlso `score.k` (rarity on the base set), `seed`, `device`, `n_jobs`.",
+    f"Params `generate`:\n\n{describe(GenerateParams, 'generate.')}\n\nAlso `score.k` (rarity on the base set), `seed`, `device`, `n_jobs`.",
 )
 def generate_command(
     base_size: int = typer.Option(..., "--base-size", "-b", help="The base set size B (one of generate.base_sizes)."),
@@ -149,7 +149,7 @@ def generate_command(
     "full 640×480 renders (tests/render).\n\n"
     "Writes `data/gqcnn/<corpus>/` (.npy shards of images, z, labels, ε; `index.parquet`; `skipped.parquet`), "
     "`metrics/render/<corpus>.json` and `reports/render/<corpus>/examples.png`.\n\n"
-    f"Params `render`:\n\n{describe(RenderParams)}\n\nAlso `grasps.max_width` (the gripper), `seed` and `n_jobs`.",
+    f"Params `render`:\n\n{describe(RenderParams, 'render.')}\n\nAlso `grasps.gripper` (the hand), `grasps.threshold` (labels), `seed` and `n_jobs`.",
 )
 def render_command(
     corpus: str = typer.Option("original", "--corpus", "-c", help="Which shapes: `original` (train and test) or `gen_<B>` (generated for base size B)."),
@@ -174,11 +174,12 @@ def export_dexnet_command(
     out: Path = typer.Argument(..., help="Folder to create (must not exist or be empty)."),
     rows_per_file: int = typer.Option(1000, "--rows-per-file", min=1, help="Datapoints per .npz file (Dex-Net: 1000)."),
 ) -> None:
-    from graspaug.stages import StageError, render
+    from graspaug.io.dexnet import export_dexnet
+    from graspaug.paths import gqcnn_dir
 
     try:
-        n = render.export_dexnet(corpus, out, rows_per_file)
-    except (StageError, FileNotFoundError, FileExistsError) as exc:
+        n = export_dexnet(gqcnn_dir(corpus), out, rows_per_file)
+    except (FileNotFoundError, FileExistsError) as exc:
         typer.echo(f"error: {exc}", err=True)
         raise typer.Exit(1) from None
     typer.echo(f"wrote {n} datapoints to {out}")
@@ -193,7 +194,7 @@ def export_dexnet_command(
     "training data, Gamma and Gaussian-process noise, 180° turns and flips.\n\n"
     "Writes `models/gqcnn/<pool>/<B>-<R>-s<seed>/` (model.pt, test_predictions.npy), `metrics/gqcnn/<pool>/<B>-<R>-s<seed>.json` "
     "(test AP, accuracy, ROC AUC) and DVCLive curves in `metrics/gqcnn/<pool>/<B>-<R>-s<seed>/`.\n\n"
-    f"Params `gqcnn`:\n\n{describe(GQCNNParams)}\n\nAlso `seed`, `device`.",
+    f"Params `gqcnn`:\n\n{describe(GQCNNParams, 'gqcnn.')}\n\nAlso `seed`, `device`.",
 )
 def train_gqcnn_command(
     base_size: int = typer.Option(..., "--base-size", "-b", help="Base set size B (one of generate.base_sizes)."),
@@ -226,8 +227,58 @@ stage_command(
     "refinement. Arms: `before` (B-0) and `after` (B at the report's best ratio), the same drops for both.\n\n"
     "Writes `metrics/sim.json` (success per arm and object, 95% Wilson intervals, paired McNemar test) and `reports/sim/` "
     "(`report.md`, `trials.csv`, `success.csv/.png`, `objects.csv`, `timing.json`, `trials/<arm>-<object>.png`).\n\n"
-    f"Params `sim`:\n\n{describe(SimParams)}",
+    f"Params `sim`:\n\n{describe(SimParams, 'sim.')}",
 )
+
+
+@app.command(
+    name="profile",
+    help="Write params.yaml for a profile: the defaults plus the few keys `profiles/<name>.yaml` changes "
+    "(`default`: the defaults alone). Profiles: `tiny` (every stage in minutes, for trying changes), `study` "
+    "(the GQ-CNN experiment over several seeds), `paper` (the paper's sizes, for a GPU). Every key is written, "
+    "commented, so DVC tracks each value; `graspaug profile default` restores the defaults.",
+)
+def profile_command(
+    name: str = typer.Argument(..., help="Profile name: `default` or a file stem in profiles/."),
+    out: Path = typer.Option(Path("params.yaml"), "--out", "-o", help="File to write."),
+    profiles: Path = typer.Option(Path("profiles"), "--profiles", help="Folder of profile overlays."),
+) -> None:
+    from graspaug.io.atomic import atomic_path
+    from graspaug.profiles import profile_yaml
+
+    try:
+        text = profile_yaml(name, profiles)
+    except ParamsError as exc:
+        typer.echo(f"error: {exc}", err=True)
+        raise typer.Exit(code=2) from None
+    with atomic_path(out) as tmp:
+        tmp.write_text(text)
+    typer.echo(f"wrote {out} (profile {name})")
+
+
+@app.command(
+    name="schema",
+    help="Write the JSON Schema of params.yaml (every key's type, range, default and meaning), for editors: "
+    "params.yaml's first line `# yaml-language-server: $schema=params.schema.json` makes VS Code's YAML extension check and complete it.",
+)
+def schema_command(out: Path = typer.Option(Path("params.schema.json"), "--out", "-o", help="File to write.")) -> None:
+    from graspaug.config import json_schema
+
+    out.write_text(json_schema())
+    typer.echo(f"wrote {out}")
+
+
+def _version(value: bool) -> None:
+    if value:
+        from importlib.metadata import version
+
+        typer.echo(f"graspaug {version('graspaug')}")
+        raise typer.Exit()
+
+
+@app.callback()
+def _root(version: bool = typer.Option(False, "--version", callback=_version, is_eager=True, help="Print the version and exit.")) -> None:
+    """graspaug: augment a grasp planner's training objects with generated shapes."""
 
 
 def main() -> None:

@@ -1,262 +1,243 @@
-"""Typed parameters, read from params.yaml.
+"""The pipeline's parameters: ``params.yaml`` read into the library's own settings classes.
 
-One frozen dataclass per params section. Every field says what it is in its
-``help`` metadata (the CLI's ``--help`` prints them) and what values it allows.
-An unknown key, a wrong type or an out-of-range value raises :class:`ParamsError`
-whose message is one line naming the key and what is allowed.
+Each params section is a settings class (:func:`graspaug.settings.settings`); a section that
+configures a library object *is* that object's settings class (``gqcnn.net`` is
+:class:`~graspaug.nets.gqcnn.GQCNNConfig`, ``grasps.sampler`` is
+:class:`~graspaug.grasping.antipodal.AntipodalSettings`, …), so every default lives on one
+field. pydantic checks types, ranges and unknown keys; :func:`load_params` turns the first
+problem into a :class:`ParamsError`, one line naming the key and what is allowed.
 """
 from __future__ import annotations
 
-import dataclasses
-import types
-import typing
-from dataclasses import dataclass, field
+import json
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
 import yaml
+from pydantic import BaseModel, ConfigDict, ValidationError, model_validator
+
+from graspaug.geometry.settings import DecodeSettings, SurfaceSettings
+from graspaug.grasping.gripper import ParallelJawGripper
+from graspaug.grasping.settings import AntipodalSettings, Perturbations, QualitySettings
+from graspaug.io.settings import CorpusSettings
+from graspaug.nets.settings import AEConfig, GQCNNConfig
+from graspaug.render.settings import RenderSettings
+from graspaug.settings import Field, is_settings, settings
+from graspaug.sim.catalog import EVERYDAY_OBJECTS
+from graspaug.sim.settings import CellLayout, CEMSettings, HandSettings, SamplerSettings, TrialSettings
+from graspaug.training.settings import AETrainConfig, TrainSettings
 
 
 class ParamsError(ValueError):
     """Invalid params; the message is one line naming the key."""
 
 
-def param(default: Any, help: str, *, choices: tuple | None = None, ge: float | None = None, le: float | None = None, gt: float | None = None, key: str | None = None) -> Any:
-    """A dataclass field with its help text and allowed values; ``key`` is its name in
-    params.yaml when that is not a Python identifier (``lambda``)."""
-    return field(default=default, metadata={"help": help, "choices": choices, "ge": ge, "le": le, "gt": gt, "key": key})
+def _floats_written_as_floats(raw: Any, section: str, key: str) -> Any:
+    written = (raw or {}).get(key) or [] if isinstance(raw, dict) else []
+    if any(isinstance(value, int) and not isinstance(value, bool) for value in written):
+        raise ValueError(f"{section}.{key}: write every ratio as a float (1.0, not 1): DVC names the networks' folders after them; got {written}")
+    return raw
 
 
-def _key(f: dataclasses.Field) -> str:
-    return f.metadata.get("key") or f.name
-
-
-@dataclass(frozen=True)
-class DataParams:
-    """Where the shape corpus comes from."""
-
-    source: str = param("pybullet", "`pybullet`: the 1000 objects of pybullet_data/random_urdfs (URDF mesh scale applied); `folder`: every .obj/.stl/.ply/.off/.glb under `path`, recursively (e.g. a local 3DNet copy).", choices=("pybullet", "folder"))
-    path: str | None = param(None, "Folder of meshes when source is `folder`, relative to the project or absolute; its files are taken as meters times `unit_scale`.")
-    unit_scale: float = param(1.0, "Meters per file unit for `folder` sources (0.001 for millimeter files).", gt=0)
-    limit: int | None = param(None, "Use only the first `limit` files in sorted order (null: all).", ge=1)
-
-
-@dataclass(frozen=True)
+@settings
 class IngestParams:
     """Checking, rebuilding, sizing and splitting the shapes."""
 
-    max_faces: int = param(1_000_000, "A file with more triangles is rejected.", ge=1)
-    max_file_mb: float = param(100.0, "A larger file is rejected before it is read, MB.", gt=0)
-    min_shapes: int = param(10, "The stage fails if fewer shapes survive the checks.", ge=1)
-    surface_resolution: int = param(96, "Marching-cubes samples along a shape's largest extent when its closed outer surface is rebuilt (cell = extent / resolution).", ge=16, le=512)
-    finest_surface_resolution: int = param(160, "Upper limit of that resolution for shapes made of thin convex parts (lattices), which get a finer grid.", ge=16, le=512)
-    cells_per_thickness: float = param(6.0, "Field cells across a typical (median) convex part; sets the finer grid for thin-part shapes (0: always surface_resolution).", ge=0)
-    face_budget: int = param(5000, "Triangles per outer surface after quadric decimation.", ge=100)
-    size_rule: str = param("mid", "Which extent the size rule fixes: `min`, `mid` (the middle one) or `max`.", choices=("min", "mid", "max"))
-    size_m: float = param(0.06, "That extent after scaling, meters. Default: middle extent 0.06 m, so a Franka Panda (0.08 m opening) closes across the two smaller extents of most objects.", gt=0)
-    max_dropped: float = param(0.1, "Reject a shape whose largest connected piece misses more than this share of its volume.", ge=0, le=1)
-    test_fraction: float = param(0.2663, "Share of shapes in the test split (0.2663 = the paper's 363 test : 1000 train).", gt=0, le=0.9)
+    max_faces: int = Field(1_000_000, ge=1, description="A file with more triangles is rejected.")
+    max_file_mb: float = Field(100.0, gt=0, description="A larger file is rejected before it is read, MB.")
+    min_shapes: int = Field(10, ge=1, description="The stage fails if fewer shapes survive the checks.")
+    test_fraction: float = Field(0.2663, gt=0, le=0.9, description="Share of shapes in the test split (0.2663 = the paper's 363 test : 1000 train).")
+    surface: SurfaceSettings = Field(default_factory=SurfaceSettings, description="How each shape's closed outer surface is rebuilt and sized.")
 
 
-@dataclass(frozen=True)
+@settings
 class VoxelizeParams:
     """Solid occupancy grids for the AutoEncoder."""
 
-    resolution: int = param(32, "Voxels per side R (32 on CPU, 64 in the paper).", choices=(16, 32, 64, 128))
-    margin: int = param(1, "Empty voxels kept around the shape's largest extent.", ge=0, le=4)
+    resolution: Literal[16, 32, 64, 128] = Field(32, description="Voxels per side R (32 on CPU, 64 in the paper).")
+    margin: int = Field(1, ge=0, le=4, description="Empty voxels kept around the shape's largest extent.")
 
 
-@dataclass(frozen=True)
+@settings
 class AEParams:
-    """AutoEncoder-Critic network and its two training phases."""
+    """AutoEncoder-Critic network and its two training phases (paper Section III)."""
 
-    z_dim: int = param(128, "Latent size (paper: 128).", ge=2)
-    base_width: int = param(16, "Channels of the first conv layer; doubles per down-sampling layer up to top_width (paper profile: 64).", ge=1)
-    top_width: int = param(128, "Channels of the 4×4×4 map before the FC layer (paper: 512).", ge=1)
-    batch_size: int = param(16, "Shapes per batch (16 reached a higher test IoU than 32 in the same CPU time).", ge=2)
-    epochs_ae: int = param(40, "Phase 1 epochs: plain AutoEncoder, binary cross-entropy.", ge=0)
-    epochs_critic: int = param(8, "Phase 2 epochs: AE-Critic initialised from phase 1.", ge=0)
-    critic_warmup: int = param(1, "First phase-2 epochs in which only the critic learns (the AE's eq. (2) term then starts from a trained critic).", ge=0)
-    lr_ae: float = param(1e-3, "Phase 1 Adam learning rate (paper: 1e-3).", gt=0)
-    lr_ae_critic: float = param(1e-4, "Phase 2 Adam learning rate of the AutoEncoder (paper: 1e-4).", gt=0)
-    lr_critic: float = param(1e-3, "Phase 2 Adam learning rate of the Critic (paper: 1e-3).", gt=0)
-    gamma: float = param(0.2, "γ of eq. (1): the critic sees γx + (1−γ)x̂ as non-interpolated (ACAI: 0.2).", ge=0, le=1)
-    lam: float = param(0.5, "λ of eq. (2): weight of the critic term in the AE loss (ACAI: 0.5).", ge=0, key="lambda")
-    flips: bool = param(True, "Flip training grids along random axes (the AE learns shape, not pose).")
+    net: AEConfig = Field(default_factory=AEConfig, description="Layer sizes.")
+    train: AETrainConfig = Field(default_factory=AETrainConfig, description="The two training phases.")
 
 
-@dataclass(frozen=True)
+@settings
 class EmbedParams:
     """Latents of every shape and their t-SNE map."""
 
-    perplexity: float = param(30.0, "t-SNE perplexity (lowered automatically below the number of shapes).", gt=0)
+    perplexity: float = Field(30.0, gt=0, description="t-SNE perplexity (lowered automatically below the number of shapes).")
 
 
-@dataclass(frozen=True)
+@settings
 class CriticEvalParams:
     """The paper's critic study: outliers of decoded interpolations, AE vs AE-Critic."""
 
-    n_shapes: int = param(200, "Random train shapes to draw pairs from (paper: 200).", ge=2)
-    n_pairs: int = param(68, "Random pairs among them; 6 weights each gives 408 shapes per model (paper: ~409).", ge=1)
-    alphas: list[float] = param((0.0, 0.1, 0.2, 0.3, 0.4, 0.5), "Interpolation weights.")
-    threshold: float = param(0.5, "Occupancy threshold of decoded grids.", gt=0, le=1)
-    n_examples: int = param(4, "Interpolation sequences drawn in the picture.", ge=1)
+    n_shapes: int = Field(200, ge=2, description="Random train shapes to draw pairs from (paper: 200).")
+    n_pairs: int = Field(68, ge=1, description="Random pairs among them; 6 weights each gives 408 shapes per model (paper: ~409).")
+    alphas: tuple[float, ...] = Field((0.0, 0.1, 0.2, 0.3, 0.4, 0.5), description="Interpolation weights in [0, 1], distinct in their first two decimals.")
+    threshold: float = Field(0.5, gt=0, le=1, description="Occupancy threshold of decoded grids.")
+    n_examples: int = Field(4, ge=1, description="Interpolation sequences drawn in the picture.")
+
+    def __post_init__(self) -> None:
+        if not self.alphas or not all(0 <= a <= 1 for a in self.alphas):
+            raise ValueError(f"critic_eval.alphas: must be a non-empty list of weights in [0, 1]; got {list(self.alphas)}")
+        if len({f"{a:.2f}" for a in self.alphas}) != len(self.alphas):
+            raise ValueError(f"critic_eval.alphas: weights must differ in the first two decimals (they name the metrics); got {list(self.alphas)}")
 
 
-@dataclass(frozen=True)
+@settings
 class GraspsParams:
     """Antipodal grasps on every shape, labelled by robust Ferrari-Canny (Dex-Net 2.0)."""
 
-    n_grasps: int = param(100, "Grasps sampled per shape (Dex-Net 2.0: up to 100; EGAD: 100).", ge=1)
-    threshold: float = param(0.002, "A grasp succeeds when its robust ε exceeds this (Dex-Net 2.0, with the torque scaling and object size below).", ge=0)
-    friction_coef: float = param(0.5, "Friction coefficient μ for sampling and quality (Dex-Net: 0.5); also the mean of the perturbed μ.", gt=0, le=1)
-    cone_faces: int = param(8, "Faces of the polyhedral friction cone (Dex-Net: 8).", ge=3, le=32)
-    torque_scaling: float = param(1000.0, "s in the wrench [f; s·τ] (1/m). With s = 1000, soft fingers bound ε by π r² μ s = 0.039 and 0.002 splits grasps as in Dex-Net 2.0.", gt=0)
-    max_width: float = param(0.08, "Gripper opening in m (Franka Panda: 0.08).", gt=0)
-    finger_radius: float = param(0.005, "Soft-finger contact radius in m for the torsion columns (Dex-Net: 0.005).", ge=0)
-    min_contact_dist: float = param(0.0025, "Contacts closer than this (m) are rejected (Dex-Net: 2.5 mm).", ge=0)
-    coverage_dist: float = param(0.0025, "Grasp centers closer than this (m) to a kept one are dropped (EGAD: 2.5 mm; 0 disables).", ge=0)
-    tries_per_point: int = param(2, "Grasp axes drawn per sampled surface point (Dex-Net: 2).", ge=1)
-    oversample: int = param(5, "Candidates per missing grasp in the first round; doubles each round (Dex-Net: 5).", ge=1)
-    max_rounds: int = param(5, "Sampling rounds before giving up on a shape (Dex-Net: 5-10).", ge=1, le=10)
-    max_surface_points: int = param(100, "Surface points sampled per round at most (Dex-Net: 100).", ge=1)
-    n_samples: int = param(25, "Perturbed samples per grasp in the robust metric (Dex-Net: 25).", ge=1)
-    center_sigma: float = param(0.005, "Std of the grasp center perturbation in m.", ge=0)
-    axis_sigma: float = param(0.001, "Std of the grasp axis rotation in rad.", ge=0)
-    object_translation_sigma: float = param(0.01, "Std of the object translation in m.", ge=0)
-    object_rotation_sigma: float = param(0.01, "Std of the object rotation in rad.", ge=0)
-    friction_sigma: float = param(0.1, "Std of the perturbed friction coefficient (truncated to [0, 1]).", ge=0)
+    threshold: float = Field(0.002, ge=0, description="A grasp succeeds when its robust ε exceeds this (Dex-Net 2.0, with the torque scaling and object size of the defaults).")
+    gripper: ParallelJawGripper = Field(default_factory=ParallelJawGripper, description="The Franka Panda hand every grasp is made for.")
+    sampler: AntipodalSettings = Field(default_factory=AntipodalSettings, description="Antipodal grasp sampling on the mesh.")
+    quality: QualitySettings = Field(default_factory=QualitySettings, description="The grasp wrench model of Ferrari-Canny ε.")
+    perturbations: Perturbations = Field(default_factory=Perturbations, description="The robust metric's perturbations.")
 
 
-@dataclass(frozen=True)
+@settings
 class ScoreParams:
     """Rarity (eq. 3-4 on AE-Critic latents) and graspness of every shape."""
 
-    k: int = param(20, "Neighbours in the rarity score, eq. (3)-(4) (scikit-learn LOF default: 20).", ge=1)
-    bins: int = param(20, "Bins of the graspness and rarity histograms.", ge=2)
+    k: int = Field(20, ge=1, description="Neighbours in the rarity score, eq. (3)-(4) (scikit-learn LOF default: 20).")
+    bins: int = Field(20, ge=2, description="Bins of the graspness and rarity histograms.")
 
 
-@dataclass(frozen=True)
+@settings
 class GenerateParams:
     """New shapes from rare and graspable neighbours of each base set (paper Section III-C)."""
 
-    base_sizes: list[int] = param((50, 100, 200), "Base set sizes drawn from the train split (paper: 50, 100, 200); smaller sets lie inside larger ones.")
-    ratios: list[float] = param((0.0, 0.5, 1.0, 1.5, 2.0), "Augmentation ratios generated:base (paper: 1:0 ... 1:2); each pool holds max ratio × base size shapes.")
-    percentile: float = param(75.0, "Shapes above this percentile of rarity, and separately of graspness, in the base set are paired (top 25%).", ge=0, le=99)
-    first_neighbour: int = param(2, "N: pair each selected shape with its N-th ... (N+K)-th nearest selected neighbours (1 = nearest; 2 avoids near-duplicates).", ge=1)
-    extra_neighbours: int = param(3, "K: see first_neighbour. Widened (logged) if a pool runs dry, see alphas.", ge=0)
-    alphas: list[float] = param((0.5, 0.3), "Interpolation weights in (0, 0.5]. If a pool runs dry, 0.4, 0.2, 0.1, 0.05 are added, then K widens, then the percentile drops by 5s (each step logged).")
-    threshold: float = param(0.5, "Occupancy threshold of decoded grids.", gt=0, le=1)
-    opening: int = param(1, "Binary opening iterations on the decoded solid (removes one-voxel spurs).", ge=0, le=3)
-    min_voxels: int = param(100, "A decode with a largest piece smaller than this is rejected (tiny).", ge=1)
-    min_main_share: float = param(0.9, "A decode whose largest piece holds less than this share of its voxels is rejected (in pieces).", gt=0, le=1)
-    smoothing_iterations: int = param(10, "Humphrey smoothing iterations on the marching-cubes mesh.", ge=0)
-    n_examples: int = param(6, "Parent pairs drawn with their child in the picture.", ge=1)
+    base_sizes: tuple[int, ...] = Field((50, 100, 200), description="Base set sizes drawn from the train split (paper: 50, 100, 200); smaller sets lie inside larger ones.")
+    ratios: tuple[float, ...] = Field((0.0, 0.5, 1.0, 1.5, 2.0), description="Augmentation ratios generated:base (paper: 1:0 ... 1:2), written as floats; each pool holds max ratio × base size shapes.")
+    percentile: float = Field(75.0, ge=0, le=99, description="Shapes above this percentile of rarity, and separately of graspness, in the base set are paired (top 25%).")
+    first_neighbour: int = Field(2, ge=1, description="N: pair each selected shape with its N-th ... (N+K)-th nearest selected neighbours (1 = nearest; 2 avoids near-duplicates).")
+    extra_neighbours: int = Field(3, ge=0, description="K: see first_neighbour. Widened (logged) if a pool runs dry, see alphas.")
+    alphas: tuple[float, ...] = Field((0.5, 0.3), description="Interpolation weights in (0, 0.5]. If a pool runs dry, 0.4, 0.2, 0.1, 0.05 are added, then K widens, then the percentile drops by 5s (each step logged).")
+    n_examples: int = Field(6, ge=1, description="Parent pairs drawn with their child in the picture.")
+    decode: DecodeSettings = Field(default_factory=DecodeSettings, description="Decoded grid → mesh.")
+
+    @model_validator(mode="before")
+    @classmethod
+    def _ratios_are_floats(cls, raw: Any) -> Any:
+        return _floats_written_as_floats(raw, "generate", "ratios")
+
+    def __post_init__(self) -> None:
+        if not self.base_sizes or any(b < 2 for b in self.base_sizes) or len(set(self.base_sizes)) != len(self.base_sizes):
+            raise ValueError(f"generate.base_sizes: must be distinct sizes >= 2; got {list(self.base_sizes)}")
+        if not self.ratios or any(r < 0 for r in self.ratios) or max(self.ratios) <= 0:
+            raise ValueError(f"generate.ratios: must be ratios >= 0, the largest > 0; got {list(self.ratios)}")
+        if not self.alphas or not all(0 < a <= 0.5 for a in self.alphas) or len(set(self.alphas)) != len(self.alphas):
+            raise ValueError(f"generate.alphas: must be distinct weights in (0, 0.5]; got {list(self.alphas)}")
 
 
-@dataclass(frozen=True)
-class RenderParams:
+@settings
+class RenderParams(RenderSettings):
     """Dex-Net 2.0 style depth crops of every grasp seen from above (the GQ-CNN's data)."""
 
-    max_poses: int = param(5, "Most probable stable resting poses rendered per shape.", ge=1)
-    min_pose_probability: float = param(0.01, "Stable poses less likely than this are pruned (Dex-Net: 0.01).", ge=0, le=1)
-    images_per_pose: int = param(1, "Random camera views per stable pose (Dex-Net 2.0: 5; each view holds every table-parallel grasp).", ge=1)
-    max_grasps_per_image: int = param(0, "At most this many grasps per view, a seeded random subset (0: all).", ge=0)
-    axis_tolerance_deg: float = param(5.0, "A grasp is rendered in a pose if its jaw axis is within this angle of parallel to the table (deg).", ge=0, le=90)
-    approach_distance: float = param(0.1, "Length of the straight approach from above checked for gripper collisions (m).", ge=0)
-    camera_distance: list[float] = param((0.65, 0.75), "Range of the camera's distance to its target point on the table (m).")
-    camera_tilt_deg: list[float] = param((0.1, 5.0), "Range of the optical axis' angle from straight down (deg).")
-    object_offset: float = param(0.1, "The camera aims up to this far from the object in x and y (m), so objects sit off the image center.", ge=0)
-    image_width: int = param(640, "Depth image width (px).", ge=32)
-    image_height: int = param(480, "Depth image height (px).", ge=32)
-    focal_length: float = param(525.0, "fx = fy (px); the principal point is the image center (Primesense/D435 at 640×480: ~525).", gt=0)
-    crop_size: int = param(96, "Side of the grasp-centered crop in image pixels (Dex-Net: 96).", ge=1)
-    out_size: int = param(32, "Side of the stored crop after block averaging (Dex-Net: 32); must divide crop_size.", ge=1)
-    shard_rows: int = param(20000, "Datapoints per .npy shard.", ge=1)
-    n_examples: int = param(24, "Crops in the example picture (half positive, half negative when there are enough).", ge=2)
+    shard_rows: int = Field(20000, ge=1, description="Datapoints per .npy shard.")
+    n_examples: int = Field(24, ge=2, description="Crops in the example picture (half positive, half negative when there are enough).")
 
 
-@dataclass(frozen=True)
+@settings
 class GQCNNParams:
     """GQ-CNN networks per base size × augmentation ratio (paper Section IV-C) and their training."""
 
-    filters: int = param(8, "Channels of each conv layer (Dex-Net 2.0 / paper profile: 64; 8 fits the CPU budget).", ge=1)
-    fc: int = param(64, "Width of fc3 and fc4 (Dex-Net: 1024).", ge=1)
-    pose_fc: int = param(16, "Width of the gripper-depth layer pc1 (Dex-Net: 16).", ge=1)
-    pool_after_conv2: bool = param(True, "Max pool after conv2_2 (Dex-Net's 2018 config; 2017: none).")
-    steps: int = param(400, "SGD steps per network, the same for every training set (the budget rule).", ge=1)
-    batch_size: int = param(64, "Datapoints per step (Dex-Net: 64-128).", ge=2)
-    lr: float = param(0.01, "SGD learning rate (Dex-Net: 0.01).", gt=0)
-    momentum: float = param(0.9, "SGD momentum (Dex-Net: 0.9).", ge=0, le=1)
-    lr_decay: float = param(0.95, "Learning rate factor every decay_steps steps (Dex-Net: 0.95).", gt=0, le=1)
-    decay_steps: int = param(100, "Steps between learning-rate decays (Dex-Net: ~0.66 epoch).", ge=1)
-    weight_decay: float = param(5e-4, "L2 weight decay (Dex-Net: 5e-4).", ge=0)
-    gamma_shape: float = param(1000.0, "Multiplicative noise ~ Gamma(k, 1/k) per image (Dex-Net: k = 1000; 0: off); unlike Dex-Net it scales the gripper depth too, so the object's height relative to the gripper keeps its meaning.", ge=0)
-    gp_prob: float = param(0.5, "Chance of adding smooth Gaussian-process noise to an image (Dex-Net: 0.5).", ge=0, le=1)
-    gp_sigma: float = param(0.005, "Its standard deviation (m) (Dex-Net: 0.005).", ge=0)
-    gp_grid: int = param(8, "Its grid side before upsampling to the image (Dex-Net: 8 for 32 px).", ge=1)
-    symmetrize: bool = param(True, "Turn images 180° and flip them about either axis at random (Dex-Net).")
-    val_fraction: float = param(0.1, "Share of the training views (whole images) held out for the validation curves; a view is held out or not by a hash of its id and the seed, the same for every ratio and pool.", ge=0, le=0.5)
-    log_every: int = param(100, "Steps between DVCLive points (loss, train/val accuracy, val AP).", ge=1)
-    seeds: list[int] = param((0,), "Training seeds; each network is trained once per seed (study profile: 0, 1, 2).")
-    random_base_sizes: list[int] = param((200,), "Base sizes that also get random-pair augmentation networks (the baseline).")
-    random_ratios: list[float] = param((0.5, 1.0, 1.5, 2.0), "Their ratios (ratio 0 is the same network as the targeted one).")
+    net: GQCNNConfig = Field(default_factory=GQCNNConfig, description="Layer sizes.")
+    train: TrainSettings = Field(default_factory=TrainSettings, description="SGD schedule and train-time noise.")
+    val_fraction: float = Field(0.1, ge=0, le=0.5, description="Share of the training views (whole images) held out for the validation curves; a view is held out or not by a hash of its id and the seed, the same for every ratio and pool.")
+    seeds: tuple[int, ...] = Field((0,), description="Training seeds; each network is trained once per seed (study profile: 0, 1, 2).")
+    random_base_sizes: tuple[int, ...] = Field((200,), description="Base sizes that also get random-pair augmentation networks (the baseline).")
+    random_ratios: tuple[float, ...] = Field((0.5, 1.0, 1.5, 2.0), description="Their ratios (ratio 0 is the same network as the targeted one).")
+
+    @model_validator(mode="before")
+    @classmethod
+    def _ratios_are_floats(cls, raw: Any) -> Any:
+        return _floats_written_as_floats(raw, "gqcnn", "random_ratios")
+
+    def __post_init__(self) -> None:
+        if not self.seeds or len(set(self.seeds)) != len(self.seeds) or min(self.seeds) < 0:
+            raise ValueError(f"gqcnn.seeds: must be distinct seeds >= 0; got {list(self.seeds)}")
 
 
-@dataclass(frozen=True)
+@settings
 class SimParams:
     """Simulated Panda pick-and-place trials before and after augmentation (paper Section IV-E)."""
 
-    objects: list[str] = param(("mug", "duck", "teddy", "bunny", "torus", "cube", "cylinder", "prism"), "Everyday objects of pybullet_data to pick (any of mug, duck, teddy, bunny, torus, cube, cylinder, prism).")
-    n_test_objects: int = param(2, "Held-out test shapes (test split of data/shapes, a seeded choice) picked as well.", ge=0)
-    attempts: int = param(10, "Attempts per object and arm (paper: 10); each attempt drops the object anew from a seeded pose, the same for both arms.", ge=1)
-    base_size: int = param(200, "Base size B of the two networks compared: B-0 (before) and B at the report's best ratio (after).", ge=2)
-    object_mass: float = param(0.1, "Mass of every object (kg; the random_urdfs objects weigh 0.1).", gt=0)
-    object_friction: float = param(0.5, "Lateral friction of the objects (pybullet multiplies it by the partner's: fingers, table).", gt=0)
-    finger_friction: float = param(1.0, "Lateral friction of the finger pads.", gt=0)
-    table_friction: float = param(0.8, "Lateral friction of the table.", gt=0)
-    grip_force: float = param(20.0, "Closing force limit per finger (N; the URDF's effort limit is 20).", gt=0)
-    camera_height: float = param(0.65, "Depth camera height above the table, looking straight down (m; paper: 0.65).", gt=0.1)
-    image_width: int = param(640, "Depth image width (px).", ge=128)
-    image_height: int = param(480, "Depth image height (px).", ge=128)
-    focal_length: float = param(525.0, "fx = fy (px); the principal point is the image center.", gt=0)
-    drop_offset: float = param(0.05, "Objects are dropped up to this far from the table center in x and y, in a random orientation (m).", ge=0, le=0.15)
-    seed_samples: int = param(250, "Antipodal seed grasps per image (Dex-Net: 100-250).", ge=1)
-    cem_iters: int = param(3, "Cross-entropy iterations (Dex-Net: 3).", ge=0)
-    elite_fraction: float = param(0.25, "Share of the best grasps refit each iteration (Dex-Net: 0.25).", gt=0, le=1)
-    gmm_components: int = param(3, "Gaussian mixture components at most; fewer when ceil(0.4 × elites) is smaller.", ge=1)
-    gmm_samples: int = param(50, "Grasps drawn from the mixture per iteration (Dex-Net: 50).", ge=1)
-    friction_coef: float = param(0.8, "Friction coefficient of the antipodality test on depth edges (Dex-Net: 0.8).", gt=0)
-    depth_grad_thresh: float = param(0.0025, "Depth gradient (m per px) that marks an edge pixel (Dex-Net: 0.0025).", gt=0)
-    min_dist_from_boundary: int = param(45, "Edge pixels this close to the image border are ignored (px; Dex-Net: 45).", ge=0)
-    min_depth_offset: float = param(0.005, "Grasp depth below the surface between the jaws, lowest (m; Dex-Net: 0.005).", ge=0)
-    max_depth_offset: float = param(0.04, "... and highest (m; Dex-Net: 0.04).", ge=0)
-    antipodal_arm: bool = param(False, "Also run the reference arm `antipodal`: a random antipodal seed grasp, no network (how much the GQ-CNN adds).")
-    n_pictures: int = param(3, "Trials per arm (first attempts of the first objects) drawn with their depth image, grasp and pick frames.", ge=0)
-    vhacd_resolution: int = param(100000, "V-HACD voxel resolution of the convex decompositions (cached per mesh in ~/.cache/graspaug/sim or $GRASPAUG_CACHE).", ge=10000)
+    objects: tuple[str, ...] = Field(tuple(EVERYDAY_OBJECTS), description=f"Everyday objects of pybullet_data to pick (any of {', '.join(EVERYDAY_OBJECTS)}).")
+    n_test_objects: int = Field(2, ge=0, description="Held-out test shapes (test split of data/shapes, a seeded choice) picked as well.")
+    attempts: int = Field(10, ge=1, description="Attempts per object and arm (paper: 10); each attempt drops the object anew from a seeded pose, the same for both arms.")
+    base_size: int = Field(200, ge=2, description="Base size B of the two networks compared: B-0 (before) and B at the report's best ratio (after).")
+    object_mass: float = Field(0.1, gt=0, description="Mass of every object (kg; the random_urdfs objects weigh 0.1).")
+    object_friction: float = Field(0.5, gt=0, description="Lateral friction of the objects (pybullet multiplies it by the partner's: fingers, table).")
+    antipodal_arm: bool = Field(False, description="Also run the reference arm `antipodal`: a random antipodal seed grasp, no network (how much the GQ-CNN adds).")
+    n_pictures: int = Field(3, ge=0, description="Trials per arm (first attempts of the first objects) drawn with their depth image, grasp and pick frames.")
+    vhacd_resolution: int = Field(100000, ge=10000, description="V-HACD voxel resolution of the convex decompositions (cached per mesh in ~/.cache/graspaug/sim or $GRASPAUG_CACHE).")
+    cell: CellLayout = Field(default_factory=CellLayout, description="The cell: table, robot, bin, overhead camera, physics step.")
+    hand: HandSettings = Field(default_factory=HandSettings, description="How the hand moves and holds.")
+    trial: TrialSettings = Field(default_factory=TrialSettings, description="The pick-and-place motion script.")
+    sampler: SamplerSettings = Field(default_factory=SamplerSettings, description="Antipodal grasp seeds on the depth image.")
+    cem: CEMSettings = Field(default_factory=CEMSettings, description="Cross-entropy refinement of the seeds by the GQ-CNN.")
+
+    def __post_init__(self) -> None:
+        unknown = [name for name in self.objects if name not in EVERYDAY_OBJECTS]
+        if unknown or len(set(self.objects)) != len(self.objects):
+            raise ValueError(f"sim.objects: must be distinct names among {', '.join(EVERYDAY_OBJECTS)}; got {list(self.objects)}")
+        if not self.objects and self.n_test_objects == 0:
+            raise ValueError("sim.objects: no objects to pick (sim.objects is empty and sim.n_test_objects is 0)")
+        if self.sampler.min_depth_offset > self.sampler.max_depth_offset:
+            raise ValueError(f"sim.sampler.max_depth_offset: must be >= sim.sampler.min_depth_offset ({self.sampler.min_depth_offset}); got {self.sampler.max_depth_offset}")
 
 
-@dataclass(frozen=True)
-class Params:
-    """All parameters of the pipeline."""
+class Params(BaseModel):
+    """All parameters of the pipeline (the whole ``params.yaml``)."""
 
-    seed: int = param(0, "Seeds every random choice: the split, network initialisation and batches, critic-study pairs, t-SNE, grasp sampling and perturbations.", ge=0)
-    device: str = param("auto", "Torch device: `auto` (CUDA when present), `cpu` or `cuda`.", choices=("auto", "cpu", "cuda"))
-    n_jobs: int = param(2, "Worker processes for per-shape loops (-1: all cores).", ge=-1)
-    executor: str = param("joblib", "Where per-shape loops (ingest, voxelize, grasps, generate, render, sim) run: `joblib` (n_jobs local processes) or `dask` (the Dask cluster at `scheduler`; needs `pip install 'graspaug[dask]'` and workers that see the project at the same path).", choices=("joblib", "dask"))
-    scheduler: str | None = param(None, "Dask scheduler address when executor is `dask`, e.g. tcp://10.0.0.5:8786.")
-    data: DataParams = field(default_factory=DataParams)
-    ingest: IngestParams = field(default_factory=IngestParams)
-    voxelize: VoxelizeParams = field(default_factory=VoxelizeParams)
-    ae: AEParams = field(default_factory=AEParams)
-    embed: EmbedParams = field(default_factory=EmbedParams)
-    critic_eval: CriticEvalParams = field(default_factory=CriticEvalParams)
-    grasps: GraspsParams = field(default_factory=GraspsParams)
-    score: ScoreParams = field(default_factory=ScoreParams)
-    generate: GenerateParams = field(default_factory=GenerateParams)
-    render: RenderParams = field(default_factory=RenderParams)
-    gqcnn: GQCNNParams = field(default_factory=GQCNNParams)
-    sim: SimParams = field(default_factory=SimParams)
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+    seed: int = Field(0, ge=0, description="Seeds every random choice: the split, network initialisation and batches, critic-study pairs, t-SNE, grasp sampling and perturbations.")
+    device: Literal["auto", "cpu", "cuda"] = Field("auto", description="Torch device: `auto` (CUDA when present), `cpu` or `cuda`.")
+    n_jobs: int = Field(2, ge=-1, description="Worker processes for per-shape loops (-1: all cores).")
+    executor: Literal["joblib", "dask"] = Field("joblib", description="Where per-shape loops (ingest, voxelize, grasps, generate, render, sim) run: `joblib` (n_jobs local processes) or `dask` (the Dask cluster at `scheduler`; needs `pip install 'graspaug[dask]'` and workers that see the project at the same path).")
+    scheduler: str | None = Field(None, description="Dask scheduler address when executor is `dask`, e.g. tcp://10.0.0.5:8786.")
+    data: CorpusSettings = Field(default_factory=CorpusSettings, description="Where the shape corpus comes from.")
+    ingest: IngestParams = Field(default_factory=IngestParams, description=IngestParams.__doc__)
+    voxelize: VoxelizeParams = Field(default_factory=VoxelizeParams, description=VoxelizeParams.__doc__)
+    ae: AEParams = Field(default_factory=AEParams, description=AEParams.__doc__)
+    embed: EmbedParams = Field(default_factory=EmbedParams, description=EmbedParams.__doc__)
+    critic_eval: CriticEvalParams = Field(default_factory=CriticEvalParams, description=CriticEvalParams.__doc__)
+    grasps: GraspsParams = Field(default_factory=GraspsParams, description=GraspsParams.__doc__)
+    score: ScoreParams = Field(default_factory=ScoreParams, description=ScoreParams.__doc__)
+    generate: GenerateParams = Field(default_factory=GenerateParams, description=GenerateParams.__doc__)
+    render: RenderParams = Field(default_factory=RenderParams, description=RenderParams.__doc__)
+    gqcnn: GQCNNParams = Field(default_factory=GQCNNParams, description=GQCNNParams.__doc__)
+    sim: SimParams = Field(default_factory=SimParams, description=SimParams.__doc__)
+
+    @model_validator(mode="after")
+    def _consistent(self) -> Params:
+        """Checks across sections: values that must agree are named in both places."""
+        agree = (("ae.net.resolution", self.ae.net.resolution, "voxelize.resolution", self.voxelize.resolution),
+                 ("gqcnn.net.image_size", self.gqcnn.net.image_size, "render.crop.out_size", self.render.crop.out_size),
+                 ("sim.sampler.max_width", self.sim.sampler.max_width, "grasps.gripper.max_width", self.grasps.gripper.max_width))
+        for key, value, other, expected in agree:
+            if value != expected:
+                raise ValueError(f"{key}: must equal {other} ({expected}); got {value}")
+        if self.n_jobs == 0:
+            raise ValueError("n_jobs: must be >= 1, or -1 for all cores; got 0")
+        if self.executor == "dask" and not self.scheduler:
+            raise ValueError("scheduler: required when executor is dask (e.g. tcp://10.0.0.5:8786)")
+        gen, net = self.generate, self.gqcnn
+        if not set(net.random_base_sizes) <= set(gen.base_sizes):
+            raise ValueError(f"gqcnn.random_base_sizes: must be among generate.base_sizes {list(gen.base_sizes)}; got {list(net.random_base_sizes)}")
+        if not set(net.random_ratios) <= set(gen.ratios) or 0.0 in net.random_ratios:
+            raise ValueError(f"gqcnn.random_ratios: must be nonzero ratios among generate.ratios {list(gen.ratios)}; got {list(net.random_ratios)}")
+        if self.sim.base_size not in gen.base_sizes:
+            raise ValueError(f"sim.base_size: must be one of generate.base_sizes {list(gen.base_sizes)}; got {self.sim.base_size}")
+        return self
 
     @property
     def workers(self):
@@ -266,129 +247,41 @@ class Params:
         return Workers(n_jobs=self.n_jobs, executor=self.executor, scheduler=self.scheduler)
 
 
-def _type_name(tp: Any) -> str:
-    if typing.get_origin(tp) in (typing.Union, types.UnionType):
-        return " or ".join(_type_name(a) for a in typing.get_args(tp))
-    return "null" if tp is type(None) else getattr(tp, "__name__", str(tp))
-
-
-def _coerce(key: str, value: Any, tp: Any) -> Any:
-    """Check ``value`` against the annotation ``tp``; ints are accepted for floats."""
-    origin = typing.get_origin(tp)
-    if origin in (typing.Union, types.UnionType):
-        for arg in typing.get_args(tp):
-            try:
-                return _coerce(key, value, arg)
-            except ParamsError:
-                continue
-        raise ParamsError(f"{key}: expected {_type_name(tp)}, got {value!r}")
-    if origin is list:
-        (item,) = typing.get_args(tp)
-        if not isinstance(value, list):
-            raise ParamsError(f"{key}: expected a list of {_type_name(item)}, got {value!r}")
-        return tuple(_coerce(f"{key}[{i}]", v, item) for i, v in enumerate(value))
-    if tp is type(None):
-        if value is None:
+def _section_class(loc: tuple) -> type | None:
+    """The settings class at ``loc`` (a path of field names or aliases) inside :class:`Params`."""
+    cls: Any = Params
+    for part in loc:
+        fields = getattr(cls, "model_fields", None) or getattr(cls, "__pydantic_fields__", {})
+        match = next((info for name, info in fields.items() if part in (name, info.alias)), None)
+        if match is None:
             return None
-    elif tp is float:
-        if isinstance(value, (int, float)) and not isinstance(value, bool):
-            return float(value)
-    elif tp is int:
-        if isinstance(value, int) and not isinstance(value, bool):
-            return value
-    elif isinstance(value, tp):
-        return value
-    raise ParamsError(f"{key}: expected {_type_name(tp)}, got {value!r}")
+        cls = match.annotation
+    return cls
 
 
-def _check_range(key: str, value: Any, meta: typing.Mapping) -> None:
-    if value is None:
-        return
-    choices = meta.get("choices")
-    if choices is not None and value not in choices:
-        raise ParamsError(f"{key}: must be one of {', '.join(map(str, choices))}; got {value!r}")
-    for bound, ok, word in (("ge", lambda v, b: v >= b, ">="), ("gt", lambda v, b: v > b, ">"), ("le", lambda v, b: v <= b, "<=")):
-        b = meta.get(bound)
-        if b is not None and not ok(value, b):
-            raise ParamsError(f"{key}: must be {word} {b:g}; got {value!r}")
-
-
-def _build(cls: type, raw: Any, prefix: str) -> Any:
-    if raw is None:
-        raw = {}
-    if not isinstance(raw, dict):
-        raise ParamsError(f"{prefix or 'params'}: expected a mapping of keys, got {raw!r}")
-    hints = typing.get_type_hints(cls)
-    fields = {_key(f): f for f in dataclasses.fields(cls)}
-    unknown = sorted(set(raw) - set(fields))
-    if unknown:
-        name = f"{prefix}{unknown[0]}"
-        raise ParamsError(f"{name}: unknown key; allowed here: {', '.join(fields)}")
-    values = {}
-    for name, f in fields.items():
-        if name not in raw:
-            continue
-        key = f"{prefix}{name}"
-        tp = hints[f.name]
-        if dataclasses.is_dataclass(tp):
-            values[f.name] = _build(tp, raw[name], f"{key}.")
-        else:
-            values[f.name] = _coerce(key, raw[name], tp)
-            _check_range(key, values[f.name], f.metadata)
-    return cls(**values)
+def _one_line(error: dict) -> str:
+    """One line naming the key: ``gqcnn.train.steps: Input should be greater than or equal to 1; got 0``."""
+    loc = error["loc"]
+    key = ".".join(str(p) for p in loc) or "params"
+    message = error["msg"].removeprefix("Value error, ")
+    if error["type"] == "value_error":  # our own checks name their keys
+        return message if " " not in message.split(": ")[0] else f"{key}: {message}"
+    if error["type"] in ("extra_forbidden", "unexpected_keyword_argument"):
+        section = _section_class(tuple(loc[:-1]))
+        fields = getattr(section, "model_fields", None) or getattr(section, "__pydantic_fields__", {})
+        allowed = ", ".join(info.alias or name for name, info in fields.items())
+        return f"{key}: unknown key; allowed here: {allowed}"
+    return f"{key}: {message}; got {error.get('input')!r}"
 
 
 def parse_params(raw: Any) -> Params:
     """Typed :class:`Params` from a parsed params.yaml mapping; raises :class:`ParamsError`."""
-    params = _build(Params, raw, "")
-    for section, key in (("generate", "ratios"), ("gqcnn", "random_ratios")):
-        written = ((raw or {}).get(section) or {}).get(key) or []
-        if any(isinstance(value, int) for value in written):
-            raise ParamsError(f"{section}.{key}: write every ratio as a float (1.0, not 1): DVC names the networks' folders after them; got {written}")
-    if params.data.source == "folder" and not params.data.path:
-        raise ParamsError("data.path: required when data.source is folder")
-    if params.n_jobs == 0:
-        raise ParamsError("n_jobs: must be >= 1, or -1 for all cores; got 0")
-    if params.executor == "dask" and not params.scheduler:
-        raise ParamsError("scheduler: required when executor is dask (e.g. tcp://10.0.0.5:8786)")
-    alphas = params.critic_eval.alphas
-    if not alphas or not all(0 <= a <= 1 for a in alphas):
-        raise ParamsError(f"critic_eval.alphas: must be a non-empty list of weights in [0, 1]; got {list(alphas)}")
-    if len({f"{a:.2f}" for a in alphas}) != len(alphas):
-        raise ParamsError(f"critic_eval.alphas: weights must differ in the first two decimals (they name the metrics); got {list(alphas)}")
-    gen = params.generate
-    if not gen.base_sizes or any(b < 2 for b in gen.base_sizes) or len(set(gen.base_sizes)) != len(gen.base_sizes):
-        raise ParamsError(f"generate.base_sizes: must be distinct sizes >= 2; got {list(gen.base_sizes)}")
-    if not gen.ratios or any(r < 0 for r in gen.ratios) or max(gen.ratios) <= 0:
-        raise ParamsError(f"generate.ratios: must be ratios >= 0, the largest > 0; got {list(gen.ratios)}")
-    if not gen.alphas or not all(0 < a <= 0.5 for a in gen.alphas) or len(set(gen.alphas)) != len(gen.alphas):
-        raise ParamsError(f"generate.alphas: must be distinct weights in (0, 0.5]; got {list(gen.alphas)}")
-    render = params.render
-    for key, values, lowest, highest in (("camera_distance", render.camera_distance, 0.01, 10.0), ("camera_tilt_deg", render.camera_tilt_deg, 0.0, 89.0)):
-        if len(values) != 2 or not lowest <= values[0] <= values[1] <= highest:
-            raise ParamsError(f"render.{key}: must be [low, high] with {lowest} <= low <= high <= {highest}; got {list(values)}")
-    net = params.gqcnn
-    if not net.seeds or len(set(net.seeds)) != len(net.seeds) or min(net.seeds) < 0:
-        raise ParamsError(f"gqcnn.seeds: must be distinct seeds >= 0; got {list(net.seeds)}")
-    if not set(net.random_base_sizes) <= set(gen.base_sizes):
-        raise ParamsError(f"gqcnn.random_base_sizes: must be among generate.base_sizes {list(gen.base_sizes)}; got {list(net.random_base_sizes)}")
-    if not set(net.random_ratios) <= set(gen.ratios) or 0.0 in net.random_ratios:
-        raise ParamsError(f"gqcnn.random_ratios: must be nonzero ratios among generate.ratios {list(gen.ratios)}; got {list(net.random_ratios)}")
-    if render.crop_size % render.out_size or render.crop_size < render.out_size:
-        raise ParamsError(f"render.out_size: must divide render.crop_size ({render.crop_size}); got {render.out_size}")
-    sim = params.sim
-    from graspaug.sim.catalog import EVERYDAY_OBJECTS
-
-    unknown = [name for name in sim.objects if name not in EVERYDAY_OBJECTS]
-    if unknown or len(set(sim.objects)) != len(sim.objects):
-        raise ParamsError(f"sim.objects: must be distinct names among {', '.join(EVERYDAY_OBJECTS)}; got {list(sim.objects)}")
-    if not sim.objects and sim.n_test_objects == 0:
-        raise ParamsError("sim.objects: no objects to pick (sim.objects is empty and sim.n_test_objects is 0)")
-    if sim.base_size not in gen.base_sizes:
-        raise ParamsError(f"sim.base_size: must be one of generate.base_sizes {list(gen.base_sizes)}; got {sim.base_size}")
-    if sim.min_depth_offset > sim.max_depth_offset:
-        raise ParamsError(f"sim.max_depth_offset: must be >= sim.min_depth_offset ({sim.min_depth_offset}); got {sim.max_depth_offset}")
-    return params
+    if raw is not None and not isinstance(raw, dict):
+        raise ParamsError(f"params: expected a mapping of keys, got {raw!r}")
+    try:
+        return Params.model_validate(raw or {})
+    except ValidationError as exc:
+        raise ParamsError(_one_line(exc.errors()[0])) from None
 
 
 def load_params(path: str | Path = "params.yaml") -> Params:
@@ -403,13 +296,16 @@ def load_params(path: str | Path = "params.yaml") -> Params:
     return parse_params(raw)
 
 
-def describe(cls: type) -> str:
-    """Markdown list of a params section's keys, types, defaults and help (for ``--help``)."""
-    hints = typing.get_type_hints(cls)
-    lines = []
-    for f in dataclasses.fields(cls):
-        if dataclasses.is_dataclass(hints[f.name]):
-            continue
-        default = f.default
-        lines.append(f"* **{_key(f)}** ({_type_name(hints[f.name])}, default {default!r}): {f.metadata.get('help', '')}")
-    return "\n".join(lines)
+def params_dict(params: Params | None = None) -> dict:
+    """``params`` (default: the defaults) as plain YAML-ready data, keys as params.yaml spells them."""
+    return (params or Params()).model_dump(mode="json", by_alias=True)
+
+
+def json_schema() -> str:
+    """JSON Schema of params.yaml (for editors: ``# yaml-language-server: $schema=params.schema.json``)."""
+    schema = Params.model_json_schema(by_alias=True)
+    schema["title"] = "graspaug params.yaml"
+    return json.dumps(schema, indent=2, ensure_ascii=False) + "\n"
+
+
+__all__ = ["Params", "ParamsError", "load_params", "parse_params", "params_dict", "json_schema", "is_settings"]

@@ -193,3 +193,34 @@ def fill_pool(stream: CandidateStream, needed: int, run_batch: Callable[[list[Ca
         for outcome in run_batch(batch):
             (rejected if outcome.reason else kept).append(outcome)
     return kept, rejected
+
+
+@dataclass(frozen=True)
+class Decoded:
+    """One candidate's outcome: the cleaned grid (bit-packed, R³ bits) and, if kept, its mesh (m)
+    or why it was rejected."""
+
+    candidate: Candidate
+    packed_grid: np.ndarray
+    mesh: object | None  # trimesh.Trimesh
+    reason: str | None
+
+
+def pool_tables(base: np.ndarray, z: np.ndarray, pools: dict[str, tuple[list[Decoded], list[Decoded]]], base_size: int) -> tuple[list[dict], list[dict]]:
+    """Rows of ``index.parquet`` (one per kept shape, in pool order) and of ``rejects.parquet``
+    for the pools (name → (kept, rejected)) of base set ``base`` (shape ids) with latents ``z`` (B, d)."""
+    rows, rejects = [], []
+    for pool, (kept, rejected) in pools.items():
+        for order, d in enumerate(kept):
+            c, m = d.candidate, d.mesh
+            rows.append({
+                "shape_id": f"gen_{base_size}_{pool[0]}{order:04d}", "base_size": base_size, "pool": pool, "order": order,
+                "parent_a": base[c.a], "parent_b": base[c.b], "alpha": c.alpha, "selected_by": c.selected_by,
+                "z": ((1 - c.alpha) * z[c.a] + c.alpha * z[c.b]).astype(np.float32), "faces": len(m.faces), "vertices": len(m.vertices),
+                "watertight": bool(m.is_watertight), "one_piece": len(m.split(only_watertight=False)) == 1, "volume": float(m.volume),
+                "extent_x": m.extents[0], "extent_y": m.extents[1], "extent_z": m.extents[2], "split": "train", "origin": "generated",
+            })
+    for pool, (_, rejected) in pools.items():
+        rejects += [{"pool": pool, "parent_a": base[d.candidate.a], "parent_b": base[d.candidate.b], "alpha": d.candidate.alpha,
+                     "selected_by": d.candidate.selected_by, "reason": d.reason} for d in rejected]
+    return rows, rejects

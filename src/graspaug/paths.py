@@ -121,3 +121,8 @@ REPORT_DIR = Path("reports/gqcnn")
 # sim
 SIM_METRICS = Path("metrics/sim.json")
 SIM_REPORT_DIR = Path("reports/sim")
+
+
+def timing_file(stage: str, item: str | None = None) -> Path:
+    """Where a stage writes how long it took (not a metric: ``dvc metrics diff`` shows results only)."""
+    return Path("reports/timing") / (f"{stage}.json" if item is None else f"{stage}/{item}.json")

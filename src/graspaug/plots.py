@@ -263,3 +263,22 @@ def pick_story(depth: np.ndarray, jaw: np.ndarray | None, window: tuple[int, int
         ax.set_yticks([])
     fig.suptitle(title, fontsize=9)
     _save(fig, path)
+
+
+def generated_pairs(base: np.ndarray, voxels, decoded: list, path: str | os.PathLike, title: str) -> None:
+    """Parent a | child | parent b for each of ``decoded`` (``graspaug.generation.Decoded``), from
+    base set ``base`` (shape ids, indexed by the candidates) and the corpus' ``voxels`` (VoxelSet)."""
+    row_of = {s: i for i, s in enumerate(voxels.shape_id)}
+
+    def parent(shape_id: str) -> tuple[np.ndarray, np.ndarray]:
+        grid = voxels.occupancy[row_of[shape_id]].astype(bool)
+        return grid, grid
+
+    rows, labels = [], []
+    resolution = voxels.occupancy.shape[1]
+    for d in decoded:
+        c = d.candidate
+        child = np.unpackbits(d.packed_grid, count=resolution**3).reshape((resolution,) * 3).astype(bool)
+        rows.append([parent(base[c.a]), (child, child), parent(base[c.b])])
+        labels.append(f"{c.selected_by}, α={c.alpha:g}")
+    voxel_rows(rows, labels, ["parent a", "generated", "parent b"], path, title)

@@ -85,30 +85,28 @@ def test_folder_ids_are_stable_and_unique(tmp_path):
 
 
 def test_a_convex_body_is_rebuilt_as_one_part_and_sized(tmp_path):
-    from graspaug.config import IngestParams
     from graspaug.geometry.prepare import prepare_shape
-    from graspaug.stages.ingest import surface_settings
+    from graspaug.geometry.prepare import SurfaceSettings
 
     path = tmp_path / "box.stl"
     trimesh.creation.box(extents=(0.1, 0.06, 0.03)).export(path)
     loaded = load_shape(path)
     assert len(loaded.parts) == 1  # one closed convex body counts as one convex part
-    prepared = prepare_shape(loaded, surface_settings(IngestParams(size_rule="mid", size_m=0.06)))
+    prepared = prepare_shape(loaded, SurfaceSettings(size_rule="mid", size_m=0.06))
     assert np.allclose(sorted(prepared.mesh.extents), [0.03, 0.06, 0.1], atol=1e-3)
     assert np.allclose(prepared.mesh.center_mass, 0, atol=1e-6)
 
 
 def test_a_closed_non_convex_body_keeps_its_triangles(tmp_path):
-    from graspaug.config import IngestParams
     from graspaug.geometry.prepare import prepare_shape
-    from graspaug.stages.ingest import surface_settings
+    from graspaug.geometry.prepare import SurfaceSettings
 
     torus = trimesh.creation.torus(major_radius=0.04, minor_radius=0.012)
     path = tmp_path / "ring.ply"
     torus.export(path)
     loaded = load_shape(path)
     assert loaded.parts == []
-    prepared = prepare_shape(loaded, surface_settings(IngestParams()))
-    assert len(prepared.mesh.faces) == len(torus.faces) < IngestParams().face_budget
+    prepared = prepare_shape(loaded, SurfaceSettings())
+    assert len(prepared.mesh.faces) == len(torus.faces) < SurfaceSettings().face_budget
     scale = prepared.normalization.scale
     assert np.allclose(np.sort(prepared.mesh.vertices, axis=0), np.sort(torus.vertices * scale + prepared.normalization.offset, axis=0), atol=1e-9)

@@ -82,13 +82,12 @@ def test_pack_roundtrip():
 
 def test_iou_on_real_default_shapes_against_half_spaces(default_loaded):
     """The accuracy target (mean IoU >= 0.97 at 64³) on a few real default objects."""
-    from graspaug.config import IngestParams
     from graspaug.geometry.prepare import prepare_shape
-    from graspaug.stages.ingest import surface_settings
+    from graspaug.geometry.prepare import SurfaceSettings
 
     scores = []
     for _, loaded in default_loaded:
-        prepared = prepare_shape(loaded, surface_settings(IngestParams()))
+        prepared = prepare_shape(loaded, SurfaceSettings())
         parts = [p.scaled(prepared.normalization.scale, prepared.normalization.offset) for p in loaded.parts]
         grid = fit_grid(prepared.mesh.bounds, 64)
         ours = voxelize_solid(prepared.mesh.vertices, prepared.mesh.faces, grid)

@@ -5,12 +5,11 @@ import numpy as np
 import pytest
 import trimesh
 
-from graspaug.config import IngestParams
 from graspaug.geometry.prepare import prepare_shape
 from graspaug.grasping.antipodal import AntipodalSettings, force_closure, sample_antipodal_grasps
 from graspaug.grasping.contacts import close_fingers
 from graspaug.grasping.gripper import ParallelJawGripper
-from graspaug.stages.ingest import surface_settings
+from graspaug.geometry.prepare import SurfaceSettings
 
 SETTINGS = AntipodalSettings(n_grasps=40, friction_coef=0.5, tries_per_point=2, oversample=5, max_rounds=5, max_surface_points=100,
                              min_contact_dist=0.0025, coverage_dist=0.0025)
@@ -20,7 +19,7 @@ PANDA = ParallelJawGripper()
 @pytest.fixture(scope="module")
 def default_meshes(default_loaded):
     """Closed outer surfaces of two default objects, as ingest makes them."""
-    settings = surface_settings(IngestParams())
+    settings = SurfaceSettings()
     return [prepare_shape(loaded, settings).mesh for _, loaded in default_loaded[:2]]
 
 

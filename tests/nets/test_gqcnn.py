@@ -18,7 +18,7 @@ def test_output_shapes_and_layer_sizes(pool):
 
 
 def test_dexnet_widths_and_normalization_in_the_model():
-    net = GQCNN()  # Dex-Net 2.0 (2018 config) widths
+    net = GQCNN(GQCNNConfig(filters=64, fc=1024))  # Dex-Net 2.0 (2018 config) widths
     assert [net.conv1_1.kernel_size, net.conv1_2.kernel_size, net.conv2_1.kernel_size] == [(7, 7), (5, 5), (3, 3)]
     assert net.conv1_1.out_channels == 64 and net.fc3.out_features == 1024 and net.fc4_image.out_features == 1024
     assert net.lrn.size == 5 and net.lrn.alpha == pytest.approx(1e-4) and net.lrn.beta == 0.75 and net.lrn.k == 1.0
@@ -28,7 +28,7 @@ def test_dexnet_widths_and_normalization_in_the_model():
     assert not torch.allclose(before, net(images, z))
     state = net.state_dict()
     assert float(state["image_mean"]) == pytest.approx(0.7) and float(state["z_std"]) == pytest.approx(0.03)
-    again = GQCNN()
+    again = GQCNN(net.config)
     again.load_state_dict(state)
     assert torch.allclose(again(images, z), net(images, z))
     with pytest.raises(ValueError, match="divisible"):

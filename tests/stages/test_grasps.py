@@ -10,9 +10,10 @@ from .test_ingest import run_stage
 PARAMS = {
     "n_jobs": 1,
     "data": {"source": "folder", "path": None},
-    "ingest": {"min_shapes": 2, "surface_resolution": 48, "finest_surface_resolution": 48},
+    "ingest": {"min_shapes": 2, "surface": {"resolution": 48, "finest_resolution": 48}},
     # a 3 cm gripper: it fits across the plate (2 cm) but not the cube (6 cm)
-    "grasps": {"n_grasps": 12, "n_samples": 5, "max_width": 0.03},
+    "grasps": {"sampler": {"n_grasps": 12}, "perturbations": {"n_samples": 5}, "gripper": {"max_width": 0.03}},
+    "sim": {"sampler": {"max_width": 0.03}},
 }
 
 

@@ -44,7 +44,7 @@ def corpus_params(tmp_path):
     expected = make_corpus(tmp_path / "meshes")
     params = {"seed": 3, "n_jobs": 2, "data": {"source": "folder", "path": "meshes"},
               "ingest": {"max_faces": 50000, "min_shapes": 3, "test_fraction": 0.4},
-              "voxelize": {"resolution": 16}}
+              "voxelize": {"resolution": 16}, "ae": {"net": {"resolution": 16}}}
     return params, expected
 
 
@@ -107,7 +107,7 @@ def test_too_few_shapes_fails_clearly_and_writes_nothing(tmp_path, corpus_params
 
 
 def test_split_sizes_follow_the_paper_ratio():
-    from graspaug.stages.ingest import assign_split
+    from graspaug.corpus import assign_split
 
     split = assign_split([f"rnd_{i:03d}" for i in range(999)], 0.2663, seed=0)
     assert sum(v == "test" for v in split.values()) == 266

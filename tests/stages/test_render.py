@@ -14,8 +14,8 @@ from .test_ingest import run_stage
 
 PARAMS = {
     "n_jobs": 1,
-    "ingest": {"min_shapes": 2, "surface_resolution": 48, "finest_surface_resolution": 48, "test_fraction": 0.34},
-    "grasps": {"n_grasps": 16, "n_samples": 5},
+    "ingest": {"min_shapes": 2, "test_fraction": 0.34, "surface": {"resolution": 48, "finest_resolution": 48}},
+    "grasps": {"sampler": {"n_grasps": 16}, "perturbations": {"n_samples": 5}},
     "render": {"max_poses": 3, "shard_rows": 7, "n_examples": 4},
 }
 
@@ -105,18 +105,21 @@ def test_render_writes_shards_index_metrics_and_a_dexnet_export(tmp_path, monkey
 
 
 def test_render_params_are_checked(tmp_path):
-    (tmp_path / "params.yaml").write_text("render:\n  camera_tilt_deg: [5.0, 1.0]\n")
+    (tmp_path / "params.yaml").write_text("render:\n  viewpoints:\n    tilt_deg: [5.0, 1.0]\n")
     result = CliRunner().invoke(app, ["render", "--params", str(tmp_path / "params.yaml")])
-    assert result.exit_code == 2 and "render.camera_tilt_deg: must be [low, high]" in result.output
-    (tmp_path / "params.yaml").write_text("render:\n  out_size: 40\n")
+    assert result.exit_code == 2 and "render.viewpoints: camera tilt range must lie in [0, 90) degrees and be ordered" in result.output
+    (tmp_path / "params.yaml").write_text("render:\n  crop:\n    out_size: 40\n")
     result = CliRunner().invoke(app, ["render", "--params", str(tmp_path / "params.yaml")])
-    assert result.exit_code == 2 and "render.out_size: must divide render.crop_size (96)" in result.output
+    assert result.exit_code == 2 and "render.crop: crop_size (96) must be a positive multiple of out_size (40)" in result.output
+    (tmp_path / "params.yaml").write_text("render:\n  crop:\n    out_size: 16\n")
+    result = CliRunner().invoke(app, ["render", "--params", str(tmp_path / "params.yaml")])
+    assert result.exit_code == 2 and "gqcnn.net.image_size: must equal render.crop.out_size (16); got 32" in result.output
 
 
 def test_a_mesh_that_cannot_be_rendered_is_skipped_with_its_reason(tmp_path):
     from graspaug.grasping.gripper import ParallelJawGripper
     from graspaug.render.dataset import RenderSettings
-    from graspaug.stages.render import render_one
+    from graspaug.render.dataset import render_file as render_one
 
     flat = trimesh.Trimesh(vertices=[[0, 0, 0], [0.05, 0, 0], [0, 0.05, 0]], faces=[[0, 1, 2]])  # no volume, no hull
     flat.export(tmp_path / "flat.ply")

@@ -1,7 +1,7 @@
 """The report's verdicts on hand-made AP tables: paired per-seed gains against their standard error."""
 import pandas as pd
 
-from graspaug.stages.report import ap_table, verdicts
+from graspaug.experiments.ap import ap_table, verdicts
 
 
 def runs_table(rows):

@@ -2,7 +2,7 @@
 import numpy as np
 import pandas as pd
 
-from graspaug.stages.sim import compare, rate_summary, report_text
+from graspaug.sim.experiment import compare, rate_summary, report_text
 
 
 def trials_table(outcomes: dict[tuple[int, str], list[bool]]) -> pd.DataFrame:

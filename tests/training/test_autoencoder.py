@@ -16,9 +16,8 @@ def train_settings(**overrides) -> AETrainConfig:
     from dataclasses import replace
 
     from graspaug.config import Params
-    from graspaug.stages.train_ae import train_config
 
-    return replace(train_config(Params()), **overrides)
+    return replace(Params().ae.train, **overrides)
 
 
 def primitive_grids(resolution: int) -> torch.Tensor:

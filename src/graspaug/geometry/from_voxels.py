@@ -11,6 +11,7 @@ import numpy as np
 import trimesh
 from scipy import ndimage
 from skimage.measure import marching_cubes
+from graspaug.geometry.settings import DecodeSettings
 
 
 @dataclass(frozen=True)
@@ -62,3 +63,18 @@ def mesh_from_occupancy(occupancy: np.ndarray, pitch: float, smoothing_iteration
     center = mesh.center_mass if mesh.is_watertight else mesh.bounds.mean(axis=0)
     mesh.apply_translation(-center)
     return mesh
+
+
+def mesh_decoded(probability: np.ndarray, pitch: float, settings: DecodeSettings) -> tuple[CleanGrid, trimesh.Trimesh | None, str | None]:
+    """Clean a decoded grid (R, R, R) of probabilities and mesh it at ``pitch`` (m per voxel);
+    a reason instead of a mesh when it is degenerate."""
+    grid = clean_occupancy(probability, settings.threshold, settings.opening, settings.min_voxels, settings.min_main_share)
+    if grid.reason:
+        return grid, None, grid.reason
+    mesh = mesh_from_occupancy(grid.occupancy, pitch, settings.smoothing_iterations)
+    pieces = len(mesh.split(only_watertight=False))
+    if pieces != 1:
+        return grid, None, f"surface in {pieces} pieces after meshing"
+    if not mesh.is_volume:
+        return grid, None, "surface not a closed volume after meshing"
+    return grid, mesh, None

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Literal
 
 import numpy as np
 import trimesh
@@ -9,30 +10,7 @@ import trimesh
 from graspaug.geometry.loading import LoadedShape, MeshRejected
 from graspaug.geometry.normalize import Normalization, normalization
 from graspaug.geometry.solid import outer_surface_of_mesh, outer_surface_of_parts, resolution_for_parts
-
-
-@dataclass(frozen=True)
-class SurfaceSettings:
-    """How the outer surface is rebuilt and sized (the ``ingest`` params hold the defaults).
-
-    Attributes
-    ----------
-    resolution : field samples along the largest extent for marching cubes
-    finest_resolution : upper limit when thin parts ask for a finer grid
-    cells_per_thickness : field cells across a typical (median) convex part
-    face_budget : at most this many triangles after decimation
-    size_rule : which extent is fixed: ``min``, ``mid`` or ``max``
-    size_m : that extent after normalization, meters
-    max_dropped : largest share of volume that may lie outside the kept piece
-    """
-
-    resolution: int
-    finest_resolution: int
-    cells_per_thickness: float
-    face_budget: int
-    size_rule: str
-    size_m: float
-    max_dropped: float
+from graspaug.geometry.settings import SurfaceSettings
 
 
 @dataclass

@@ -22,20 +22,7 @@ import trimesh
 from graspaug.grasping.contacts import close_fingers, first_entries
 from graspaug.grasping.gripper import ParallelJawGripper
 from graspaug.grasping.quality import contact_frames
-
-
-@dataclass(frozen=True)
-class AntipodalSettings:
-    """How grasps are sampled; see the module docstring."""
-
-    n_grasps: int
-    friction_coef: float
-    tries_per_point: int
-    oversample: int
-    max_rounds: int
-    max_surface_points: int  # per round
-    min_contact_dist: float  # m
-    coverage_dist: float  # m, 0 disables coverage rejection
+from graspaug.grasping.settings import AntipodalSettings
 
 
 @dataclass(frozen=True)

@@ -1,10 +1,10 @@
 """The parallel-jaw gripper that every grasp in the project is made for."""
 from __future__ import annotations
 
-from dataclasses import dataclass
+from graspaug.settings import Field, settings
 
 
-@dataclass(frozen=True)
+@settings
 class ParallelJawGripper:
     """A two-finger parallel gripper (lengths in meters).
 
@@ -17,16 +17,16 @@ class ParallelJawGripper:
     friction columns of the grasp wrench (Dex-Net's default 0.005 m).
     """
 
-    name: str = "franka_panda"
-    max_width: float = 0.08  # jaw opening (m)
-    min_width: float = 0.0  # smallest closing width (m)
-    finger_width: float = 0.021  # across the jaw, perpendicular to the grasp axis (m)
-    finger_length: float = 0.0538  # along the approach direction (m)
-    finger_thickness: float = 0.0264  # along the grasp axis, outward from the jaw face (m)
-    fingertip_offset: float = 0.0072  # how far the fingertips reach past the grasp center (m)
-    palm_offset: float = 0.039  # distance from the grasp center back to the palm (m)
-    palm_size: tuple[float, float, float] = (0.2045, 0.0632, 0.0919)  # along the axis, across, along the approach (m)
-    finger_radius: float = 0.005  # soft contact patch radius (m)
+    name: str = Field("franka_panda", description="Name of the gripper (recorded with the data).")
+    max_width: float = Field(0.08, gt=0, description="Jaw opening (m; Franka Panda: 0.08).")
+    min_width: float = Field(0.0, ge=0, description="Smallest closing width (m).")
+    finger_width: float = Field(0.021, gt=0, description="Finger size across the jaw, perpendicular to the grasp axis (m).")
+    finger_length: float = Field(0.0538, gt=0, description="Finger size along the approach direction (m).")
+    finger_thickness: float = Field(0.0264, gt=0, description="Finger size along the grasp axis, outward from the jaw face (m).")
+    fingertip_offset: float = Field(0.0072, description="How far the fingertips reach past the grasp center (m).")
+    palm_offset: float = Field(0.039, ge=0, description="Distance from the grasp center back to the palm (m).")
+    palm_size: tuple[float, float, float] = Field((0.2045, 0.0632, 0.0919), description="Palm box along the axis, across, along the approach (m).")
+    finger_radius: float = Field(0.005, ge=0, description="Soft-finger contact radius for the torsion columns of the grasp wrench (m; Dex-Net: 0.005).")
 
     def __post_init__(self) -> None:
         if not 0 <= self.min_width < self.max_width:

@@ -13,29 +13,8 @@ from scipy.stats import truncnorm
 from graspaug.grasping.contacts import close_fingers
 from graspaug.grasping.gripper import ParallelJawGripper
 from graspaug.grasping.quality import X_AXIS, ferrari_canny, grasp_wrenches
-
-
-@dataclass(frozen=True)
-class QualitySettings:
-    """The wrench-space model: friction coefficient μ, cone faces, torque scaling s (1/m)."""
-
-    friction_coef: float
-    cone_faces: int
-    torque_scaling: float
-
-
-@dataclass(frozen=True)
-class Perturbations:
-    """Gaussian noise of the robust metric: grasp center (m), grasp axis rotation (rad),
-    object translation (m) and rotation (rad), and the friction coefficient's std (its mean
-    is ``QualitySettings.friction_coef``; samples are truncated to [0, 1])."""
-
-    n_samples: int
-    center_sigma: float
-    axis_sigma: float
-    object_translation_sigma: float
-    object_rotation_sigma: float
-    friction_sigma: float
+from graspaug.grasping.settings import QualitySettings
+from graspaug.grasping.settings import Perturbations
 
 
 Epsilon = Callable[[np.ndarray, np.ndarray], np.ndarray]  # (wrench sets, origin known inside) -> ε

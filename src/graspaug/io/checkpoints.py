@@ -15,10 +15,7 @@ import torch
 
 from graspaug.io.atomic import atomic_path
 from graspaug.nets.ae_critic import AEConfig, AutoEncoder, Critic
-
-
-class CheckpointMismatch(RuntimeError):
-    """A checkpoint was trained with other settings than the ones asked for."""
+from graspaug.errors import CheckpointMismatch
 
 
 def save_autoencoder(path: str | os.PathLike, ae: AutoEncoder, critic: Critic | None, train_params: dict[str, Any]) -> None:

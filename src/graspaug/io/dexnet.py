@@ -46,3 +46,44 @@ def read_tensor_field(folder: str | os.PathLike, name: str) -> np.ndarray:
     if not files:
         raise FileNotFoundError(f"{folder}: no tensors/{name}_00000.npz")
     return np.concatenate([np.load(f)["arr_0"] for f in files])
+
+
+def export_dexnet(source: str | os.PathLike, out: str | os.PathLike, rows_per_file: int = 1000) -> int:
+    """Write the rendered dataset in folder ``source`` (``data/gqcnn/<corpus>``) in Dex-Net 2.0's
+    tensor layout into ``out``; returns the number of datapoints."""
+    from graspaug.io.atomic import atomic_path
+    from graspaug.io.gqcnn import GraspImages
+
+    source = Path(source)
+    if not (source / "index.parquet").exists():
+        raise FileNotFoundError(f"{source}: no rendered dataset (run `dvc repro` or `graspaug render --corpus {source.name}` first)")
+    out = Path(out)
+    if out.exists() and any(out.iterdir()):
+        raise FileExistsError(f"{out} exists and is not empty; choose a new folder")
+    data = GraspImages.open(source)
+    info = json.loads((source / "dataset.json").read_text())
+    index = data.index
+    obj_ids, obj_labels = np.unique(index.shape_id.to_numpy(), return_inverse=True)
+    pose_keys = index.shape_id + ":" + index.pose_id.astype(str)
+    pose_ids, pose_labels = np.unique(pose_keys.to_numpy(), return_inverse=True)
+    _, image_labels = np.unique((pose_keys + ":" + index.image_id.astype(str)).to_numpy(), return_inverse=True)
+    cx, cy = info["intrinsics"]["cx"], info["intrinsics"]["cy"]
+    hand_poses = np.stack([index.center_v, index.center_u, index.z, index.angle, index.center_v - cy, index.center_u - cx, index.width_px], axis=1)
+    fields = {
+        "depth_ims_tf_table": data.images()[..., None],
+        "hand_poses": hand_poses.astype(np.float32),
+        # Dex-Net stores each metric times collision_free, and gqcnn labels by the metric alone
+        "robust_ferrari_canny": (index.eps * index.collision_free).to_numpy(np.float32),
+        "robust_ferrari_canny_raw": index.eps.to_numpy(np.float32),
+        "collision_free": index.collision_free.to_numpy(np.uint8),
+        "obj_labels": obj_labels.astype(np.uint32),
+        "pose_labels": pose_labels.astype(np.uint32),
+        "image_labels": image_labels.astype(np.uint32),
+    }
+    extra = {"source": f"graspaug render ({source.name})", "dataset": info, "obj_ids": obj_ids.tolist(), "pose_ids": pose_ids.tolist(),
+             "hand_poses_columns": ["center_row", "center_col", "depth", "angle", "center_row_minus_cy", "center_col_minus_cx", "width_px"],
+             "label_rule": f"robust_ferrari_canny > {info['grasps_threshold']} (robust_ferrari_canny is 0 for colliding grasps, as in Dex-Net; "
+                           "robust_ferrari_canny_raw keeps the robust epsilon before that)"}
+    with atomic_path(out, directory=True) as folder:
+        write_tensor_dataset(folder, fields, rows_per_file, extra)
+    return len(index)

@@ -18,35 +18,11 @@ channels and the stride-1 layer ``top_width``. Paper profile (R = 64): base 64 �
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import torch
 import torch.nn.functional as F
 from torch import nn
-
-
-@dataclass(frozen=True)
-class AEConfig:
-    resolution: int = 32  # R: voxels per side, a power of two >= 8
-    z_dim: int = 128  # latent size (paper: 128)
-    base_width: int = 16  # channels of the first conv (paper profile: 64)
-    top_width: int = 128  # channels of the 4³ map (paper: 512)
-
-    @property
-    def n_down(self) -> int:
-        """Stride-2 layers from R³ to 4³."""
-        return int(round(math.log2(self.resolution // 4)))
-
-    @property
-    def widths(self) -> list[int]:
-        """Channels after each down-sampling conv, then after the stride-1 conv."""
-        down = [min(self.base_width * 2**i, self.top_width) for i in range(self.n_down)]
-        return down + [self.top_width]
-
-    def __post_init__(self):
-        r = self.resolution
-        if r < 8 or r & (r - 1):
-            raise ValueError(f"resolution must be a power of two >= 8, got {r}")
+from graspaug.nets.settings import AEConfig
 
 
 def _down(c_in: int, c_out: int) -> list[nn.Module]:

@@ -13,26 +13,12 @@ depths in meters.
 """
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
+from dataclasses import asdict
 
 import torch
 import torch.nn.functional as F
 from torch import nn
-
-
-@dataclass(frozen=True)
-class GQCNNConfig:
-    image_size: int = 32  # crop side (px)
-    filters: int = 64  # channels of each conv layer (Dex-Net: 64)
-    fc: int = 1024  # width of fc3 and fc4 (Dex-Net: 1024)
-    pose_fc: int = 16  # width of pc1 (Dex-Net: 16)
-    pool_after_conv2: bool = True  # the 2018 config's second max pool (2017: none)
-
-    def __post_init__(self) -> None:
-        if self.image_size % (4 if self.pool_after_conv2 else 2):
-            raise ValueError(f"image_size {self.image_size} must be divisible by the pooling")
-        if min(self.filters, self.fc, self.pose_fc) < 1:
-            raise ValueError(f"layer widths must be >= 1, got {self}")
+from graspaug.nets.settings import GQCNNConfig
 
 
 class LocalResponseNorm(nn.Module):

@@ -5,8 +5,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from graspaug.settings import Field, settings
 
-@dataclass(frozen=True)
+
+@settings
 class Intrinsics:
     """A pinhole camera's image size (pixels) and intrinsics (pixels).
 
@@ -14,12 +16,12 @@ class Intrinsics:
     640×480 with fx = fy = 525 px and the principal point at the image center.
     """
 
-    width: int = 640
-    height: int = 480
-    fx: float = 525.0
-    fy: float = 525.0
-    cx: float = 319.5
-    cy: float = 239.5
+    width: int = Field(640, ge=1, description="Image width (px).")
+    height: int = Field(480, ge=1, description="Image height (px).")
+    fx: float = Field(525.0, gt=0, description="Focal length along u (px; Primesense/D435 at 640×480: ~525).")
+    fy: float = Field(525.0, gt=0, description="Focal length along v (px).")
+    cx: float = Field(319.5, description="Principal point u (px; the image center is (width - 1) / 2).")
+    cy: float = Field(239.5, description="Principal point v (px; the image center is (height - 1) / 2).")
 
     def __post_init__(self) -> None:
         if self.width < 1 or self.height < 1 or self.fx <= 0 or self.fy <= 0:
@@ -87,7 +89,7 @@ def look_at(eye: np.ndarray, target: np.ndarray, roll: float = 0.0) -> CameraPos
     return CameraPose(rotation=np.stack([x, y, z], axis=1), position=eye)
 
 
-@dataclass(frozen=True)
+@settings
 class ViewpointRanges:
     """Dex-Net 2.0's random camera placement around an object resting at the table origin.
 
@@ -96,9 +98,9 @@ class ViewpointRanges:
     and rolled uniformly about its axis.
     """
 
-    distance: tuple[float, float] = (0.65, 0.75)
-    tilt_deg: tuple[float, float] = (0.1, 5.0)
-    object_offset: float = 0.1
+    distance: tuple[float, float] = Field((0.65, 0.75), description="Range of the camera's distance to its target point on the table (m).")
+    tilt_deg: tuple[float, float] = Field((0.1, 5.0), description="Range of the optical axis' angle from straight down (deg).")
+    object_offset: float = Field(0.1, ge=0, description="The camera aims up to this far from the object in x and y (m), so objects sit off the image center.")
 
     def __post_init__(self) -> None:
         if not 0 < self.distance[0] <= self.distance[1]:

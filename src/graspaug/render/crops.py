@@ -26,22 +26,7 @@ from scipy import ndimage
 
 from graspaug.render.camera import CameraPose, Intrinsics
 from graspaug.render.depth import object_depth, table_depth
-
-
-@dataclass(frozen=True)
-class CropGeometry:
-    """Crop size around the grasp and output size (pixels); the first must be a multiple of the second."""
-
-    crop_size: int = 96
-    out_size: int = 32
-
-    def __post_init__(self) -> None:
-        if self.out_size < 1 or self.crop_size < self.out_size or self.crop_size % self.out_size:
-            raise ValueError(f"crop_size ({self.crop_size}) must be a positive multiple of out_size ({self.out_size})")
-
-    @property
-    def factor(self) -> int:
-        return self.crop_size // self.out_size
+from graspaug.render.settings import CropGeometry
 
 
 def crop_sample_points(centers: np.ndarray, angles: np.ndarray, geometry: CropGeometry) -> tuple[np.ndarray, np.ndarray]:

@@ -1,40 +1,27 @@
 """One shape's Dex-Net 2.0 datapoints: stable poses × camera views × table-parallel grasps."""
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+import logging
+from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
+import pandas as pd
 import trimesh
 
 from graspaug.grasping.gripper import ParallelJawGripper
+from graspaug.io.meshes import read_mesh
 from graspaug.render.camera import CameraPose, Intrinsics, ViewpointRanges, sample_viewpoint
 from graspaug.render.collision import CollisionChecker, approach_directions
 from graspaug.render.crops import CropGeometry, crops_by_ray_casting
 from graspaug.render.stable_poses import stable_poses
+from graspaug.rng import shape_rng
+from graspaug.render.settings import RenderSettings
+
+log = logging.getLogger(__name__)
 
 COLUMNS = ("grasp_index", "pose_id", "pose_probability", "image_id", "camera_height", "camera_tilt", "center_u", "center_v", "angle", "z",
            "width_px", "collision_free")
-
-
-@dataclass(frozen=True)
-class RenderSettings:
-    """How one shape's datapoints are made (Dex-Net 2.0's recipe by default).
-
-    ``max_poses`` most probable stable poses with probability >= ``min_pose_probability``;
-    ``images_per_pose`` random camera views of each; in each view every grasp whose jaw axis is
-    within ``axis_tolerance_deg`` of parallel to the table (at most ``max_grasps_per_image``,
-    a seeded random subset; 0: all), approached from above over ``approach_distance`` (m).
-    """
-
-    max_poses: int = 5
-    min_pose_probability: float = 0.01
-    images_per_pose: int = 2
-    max_grasps_per_image: int = 0
-    axis_tolerance_deg: float = 5.0
-    approach_distance: float = 0.1
-    viewpoints: ViewpointRanges = field(default_factory=ViewpointRanges)
-    intrinsics: Intrinsics = field(default_factory=Intrinsics)
-    crop: CropGeometry = field(default_factory=CropGeometry)
 
 
 @dataclass(frozen=True)
@@ -155,3 +142,51 @@ def render_shape(mesh: trimesh.Trimesh, centers: np.ndarray, axes: np.ndarray, g
                  for name in COLUMNS}
         return ShapeDatapoints(np.zeros((0, out, out), np.float32), empty, n_poses, n_rays)
     return ShapeDatapoints(np.concatenate(images), {name: np.concatenate(parts) for name, parts in rows.items()}, n_poses, n_rays)
+
+
+SHAPE_COLUMNS = ("shape_id", "origin", "split", "base_size", "pool", "order")
+
+
+def datapoints_index(shapes, by_shape: dict, results: list, threshold: float) -> tuple[list, list, list, int, list]:
+    """Gather every shape's datapoints: (image arrays, index parts, skipped shapes with reasons,
+    rays cast, stable poses per shape). ``shapes``: the corpus table; ``by_shape``: shape id →
+    its grasp rows; ``results``: (ShapeDatapoints or None, reason) per shape; ``threshold``:
+    robust ε above which a grasp succeeds (label = collision free and success)."""
+    images, parts, skipped, n_rays, n_poses = [], [], [], 0, []
+    for shape, (data, reason) in zip(shapes.itertuples(index=False), results):
+        if data is None:
+            skipped.append({"shape_id": shape.shape_id, "reason": reason})
+            log.warning("render: %s has no datapoints: %s", shape.shape_id, reason)
+            continue
+        rows = by_shape[shape.shape_id].iloc[data.columns["grasp_index"]]
+        part = pd.DataFrame({name: [getattr(shape, name)] * len(data) for name in SHAPE_COLUMNS})
+        part["grasp_id"] = rows["grasp_id"].to_numpy()
+        for name, values in data.columns.items():
+            if name != "grasp_index":
+                part[name] = values
+        part["eps"] = rows["eps_mean"].to_numpy()
+        part["success"] = part["eps"] > threshold
+        part["label"] = part["collision_free"] & part["success"]
+        parts.append(part)
+        images.append(data.images)
+        n_rays += data.n_rays
+        n_poses.append(data.n_poses)
+    return images, parts, skipped, n_rays, n_poses
+
+
+def render_file(path: Path, shape_id: str, centers: np.ndarray, axes: np.ndarray, settings: RenderSettings, hand, seed: int) -> tuple[ShapeDatapoints | None, str | None]:
+    """One shape's datapoints, or None and why there are none."""
+    if len(centers) == 0:
+        return None, "the shape has no grasps"
+    try:
+        mesh = read_mesh(path)
+    except Exception as exc:  # a broken file is skipped with its reason, not fatal
+        return None, f"mesh could not be read: {exc}"
+    try:
+        data = render_shape(mesh, centers, axes, hand, settings, shape_rng(seed, shape_id, "render"))
+    except Exception as exc:  # a degenerate mesh (no hull, no volume) is skipped with its reason
+        return None, f"rendering failed: {type(exc).__name__}: {exc}"
+    if len(data) == 0:
+        return None, (f"none of its {len(centers)} grasps has its jaw axis within {settings.axis_tolerance_deg} deg of the table "
+                      f"in its {data.n_poses} stable poses")
+    return data, None

@@ -8,11 +8,11 @@ rate; nothing is teleported once an object is in contact.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 import pybullet
 import pybullet_data
+from graspaug.sim.settings import HandSettings
+
 
 ARM_JOINTS = tuple(range(7))
 FINGER_JOINTS = (9, 10)
@@ -22,16 +22,6 @@ UPPER_LIMITS = np.array([2.9671, 1.8326, 2.9671, 0.0, 2.9671, 3.8223, 2.9671])
 ARM_EFFORT = np.array([87.0, 87.0, 87.0, 87.0, 12.0, 12.0, 12.0])  # N m, the URDF's limits
 REST_POSE = np.array([0.0, -0.6, 0.0, -2.4, 0.0, 1.8, 0.785])  # arm folded back, hand down (rad)
 FINGER_OPEN = 0.04  # each finger's travel at full opening (m): 0.08 m between the jaws
-
-
-@dataclass(frozen=True)
-class HandSettings:
-    """How the hand moves and holds (SI units)."""
-
-    grip_force: float = 40.0  # the closing force limit per finger (N)
-    finger_friction: float = 1.0  # lateral friction of the finger pads
-    speed: float = 0.25  # Cartesian speed of the grasp center (m/s)
-    close_time: float = 0.5  # time given to close the fingers (s)
 
 
 class Panda:

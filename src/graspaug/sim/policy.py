@@ -19,6 +19,8 @@ from sklearn.mixture import GaussianMixture
 from graspaug.nets.gqcnn import GQCNN
 from graspaug.render.camera import CameraPose, Intrinsics
 from graspaug.render.crops import CropGeometry, crops_from_depth_image
+from graspaug.sim.settings import SamplerSettings
+from graspaug.sim.settings import CEMSettings
 
 
 @dataclass(frozen=True)
@@ -36,32 +38,6 @@ class ImageGrasps:
 
     def take(self, index) -> ImageGrasps:
         return ImageGrasps(self.centers[index], self.angles[index], self.depths[index], self.widths[index])
-
-
-@dataclass(frozen=True)
-class SamplerSettings:
-    """Dex-Net's antipodal depth-image sampler (REFERENCE.md: run-time grasp planning)."""
-
-    friction_coef: float = 0.8  # friction cone half angle = atan(0.8)
-    depth_grad_thresh: float = 0.0025  # |∇depth| (m per px) that marks an edge pixel
-    min_dist_from_boundary: int = 45  # px
-    min_depth_offset: float = 0.005  # grasp depth below the surface between the jaws (m)
-    max_depth_offset: float = 0.04
-    max_width: float = 0.08  # jaw opening (m)
-    max_edge_pixels: int = 3000  # edge pixels kept at random to pair up
-
-
-@dataclass(frozen=True)
-class CEMSettings:
-    """Cross-entropy refinement (REFERENCE.md: 100–250 seeds, 3 iterations, top 25 %, GMM with
-    3 components or ceil(0.4 × elites) whichever is fewer, 50 new grasps per iteration)."""
-
-    num_seed_samples: int = 250
-    num_iters: int = 3
-    elite_fraction: float = 0.25
-    gmm_components: int = 3
-    gmm_component_fraction: float = 0.4
-    num_gmm_samples: int = 50
 
 
 @dataclass(frozen=True)

@@ -8,8 +8,6 @@ one so that the same seed always gives the same physics.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 import pybullet
 import pybullet_data
@@ -18,34 +16,7 @@ from graspaug.render.camera import CameraPose, Intrinsics, look_at
 from graspaug.render.pybullet_depth import render_depth
 from graspaug.sim.objects import SimObject
 from graspaug.sim.panda import HandSettings, Panda
-
-
-@dataclass(frozen=True)
-class CellLayout:
-    """Where things stand (m) and how the world steps."""
-
-    camera_height: float = 0.65
-    intrinsics: Intrinsics = Intrinsics()
-    table_size: tuple[float, float] = (1.2, 1.2)
-    table_friction: float = 0.8
-    robot_base: tuple[float, float, float] = (-0.6, 0.0, 0.0)
-    bin_position: tuple[float, float, float] = (-0.25, 0.5, 0.0)
-    bin_scale: float = 0.5  # traybox is 0.6 × 0.6 × 0.15 m at scale 1
-    time_step: float = 1 / 240
-    gravity: float = 9.81
-
-    @property
-    def bin_half_extent(self) -> float:
-        """Half the inner width of the bin (m)."""
-        return 0.29 * self.bin_scale
-
-    @property
-    def bin_height(self) -> float:
-        return 0.15 * self.bin_scale
-
-    @property
-    def camera(self) -> CameraPose:
-        return look_at(np.array([0.0, 0.0, self.camera_height]), np.zeros(3))
+from graspaug.sim.settings import CellLayout
 
 
 class PickScene:

@@ -17,22 +17,9 @@ from graspaug.sim.objects import SimObject
 from graspaug.sim.panda import FINGER_OPEN, HandSettings
 from graspaug.sim.policy import ImageGrasps, PlannedGrasp, grasp_in_table_frame
 from graspaug.sim.scene import CellLayout, PickScene
+from graspaug.sim.settings import TrialSettings
 
 OUTCOMES = ("success", "no_grasp", "not_lifted", "dropped", "outside_bin")
-
-
-@dataclass(frozen=True)
-class TrialSettings:
-    """The motion script (m, s)."""
-
-    drop_offset: float = 0.05  # drop point uniform in ±offset around the table origin (x and y)
-    drop_clearance: float = 0.02  # gap between the table and the object's lowest point at release
-    settle_time: float = 2.0  # at most this long for the object to come to rest
-    pregrasp_height: float = 0.15  # above the grasp center
-    lift_height: float = 0.2
-    carry_height: float = 0.25  # grasp center above the bin floor when released
-    carry_speed: float = 0.5  # m/s
-    release_time: float = 1.0  # after opening, before the bin check
 
 
 @dataclass

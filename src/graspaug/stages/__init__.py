@@ -1,8 +1,9 @@
 """One thin module per DVC stage: read its params, call library functions, write outputs."""
 
 
-class StageError(RuntimeError):
-    """A stage cannot produce valid outputs; the message says why (the CLI prints it, exit code 1)."""
+from graspaug.errors import StageError
+
+__all__ = ["StageError", "corpus_paths"]
 
 
 def corpus_paths(corpus: str):

@@ -15,15 +15,15 @@ import numpy as np
 import pandas as pd
 
 from graspaug.config import Params
+from graspaug.device import resolve_device
 from graspaug.geometry.clusters import largest_cluster, outlier_percentage
 from graspaug.io.atomic import atomic_path
 from graspaug.io.checkpoints import load_autoencoder
 from graspaug.io.tables import write_csv
 from graspaug.plots import lines, voxel_rows
 from graspaug.stages import StageError
-from graspaug.paths import AE_CRITIC_MODEL, AE_MODEL, CRITIC_EVAL_METRICS, INTERPOLATIONS_PNG, OUTLIERS_CSV, OUTLIERS_PNG
-from graspaug.stages.train_ae import net_config, split_voxels
-from graspaug.training.autoencoder import decode, encode, resolve_device
+from graspaug.paths import AE_CRITIC_MODEL, AE_MODEL, CRITIC_EVAL_METRICS, INTERPOLATIONS_PNG, OUTLIERS_CSV, OUTLIERS_PNG, SHAPES_TABLE, VOXELS
+from graspaug.training.autoencoder import decode, encode, grids_by_split
 
 log = logging.getLogger(__name__)
 
@@ -46,7 +46,7 @@ def interpolate(z: np.ndarray, pairs: np.ndarray, alphas: np.ndarray) -> np.ndar
 def run(params: Params) -> None:
     cfg = params.critic_eval
     device = resolve_device(params.device)
-    train = split_voxels()["train"]
+    train = grids_by_split(VOXELS, SHAPES_TABLE)["train"]
     pairs = random_pairs(len(train), cfg.n_shapes, cfg.n_pairs, np.random.default_rng(params.seed))
     if len(pairs) == 0:
         raise StageError(f"critic_eval needs at least 2 train shapes, the split has {len(train)}")
@@ -58,7 +58,7 @@ def run(params: Params) -> None:
     empty_grids: dict[str, int] = {}
     sequences = {}
     for name, path in MODELS.items():
-        ae, _, _ = load_autoencoder(path, net_config(params))
+        ae, _, _ = load_autoencoder(path, params.ae.net)
         z = encode(ae, train, device)
         grids = decode(ae, interpolate(z, pairs, alphas).reshape(-1, z.shape[1]), device) > cfg.threshold
         pct = np.array([outlier_percentage(g) for g in grids]).reshape(len(pairs), len(alphas))

@@ -14,27 +14,18 @@ from graspaug.config import Params
 from graspaug.io.checkpoints import load_autoencoder
 from graspaug.io.tables import write_csv, write_table
 from graspaug.plots import scatter_2d
-from graspaug.paths import AE_CRITIC_MODEL, LATENTS, TSNE_CSV, TSNE_PNG
-from graspaug.stages.train_ae import load_grids, net_config
-from graspaug.training.autoencoder import encode, resolve_device
+from graspaug.paths import AE_CRITIC_MODEL, LATENTS, SHAPES_TABLE, TSNE_CSV, TSNE_PNG, VOXELS
+from graspaug.device import resolve_device
+from graspaug.embedding import tsne_2d
+from graspaug.training.autoencoder import encode, voxel_grids
 
 log = logging.getLogger(__name__)
 
 
-def tsne_2d(z: np.ndarray, perplexity: float, seed: int) -> np.ndarray:
-    """(N, 2) t-SNE of (N, d) latents (scikit-learn, PCA init, seeded)."""
-    from sklearn.manifold import TSNE
-
-    if len(z) < 3:
-        return np.zeros((len(z), 2))
-    perplexity = min(perplexity, (len(z) - 1) / 3)
-    return TSNE(n_components=2, perplexity=perplexity, init="pca", random_state=seed).fit_transform(z)
-
-
 def run(params: Params) -> None:
     device = resolve_device(params.device)
-    ae, _, _ = load_autoencoder(AE_CRITIC_MODEL, net_config(params))
-    shape_ids, split, grids = load_grids()
+    ae, _, _ = load_autoencoder(AE_CRITIC_MODEL, params.ae.net)
+    shape_ids, split, grids = voxel_grids(VOXELS, SHAPES_TABLE)
     z = encode(ae, grids, device)
 
     latents = pd.DataFrame({"shape_id": shape_ids, "split": split, "z": list(z.astype(np.float32))})

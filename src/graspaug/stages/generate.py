@@ -16,56 +16,33 @@ from __future__ import annotations
 
 import logging
 import time
-from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
-import trimesh
 
-from graspaug.config import GenerateParams, Params
-from graspaug.generation import Candidate, PoolExhausted, RandomStream, TargetedStream, above_percentile, fill_pool, nested_base_sets, pool_size
-from graspaug.geometry.from_voxels import CleanGrid, clean_occupancy, mesh_from_occupancy
+from graspaug.config import Params
+from graspaug.device import resolve_device
+from graspaug.embedding import tsne_2d
+from graspaug.generation import (
+    Candidate, Decoded, PoolExhausted, RandomStream, TargetedStream, above_percentile, fill_pool, nested_base_sets, pool_size, pool_tables,
+)
+from graspaug.geometry.from_voxels import mesh_decoded
 from graspaug.io.atomic import atomic_path
 from graspaug.io.checkpoints import load_autoencoder
 from graspaug.io.meshes import mesh_path, write_obj
 from graspaug.io.tables import read_table, write_json, write_table
 from graspaug.io.voxels import read_voxels
 from graspaug.paths import (
-    AE_CRITIC_MODEL, GENERATED_SUFFIX, LATENTS, SCORES, SHAPES_TABLE, VOXELS, generate_metrics, generate_reports, generated_dir,
+    AE_CRITIC_MODEL, GENERATED_SUFFIX, LATENTS, SCORES, SHAPES_TABLE, VOXELS, generate_metrics, generate_reports, generated_dir, timing_file,
 )
-from graspaug.plots import scatter_2d, voxel_rows
+from graspaug.plots import generated_pairs, scatter_2d
 from graspaug.scores import rarity
 from graspaug.stages import StageError
-from graspaug.stages.train_ae import net_config
-from graspaug.training.autoencoder import decode, resolve_device
+from graspaug.training.autoencoder import decode
 
 log = logging.getLogger(__name__)
 
 BASE_SEED = 0xBA5E  # base sets: their own stream of the seed
-
-
-@dataclass(frozen=True)
-class Decoded:
-    """One candidate's outcome: the cleaned grid (bit-packed, R³ bits) and, if kept, its mesh (m)."""
-
-    candidate: Candidate
-    packed_grid: np.ndarray
-    mesh: trimesh.Trimesh | None
-    reason: str | None
-
-
-def mesh_decoded(probability: np.ndarray, pitch: float, cfg: GenerateParams) -> tuple[CleanGrid, trimesh.Trimesh | None, str | None]:
-    """Clean a decoded grid and mesh it; a reason instead of a mesh if it is degenerate."""
-    grid = clean_occupancy(probability, cfg.threshold, cfg.opening, cfg.min_voxels, cfg.min_main_share)
-    if grid.reason:
-        return grid, None, grid.reason
-    mesh = mesh_from_occupancy(grid.occupancy, pitch, cfg.smoothing_iterations)
-    pieces = len(mesh.split(only_watertight=False))
-    if pieces != 1:
-        return grid, None, f"surface in {pieces} pieces after meshing"
-    if not mesh.is_volume:
-        return grid, None, "surface not a closed volume after meshing"
-    return grid, mesh, None
 
 
 def run(params: Params, base_size: int) -> None:
@@ -90,7 +67,7 @@ def run(params: Params, base_size: int) -> None:
     pitch = np.array([pitch_of[s] for s in base])
 
     device = resolve_device(params.device)
-    ae, _, _ = load_autoencoder(AE_CRITIC_MODEL, net_config(params))
+    ae, _, _ = load_autoencoder(AE_CRITIC_MODEL, params.ae.net)
 
     def run_batch(candidates: list[Candidate]) -> list[Decoded]:
         a = np.array([c.a for c in candidates])
@@ -98,7 +75,7 @@ def run(params: Params, base_size: int) -> None:
         alpha = np.array([c.alpha for c in candidates], dtype=np.float32)[:, None]
         probability = decode(ae, (1 - alpha) * z[a] + alpha * z[b], device)
         child_pitch = (1 - alpha[:, 0]) * pitch[a] + alpha[:, 0] * pitch[b]  # metric size: the parents' scales interpolated
-        out = parallel_map(lambda job: mesh_decoded(job[0], job[1], cfg), list(zip(probability, child_pitch)), params.workers, f"generate {base_size}")
+        out = parallel_map(lambda job: mesh_decoded(job[0], job[1], cfg.decode), list(zip(probability, child_pitch)), params.workers, f"generate {base_size}")
         return [Decoded(c, np.packbits(grid.occupancy), mesh, reason) for c, (grid, mesh, reason) in zip(candidates, out)]
 
     needed = pool_size(cfg.ratios, base_size)
@@ -114,21 +91,7 @@ def run(params: Params, base_size: int) -> None:
         log.info("generate %d: %s", base_size, note)
     (targeted, targeted_rejects), (randoms, random_rejects) = pools["targeted"], pools["random"]
 
-    rows, reject_rows = [], []
-    for pool, kept in (("targeted", targeted), ("random", randoms)):
-        for order, d in enumerate(kept):
-            c, m = d.candidate, d.mesh
-            za, zb = z[c.a], z[c.b]
-            rows.append({
-                "shape_id": f"gen_{base_size}_{pool[0]}{order:04d}", "base_size": base_size, "pool": pool, "order": order,
-                "parent_a": base[c.a], "parent_b": base[c.b], "alpha": c.alpha, "selected_by": c.selected_by,
-                "z": ((1 - c.alpha) * za + c.alpha * zb).astype(np.float32), "faces": len(m.faces), "vertices": len(m.vertices),
-                "watertight": bool(m.is_watertight), "one_piece": len(m.split(only_watertight=False)) == 1, "volume": float(m.volume),
-                "extent_x": m.extents[0], "extent_y": m.extents[1], "extent_z": m.extents[2], "split": "train", "origin": "generated",
-            })
-    for pool, rejects in (("targeted", targeted_rejects), ("random", random_rejects)):
-        reject_rows += [{"pool": pool, "parent_a": base[d.candidate.a], "parent_b": base[d.candidate.b], "alpha": d.candidate.alpha,
-                         "selected_by": d.candidate.selected_by, "reason": d.reason} for d in rejects]
+    rows, reject_rows = pool_tables(base, z, pools, base_size)
     index = pd.DataFrame(rows)
     index["rarity_vs_base"] = rarity(z, params.score.k, query=np.stack(index.z.to_numpy()))
     rare_group = set(above_percentile(base_rarity, targeted_stream.percentile))
@@ -144,9 +107,8 @@ def run(params: Params, base_size: int) -> None:
         write_table(pd.DataFrame(reject_rows, columns=["pool", "parent_a", "parent_b", "alpha", "selected_by", "reason"]), folder / "rejects.parquet")
         write_table(base_table, folder / "base.parquet")
 
-    draw_examples(base, voxels, targeted, randoms, cfg.n_examples, base_size)
-    from graspaug.stages.embed import tsne_2d
-
+    generated_pairs(base, voxels, targeted[:cfg.n_examples] + randoms[:2], generate_reports(base_size) / "pairs.png",
+                    f"Generated shapes of base set {base_size}")
     xy = tsne_2d(np.concatenate([z, np.stack(index.z.to_numpy())]), params.embed.perplexity, params.seed)
     groups = ["base"] * base_size + [f"generated ({s})" for s in index.selected_by]
     scatter_2d(xy, groups, generate_reports(base_size) / "tsne.png", f"t-SNE of base set {base_size} and its generated shapes")
@@ -162,29 +124,12 @@ def run(params: Params, base_size: int) -> None:
         "random": {"kept": len(randoms), "tried": len(randoms) + len(random_rejects), "kept_share": round(kept_share["random"], 4)},
         "rejects": {str(k): int(v) for k, v in reasons.value_counts().sort_index().items()},
         "kept_watertight_one_piece_share": round(float((index.watertight & index.one_piece).mean()), 4),
-        "seconds": round(time.perf_counter() - start, 1),
     }
     for name, share in kept_share.items():
         if share < 0.95:
             log.warning("generate %d: only %.1f%% of the %s pool's decodes were usable meshes", base_size, 100 * share, name)
     write_json(summary, generate_metrics(base_size))
+    seconds = round(time.perf_counter() - start, 1)
+    write_json({"seconds": seconds}, timing_file("generate", str(base_size)))
     log.info("generate %d: %d targeted (%d tried) + %d random (%d tried) shapes, %d rejected, in %.1f s", base_size, len(targeted),
-             summary["targeted"]["tried"], len(randoms), summary["random"]["tried"], len(reject_rows), summary["seconds"])
-
-
-def draw_examples(base: np.ndarray, voxels, targeted: list[Decoded], randoms: list[Decoded], n_examples: int, base_size: int) -> None:
-    """Parent a | child | parent b, for the first targeted shapes and two random ones."""
-    row_of = {s: i for i, s in enumerate(voxels.shape_id)}
-
-    def parent(shape_id: str) -> tuple[np.ndarray, np.ndarray]:
-        grid = voxels.occupancy[row_of[shape_id]].astype(bool)
-        return grid, grid
-
-    rows, labels = [], []
-    resolution = voxels.occupancy.shape[1]
-    for d in targeted[:n_examples] + randoms[:2]:
-        c = d.candidate
-        child = np.unpackbits(d.packed_grid, count=resolution**3).reshape((resolution,) * 3).astype(bool)
-        rows.append([parent(base[c.a]), (child, child), parent(base[c.b])])
-        labels.append(f"{c.selected_by}, α={c.alpha:g}")
-    voxel_rows(rows, labels, ["parent a", "generated", "parent b"], generate_reports(base_size) / "pairs.png", f"Generated shapes of base set {base_size}")
+             summary["targeted"]["tried"], len(randoms), summary["random"]["tried"], len(reject_rows), seconds)

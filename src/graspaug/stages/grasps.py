@@ -17,12 +17,11 @@ import numpy as np
 import pandas as pd
 
 from graspaug.config import GraspsParams, Params
-from graspaug.grasping.antipodal import AntipodalSettings, sample_antipodal_grasps
-from graspaug.grasping.gripper import ParallelJawGripper
-from graspaug.grasping.robust import Perturbations, QualitySettings, grasp_epsilon, robust_ferrari_canny
+from graspaug.grasping.antipodal import sample_antipodal_grasps
+from graspaug.grasping.robust import grasp_epsilon, robust_ferrari_canny
 from graspaug.io.meshes import mesh_path, read_mesh
 from graspaug.io.tables import read_table, write_json, write_table
-from graspaug.paths import grasps_metrics, grasps_table
+from graspaug.paths import grasps_metrics, grasps_table, timing_file
 from graspaug.rng import shape_rng
 from graspaug.stages import corpus_paths
 
@@ -31,38 +30,14 @@ log = logging.getLogger(__name__)
 VECTORS = ("center", "axis", "p1", "n1", "p2", "n2")
 
 
-def gripper(cfg: GraspsParams) -> ParallelJawGripper:
-    return ParallelJawGripper(max_width=cfg.max_width, finger_radius=cfg.finger_radius)
-
-
-def sampler_settings(cfg: GraspsParams) -> AntipodalSettings:
-    return AntipodalSettings(
-        n_grasps=cfg.n_grasps, friction_coef=cfg.friction_coef, tries_per_point=cfg.tries_per_point,
-        oversample=cfg.oversample, max_rounds=cfg.max_rounds, max_surface_points=cfg.max_surface_points,
-        min_contact_dist=cfg.min_contact_dist, coverage_dist=cfg.coverage_dist,
-    )
-
-
-def quality_settings(cfg: GraspsParams) -> QualitySettings:
-    return QualitySettings(friction_coef=cfg.friction_coef, cone_faces=cfg.cone_faces, torque_scaling=cfg.torque_scaling)
-
-
-def perturbations(cfg: GraspsParams) -> Perturbations:
-    return Perturbations(
-        n_samples=cfg.n_samples, center_sigma=cfg.center_sigma, axis_sigma=cfg.axis_sigma,
-        object_translation_sigma=cfg.object_translation_sigma, object_rotation_sigma=cfg.object_rotation_sigma, friction_sigma=cfg.friction_sigma,
-    )
-
-
 def grasps_of_shape(path: Path, shape_id: str, cfg: GraspsParams, seed: int) -> tuple[pd.DataFrame, str | None]:
     """The grasp rows of one mesh file and, if it has none, why."""
     mesh = read_mesh(path)
     rng = shape_rng(seed, shape_id)
-    hand = gripper(cfg)
-    grasps = sample_antipodal_grasps(mesh, hand, sampler_settings(cfg), rng)
-    quality = quality_settings(cfg)
-    eps = grasp_epsilon(mesh, grasps.center, grasps.axis, cfg.friction_coef, hand, quality)
-    eps_mean, eps_std = robust_ferrari_canny(mesh, grasps.center, grasps.axis, hand, quality, perturbations(cfg), rng)
+    hand, quality = cfg.gripper, cfg.quality
+    grasps = sample_antipodal_grasps(mesh, hand, cfg.sampler, rng)
+    eps = grasp_epsilon(mesh, grasps.center, grasps.axis, quality.friction_coef, hand, quality)
+    eps_mean, eps_std = robust_ferrari_canny(mesh, grasps.center, grasps.axis, hand, quality, cfg.perturbations, rng)
     columns: dict[str, object] = {"shape_id": np.full(len(grasps), shape_id, dtype=object), "grasp_id": np.arange(len(grasps))}
     for name in VECTORS:
         values = getattr(grasps, name)
@@ -72,8 +47,8 @@ def grasps_of_shape(path: Path, shape_id: str, cfg: GraspsParams, seed: int) -> 
     reason = None
     if len(grasps) == 0:
         smallest = float(np.min(mesh.bounding_box_oriented.extents))
-        reason = (f"its oriented bounding box's smallest side, {smallest:.3f} m, is wider than the {cfg.max_width} m opening" if smallest >= cfg.max_width
-                  else f"no antipodal grasp passed the width and force-closure tests in {cfg.max_rounds} rounds")
+        reason = (f"its oriented bounding box's smallest side, {smallest:.3f} m, is wider than the {hand.max_width} m opening" if smallest >= hand.max_width
+                  else f"no antipodal grasp passed the width and force-closure tests in {cfg.sampler.max_rounds} rounds")
     return pd.DataFrame(columns), reason
 
 
@@ -103,8 +78,8 @@ def run(params: Params, corpus: str = "original") -> None:
         "success_share": round(float(table.success.mean()), 4) if len(table) else None,
         "eps_mean_median": round(float(table.eps_mean.median()), 6) if len(table) else None,
         "nominal_force_closure_share": round(float((table.eps > 0).mean()), 4) if len(table) else None,
-        "seconds": round(seconds, 1),
     }
     write_json(summary, grasps_metrics(corpus))
+    write_json({"seconds": round(seconds, 1)}, timing_file("grasps", corpus))
     log.info("grasps (%s): %d grasps on %d shapes (%d without), %.1f%% successful, in %.1f s", corpus, len(table), len(shape_ids),
              summary["shapes_without_grasps"], 100 * (summary["success_share"] or 0), seconds)

@@ -11,47 +11,19 @@ import logging
 import math
 import time
 
-import numpy as np
 import torch
 
 from graspaug.config import Params
 from graspaug.io.atomic import atomic_path
 from graspaug.io.checkpoints import save_autoencoder
-from graspaug.io.tables import read_table
-from graspaug.io.voxels import read_voxels
-from graspaug.nets.ae_critic import AEConfig, AutoEncoder, Critic
-from graspaug.paths import AE_CRITIC_MODEL, AE_MODEL, SHAPES_TABLE, TRAIN_AE_LIVE, TRAIN_AE_SUMMARY, VOXELS
+from graspaug.device import resolve_device
+from graspaug.nets.ae_critic import AutoEncoder, Critic
+from graspaug.io.tables import write_json
+from graspaug.paths import AE_CRITIC_MODEL, AE_MODEL, SHAPES_TABLE, TRAIN_AE_LIVE, TRAIN_AE_SUMMARY, VOXELS, timing_file
 from graspaug.stages import StageError
-from graspaug.training.autoencoder import AETrainConfig, reconstruction_iou, resolve_device, train_ae_critic, train_autoencoder
+from graspaug.training.autoencoder import grids_by_split, reconstruction_iou, train_ae_critic, train_autoencoder
 
 log = logging.getLogger(__name__)
-
-
-def net_config(params: Params) -> AEConfig:
-    """The network's settings from params (resolution from ``voxelize``)."""
-    return AEConfig(resolution=params.voxelize.resolution, z_dim=params.ae.z_dim, base_width=params.ae.base_width, top_width=params.ae.top_width)
-
-
-def train_config(params: Params) -> AETrainConfig:
-    a = params.ae
-    return AETrainConfig(
-        batch_size=a.batch_size, epochs_ae=a.epochs_ae, epochs_critic=a.epochs_critic, critic_warmup=a.critic_warmup,
-        lr_ae=a.lr_ae, lr_ae_critic=a.lr_ae_critic, lr_critic=a.lr_critic, gamma=a.gamma, lam=a.lam, flips=a.flips,
-    )
-
-
-def load_grids() -> tuple[np.ndarray, np.ndarray, torch.Tensor]:
-    """Every shape's ``shape_id``, ``split`` and (N, 1, R, R, R) uint8 grid, in the voxel file's order."""
-    voxels = read_voxels(VOXELS)
-    split = read_table(SHAPES_TABLE).set_index("shape_id")["split"]
-    labels = split.reindex(voxels.shape_id).to_numpy()
-    return voxels.shape_id, labels, torch.from_numpy(voxels.occupancy[:, None].astype(np.uint8))
-
-
-def split_voxels() -> dict[str, torch.Tensor]:
-    """(N, 1, R, R, R) uint8 grids per split, in the voxel file's order."""
-    _, labels, grids = load_grids()
-    return {name: grids[labels == name] for name in ("train", "test")}
 
 
 def run(params: Params) -> None:
@@ -61,8 +33,8 @@ def run(params: Params) -> None:
     torch.manual_seed(params.seed)
     gen = torch.Generator().manual_seed(params.seed)
     device = resolve_device(params.device)
-    cfg, tcfg = net_config(params), train_config(params)
-    data = split_voxels()
+    cfg, tcfg = params.ae.net, params.ae.train
+    data = grids_by_split(VOXELS, SHAPES_TABLE)
     train, test = data["train"], data["test"]
     if len(train) < 2:
         raise StageError(f"train_ae needs at least 2 train shapes, the split has {len(train)}")
@@ -99,10 +71,12 @@ def run(params: Params) -> None:
     save_autoencoder(AE_CRITIC_MODEL, ae, critic, dataclasses.asdict(tcfg))
 
     summary["train_s"] = time.perf_counter() - start
+    timing = {k: round(summary.pop(k), 2) for k in ("ae_shapes_per_s", "ae_train_s", "ae_critic_shapes_per_s", "ae_critic_train_s", "train_s")}
     with atomic_path(TRAIN_AE_SUMMARY) as tmp:
         # NaN (e.g. IoU of an empty test split) is not JSON: write null
         tmp.write_text(json.dumps({k: round(float(v), 5) if math.isfinite(v) else None for k, v in summary.items()}, indent=2) + "\n")
+    write_json(timing, timing_file("train_ae"))
     log.info(
         "train_ae: test IoU AE %.3f, AE-Critic %.3f; %.0f s (%.1f / %.1f shapes/s)",
-        summary["ae_iou_test"], summary["ae_critic_iou_test"], summary["train_s"], summary["ae_shapes_per_s"], summary["ae_critic_shapes_per_s"],
+        summary["ae_iou_test"], summary["ae_critic_iou_test"], timing["train_s"], timing["ae_shapes_per_s"], timing["ae_critic_shapes_per_s"],
     )

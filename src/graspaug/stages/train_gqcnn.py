@@ -18,81 +18,21 @@ import dataclasses
 import json
 import logging
 import time
-import zlib
 
 import numpy as np
 import torch
 
-from graspaug.config import GQCNNParams, Params
-from graspaug.generation import ratio_count
+from graspaug.config import Params
+from graspaug.device import resolve_device
 from graspaug.io.atomic import atomic_path
-from graspaug.io.gqcnn import GraspImages
-from graspaug.io.tables import read_table, write_json
-from graspaug.nets.gqcnn import GQCNN, GQCNNConfig
-from graspaug.paths import base_set_table, gqcnn_dir, gqcnn_live, gqcnn_metrics, gqcnn_model_dir
+from graspaug.io.tables import write_json
+from graspaug.nets.gqcnn import GQCNN
+from graspaug.paths import gqcnn_live, gqcnn_metrics, gqcnn_model_dir
 from graspaug.stages import StageError
-from graspaug.training.autoencoder import resolve_device
-from graspaug.training.gqcnn import GraspArrays, NoiseSettings, TrainSettings, classification_metrics, predict, train_gqcnn
+from graspaug.training.gqcnn import classification_metrics, predict, train_gqcnn
+from graspaug.training.gqcnn_data import POOLS, held_out_views, test_set, training_set
 
 log = logging.getLogger(__name__)
-
-POOLS = ("targeted", "random")
-
-
-def network_config(cfg: GQCNNParams, image_size: int) -> GQCNNConfig:
-    return GQCNNConfig(image_size=image_size, filters=cfg.filters, fc=cfg.fc, pose_fc=cfg.pose_fc, pool_after_conv2=cfg.pool_after_conv2)
-
-
-def train_settings(cfg: GQCNNParams) -> TrainSettings:
-    return TrainSettings(
-        steps=cfg.steps, batch_size=cfg.batch_size, lr=cfg.lr, momentum=cfg.momentum, lr_decay=cfg.lr_decay, decay_steps=cfg.decay_steps,
-        weight_decay=cfg.weight_decay, log_every=cfg.log_every,
-        noise=NoiseSettings(gamma_shape=cfg.gamma_shape, gp_prob=cfg.gp_prob, gp_sigma=cfg.gp_sigma, gp_grid=cfg.gp_grid, symmetrize=cfg.symmetrize),
-    )
-
-
-def _arrays(data: GraspImages, rows: np.ndarray) -> GraspArrays:
-    return GraspArrays(data.images(rows), data.read("z", rows), data.read("labels", rows))
-
-
-def training_set(base_size: int, ratio: float, pool: str) -> tuple[GraspArrays, np.ndarray, dict]:
-    """The datapoints of the base shapes and of the first round(R·B) shapes of the pool, their
-    view keys (for the validation split) and counts."""
-    base = set(read_table(base_set_table(base_size)).shape_id)
-    original = GraspImages.open(gqcnn_dir("original"))
-    rows = np.flatnonzero(original.index.shape_id.isin(base).to_numpy())
-    parts = [_arrays(original, rows)]
-    keys = [("o:" + original.index.shape_id.iloc[rows] + ":" + original.index.image_id.iloc[rows].astype(str)).to_numpy()]
-    n_generated, generated_shapes = ratio_count(ratio, base_size), 0
-    if n_generated:
-        generated = GraspImages.open(gqcnn_dir(f"gen_{base_size}"))
-        index = generated.index
-        gen_rows = np.flatnonzero(((index.pool == pool) & (index.order < n_generated)).to_numpy())
-        parts.append(_arrays(generated, gen_rows))
-        keys.append(("g:" + index.shape_id.iloc[gen_rows] + ":" + index.image_id.iloc[gen_rows].astype(str)).to_numpy())
-        generated_shapes = int(index.shape_id.iloc[gen_rows].nunique())
-    data = GraspArrays(*(np.concatenate([getattr(p, f) for p in parts]) for f in ("images", "z", "labels")))
-    info = {"base_shapes": int(original.index.shape_id.iloc[rows].nunique()), "generated_shapes_asked": n_generated,
-            "generated_shapes": generated_shapes, "datapoints": len(data), "positive_share": round(float(data.labels.mean()), 4) if len(data) else None}
-    return data, np.concatenate(keys), info
-
-
-def held_out_views(keys: np.ndarray, fraction: float, *seeds: int) -> np.ndarray:
-    """(N,) bool: datapoints whose view (key) is held out for validation. Decided per view by a
-    hash of the seeds and the key, so a base shape's view is held out (or not) alike for every
-    ratio and pool: variants differ only by the generated shapes they add."""
-    prefix = ":".join(map(str, seeds)) + ":"
-    unique, inverse = np.unique(keys, return_inverse=True)
-    chosen = np.array([zlib.crc32((prefix + key).encode()) / 2**32 < fraction for key in unique], dtype=bool)
-    return chosen[inverse] if len(unique) else np.zeros(len(keys), dtype=bool)
-
-
-def test_set() -> tuple[GraspArrays, np.ndarray]:
-    """Every test-split datapoint of the original corpus and its row in the index."""
-    original = GraspImages.open(gqcnn_dir("original"))
-    rows = np.flatnonzero((original.index.split == "test").to_numpy())
-    return _arrays(original, rows), rows
-
 
 def run(params: Params, base_size: int, ratio: float, pool: str = "targeted", seed: int = 0) -> None:
     cfg = params.gqcnn
@@ -115,7 +55,7 @@ def run(params: Params, base_size: int, ratio: float, pool: str = "targeted", se
     test, test_rows = test_set()
 
     torch.manual_seed(params.seed * 1_000_003 + seed)
-    net = GQCNN(network_config(cfg, train.images.shape[1]))
+    net = GQCNN(cfg.net)
     gen = torch.Generator().manual_seed(params.seed * 1_000_003 + seed + 1)
     from dvclive import Live
 
@@ -128,14 +68,14 @@ def run(params: Params, base_size: int, ratio: float, pool: str = "targeted", se
             for name, value in metrics.items():
                 live.log_metric(name, value)
 
-        speed = train_gqcnn(net, fit, val if len(val) else None, train_settings(cfg), device, gen, on_log)
+        speed = train_gqcnn(net, fit, val if len(val) else None, cfg.train, device, gen, on_log)
     probability = predict(net, test, device)
     scores = classification_metrics(test.labels, probability)
     summary = {  # the metrics file: stable keys, no timings (they would show in every `dvc metrics diff`)
         "pool": pool, "base_size": base_size, "ratio": float(ratio), "seed": seed,
         "test": {k: (round(v, 5) if isinstance(v, float) else v) for k, v in scores.items()},
         "train": {**info, "fit_datapoints": len(fit), "val_datapoints": len(val)},
-        "steps": cfg.steps, "batch_size": cfg.batch_size, "parameters": net.describe()["parameters"],
+        "steps": cfg.train.steps, "batch_size": cfg.train.batch_size, "parameters": net.describe()["parameters"],
     }
     timing = {"samples_per_second": round(speed["samples_per_second"], 1), "seconds": round(time.perf_counter() - start, 1)}
     with atomic_path(gqcnn_model_dir(pool, base_size, ratio, seed), directory=True) as folder:

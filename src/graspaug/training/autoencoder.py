@@ -8,41 +8,16 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
 
 import numpy as np
 import torch
 from tqdm import tqdm
 
 from graspaug.nets.ae_critic import AutoEncoder, Critic, autoencoder_loss, critic_loss
-
-
-@dataclass(frozen=True)
-class AETrainConfig:
-    """Training settings; the ``ae`` params section holds their defaults and meaning."""
-
-    batch_size: int
-    epochs_ae: int  # phase 1: plain AE, BCE
-    epochs_critic: int  # phase 2: AE-Critic from phase 1
-    critic_warmup: int  # first phase-2 epochs that train only the critic (a random critic would push the AE around)
-    lr_ae: float  # phase 1 Adam
-    lr_ae_critic: float  # phase 2 AE Adam
-    lr_critic: float  # phase 2 critic Adam
-    gamma: float  # γ of eq. (1)
-    lam: float  # λ of eq. (2)
-    flips: bool  # random axis flips of training grids (shape, not pose, is learned)
+from graspaug.training.settings import AETrainConfig
 
 
 EpochCallback = Callable[[int, dict[str, float]], None]
-
-
-def resolve_device(device: str) -> torch.device:
-    """``auto`` → CUDA when present, else CPU."""
-    if device == "auto":
-        return torch.device("cuda" if torch.cuda.is_available() else "cpu")
-    if device == "cuda" and not torch.cuda.is_available():
-        raise RuntimeError("device: cuda was asked for but torch sees no CUDA device")
-    return torch.device(device)
 
 
 def _batches(n: int, batch_size: int, gen: torch.Generator) -> list[torch.Tensor]:
@@ -173,3 +148,19 @@ def reconstruction_iou(ae: AutoEncoder, voxels: torch.Tensor, device: torch.devi
     inter = (recon & x).sum(axis=(1, 2, 3))
     union = (recon | x).sum(axis=(1, 2, 3))
     return float(np.mean(np.where(union > 0, inter / np.maximum(union, 1), 1.0)))
+
+
+def voxel_grids(voxels_path, shapes_path) -> tuple[np.ndarray, np.ndarray, torch.Tensor]:
+    """Every shape's ``shape_id``, ``split`` and (N, 1, R, R, R) uint8 grid, in the voxel file's order."""
+    from graspaug.io.tables import read_table
+    from graspaug.io.voxels import read_voxels
+
+    voxels = read_voxels(voxels_path)
+    split = read_table(shapes_path).set_index("shape_id")["split"]
+    return voxels.shape_id, split.reindex(voxels.shape_id).to_numpy(), torch.from_numpy(voxels.occupancy[:, None].astype(np.uint8))
+
+
+def grids_by_split(voxels_path, shapes_path) -> dict[str, torch.Tensor]:
+    """(N, 1, R, R, R) uint8 grids of the ``train`` and ``test`` splits, in the voxel file's order."""
+    _, labels, grids = voxel_grids(voxels_path, shapes_path)
+    return {name: grids[labels == name] for name in ("train", "test")}

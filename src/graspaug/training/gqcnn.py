@@ -18,6 +18,8 @@ from sklearn.metrics import accuracy_score, average_precision_score, roc_auc_sco
 from tqdm import tqdm
 
 from graspaug.nets.gqcnn import GQCNN
+from graspaug.training.settings import NoiseSettings
+from graspaug.training.settings import TrainSettings
 
 
 @dataclass(frozen=True)
@@ -33,40 +35,6 @@ class GraspArrays:
 
     def subset(self, rows: np.ndarray) -> GraspArrays:
         return GraspArrays(self.images[rows], self.z[rows], self.labels[rows])
-
-
-@dataclass(frozen=True)
-class NoiseSettings:
-    """Dex-Net 2.0's train-time image noise.
-
-    Each image and its gripper depth are multiplied by a Gamma(``gamma_shape``, 1 / ``gamma_shape``) draw (mean 1);
-    with probability ``gp_prob`` it also gets a smooth Gaussian-process field: N(0,
-    ``gp_sigma``) m on a ``gp_grid`` × ``gp_grid`` grid, upsampled (bicubic) to the image.
-    With ``symmetrize``, each image is turned 180° and flipped about either axis with
-    probability 0.5 each (a parallel-jaw grasp looks the same).
-    """
-
-    gamma_shape: float = 1000.0
-    gp_prob: float = 0.5
-    gp_sigma: float = 0.005
-    gp_grid: int = 8
-    symmetrize: bool = True
-
-
-@dataclass(frozen=True)
-class TrainSettings:
-    """SGD with momentum, L2 weight decay, and lr × ``lr_decay`` every ``decay_steps`` steps."""
-
-    steps: int = 400
-    batch_size: int = 64
-    lr: float = 0.01
-    momentum: float = 0.9
-    lr_decay: float = 0.95
-    decay_steps: int = 100
-    weight_decay: float = 5e-4
-    log_every: int = 100
-    eval_batch: int = 128  # the CPU is fastest on small inference batches
-    noise: NoiseSettings = NoiseSettings()
 
 
 LogCallback = Callable[[int, dict[str, float]], None]

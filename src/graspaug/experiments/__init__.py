@@ -1,0 +1,1 @@
+"""Experiment logic the stages report: tables, contrasts, verdicts."""

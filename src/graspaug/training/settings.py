@@ -1,0 +1,54 @@
+"""Training settings of the AutoEncoder-Critic and the GQ-CNN."""
+from __future__ import annotations
+
+from graspaug.settings import Field, settings
+
+
+@settings
+class AETrainConfig:
+    """The two training phases (params section ``ae.train``)."""
+
+    batch_size: int = Field(16, ge=2, description="Shapes per batch (16 reached a higher test IoU than 32 in the same CPU time).")
+    epochs_ae: int = Field(40, ge=0, description="Phase 1 epochs: plain AutoEncoder, binary cross-entropy.")
+    epochs_critic: int = Field(8, ge=0, description="Phase 2 epochs: AE-Critic initialised from phase 1.")
+    critic_warmup: int = Field(1, ge=0, description="First phase-2 epochs in which only the critic learns (the AE's eq. (2) term then starts from a trained critic).")
+    lr_ae: float = Field(1e-3, gt=0, description="Phase 1 Adam learning rate (paper: 1e-3).")
+    lr_ae_critic: float = Field(1e-4, gt=0, description="Phase 2 Adam learning rate of the AutoEncoder (paper: 1e-4).")
+    lr_critic: float = Field(1e-3, gt=0, description="Phase 2 Adam learning rate of the Critic (paper: 1e-3).")
+    gamma: float = Field(0.2, ge=0, le=1, description="γ of eq. (1): the critic sees γx + (1−γ)x̂ as non-interpolated (ACAI: 0.2).")
+    lam: float = Field(0.5, ge=0, alias="lambda", description="λ of eq. (2): weight of the critic term in the AE loss (ACAI: 0.5).")
+    flips: bool = Field(True, description="Flip training grids along random axes (the AE learns shape, not pose).")
+
+
+@settings
+class NoiseSettings:
+    """Dex-Net 2.0's train-time image noise.
+
+    Each image and its gripper depth are multiplied by a Gamma(``gamma_shape``, 1 / ``gamma_shape``) draw (mean 1);
+    with probability ``gp_prob`` it also gets a smooth Gaussian-process field: N(0,
+    ``gp_sigma``) m on a ``gp_grid`` × ``gp_grid`` grid, upsampled (bicubic) to the image.
+    With ``symmetrize``, each image is turned 180° and flipped about either axis with
+    probability 0.5 each (a parallel-jaw grasp looks the same).
+    """
+
+    gamma_shape: float = Field(1000.0, ge=0, description="Multiplicative noise ~ Gamma(k, 1/k) per image (Dex-Net: k = 1000; 0: off); unlike Dex-Net it scales the gripper depth too, so the object's height relative to the gripper keeps its meaning.")
+    gp_prob: float = Field(0.5, ge=0, le=1, description="Chance of adding smooth Gaussian-process noise to an image (Dex-Net: 0.5).")
+    gp_sigma: float = Field(0.005, ge=0, description="Its standard deviation (m) (Dex-Net: 0.005).")
+    gp_grid: int = Field(8, ge=1, description="Its grid side before upsampling to the image (Dex-Net: 8 for 32 px).")
+    symmetrize: bool = Field(True, description="Turn images 180° and flip them about either axis at random (Dex-Net).")
+
+
+@settings
+class TrainSettings:
+    """SGD with momentum, L2 weight decay, and lr × ``lr_decay`` every ``decay_steps`` steps (params section ``gqcnn.train``)."""
+
+    steps: int = Field(400, ge=1, description="SGD steps per network, the same for every training set (the budget rule).")
+    batch_size: int = Field(64, ge=2, description="Datapoints per step (Dex-Net: 64-128).")
+    lr: float = Field(0.01, gt=0, description="SGD learning rate (Dex-Net: 0.01).")
+    momentum: float = Field(0.9, ge=0, le=1, description="SGD momentum (Dex-Net: 0.9).")
+    lr_decay: float = Field(0.95, gt=0, le=1, description="Learning rate factor every decay_steps steps (Dex-Net: 0.95).")
+    decay_steps: int = Field(100, ge=1, description="Steps between learning-rate decays (Dex-Net: ~0.66 epoch).")
+    weight_decay: float = Field(5e-4, ge=0, description="L2 weight decay (Dex-Net: 5e-4).")
+    log_every: int = Field(100, ge=1, description="Steps between DVCLive points (loss, train/val accuracy, val AP).")
+    eval_batch: int = Field(128, ge=1, description="Datapoints per inference batch (the CPU is fastest on small ones).")
+    noise: NoiseSettings = Field(default_factory=NoiseSettings, description="Dex-Net 2.0's train-time image noise.")

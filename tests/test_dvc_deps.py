@@ -1,0 +1,186 @@
+"""Every dvc.yaml stage lists exactly the graspaug source files it runs: no more, no less, no folders.
+
+A stage's code is the import closure (found with ``ast``, nothing is imported) of the CLI entry point
+plus the stage module that its ``cmd`` names: ``graspaug x-y ...`` runs ``graspaug.stages.x_y``.
+``python tests/test_dvc_deps.py`` prints each stage's expected ``src/`` deps, ready to paste.
+"""
+from __future__ import annotations
+
+import ast
+import sys
+from pathlib import Path
+
+import yaml
+
+REPO = Path(__file__).resolve().parents[1]
+SRC = REPO / "src"
+DVC_YAML = REPO / "dvc.yaml"
+CLI = "graspaug.cli"
+STAGES = "graspaug.stages."
+
+
+def module_file(module: str, src: Path) -> Path | None:
+    """The file of a dotted module name under ``src`` (``a/b.py`` or ``a/b/__init__.py``), or None."""
+    base = src.joinpath(*module.split("."))
+    return next((f for f in (base.with_suffix(".py"), base / "__init__.py") if f.is_file()), None)
+
+
+def _with_packages(module: str) -> set[str]:
+    """``a.b.c`` -> ``{a, a.b, a.b.c}``: importing a module first runs every package it sits in."""
+    parts = module.split(".")
+    return {".".join(parts[:i]) for i in range(1, len(parts) + 1)}
+
+
+def _is_inert(tree: ast.Module) -> bool:
+    """Only a docstring and dunder metadata (``__version__ = "0.1.0"``): editing it changes no result."""
+    return all(isinstance(node, (ast.Expr, ast.Assign)) and isinstance(node.value, ast.Constant)
+               and all(isinstance(t, ast.Name) and t.id.startswith("__") for t in getattr(node, "targets", []))
+               for node in tree.body)
+
+
+def module_imports(module: str, src: Path) -> set[str]:
+    """Modules of the same top package that ``module`` imports anywhere (function bodies too), with
+    every package they sit in: ``from a.b import c`` gives ``a``, ``a.b``, and ``a.b.c`` if it is a module."""
+    root, file = module.split(".")[0], module_file(module, src)
+    package = module if file.name == "__init__.py" else module.rpartition(".")[0]
+    names: set[str] = set()
+    for node in ast.walk(ast.parse(file.read_text(), str(file))):
+        if isinstance(node, ast.Import):
+            names.update(alias.name for alias in node.names)
+        elif isinstance(node, ast.ImportFrom):
+            base = package.split(".")[: len(package.split(".")) - node.level + 1] if node.level else []
+            origin = ".".join(base + ([node.module] if node.module else []))
+            names.add(origin)
+            names.update(f"{origin}.{alias.name}" for alias in node.names if alias.name != "*")
+    return {m for n in names for m in _with_packages(n) if m.split(".")[0] == root and module_file(m, src)}
+
+
+def _closure(starts: set[str], src: Path) -> set[str]:
+    """Repo-relative files of ``starts`` and everything they import, transitively."""
+    seen: set[str] = set()
+    todo = set().union(*map(_with_packages, starts))
+    while todo:
+        module = todo.pop()
+        if module not in seen:
+            seen.add(module)
+            todo |= module_imports(module, src) - seen
+    files = {module_file(m, src) for m in seen if "." in m or not _is_inert(ast.parse(module_file(m, src).read_text()))}
+    return {f.relative_to(src.parent).as_posix() for f in files}
+
+
+def import_closure(module: str, src: Path) -> set[str]:
+    """Repo-relative paths of ``module``, its packages' ``__init__.py`` and every module of its top
+    package that it imports, transitively (lazy imports in functions included; the top package's
+    ``__init__.py`` only when it holds more than a docstring and ``__version__``-style metadata)."""
+    return _closure({module}, src)
+
+
+CLI_SHARED = ("_load", "_run")  # the cli.py functions every stage command runs
+
+
+def cli_imports(src: Path) -> set[str]:
+    """What cli.py imports for every stage command: its module-level imports and those inside
+    ``_load`` and ``_run`` (other commands' lazy imports run only for those commands)."""
+    tree = ast.parse(module_file(CLI, src).read_text())
+    shared = [node for node in tree.body if not isinstance(node, (ast.FunctionDef, ast.ClassDef))]
+    shared += [node for node in tree.body if isinstance(node, ast.FunctionDef) and node.name in CLI_SHARED]
+    names: set[str] = set()
+    for node in (n for top in shared for n in ast.walk(top)):
+        if isinstance(node, ast.Import):
+            names.update(alias.name for alias in node.names)
+        elif isinstance(node, ast.ImportFrom) and node.module:
+            names.add(node.module)
+            names.update(f"{node.module}.{alias.name}" for alias in node.names)
+    return {m for n in names for m in _with_packages(n) if m.startswith("graspaug") and module_file(m, src)}
+
+
+def stage_code(cmd: str, src: Path = SRC) -> set[str]:
+    """The code a ``graspaug <command> ...`` cmd runs: cli.py with what it imports for every command
+    (:func:`cli_imports`), and the stage module's closure."""
+    program, command = cmd.split()[:2]
+    stage_module = STAGES + command.replace("-", "_")
+    if program != "graspaug" or module_file(stage_module, src) is None:
+        raise ValueError(f"cmd {cmd!r} does not run a graspaug stage module ({stage_module})")
+    cli_file = module_file(CLI, src).relative_to(src.parent).as_posix()
+    return _closure({stage_module} | cli_imports(src), src) | {cli_file}
+
+
+def dvc_stages(dvc: dict) -> dict[str, dict]:
+    """Stage name -> its definition; a ``foreach`` stage's is its ``do:`` block (matrix stages are flat)."""
+    return {name: body.get("do", body) for name, body in dvc["stages"].items()}
+
+
+def expected_code_deps(dvc_yaml: Path = DVC_YAML, src: Path = SRC) -> dict[str, set[str]]:
+    """Stage name -> the ``src/`` files it must list as deps."""
+    return {name: stage_code(body["cmd"], src) for name, body in dvc_stages(yaml.safe_load(dvc_yaml.read_text())).items()}
+
+
+def compare_code_deps(dvc: dict, src: Path = SRC) -> dict[str, dict[str, set[str]]]:
+    """Stage name -> {"missing": expected but not listed, "extra": listed but not expected (folders
+    always)}, for stages where either is non-empty."""
+    problems = {}
+    for name, body in dvc_stages(dvc).items():
+        listed = {d for d in (d if isinstance(d, str) else next(iter(d)) for d in body.get("deps", [])) if d.startswith("src/")}
+        expected = stage_code(body["cmd"], src)
+        missing, extra = expected - listed, listed - expected
+        if missing or extra:
+            problems[name] = {"missing": missing, "extra": extra}
+    return problems
+
+
+def _yaml_lists(deps: dict[str, set[str]]) -> str:
+    return "\n".join(f"{name}:\n" + "".join(f"  - {p}\n" for p in sorted(paths)) for name, paths in deps.items())
+
+
+def _real_dvc() -> dict:
+    return yaml.safe_load(DVC_YAML.read_text())
+
+def test_every_stage_lists_exactly_its_code():
+    """dvc.yaml's src/ deps equal each stage's import closure."""
+    problems = compare_code_deps(_real_dvc())
+    report = "".join(f"\n{name}:\n" + "".join(f"  {kind}: {p}\n" for kind in ("missing", "extra") for p in sorted(d[kind]))
+                     for name, d in problems.items())
+    expected = {name: paths for name, paths in expected_code_deps().items() if name in problems}
+    assert not problems, f"dvc.yaml code deps differ from the imports:{report}\nExpected src/ deps:\n{_yaml_lists(expected)}"
+
+
+def test_a_planted_missing_dep_is_caught():
+    """Drop one listed src file from one stage: exactly that path becomes missing."""
+    dvc, planted = _real_dvc(), "src/graspaug/stages/render.py"
+    dvc_stages(dvc)["render"]["deps"].remove(planted)
+    before = compare_code_deps(_real_dvc()).get("render", {}).get("missing", set())
+    assert compare_code_deps(dvc)["render"]["missing"] - before == {planted}
+
+
+def test_a_listed_folder_is_caught():
+    """A folder is never an exact code dep."""
+    dvc = _real_dvc()
+    dvc_stages(dvc)["voxelize"]["deps"].append("src/graspaug/io")
+    assert "src/graspaug/io" in compare_code_deps(dvc)["voxelize"]["extra"]
+
+
+def test_import_closure_follows_every_import_form(tmp_path):
+    """Absolute, relative, lazy and `from pkg import module` imports, and the __init__ chain."""
+    files = {
+        "pkg/__init__.py": '"""Docstring only."""\n__version__ = "1"\n',
+        "pkg/top.py": "import os\nimport pkg.a.absolute\nfrom pkg import sub\nfrom pkg.b import helper\n",
+        "pkg/sub.py": "def f():\n    from . import lazy\n",
+        "pkg/lazy.py": "",
+        "pkg/a/__init__.py": "",
+        "pkg/a/absolute.py": "from ..b.helper import name\nfrom .sibling import x\n",
+        "pkg/a/sibling.py": "x = 1\n",
+        "pkg/b/__init__.py": "from pkg.b.helper import name\n",
+        "pkg/b/helper.py": "name = 1\n",
+        "pkg/unused.py": "",
+    }
+    for path, text in files.items():
+        (tmp_path / "src" / path).parent.mkdir(parents=True, exist_ok=True)
+        (tmp_path / "src" / path).write_text(text)
+    expected = {f"src/{p}" for p in files} - {"src/pkg/__init__.py", "src/pkg/unused.py"}
+    assert import_closure("pkg.top", tmp_path / "src") == expected
+    (tmp_path / "src/pkg/__init__.py").write_text("import logging\n")
+    assert "src/pkg/__init__.py" in import_closure("pkg.a.sibling", tmp_path / "src")
+
+
+if __name__ == "__main__":
+    sys.stdout.write(_yaml_lists(expected_code_deps()))
