@@ -224,3 +224,24 @@ def pool_tables(base: np.ndarray, z: np.ndarray, pools: dict[str, tuple[list[Dec
         rejects += [{"pool": pool, "parent_a": base[d.candidate.a], "parent_b": base[d.candidate.b], "alpha": d.candidate.alpha,
                      "selected_by": d.candidate.selected_by, "reason": d.reason} for d in rejected]
     return rows, rejects
+
+
+def pool_summary(base_size: int, needed: int, pools: dict, targeted: TargetedStream, index, reject_rows: list[dict]) -> tuple[dict, dict[str, float]]:
+    """``metrics/generate/<B>.json`` for the pools (name → (kept, rejected) Decoded lists), and
+    each pool's share of usable decodes."""
+    import pandas as pd
+
+    reasons = pd.Series([r["reason"].split(":")[0] for r in reject_rows], dtype=object)
+    kept_share = {name: len(kept) / (len(kept) + len(rejected)) for name, (kept, rejected) in pools.items()}
+    (kept_t, rejected_t), (kept_r, rejected_r) = pools["targeted"], pools["random"]
+    summary = {
+        "base_size": base_size, "pool_size": needed,
+        "targeted": {"kept": len(kept_t), "tried": len(kept_t) + len(rejected_t), "kept_share": round(kept_share["targeted"], 4),
+                     "by_rarity": int((index.selected_by == "rarity").sum()), "by_graspness": int((index.selected_by == "graspness").sum()),
+                     "k_used": targeted.extra, "alphas_used": targeted.alphas, "percentile_used": targeted.percentile,
+                     "widening": targeted.notes},
+        "random": {"kept": len(kept_r), "tried": len(kept_r) + len(rejected_r), "kept_share": round(kept_share["random"], 4)},
+        "rejects": {str(k): int(v) for k, v in reasons.value_counts().sort_index().items()},
+        "kept_watertight_one_piece_share": round(float((index.watertight & index.one_piece).mean()), 4),
+    }
+    return summary, kept_share

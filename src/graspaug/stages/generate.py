@@ -24,7 +24,7 @@ from graspaug.config import Params
 from graspaug.device import resolve_device
 from graspaug.embedding import tsne_2d
 from graspaug.generation import (
-    Candidate, Decoded, PoolExhausted, RandomStream, TargetedStream, above_percentile, fill_pool, nested_base_sets, pool_size, pool_tables,
+    Candidate, Decoded, PoolExhausted, RandomStream, TargetedStream, above_percentile, fill_pool, nested_base_sets, pool_size, pool_summary, pool_tables,
 )
 from graspaug.geometry.from_voxels import mesh_decoded
 from graspaug.io.atomic import atomic_path
@@ -89,7 +89,7 @@ def run(params: Params, base_size: int) -> None:
             raise StageError(f"generate {base_size}, {name} pool: {exc}") from None
     for note in targeted_stream.notes:
         log.info("generate %d: %s", base_size, note)
-    (targeted, targeted_rejects), (randoms, random_rejects) = pools["targeted"], pools["random"]
+    (targeted, _), (randoms, _) = pools["targeted"], pools["random"]
 
     rows, reject_rows = pool_tables(base, z, pools, base_size)
     index = pd.DataFrame(rows)
@@ -113,18 +113,7 @@ def run(params: Params, base_size: int) -> None:
     groups = ["base"] * base_size + [f"generated ({s})" for s in index.selected_by]
     scatter_2d(xy, groups, generate_reports(base_size) / "tsne.png", f"t-SNE of base set {base_size} and its generated shapes")
 
-    reasons = pd.Series([r["reason"].split(":")[0] for r in reject_rows], dtype=object)
-    kept_share = {name: len(pools[name][0]) / (len(pools[name][0]) + len(pools[name][1])) for name in pools}
-    summary = {
-        "base_size": base_size, "pool_size": needed,
-        "targeted": {"kept": len(targeted), "tried": len(targeted) + len(targeted_rejects), "kept_share": round(kept_share["targeted"], 4),
-                     "by_rarity": int((index.selected_by == "rarity").sum()), "by_graspness": int((index.selected_by == "graspness").sum()),
-                     "k_used": targeted_stream.extra, "alphas_used": targeted_stream.alphas, "percentile_used": targeted_stream.percentile,
-                     "widening": targeted_stream.notes},
-        "random": {"kept": len(randoms), "tried": len(randoms) + len(random_rejects), "kept_share": round(kept_share["random"], 4)},
-        "rejects": {str(k): int(v) for k, v in reasons.value_counts().sort_index().items()},
-        "kept_watertight_one_piece_share": round(float((index.watertight & index.one_piece).mean()), 4),
-    }
+    summary, kept_share = pool_summary(base_size, needed, pools, targeted_stream, index, reject_rows)
     for name, share in kept_share.items():
         if share < 0.95:
             log.warning("generate %d: only %.1f%% of the %s pool's decodes were usable meshes", base_size, 100 * share, name)
