@@ -7,11 +7,9 @@ import trimesh
 from joblib import Parallel, delayed
 
 from graspaug.geometry.loading import MeshRejected, load_shape
-from graspaug.config import IngestParams
 from graspaug.geometry.prepare import SurfaceSettings, prepare_shape
 from graspaug.geometry.solid import ConvexPart
 from graspaug.io.sources import Source, pybullet_sources
-from graspaug.stages.ingest import surface_settings
 
 
 @dataclass
@@ -33,6 +31,6 @@ def _one(source: Source, settings: SurfaceSettings) -> BenchShape | None:
 
 def default_shapes(n: int | None, n_jobs: int = 2) -> list[BenchShape]:
     """The first ``n`` shapes of the default corpus (None: all), as the ingest stage's defaults make them."""
-    settings = surface_settings(IngestParams())
+    settings = SurfaceSettings()
     shapes = Parallel(n_jobs=n_jobs)(delayed(_one)(s, settings) for s in pybullet_sources(n))
     return [s for s in shapes if s is not None]

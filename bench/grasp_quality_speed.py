@@ -26,7 +26,6 @@ from graspaug.grasping.antipodal import sample_antipodal_grasps
 from graspaug.grasping.quality import ferrari_canny, ferrari_canny_qhull
 from graspaug.grasping.robust import robust_ferrari_canny
 from graspaug.rng import shape_rng
-from graspaug.stages.grasps import gripper, perturbations, quality_settings, sampler_settings
 
 from _corpus import default_shapes
 
@@ -56,19 +55,19 @@ def main() -> None:
     args = parser.parse_args()
 
     cfg = GraspsParams()
-    hand, quality, noise = gripper(cfg), quality_settings(cfg), perturbations(cfg)
-    shapes = default_shapes(int(np.ceil(args.grasps / cfg.n_grasps)) + 5)
+    hand, quality, noise = cfg.gripper, cfg.quality, cfg.perturbations
+    shapes = default_shapes(int(np.ceil(args.grasps / cfg.sampler.n_grasps)) + 5)
     jobs, total = [], 0
     for shape in shapes:
         if total >= args.grasps:
             break
-        grasps = sample_antipodal_grasps(shape.mesh, hand, sampler_settings(cfg), shape_rng(args.seed, shape.shape_id))
+        grasps = sample_antipodal_grasps(shape.mesh, hand, cfg.sampler, shape_rng(args.seed, shape.shape_id))
         grasps = grasps.take(np.arange(min(len(grasps), args.grasps - total)))
         jobs.append((shape, grasps))
         total += len(grasps)
     print(f"{total} grasps on {len(jobs)} default shapes, {noise.n_samples} perturbed samples each ({total * noise.n_samples} wrench sets)")
 
-    ferrari_canny(np.zeros((1, 2 * cfg.cone_faces + 4, 6)))  # compile (cached on disk) before timing
+    ferrari_canny(np.zeros((1, 2 * cfg.quality.cone_faces + 4, 6)))  # compile (cached on disk) before timing
     results = {}
     for name, fn in (("plain qhull loop", qhull_loop), ("ours", ferrari_canny)):
         timed = Timed(fn)

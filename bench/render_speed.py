@@ -33,8 +33,6 @@ from graspaug.render.depth import render_depth
 from graspaug.render.pybullet_depth import PybulletDepthScene
 from graspaug.render.stable_poses import stable_poses
 from graspaug.rng import shape_rng
-from graspaug.stages.grasps import gripper, sampler_settings
-from graspaug.stages.render import render_settings
 
 from _corpus import default_shapes
 
@@ -45,12 +43,12 @@ def main() -> None:
     parser.add_argument("--seed", type=int, default=0)
     args = parser.parse_args()
 
-    grasp_cfg, settings = GraspsParams(), render_settings(RenderParams())
-    hand = gripper(grasp_cfg)
+    grasp_cfg, settings = GraspsParams(), RenderParams()
+    hand = grasp_cfg.gripper
     shapes = default_shapes(args.shapes)
     jobs = []
     for shape in shapes:
-        grasps = sample_antipodal_grasps(shape.mesh, hand, sampler_settings(grasp_cfg), shape_rng(args.seed, shape.shape_id))
+        grasps = sample_antipodal_grasps(shape.mesh, hand, grasp_cfg.sampler, shape_rng(args.seed, shape.shape_id))
         scenes, _ = plan_scenes(shape.mesh, grasps.center, grasps.axis, hand.max_width, settings, shape_rng(args.seed, shape.shape_id, "render"))
         jobs += [(shape.mesh, scene) for scene in scenes]
     n_grasps = sum(len(scene.grasp_index) for _, scene in jobs)
