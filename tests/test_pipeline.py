@@ -254,6 +254,28 @@ def test_dvc_repro_sim(tiny_repo, tmp_path):
     assert "Running stage" not in again.stdout
 
 
+def test_every_declared_plot_renders(tiny_repo):
+    """`dvc plots show` on the finished tiny run: every plot dvc.yaml declares (per stage, for
+    whatever base sizes params name, and the top-level ones) has data or an image, no errors."""
+    import json
+
+    work, env = tiny_repo
+    run(["dvc", "repro", "sim"], work, env)  # no-op after the tests above
+    shown = json.loads(run(["dvc", "plots", "show", "--json", "--split"], work, env).stdout)
+    assert shown, "dvc plots show returned nothing"
+    errors = shown.get("errors") if isinstance(shown, dict) and "errors" in shown else None
+    assert not errors, errors
+    plots = shown.get("data", shown)
+    for name, renders in plots.items():
+        assert renders, f"plot {name} has nothing to render"
+        for render in renders:
+            assert render.get("type") in ("image", "vega"), (name, render.get("type"))
+            if render["type"] == "image":
+                assert (work / render["url"]).exists() if not render["url"].startswith("data:") else True, name
+    generated = {name for name in plots if "reports/generate/" in name}
+    assert {f"reports/generate/{b}/pairs.png" for b in (4, 6)} <= generated  # the tiny profile's base sizes, not hard-coded ones
+
+
 def test_queued_two_point_sweep_lines_up_metrics(tiny_repo):
     """`dvc exp run --queue -S` twice, `dvc queue start`, then `dvc exp show` / `dvc metrics diff`."""
     import json
