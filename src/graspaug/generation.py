@@ -245,3 +245,15 @@ def pool_summary(base_size: int, needed: int, pools: dict, targeted: TargetedStr
         "kept_watertight_one_piece_share": round(float((index.watertight & index.one_piece).mean()), 4),
     }
     return summary, kept_share
+
+
+def base_scores_table(base: np.ndarray, rarity: np.ndarray, graspness: np.ndarray, percentile: float):
+    """``base.parquet``: the base set's shape ids, rarity (against the base set), graspness and
+    whether each was selected by rarity and by graspness at ``percentile`` (the one finally used)."""
+    import pandas as pd
+
+    rare, graspable = set(above_percentile(rarity, percentile)), set(above_percentile(graspness, percentile))
+    return pd.DataFrame({"shape_id": base, "rarity": rarity, "graspness": graspness,
+                         "selected_by_rarity": [i in rare for i in range(len(base))],
+                         "selected_by_graspness": [i in graspable for i in range(len(base))]})
+

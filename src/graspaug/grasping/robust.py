@@ -3,7 +3,6 @@ and friction coefficients (Dex-Net's ``RobustPointGraspMetrics3D``), in SI units
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
 
 import numpy as np
 import trimesh

@@ -12,7 +12,6 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from graspaug.geometry.loading import MESH_SUFFIXES
-from graspaug.io.settings import CorpusSettings
 
 
 @dataclass(frozen=True)

@@ -17,7 +17,6 @@ channels and the stride-1 layer ``top_width``. Paper profile (R = 64): base 64 â
 """
 from __future__ import annotations
 
-import math
 
 import torch
 import torch.nn.functional as F

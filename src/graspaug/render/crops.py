@@ -17,7 +17,6 @@ analytic), then runs the same bilinear + block-average sampling in compiled code
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
 
 import numba
 import numpy as np

@@ -11,7 +11,7 @@ import trimesh
 
 from graspaug.grasping.gripper import ParallelJawGripper
 from graspaug.io.meshes import read_mesh
-from graspaug.render.camera import CameraPose, Intrinsics, ViewpointRanges, sample_viewpoint
+from graspaug.render.camera import CameraPose, Intrinsics, sample_viewpoint
 from graspaug.render.collision import CollisionChecker, approach_directions
 from graspaug.render.crops import CropGeometry, crops_by_ray_casting
 from graspaug.render.stable_poses import stable_poses

@@ -12,7 +12,6 @@ import numpy as np
 import pybullet
 import pybullet_data
 
-from graspaug.render.camera import CameraPose, Intrinsics, look_at
 from graspaug.render.pybullet_depth import render_depth
 from graspaug.sim.objects import SimObject
 from graspaug.sim.panda import HandSettings, Panda

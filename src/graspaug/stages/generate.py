@@ -24,7 +24,7 @@ from graspaug.config import Params
 from graspaug.device import resolve_device
 from graspaug.embedding import tsne_2d
 from graspaug.generation import (
-    Candidate, Decoded, PoolExhausted, RandomStream, TargetedStream, above_percentile, fill_pool, nested_base_sets, pool_size, pool_summary, pool_tables,
+    Candidate, Decoded, PoolExhausted, RandomStream, TargetedStream, base_scores_table, fill_pool, nested_base_sets, pool_size, pool_summary, pool_tables,
 )
 from graspaug.geometry.from_voxels import mesh_decoded
 from graspaug.io.atomic import atomic_path
@@ -94,11 +94,7 @@ def run(params: Params, base_size: int) -> None:
     rows, reject_rows = pool_tables(base, z, pools, base_size)
     index = pd.DataFrame(rows)
     index["rarity_vs_base"] = rarity(z, params.score.k, query=np.stack(index.z.to_numpy()))
-    rare_group = set(above_percentile(base_rarity, targeted_stream.percentile))
-    grasp_group = set(above_percentile(graspness, targeted_stream.percentile))
-    base_table = pd.DataFrame({"shape_id": base, "rarity": base_rarity, "graspness": graspness,
-                               "selected_by_rarity": [i in rare_group for i in range(base_size)],
-                               "selected_by_graspness": [i in grasp_group for i in range(base_size)]})
+    base_table = base_scores_table(base, base_rarity, graspness, targeted_stream.percentile)
     with atomic_path(generated_dir(base_size), directory=True) as folder:
         (folder / "meshes").mkdir()
         for row, d in zip(rows, targeted + randoms):

@@ -24,7 +24,6 @@ from graspaug.io.atomic import atomic_path
 from graspaug.io.tables import read_table, write_csv, write_json
 from graspaug.paths import AP_METRICS, LATENTS, REPORT_DIR, SCORES, base_set_table, generated_index, gqcnn_dir, gqcnn_model_dir, grasps_table
 from graspaug.scores import rarity
-from graspaug.stages import StageError
 
 log = logging.getLogger(__name__)
 
@@ -33,10 +32,7 @@ def run(params: Params) -> None:
     from graspaug.plots import ap_vs_ratio, improvement_by_interval, scatter_colored
 
     asked = variants(params.generate, params.gqcnn)
-    try:
-        runs = collect(asked)
-    except FileNotFoundError as exc:
-        raise StageError(str(exc)) from None
+    runs = collect(asked)  # a missing network is a FileNotFoundError, which the CLI prints in one line
     first = asked[0]
     positive_share = json.loads((gqcnn_model_dir(*first) / "summary.json").read_text())["test"]["positive_share"]
     if runs.ap.isna().all():

@@ -28,7 +28,7 @@ from graspaug.parallel import parallel_map
 from graspaug.paths import AP_METRICS, SHAPES_DIR, SHAPES_TABLE, SIM_METRICS, SIM_REPORT_DIR
 from graspaug.rng import shape_rng
 from graspaug.sim.experiment import (
-    ObjectJob, arms, compare, mean_or_none, model_path, picture, prepare_objects, rate_summary, report_text, run_object, test_shape_ids,
+    ObjectJob, arms, compare, model_path, picture, planning_timing, prepare_objects, rate_summary, report_text, run_object, test_shape_ids,
 )
 
 log = logging.getLogger(__name__)
@@ -82,12 +82,7 @@ def run(params: Params) -> None:
         if cfg.antipodal_arm:
             metrics["per_object"][name]["antipodal"] = rate_summary(reference.success[reference.object == name])
 
-    planning = trials.planning_time.dropna()
-    timing = {"planning_time_mean": float(planning.mean()) if len(planning) else None,
-              "planning_time_median": float(planning.median()) if len(planning) else None,
-              "planning_time_max": float(planning.max()) if len(planning) else None,
-              "planning_time_by_arm": {arm: mean_or_none(trials.planning_time[trials.arm == arm]) for arm in ratios},
-              "trials": int(len(trials)), "stage_seconds": None}
+    timing = planning_timing(trials, list(ratios))
 
     with atomic_path(SIM_REPORT_DIR, directory=True) as out:
         write_csv(pd.concat([trials, reference]).drop(columns=["planning_time"]), out / "trials.csv")
