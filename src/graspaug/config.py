@@ -55,6 +55,7 @@ class IngestParams:
     size_rule: str = param("mid", "Which extent the size rule fixes: `min`, `mid` (the middle one) or `max`.", choices=("min", "mid", "max"))
     size_m: float = param(0.06, "That extent after scaling, meters. Default: middle extent 0.06 m, so a Franka Panda (0.08 m opening) closes across the two smaller extents of most objects.", gt=0)
     max_dropped: float = param(0.1, "Reject a shape whose largest connected piece misses more than this share of its volume.", ge=0, le=1)
+    max_gap: float = param(0.05, "Widest hole or crack bridged when an open mesh (a scan) is rebuilt as a solid, as a share of the shape's largest extent (0.05: 5 mm on a 10 cm object); a mesh that needs a wider one bridged is rejected. Openings wider than this (a mug's top) stay open, narrower concave gaps get filled.", ge=0, le=0.5)
     test_fraction: float = param(0.2663, "Share of shapes in the test split (0.2663 = the paper's 363 test : 1000 train).", gt=0, le=0.9)
 
 

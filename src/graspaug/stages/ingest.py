@@ -57,6 +57,8 @@ def _ingest_one(source: Source, max_faces: int, max_file_mb: float, settings: Su
         "n_parts": prepared.n_parts,
         "surface_resolution": prepared.resolution,
         "dropped_volume": prepared.dropped_volume,
+        "closed_by": prepared.closed_by,
+        "hull_fill": prepared.hull_fill,
     }
 
 
@@ -70,6 +72,7 @@ def surface_settings(cfg: IngestParams) -> SurfaceSettings:
         size_rule=cfg.size_rule,
         size_m=cfg.size_m,
         max_dropped=cfg.max_dropped,
+        max_gap=cfg.max_gap,
     )
 
 
@@ -111,6 +114,12 @@ def run(params: Params) -> None:
 
     for reason, n in Counter(rejects["reason"]).most_common():
         log.info("rejected %d: %s", n, reason)
+    closed = shapes["closed_by"].value_counts()
+    log.info(
+        "ingest: closed_by as_is %d, merged %d, filled %d; hull_fill median %.2f, min %.2f (%s)",
+        closed.get("as_is", 0), closed.get("merged", 0), closed.get("filled", 0),
+        shapes["hull_fill"].median(), shapes["hull_fill"].min(), shapes.loc[shapes["hull_fill"].idxmin(), "shape_id"],
+    )
     counts = shapes["split"].value_counts()
     log.info(
         "ingest: %d shapes (%d train, %d test), %d rejected, %d/%d watertight, median %d faces, in %.1f s",
