@@ -8,11 +8,8 @@ import trimesh
 
 from graspaug.geometry.loading import LoadedShape, MeshRejected
 from graspaug.geometry.normalize import Normalization, normalization
-from graspaug.geometry.closing import close_surface
+from graspaug.geometry.closing import MIN_ENCLOSED, close_surface
 from graspaug.geometry.solid import outer_surface_of_parts, resolution_for_parts
-
-# an open mesh whose fill leaves more of its area than this bounding nothing is rejected
-MIN_ENCLOSED = 0.9
 
 
 @dataclass(frozen=True)
@@ -22,7 +19,7 @@ class SurfaceSettings:
     Attributes
     ----------
     resolution : field samples along the largest extent for marching cubes
-    finest_resolution : upper limit when thin parts ask for a finer grid
+    finest_resolution : upper limit when thin parts ask for a finer grid (and for a second fill of an open mesh with thin walls)
     cells_per_thickness : field cells across a typical (median) convex part
     face_budget : at most this many triangles after decimation
     size_rule : which extent is fixed: ``min``, ``mid`` or ``max``
@@ -71,8 +68,8 @@ def prepare_shape(loaded: LoadedShape, settings: SurfaceSettings) -> PreparedSha
         surface, dropped = outer_surface_of_parts(loaded.parts, resolution, settings.face_budget)
     else:
         resolution = settings.resolution
-        closed = close_surface(loaded.mesh, resolution, settings.face_budget, settings.max_gap)
-        surface, dropped = closed.mesh, closed.dropped
+        closed = close_surface(loaded.mesh, resolution, settings.face_budget, settings.max_gap, settings.finest_resolution)
+        surface, dropped, resolution = closed.mesh, closed.dropped, closed.resolution
         if closed.filled:
             closed_by = "filled"
             if closed.enclosed < MIN_ENCLOSED:
