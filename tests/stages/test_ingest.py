@@ -78,7 +78,8 @@ def test_ingest_keeps_good_shapes_and_records_every_reject(tmp_path, corpus_para
     assert hull_fill["f_good_box"] == pytest.approx(1.0) and hull_fill["f_good_holed_ball"] > 0.95  # solid, not a shell
     assert 0.5 < hull_fill["f_good_ring"] < 0.7  # a torus fills about 0.6 of its hull
     summary = [r.getMessage() for r in caplog.records if "closed_by" in r.getMessage()]
-    assert len(summary) == 1 and summary[0].startswith("ingest: closed_by as_is 4, merged 1, filled 2; hull_fill median 1.00, min 0.6")
+    assert len(summary) == 1
+    assert summary[0].startswith("ingest: closed_by as_is 4, merged 1, filled 2; hull_fill median 1.00, min 0.6")
     # the two touching boxes became one piece; the mid extent is 0.06 m after scaling
     for _, row in shapes.iterrows():
         mesh = trimesh.load(tmp_path / f"data/shapes/{row.shape_id}.ply", process=False)

@@ -74,7 +74,7 @@ from graspaug.geometry.solid import decimate, largest_piece, surface_from_field
 # an open mesh whose fill leaves more of its area than 1 - this bounding nothing is not closed
 MIN_ENCLOSED = 0.9
 # pairs of (sample, triangle) evaluated at once in the distance pass
-_PAIRS_PER_CHUNK = 2_000_000
+_PAIRS_PER_CHUNK = 1_000_000  # about 300 MB of temporaries
 # the shell: samples this close to the surface, in cells; sqrt(3)/2 makes it leak-proof
 # for 26-connected paths (a grid step that crosses the surface has an end this close)
 _SHELL = 0.8661
@@ -135,7 +135,9 @@ def _dot(p: list[np.ndarray], q: list[np.ndarray]) -> np.ndarray:
     return p[0] * q[0] + p[1] * q[1] + p[2] * q[2]
 
 
-def closest_on_triangles(a: list[np.ndarray], b: list[np.ndarray], c: list[np.ndarray], x: list[np.ndarray]) -> tuple[np.ndarray, list[np.ndarray]]:
+def closest_on_triangles(
+    a: list[np.ndarray], b: list[np.ndarray], c: list[np.ndarray], x: list[np.ndarray]
+) -> tuple[np.ndarray, list[np.ndarray]]:
     """Closest points on triangles ``(a, b, c)`` to points ``x``, pair by pair.
 
     The projection onto the triangle's plane when it falls inside, else the nearest
@@ -172,7 +174,9 @@ def closest_on_triangles(a: list[np.ndarray], b: list[np.ndarray], c: list[np.nd
     return best_sq, best
 
 
-def band_distance(triangles: np.ndarray, origin: np.ndarray, pitch: float, shape: tuple[int, int, int], radius: float) -> tuple[np.ndarray, np.ndarray]:
+def band_distance(
+    triangles: np.ndarray, origin: np.ndarray, pitch: float, shape: tuple[int, int, int], radius: float
+) -> tuple[np.ndarray, np.ndarray]:
     """Exact distance to the triangles at the grid samples within ``radius`` of them.
 
     Every (sample, triangle) pair within the triangle's bounding sphere grown by
@@ -302,7 +306,7 @@ def fill_open_mesh(mesh: trimesh.Trimesh, resolution: int, face_budget: int, max
         side[blocked] = True
         decided[blocked] = True
     inside[tuple(shell_idx.T)] = side
-    _vote_undecided(inside, shell_idx[~decided], decided_grid(near, shell_idx, decided))
+    _vote_undecided(inside, shell_idx[~decided], _decided_grid(near, shell_idx, decided))
 
     # exact distance near the surface; elsewhere an estimate (only its sign matters off the walls);
     # inside samples on the surface itself (faces shared by two bodies) get a hair inside
@@ -316,7 +320,7 @@ def fill_open_mesh(mesh: trimesh.Trimesh, resolution: int, face_budget: int, max
     return FilledSolid(decimate(surface, face_budget), dropped, enclosed, gap_m)
 
 
-def decided_grid(near: np.ndarray, shell_idx: np.ndarray, decided: np.ndarray) -> np.ndarray:
+def _decided_grid(near: np.ndarray, shell_idx: np.ndarray, decided: np.ndarray) -> np.ndarray:
     """Samples whose side is known: off the shell, or on it and decided by the walk."""
     known = ~near
     known[tuple(shell_idx[decided].T)] = True
@@ -355,7 +359,9 @@ def _enclosed_share(triangles: np.ndarray, inside: np.ndarray, origin: np.ndarra
     return float(area[next_to_inside[tuple(nearest.T)]].sum() / area.sum())
 
 
-def close_surface(mesh: trimesh.Trimesh, resolution: int, face_budget: int, max_gap: float, finest_resolution: int = 0) -> ClosedSurface:
+def close_surface(
+    mesh: trimesh.Trimesh, resolution: int, face_budget: int, max_gap: float, finest_resolution: int = 0
+) -> ClosedSurface:
     """One closed outer surface for a mesh: as it is when closed, else rebuilt by :func:`fill_open_mesh`.
 
     Holes of three or four edges are filled and the winding made consistent first. One

@@ -220,7 +220,9 @@ def outer_surface_of_parts(parts: list[ConvexPart], resolution: int, face_budget
     return decimate(mesh, face_budget), dropped
 
 
-def outer_surface_of_mesh(mesh: trimesh.Trimesh, resolution: int, face_budget: int, max_gap: float = 0.05) -> tuple[trimesh.Trimesh, float]:
+def outer_surface_of_mesh(
+    mesh: trimesh.Trimesh, resolution: int, face_budget: int, max_gap: float = 0.05
+) -> tuple[trimesh.Trimesh, float]:
     """One closed outer surface for an arbitrary mesh (several bodies, holes, inner faces).
 
     See :func:`graspaug.geometry.closing.close_surface`: a closed body is kept, several
