@@ -4,6 +4,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 
 from graspaug.geometry.loading import MeshRejected, load_shape, sha256_of
 from graspaug.geometry.prepare import SurfaceSettings, prepare_shape
@@ -43,6 +44,8 @@ def ingest_source(source: Source, max_faces: int, max_file_mb: float, settings: 
         "n_parts": prepared.n_parts,
         "surface_resolution": prepared.resolution,
         "dropped_volume": prepared.dropped_volume,
+        "closed_by": prepared.closed_by,  # as_is, merged (vertices merged by position) or filled (open mesh filled)
+        "hull_fill": prepared.hull_fill,  # volume / convex-hull volume (a hollow shell shows as a small value)
     }
 
 
@@ -52,3 +55,13 @@ def assign_split(shape_ids: list[str], test_fraction: float, seed: int) -> dict[
     order = np.random.default_rng(seed).permutation(len(ids))
     n_test = int(round(test_fraction * len(ids)))
     return {ids[i]: ("test" if rank < n_test else "train") for rank, i in enumerate(order)}
+
+
+def closing_summary(shapes: pd.DataFrame) -> str:
+    """One line on how the corpus was closed: counts of ``closed_by`` and the ``hull_fill`` spread."""
+    closed = shapes["closed_by"].value_counts()
+    lowest = shapes.loc[shapes["hull_fill"].idxmin()]
+    return (
+        f"closed_by as_is {closed.get('as_is', 0)}, merged {closed.get('merged', 0)}, filled {closed.get('filled', 0)}; "
+        f"hull_fill median {shapes['hull_fill'].median():.2f}, lowest {lowest['hull_fill']:.2f} ({lowest['shape_id']})"
+    )

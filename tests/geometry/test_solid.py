@@ -4,6 +4,8 @@ import trimesh
 
 from graspaug.geometry.solid import convex_part, outer_surface_of_mesh, outer_surface_of_parts, union_contains
 
+from .scan_meshes import holed_sphere
+
 
 def box_part(lo, hi):
     return convex_part(trimesh.creation.box(bounds=np.array([lo, hi])).vertices)
@@ -47,12 +49,20 @@ def test_a_hair_gap_is_closed_but_a_real_gap_is_not():
 
 
 def test_open_and_multi_body_meshes_are_rebuilt_closed():
+    ball, volume = holed_sphere()
+    assert not ball.is_watertight
+    closed, _ = outer_surface_of_mesh(ball, resolution=64, face_budget=3000)
+    assert closed.is_watertight and closed.body_count == 1
+    assert closed.volume == pytest.approx(volume, rel=0.03)  # solid, not a shell
+    boxes = trimesh.util.concatenate([trimesh.creation.box(extents=(0.04, 0.02, 0.02)),
+                                      trimesh.creation.box(extents=(0.02, 0.02, 0.04))])  # overlapping closed bodies
+    closed, _ = outer_surface_of_mesh(boxes, resolution=64, face_budget=3000)
+    assert closed.is_watertight and closed.body_count == 1
+    assert closed.volume == pytest.approx(0.04 * 0.02 * 0.02 + 2 * 0.01 * 0.02 * 0.02, rel=0.05)
     cup = trimesh.creation.cylinder(radius=0.03, height=0.05, sections=48)
-    cup.update_faces(cup.face_normals[:, 2] < 0.9)  # remove the lid: open
-    cup.remove_unreferenced_vertices()
-    assert not cup.is_watertight
+    cup.update_faces(cup.face_normals[:, 2] < 0.9)  # no lid: an open sheet bounds (almost) no volume
     closed, _ = outer_surface_of_mesh(cup, resolution=64, face_budget=3000)
-    assert closed.is_watertight and closed.body_count == 1 and closed.volume > 0
+    assert closed.volume < 0.01 * np.pi * 0.03**2 * 0.05  # at most the fillet of its inner crease
 
 
 # 26 unit directions: the axes, face diagonals and body diagonals of a cube

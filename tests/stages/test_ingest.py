@@ -1,4 +1,5 @@
 """The ingest and voxelize stages through the real CLI, on a folder corpus with broken files."""
+import logging
 import os
 
 import numpy as np
@@ -11,6 +12,7 @@ from typer.testing import CliRunner
 from graspaug.cli import app
 from graspaug.io.voxels import read_voxels
 
+from ..geometry import scan_meshes
 from ..geometry.test_loading import write_broken_corpus
 
 
@@ -26,6 +28,8 @@ def make_corpus(folder):
     two = trimesh.util.concatenate([trimesh.creation.box(extents=(0.04, 0.04, 0.04)),
                                     trimesh.creation.box(extents=(0.04, 0.04, 0.04)).apply_translation((0.04, 0, 0))])
     two.export(good / "two_boxes.glb")
+    (good / "seamed_can.obj").write_text(scan_meshes.seamed_cylinder()[0])  # closed once merged by position
+    scan_meshes.holed_sphere()[0].export(good / "holed_ball.ply")  # open: filled
     return expected
 
 
@@ -48,22 +52,34 @@ def corpus_params(tmp_path):
     return params, expected
 
 
-def test_ingest_keeps_good_shapes_and_records_every_reject(tmp_path, corpus_params):
+def test_ingest_keeps_good_shapes_and_records_every_reject(tmp_path, corpus_params, caplog):
     params, expected = corpus_params
-    result = run_stage(tmp_path, "ingest", params)
+    with caplog.at_level(logging.INFO):
+        result = run_stage(tmp_path, "ingest", params)
     assert result.exit_code == 0, result.output
     shapes = pd.read_parquet(tmp_path / "data/shapes.parquet")
     rejects = pd.read_parquet(tmp_path / "data/rejects.parquet")
-    assert sorted(shapes.shape_id) == ["f_good_ball", "f_good_box", "f_good_can", "f_good_ring", "f_good_two_boxes"]
+    assert sorted(shapes.shape_id) == ["f_good_ball", "f_good_box", "f_good_can", "f_good_holed_ball", "f_good_ring",
+                                       "f_good_seamed_can", "f_good_two_boxes"]
     assert len(rejects) == len(expected)
     for _, row in rejects.iterrows():
         stem = row.source.rsplit("/", 1)[1].rsplit(".", 1)[0]
         assert row.reason.startswith(expected[stem]), row.reason
     assert shapes.watertight.all()
-    assert set(shapes.split) == {"train", "test"} and (shapes.split == "test").sum() == 2
+    assert set(shapes.split) == {"train", "test"} and (shapes.split == "test").sum() == 3
     assert (shapes.origin == "original").all()
-    for col in ("source", "source_sha256", "faces", "vertices", "volume", "extent_x", "scale"):
+    for col in ("source", "source_sha256", "faces", "vertices", "volume", "extent_x", "scale", "closed_by", "hull_fill"):
         assert col in shapes
+    closed_by = dict(zip(shapes.shape_id, shapes.closed_by))
+    assert closed_by.pop("f_good_seamed_can") == "merged" and closed_by.pop("f_good_holed_ball") == "filled"
+    assert closed_by.pop("f_good_two_boxes") == "filled"  # their shared faces are inside: not a closed surface
+    assert set(closed_by.values()) == {"as_is"}
+    hull_fill = dict(zip(shapes.shape_id, shapes.hull_fill))
+    assert hull_fill["f_good_box"] == pytest.approx(1.0) and hull_fill["f_good_holed_ball"] > 0.95  # solid, not a shell
+    assert 0.5 < hull_fill["f_good_ring"] < 0.7  # a torus fills about 0.6 of its hull
+    summary = [r.getMessage() for r in caplog.records if "closed_by" in r.getMessage()]
+    assert len(summary) == 1
+    assert summary[0].startswith("ingest: closed_by as_is 4, merged 1, filled 2; hull_fill median 1.00, lowest 0.6")
     # the two touching boxes became one piece; the mid extent is 0.06 m after scaling
     for _, row in shapes.iterrows():
         mesh = trimesh.load(tmp_path / f"data/shapes/{row.shape_id}.ply", process=False)
@@ -76,7 +92,7 @@ def test_ingest_keeps_good_shapes_and_records_every_reject(tmp_path, corpus_para
     assert result.exit_code == 0, result.output
     vox = read_voxels(tmp_path / "data/voxels.npz")
     assert list(vox.shape_id) == list(shapes.shape_id)
-    assert vox.occupancy.shape == (5, 16, 16, 16) and vox.occupancy.any(axis=(1, 2, 3)).all()
+    assert vox.occupancy.shape == (7, 16, 16, 16) and vox.occupancy.any(axis=(1, 2, 3)).all()
     # the grid puts the voxels back in meters: occupied volume near the mesh volume
     vol = vox.occupancy.sum(axis=(1, 2, 3)) * vox.pitch**3
     assert np.allclose(vol, shapes.volume, rtol=0.35)
@@ -97,10 +113,10 @@ def test_split_is_seeded_and_deterministic(tmp_path, corpus_params):
 
 def test_too_few_shapes_fails_clearly_and_writes_nothing(tmp_path, corpus_params):
     params, _ = corpus_params
-    params["ingest"]["min_shapes"] = 6
+    params["ingest"]["min_shapes"] = 8
     result = run_stage(tmp_path, "ingest", params)
     assert result.exit_code == 1
-    assert "error: only 5 of 13 shapes are usable, ingest.min_shapes=6" in result.output
+    assert "error: only 7 of 15 shapes are usable, ingest.min_shapes=8" in result.output
     assert not (tmp_path / "data/shapes.parquet").exists()
     assert not (tmp_path / "data/shapes").exists()
     assert not [p for p in (tmp_path / "data").iterdir() if p.name.startswith(".")]

@@ -4,6 +4,12 @@ A file becomes either a :class:`LoadedShape` (its triangles, and its convex part
 when it is an assembly of closed convex pieces like pybullet's ``random_urdfs``)
 or a :class:`MeshRejected` exception whose message is the one-line reason that
 the ingest stage records.
+
+Meshes are loaded by geometry: when the file's pieces are not closed as they are
+(textured exports split vertices at UV seams, so one object loads as many open
+pieces), vertices are merged by position alone (UVs and normals ignored), degenerate
+and duplicate faces dropped and holes of three or four edges filled; ``closed_by``
+says which of these closed it (see :class:`LoadedShape`).
 """
 from __future__ import annotations
 
@@ -35,10 +41,14 @@ class LoadedShape:
     ----------
     mesh : all triangles (parts concatenated), meters
     parts : convex parts as half-spaces, meters; empty unless every piece is a closed convex body
+    closed_by : ``as_is`` when every piece is closed as loaded, ``merged`` when closed after
+        merging vertices by position (and filling holes of three or four edges), ``open``
+        when still open (:func:`graspaug.geometry.closing.fill_open_mesh` fills it)
     """
 
     mesh: trimesh.Trimesh
     parts: list[ConvexPart]
+    closed_by: str = "as_is"
 
 
 def sha256_of(path: str | os.PathLike) -> str:
@@ -48,6 +58,16 @@ def sha256_of(path: str | os.PathLike) -> str:
         for block in iter(lambda: f.read(1 << 20), b""):
             digest.update(block)
     return digest.hexdigest()
+
+
+def by_geometry(mesh: trimesh.Trimesh) -> trimesh.Trimesh:
+    """The triangles alone: vertices merged by position (UVs, normals and colors dropped),
+    degenerate and duplicate faces removed."""
+    out = trimesh.Trimesh(mesh.vertices, mesh.faces, process=False)
+    out.merge_vertices(merge_tex=True, merge_norm=True)
+    out.update_faces(out.nondegenerate_faces() & out.unique_faces())
+    out.remove_unreferenced_vertices()
+    return out
 
 
 def _first_line(exc: BaseException) -> str:
@@ -114,7 +134,15 @@ def load_shape(path: str | os.PathLike, unit_scale: float = 1.0, max_faces: int 
     if len(spread) < 3 or spread[2] <= _FLAT_RATIO * spread[0]:
         raise MeshRejected(f"degenerate: flat, extents {np.array2string(mesh.extents, precision=4)} m")
 
+    closed_by = "as_is"
+    if not all(p.is_watertight for p in pieces):
+        pieces = [by_geometry(p) for p in pieces]
+        mesh = by_geometry(mesh)
+        if not all(p.is_watertight for p in pieces):
+            trimesh.repair.fill_holes(mesh)  # a missing triangle or quad
+        closed_by = "merged" if all(p.is_watertight for p in pieces) or mesh.is_watertight else "open"
+
     parts: list[ConvexPart] = []
     if all(p.is_watertight and p.is_convex for p in pieces):
         parts = [part for part in map(convex_part, (p.vertices for p in pieces)) if part is not None]
-    return LoadedShape(mesh=mesh, parts=parts)
+    return LoadedShape(mesh=mesh, parts=parts, closed_by=closed_by)

@@ -8,7 +8,8 @@ import trimesh
 
 from graspaug.geometry.loading import LoadedShape, MeshRejected
 from graspaug.geometry.normalize import Normalization, normalization
-from graspaug.geometry.solid import outer_surface_of_mesh, outer_surface_of_parts, resolution_for_parts
+from graspaug.geometry.closing import MIN_ENCLOSED, close_surface
+from graspaug.geometry.solid import outer_surface_of_parts, resolution_for_parts
 from graspaug.geometry.settings import SurfaceSettings
 
 
@@ -21,6 +22,8 @@ class PreparedShape:
     n_parts: int  # convex parts used (0 when rebuilt from the triangles)
     resolution: int  # field samples along the largest extent that were used
     dropped_volume: float  # share of the solid's volume not in the kept piece
+    closed_by: str = "as_is"  # as_is, merged (vertices merged by position) or filled (open mesh filled)
+    hull_fill: float = 1.0  # volume / convex hull volume
 
 
 def prepare_shape(loaded: LoadedShape, settings: SurfaceSettings) -> PreparedShape:
@@ -29,15 +32,26 @@ def prepare_shape(loaded: LoadedShape, settings: SurfaceSettings) -> PreparedSha
     Raises
     ------
     MeshRejected
+        when an open mesh can only be closed by bridging a hole wider than
+        ``settings.max_gap`` (more than ``1 - MIN_ENCLOSED`` of its area bounds nothing),
         when the rebuilt solid has no volume or is split into pieces of which the
         largest misses more than ``settings.max_dropped`` of the volume.
     """
+    closed_by = loaded.closed_by
     if loaded.parts:
         resolution = resolution_for_parts(loaded.parts, settings.resolution, settings.finest_resolution, settings.cells_per_thickness)
         surface, dropped = outer_surface_of_parts(loaded.parts, resolution, settings.face_budget)
     else:
         resolution = settings.resolution
-        surface, dropped = outer_surface_of_mesh(loaded.mesh, resolution, settings.face_budget)
+        closed = close_surface(loaded.mesh, resolution, settings.face_budget, settings.max_gap, settings.finest_resolution)
+        surface, dropped, resolution = closed.mesh, closed.dropped, closed.resolution
+        if closed.filled:
+            closed_by = "filled"
+            if closed.enclosed < MIN_ENCLOSED:
+                raise MeshRejected(
+                    f"open: {1 - closed.enclosed:.0%} of the surface encloses nothing, a hole wider than "
+                    f"max_gap={settings.max_gap:g} of the largest extent ({1000 * closed.gap_m:.1f} mm) would have to be bridged"
+                )
     if len(surface.faces) == 0 or not surface.volume > 0:
         raise MeshRejected("degenerate: the rebuilt solid has no volume")
     if dropped > settings.max_dropped:
@@ -48,4 +62,6 @@ def prepare_shape(loaded: LoadedShape, settings: SurfaceSettings) -> PreparedSha
     mesh = norm.apply(surface)
     if not np.isfinite(mesh.vertices).all():
         raise MeshRejected("degenerate: normalization produced non-finite coordinates")
-    return PreparedShape(mesh=mesh, normalization=norm, n_parts=len(loaded.parts), resolution=resolution, dropped_volume=dropped)
+    hull_fill = float(mesh.volume / mesh.convex_hull.volume)
+    return PreparedShape(mesh=mesh, normalization=norm, n_parts=len(loaded.parts), resolution=resolution, dropped_volume=dropped,
+                         closed_by=closed_by, hull_fill=hull_fill)

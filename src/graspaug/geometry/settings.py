@@ -17,6 +17,7 @@ class SurfaceSettings:
     size_rule: Literal["min", "mid", "max"] = Field("mid", description="Which extent the size rule fixes: `min`, `mid` (the middle one) or `max`.")
     size_m: float = Field(0.06, gt=0, description="That extent after scaling, meters. Default: middle extent 0.06 m, so a Franka Panda (0.08 m opening) closes across the two smaller extents of most objects.")
     max_dropped: float = Field(0.1, ge=0, le=1, description="Reject a shape whose largest connected piece misses more than this share of its volume.")
+    max_gap: float = Field(0.05, ge=0, le=0.5, description="Widest hole or crack bridged when an open mesh (a scan, a file split at UV seams) is rebuilt as a solid, as a share of the shape's largest extent (0.05: 5 mm on a 10 cm object); a mesh that needs a wider one bridged is rejected. Openings wider than this (a mug's top) stay open.")
 
 
 @settings

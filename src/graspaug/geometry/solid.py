@@ -220,40 +220,47 @@ def outer_surface_of_parts(parts: list[ConvexPart], resolution: int, face_budget
     return decimate(mesh, face_budget), dropped
 
 
-def outer_surface_of_mesh(mesh: trimesh.Trimesh, resolution: int, face_budget: int) -> tuple[trimesh.Trimesh, float]:
+def outer_surface_of_mesh(
+    mesh: trimesh.Trimesh, resolution: int, face_budget: int, max_gap: float = 0.05
+) -> tuple[trimesh.Trimesh, float]:
     """One closed outer surface for an arbitrary mesh (several bodies, holes, inner faces).
 
-    Small holes are filled and the winding made consistent first; a single closed
-    body is then kept as it is (decimated to the budget). Anything else
-    is rebuilt: solid occupancy on a fine grid (winding count for closed bodies,
-    a filled surface shell for open ones), lightly smoothed, then marching cubes.
+    See :func:`graspaug.geometry.closing.close_surface`: a closed body is kept, several
+    become their union, an open mesh is filled bridging gaps up to ``max_gap`` (share of
+    the largest extent). An open sheet that encloses nothing comes out empty or as slivers
+    (``close_surface`` says how much of the area encloses the solid).
+
+    Returns
+    -------
+    mesh : closed, outward-oriented surface, meters
+    dropped : float — share of the volume in pieces that were dropped
+    """
+    from graspaug.geometry.closing import close_surface
+
+    closed = close_surface(mesh, resolution, face_budget, max_gap)
+    return closed.mesh, closed.dropped
+
+
+def union_of_closed_bodies(mesh: trimesh.Trimesh, resolution: int, face_budget: int) -> tuple[trimesh.Trimesh, float]:
+    """The union of several closed bodies: winding-count occupancy on a fine grid, lightly
+    smoothed, then marching cubes; the largest piece, decimated.
+
+    Returns
+    -------
+    mesh : closed, outward-oriented surface of the largest piece, meters
+    dropped : float — share of the volume in pieces that were dropped
     """
     from scipy import ndimage
 
     from graspaug.geometry.voxelize import VoxelGrid, voxelize_solid
 
-    mesh = mesh.copy()
-    trimesh.repair.fill_holes(mesh)  # closes holes of one or a few missing triangles
-    trimesh.repair.fix_normals(mesh)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        closed = mesh.is_watertight and mesh.body_count == 1 and mesh.volume > 0
-    if closed:
-        return decimate(mesh, face_budget), 0.0
     bounds = mesh.bounds
     origin, pitch, shape = _field_grid(bounds, resolution)
     n = max(shape)
     grid = VoxelGrid(n, pitch, origin - 0.5 * pitch)  # voxel centers on the sample points
     occupied = np.zeros((n, n, n), dtype=bool)
     for body in mesh.split(only_watertight=False):
-        if body.is_watertight:
-            occupied |= voxelize_solid(body.vertices, body.faces, grid)
-        else:
-            shell = np.zeros_like(occupied)
-            pts = body.sample(max(20000, 50 * len(body.faces)), seed=0)
-            ijk = np.floor((pts - grid.origin) / pitch).astype(int)
-            ijk = ijk[np.all((ijk >= 0) & (ijk < n), axis=1)]
-            shell[tuple(ijk.T)] = True
-            occupied |= ndimage.binary_fill_holes(shell)
+        occupied |= voxelize_solid(body.vertices, body.faces, grid)
     smooth = ndimage.gaussian_filter(occupied.astype(np.float32), sigma=0.7)
     out = surface_from_field(0.5 - smooth, origin, pitch)
     out, dropped = largest_piece(out)

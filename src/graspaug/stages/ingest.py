@@ -11,7 +11,7 @@ from collections import Counter
 import pandas as pd
 
 from graspaug.config import Params
-from graspaug.corpus import assign_split, ingest_source
+from graspaug.corpus import assign_split, closing_summary, ingest_source
 from graspaug.io.atomic import atomic_path
 from graspaug.io.sources import folder_sources, pybullet_sources
 from graspaug.io.tables import write_table
@@ -50,6 +50,7 @@ def run(params: Params) -> None:
 
     for reason, n in Counter(rejects["reason"]).most_common():
         log.info("rejected %d: %s", n, reason)
+    log.info("ingest: %s", closing_summary(shapes))
     counts = shapes["split"].value_counts()
     log.info(
         "ingest: %d shapes (%d train, %d test), %d rejected, %d/%d watertight, median %d faces, in %.1f s",
