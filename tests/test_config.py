@@ -9,6 +9,7 @@ from typer.testing import CliRunner
 from graspaug.cli import app
 from graspaug.config import Params, ParamsError, json_schema, load_params, params_dict, parse_params
 from graspaug.profiles import merge, profile_names, profile_params, profile_yaml
+from graspaug.training.settings import TrainSettings
 
 
 def test_params_yaml_holds_exactly_the_settings_defaults(repo_root):
@@ -23,8 +24,8 @@ def test_params_yaml_holds_exactly_the_settings_defaults(repo_root):
 def test_schema_file_is_up_to_date(repo_root):
     assert (repo_root / "params.schema.json").read_text() == json_schema()
     schema = json.loads(json_schema())
-    steps = schema["$defs"]["TrainSettings"]["properties"]["steps"]
-    assert steps["default"] == 400 and steps["minimum"] == 1 and "SGD steps" in steps["description"]
+    steps = schema["$defs"]["TrainSettings"]["properties"]["max_steps"]
+    assert steps["default"] == TrainSettings().max_steps and steps["minimum"] == 1 and "SGD steps" in steps["description"]
 
 
 @pytest.mark.parametrize(
@@ -54,7 +55,7 @@ def test_schema_file_is_up_to_date(repo_root):
         ({"render": {"crop": {"out_size": 16}}}, "gqcnn.net.image_size: must equal render.crop.out_size (16); got 32"),
         ({"sim": {"objects": ["mug", "teapot"]}}, "sim.objects: must be distinct names among mug, duck,"),
         ({"sim": {"objects": [], "n_test_objects": 0}}, "sim.objects: no objects to pick"),
-        ({"sim": {"base_size": 300}}, "sim.base_size: must be one of generate.base_sizes [50, 100, 200]; got 300"),
+        ({"sim": {"base_size": 300}}, "sim.base_size: must be one of gqcnn.augment_base_sizes [50]; got 300"),
         ({"sim": {"sampler": {"min_depth_offset": 0.05}}}, "sim.sampler.max_depth_offset: must be >= sim.sampler.min_depth_offset (0.05); got 0.04"),
         ({"sim": {"attempts": 0}}, "sim.attempts: Input should be greater than or equal to 1; got 0"),
     ],
@@ -76,7 +77,7 @@ def test_params_and_sections_are_frozen():
     with pytest.raises(pydantic.ValidationError):
         Params().seed = 3
     with pytest.raises(dataclasses.FrozenInstanceError):
-        Params().gqcnn.train.steps = 3
+        Params().gqcnn.train.max_steps = 3
 
 
 def test_sections_are_the_library_settings():
@@ -127,9 +128,9 @@ def test_every_overlay_names_only_real_keys(repo_root):
 def test_profiles_are_small_overlays(repo_root):
     folder = repo_root / "profiles"
     study, paper, tiny = (profile_params(n, folder) for n in ("study", "paper", "tiny"))
-    assert study.gqcnn.seeds == (0, 1, 2)
-    assert study.model_copy(update={"gqcnn": dataclasses.replace(study.gqcnn, seeds=(0,))}) == Params()
-    assert yaml.safe_load((folder / "study.yaml").read_text()) == {"gqcnn": {"seeds": [0, 1, 2]}}
+    assert len(study.gqcnn.seeds) >= 5 and study.generate.base_sizes == (50, 100, 200) and len(study.generate.ratios) == 5
+    assert set(study.gqcnn.augment_base_sizes) == set(study.generate.base_sizes)  # the paper's 15 cells, three pools
+    assert yaml.safe_load((folder / "study.yaml").read_text()).keys() == {"generate", "gqcnn"}
     assert paper.voxelize.resolution == paper.ae.net.resolution == 64
     assert (paper.ae.net.base_width, paper.ae.net.top_width, paper.ae.net.z_dim) == (64, 512, 128)
     assert (paper.gqcnn.net.filters, paper.gqcnn.net.fc) == (64, 1024) and len(paper.gqcnn.seeds) >= 3
@@ -142,6 +143,6 @@ def test_profile_command_writes_a_complete_params_file(repo_root, tmp_path):
     result = CliRunner().invoke(app, ["profile", "study", "--out", str(out), "--profiles", str(repo_root / "profiles")])
     assert result.exit_code == 0, result.output
     assert load_params(out) == profile_params("study", repo_root / "profiles")
-    assert yaml.safe_load(out.read_text())["gqcnn"]["train"]["steps"] == 400  # every key written, for DVC
+    assert yaml.safe_load(out.read_text())["gqcnn"]["train"]["max_steps"] == TrainSettings().max_steps  # every key written, for DVC
     missing = CliRunner().invoke(app, ["profile", "nope", "--out", str(out), "--profiles", str(repo_root / "profiles")])
     assert missing.exit_code == 2 and "profile 'nope' not found" in missing.output

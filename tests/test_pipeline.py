@@ -180,37 +180,45 @@ def test_dvc_repro_gqcnn_matrix_and_report(tiny_repo):
 
     work, env = tiny_repo
     run(["dvc", "repro", "report"], work, env)
-    names = [f"targeted/{b}-{r}-s0" for b in (4, 6) for r in (0.0, 0.5, 1.0, 2.0)] + ["random/6-1.0-s0"]
-    for name in names:
-        summary = json.loads((work / f"metrics/gqcnn/{name}.json").read_text())
-        assert set(summary["test"]) == {"ap", "accuracy", "roc_auc", "positive_share", "datapoints"}
-        assert summary["steps"] == 6 and summary["test"]["datapoints"] > 0
-        folder = work / f"models/gqcnn/{name}"
-        assert np.load(folder / "test_predictions.npy").shape == (summary["test"]["datapoints"],)
-        assert (work / f"metrics/gqcnn/{name}/plots/metrics/loss.tsv").exists()  # DVCLive curves, every 3 steps
-    with_generated = json.loads((work / "metrics/gqcnn/targeted/6-2.0-s0.json").read_text())["train"]
-    assert with_generated["generated_shapes_asked"] == 12 and with_generated["base_shapes"] <= 6
+    names = ["targeted/4-0"] + [f"{p}/6-{r:g}" for p in ("targeted", "random", "real") for r in (0.5, 1.0)] + ["targeted/6-0", "ceiling"]
+    digests, validation = {}, {}
+    for seed in (0, 1):
+        metrics = json.loads((work / f"metrics/gqcnn/s{seed}.json").read_text())["networks"]
+        assert set(metrics) == {"targeted", "random", "real", "ceiling"} and set(metrics["targeted"]["6"]) == {"0", "0.5", "1"}
+        assert set(metrics["targeted"]["4"]) == {"0"} and set(metrics["real"]["6"]) == {"0.5", "1"}
+        split = json.loads((work / f"models/gqcnn/s{seed}/split.json").read_text())
+        for name in names:
+            folder = work / f"models/gqcnn/s{seed}/{name}"
+            summary = json.loads((folder / "summary.json").read_text())
+            assert set(summary["test"]) == {"ap", "accuracy", "roc_auc", "positive_share", "datapoints"}
+            assert 4 <= summary["train"]["steps"] <= 6 and 1 <= summary["train"]["best_step"] <= summary["train"]["steps"]
+            assert np.load(folder / "test_predictions.npy").shape == (summary["test"]["datapoints"],)
+            assert len(pd.read_csv(folder / "history.csv")) == 2  # evals: 2
+            digests.setdefault(seed, set()).add(summary["init_digest"])
+            validation.setdefault(seed, set()).add(summary["validation"]["datapoints"])
+        assert len(split["validation"]) == 2 and not set(split["validation"]) & set(split["base"]["6"]) and not set(split["validation"]) & set(split["real_pool"])
+        assert (work / f"reports/gqcnn/validation/s{seed}.png").stat().st_size > 0
+    # paired: every network of a seed starts from the same weights, seeds from different ones; one validation set for all
+    assert len(digests[0]) == len(digests[1]) == 1 and digests[0] != digests[1]
+    assert len(validation[0] | validation[1]) == 1
+    real = json.loads((work / "models/gqcnn/s0/real/6-1/summary.json").read_text())["train"]
+    assert real["original_shapes"] == 12 and real["generated_shapes_asked"] == 0
+    targeted = json.loads((work / "models/gqcnn/s0/targeted/6-1/summary.json").read_text())["train"]
+    assert targeted["generated_shapes_asked"] == 6 and targeted["original_shapes"] == 6 and 0 < targeted["positive_share"] < 1
     ap = json.loads((work / "metrics/ap.json").read_text())
     report = (work / "reports/gqcnn/report.md").read_text()
-    assert set(ap["ap"]["targeted"]) == {"4", "6"} and set(ap["ap"]["targeted"]["6"]) == {"0", "0.5", "1", "2"}
-    index = pd.read_parquet(work / "data/gqcnn/original/index.parquet")
-    test_labels = index.label[index.split == "test"]
-    if 0 < test_labels.sum() < len(test_labels):  # AP exists only when the tiny test set has both labels
-        assert all(0 < cell["mean"] <= 1 and cell["n"] == 1 for cell in ap["ap"]["targeted"]["6"].values())
-        best = ap["summary"]["6"]
-        assert best["best_ap"] == max(cell["mean"] for cell in ap["ap"]["targeted"]["6"].values())
-        assert best["seeds"] == 1 and best["gain_se"] is None and best["beyond_seed_spread"] is False  # one seed: no claim
-    else:
-        assert all(cell["mean"] is None and cell["n"] == 0 for cell in ap["ap"]["targeted"]["6"].values())
-        assert "no test AP" in report
-    train_positive = json.loads((work / "metrics/gqcnn/targeted/6-2.0-s0.json").read_text())["train"]["positive_share"]
-    assert 0 < train_positive < 1  # the tiny params give the networks both labels to learn from
-    assert set(ap["ap"]["random"]["6"]) == {"0", "1"}  # ratio 0 is shared with the targeted curve
-    assert "| targeted | 4 |" in report and "| random | 6 |" in report and "## What the numbers say" in report
+    assert set(ap["contrasts"]) - {"targeted_vs_none_chosen@6"} == {"real_data", "targeted_vs_none@6", "targeted_vs_random@6", "targeted_vs_real@6"}
+    assert ("targeted_vs_none_chosen@6" in ap["contrasts"]) == ("6" in ap["chosen_ratio"])
+    for c in ap["contrasts"].values():
+        assert {"mean", "ci_low", "ci_high", "n_seeds", "boot_low", "boot_high"} <= set(c)
+        if c["mean"] is not None:
+            assert c["n_seeds"] == 2 and c["ci_low"] <= c["mean"] <= c["ci_high"]
+    assert set(ap["networks"]["targeted"]["6"]) == {"0", "0.5", "1"} and ap["seeds"] == [0, 1]
+    assert "| targeted | 4 | 1:0 |" in report and "| real | 6 | 1:0.5 |" in report and "## Contrasts" in report and "## What the numbers say" in report
     for picture in ("ap_vs_ratio", "improvement_by_score", "tsne_graspness"):
         assert (work / f"reports/gqcnn/{picture}.png").stat().st_size > 0
     shown = run(["dvc", "metrics", "show", "--json"], work, env)
-    assert "metrics/gqcnn/targeted/6-2.0-s0.json" in shown.stdout
+    assert "metrics/gqcnn/s1.json" in shown.stdout and "real_data" in shown.stdout
     again = run(["dvc", "repro", "report"], work, env)
     assert "Running stage" not in again.stdout
 
@@ -223,17 +231,17 @@ def test_dvc_repro_sim(tiny_repo, tmp_path):
     run(["dvc", "repro", "sim"], work, env)
     metrics = json.loads((work / "metrics/sim.json").read_text())
     ap = json.loads((work / "metrics/ap.json").read_text())
-    after_ratio = ap["summary"]["6"]["best_ratio"] if "6" in ap["summary"] else 2.0  # no test AP: the largest ratio
+    after_ratio = ap["summary"]["6"]["best_ratio"] if "6" in ap["summary"] else 1.0  # no validation AP: the largest ratio
     assert metrics["arms"]["before"]["ratio"] == 0.0 and metrics["arms"]["after"]["ratio"] == after_ratio
-    assert metrics["setup"]["after_ratio_from_report"] == ("6" in ap["summary"]) and metrics["setup"]["model_seeds"] == [0]
-    assert metrics["per_seed"]["0"]["before"] == {k: v for k, v in metrics["arms"]["before"].items() if k != "ratio"}
+    assert metrics["setup"]["after_ratio_from_report"] == ("6" in ap["summary"]) and metrics["setup"]["model_seeds"] == [0, 1]
+    assert metrics["per_seed"]["0"]["before"]["attempts"] == metrics["per_seed"]["1"]["before"]["attempts"] == 4
     for arm in ("before", "after"):
         a = metrics["arms"][arm]
-        assert a["attempts"] == 4 and 0 <= a["successes"] <= 4
+        assert a["attempts"] == 8 and 0 <= a["successes"] <= 8  # two training seeds, the same 4 drops each
         assert a["wilson_low"] <= a["success_rate"] <= a["wilson_high"]
     assert metrics["antipodal_reference"]["attempts"] == 4  # the reference arm without a network
     trials = pd.read_csv(work / "reports/sim/trials.csv")
-    assert len(trials) == 12 and set(trials.object) == {"cube", metrics["setup"]["test_shapes"][0]}
+    assert len(trials) == 20 and set(trials.object) == {"cube", metrics["setup"]["test_shapes"][0]}
     planned = (trials.arm != "antipodal") & (trials.outcome != "no_grasp")
     assert trials.quality[trials.arm == "antipodal"].isna().all() and trials.quality[planned].notna().all()
     trials = trials[trials.arm != "antipodal"]
@@ -309,12 +317,12 @@ def test_queued_two_point_sweep_lines_up_metrics(tiny_repo):
         assert data["params"]["params.yaml"]["data"]["sim"]["hand"]["grip_force"] == force
         sim = data["metrics"]["metrics/sim.json"]["data"]
         ap = data["metrics"]["metrics/ap.json"]["data"]
-        assert sim["arms"]["before"]["attempts"] == 4 and "ap" in ap
+        assert sim["arms"]["before"]["attempts"] == 8 and "contrasts" in ap
     changed = json.loads(run(["dvc", "params", "diff", "grip-10", "grip-40", "--json"], work, env).stdout)
     assert list(changed["params.yaml"]) == ["sim.hand.grip_force"]
     assert (changed["params.yaml"]["sim.hand.grip_force"]["old"], changed["params.yaml"]["sim.hand.grip_force"]["new"]) == (10.0, 40.0)
     diff = json.loads(run(["dvc", "metrics", "diff", "grip-10", "grip-40", "--json", "--all"], work, env).stdout)
-    assert diff["metrics/sim.json"]["arms.before.attempts"] == {"old": 4, "new": 4, "diff": 0}  # --all lines up every metric
+    assert diff["metrics/sim.json"]["arms.before.attempts"] == {"old": 8, "new": 8, "diff": 0}  # --all lines up every metric
     run(["dvc", "queue", "stop"], work, env)
 
 

@@ -187,25 +187,24 @@ def export_dexnet_command(
 
 @app.command(
     name="train-gqcnn",
-    help="Train one GQ-CNN (Dex-Net 2.0) for base size B, augmentation ratio R, pool and seed (paper Section IV-C): "
-    "training set = the rendered grasps of the B base shapes + those of the first round(R × B) shapes of B's targeted "
-    "(or random) pool; test = every test-split grasp of the original corpus. The same number of SGD steps for every "
-    "variant. Dex-Net's recipe: SGD momentum 0.9, lr 0.01 decaying 0.95, L2 5e-4, image/z normalization from the "
-    "training data, Gamma and Gaussian-process noise, 180° turns and flips.\n\n"
-    "Writes `models/gqcnn/<pool>/<B>-<R>-s<seed>/` (model.pt, test_predictions.npy), `metrics/gqcnn/<pool>/<B>-<R>-s<seed>.json` "
-    "(test AP, accuracy, ROC AUC) and DVCLive curves in `metrics/gqcnn/<pool>/<B>-<R>-s<seed>/`.\n\n"
-    f"Params `gqcnn`:\n\n{describe(GQCNNParams, 'gqcnn.')}\n\nAlso `seed`, `device`.",
+    help="Train every GQ-CNN (Dex-Net 2.0) of one training seed as a paired set (paper Section IV-C): `targeted` at every "
+    "base size B × ratio R of `generate` (the B base shapes' rendered grasps + those of the first round(R × B) shapes of B's "
+    "targeted pool), `random` (random-pair interpolants) and `real` (round(R × B) more real train shapes) at every nonzero "
+    "ratio of `gqcnn.augment_base_sizes`, and the `ceiling` (every train shape outside validation). Every network of the "
+    "seed starts from the same weights and noise stream and is validated on the same `gqcnn.val_shapes` train shapes; it "
+    "trains `gqcnn.train.epochs` passes over its own set (within min/max steps), the learning rate annealed along a "
+    "cosine, and keeps the weights with the best validation AP. Test = every test-split grasp of the original corpus.\n\n"
+    "Writes `models/gqcnn/s<seed>/<pool>/<B>-<R>/` (model.pt, predictions, history.csv), `metrics/gqcnn/s<seed>.json` "
+    "(validation and test AP per network) and `reports/gqcnn/validation/s<seed>.png` (validation AP vs step).\n\n"
+    f"Params `gqcnn`:\n\n{describe(GQCNNParams, 'gqcnn.')}\n\nAlso `seed`, `device`, `n_jobs`.",
 )
 def train_gqcnn_command(
-    base_size: int = typer.Option(..., "--base-size", "-b", help="Base set size B (one of generate.base_sizes)."),
-    ratio: float = typer.Option(..., "--ratio", "-r", help="Augmentation ratio R (one of generate.ratios)."),
-    pool: str = typer.Option("targeted", "--pool", help="`targeted` (the paper's selection) or `random` (random pairs, the baseline)."),
     seed: int = typer.Option(0, "--seed", "-s", help="Training seed (one of gqcnn.seeds)."),
     params: Path = ParamsOption,
 ) -> None:
     from graspaug.stages import train_gqcnn
 
-    _run(lambda p: train_gqcnn.run(p, base_size, ratio, pool, seed), _load(params))
+    _run(lambda p: train_gqcnn.run(p, seed), _load(params))
 
 
 stage_command(

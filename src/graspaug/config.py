@@ -113,7 +113,7 @@ class ScoreParams:
 class GenerateParams:
     """New shapes from rare and graspable neighbours of each base set (paper Section III-C)."""
 
-    base_sizes: tuple[int, ...] = Field((50, 100, 200), description="Base set sizes drawn from the train split (paper: 50, 100, 200); smaller sets lie inside larger ones.")
+    base_sizes: tuple[int, ...] = Field((50, 200), description="Base set sizes drawn from the train split (paper: 50, 100, 200); smaller sets lie inside larger ones.")
     ratios: tuple[float, ...] = Field((0.0, 0.5, 1.0, 1.5, 2.0), description="Augmentation ratios generated:base (paper: 1:0 ... 1:2), written as floats; each pool holds max ratio × base size shapes.")
     percentile: float = Field(75.0, ge=0, le=99, description="Shapes above this percentile of rarity, and separately of graspness, in the base set are paired (top 25%).")
     first_neighbour: int = Field(2, ge=1, description="N: pair each selected shape with its N-th ... (N+K)-th nearest selected neighbours (1 = nearest; 2 avoids near-duplicates).")
@@ -146,19 +146,21 @@ class RenderParams(RenderSettings):
 
 @settings
 class GQCNNParams:
-    """GQ-CNN networks per base size × augmentation ratio (paper Section IV-C) and their training."""
+    """GQ-CNN networks per base size × augmentation ratio (paper Section IV-C), their training and the experiment's design.
+
+    Per training seed: a 1:0 network (the base set alone) at every base size of `generate`;
+    `targeted`, `random` (random-pair interpolants) and `real` (more real train shapes, the
+    positive control for augmentation) at every nonzero ratio of `augment_base_sizes`; the
+    `ceiling` (every train shape outside validation). Every network of a seed starts from the same weights and noise
+    stream; all are validated on the same `val_shapes` train shapes that no network trains on.
+    """
 
     net: GQCNNConfig = Field(default_factory=GQCNNConfig, description="Layer sizes.")
-    train: TrainSettings = Field(default_factory=TrainSettings, description="SGD schedule and train-time noise.")
-    val_fraction: float = Field(0.1, ge=0, le=0.5, description="Share of the training views (whole images) held out for the validation curves; a view is held out or not by a hash of its id and the seed, the same for every ratio and pool.")
-    seeds: tuple[int, ...] = Field((0,), description="Training seeds; each network is trained once per seed (study profile: 0, 1, 2).")
-    random_base_sizes: tuple[int, ...] = Field((200,), description="Base sizes that also get random-pair augmentation networks (the baseline).")
-    random_ratios: tuple[float, ...] = Field((0.5, 1.0, 1.5, 2.0), description="Their ratios (ratio 0 is the same network as the targeted one).")
-
-    @model_validator(mode="before")
-    @classmethod
-    def _ratios_are_floats(cls, raw: Any) -> Any:
-        return _floats_written_as_floats(raw, "gqcnn", "random_ratios")
+    train: TrainSettings = Field(default_factory=TrainSettings, description="SGD schedule, checkpoint choice and train-time noise.")
+    val_shapes: int = Field(100, ge=1, description="Train-split shapes outside every base set held out for validation (checkpoints and the best ratio are chosen on them), the same for every network and seed.")
+    seeds: tuple[int, ...] = Field((0, 1, 2), description="Training seeds, the replicates of the paired design (study profile: 5).")
+    augment_base_sizes: tuple[int, ...] = Field((50,), description="Base sizes that get augmented networks: targeted, random and real at every nonzero ratio of generate.ratios (the others get their 1:0 network only; study profile: all).")
+    ceiling: bool = Field(True, description="Also train one network per seed on every train shape outside validation (how much of the gap augmentation closes).")
 
     def __post_init__(self) -> None:
         if not self.seeds or len(set(self.seeds)) != len(self.seeds) or min(self.seeds) < 0:
@@ -172,7 +174,7 @@ class SimParams:
     objects: tuple[str, ...] = Field(tuple(EVERYDAY_OBJECTS), description=f"Everyday objects of pybullet_data to pick (any of {', '.join(EVERYDAY_OBJECTS)}).")
     n_test_objects: int = Field(2, ge=0, description="Held-out test shapes (test split of data/shapes, a seeded choice) picked as well.")
     attempts: int = Field(10, ge=1, description="Attempts per object and arm (paper: 10); each attempt drops the object anew from a seeded pose, the same for both arms.")
-    base_size: int = Field(200, ge=2, description="Base size B of the two networks compared: B-0 (before) and B at the report's best ratio (after).")
+    base_size: int = Field(50, ge=2, description="Base size B of the two networks compared: B-0 (before) and B at the ratio chosen on validation AP (after); one of gqcnn.augment_base_sizes.")
     object_mass: float = Field(0.1, gt=0, description="Mass of every object (kg; the random_urdfs objects weigh 0.1).")
     object_friction: float = Field(0.5, gt=0, description="Lateral friction of the objects (pybullet multiplies it by the partner's: fingers, table).")
     antipodal_arm: bool = Field(False, description="Also run the reference arm `antipodal`: a random antipodal seed grasp, no network (how much the GQ-CNN adds).")
@@ -231,12 +233,10 @@ class Params(BaseModel):
         if self.executor == "dask" and not self.scheduler:
             raise ValueError("scheduler: required when executor is dask (e.g. tcp://10.0.0.5:8786)")
         gen, net = self.generate, self.gqcnn
-        if not set(net.random_base_sizes) <= set(gen.base_sizes):
-            raise ValueError(f"gqcnn.random_base_sizes: must be among generate.base_sizes {list(gen.base_sizes)}; got {list(net.random_base_sizes)}")
-        if not set(net.random_ratios) <= set(gen.ratios) or 0.0 in net.random_ratios:
-            raise ValueError(f"gqcnn.random_ratios: must be nonzero ratios among generate.ratios {list(gen.ratios)}; got {list(net.random_ratios)}")
-        if self.sim.base_size not in gen.base_sizes:
-            raise ValueError(f"sim.base_size: must be one of generate.base_sizes {list(gen.base_sizes)}; got {self.sim.base_size}")
+        if not set(net.augment_base_sizes) <= set(gen.base_sizes):
+            raise ValueError(f"gqcnn.augment_base_sizes: must be among generate.base_sizes {list(gen.base_sizes)}; got {list(net.augment_base_sizes)}")
+        if self.sim.base_size not in net.augment_base_sizes:
+            raise ValueError(f"sim.base_size: must be one of gqcnn.augment_base_sizes {list(net.augment_base_sizes)}; got {self.sim.base_size}")
         return self
 
     @property

@@ -98,22 +98,28 @@ def render_examples(corpus: str) -> Path:
     return Path(f"reports/render/{corpus}/examples.png")
 
 
-# train_gqcnn (one network per pool × base size × ratio × seed) and report
-def gqcnn_name(base_size: int, ratio: float, seed: int) -> str:
-    """``<B>-<R>-s<seed>``, R written as DVC writes the float from params.yaml (``0.5``, ``1.0``)."""
-    return f"{base_size}-{float(ratio)}-s{seed}"
+# train_gqcnn (every network of one training seed) and report
+def gqcnn_variant_name(pool: str, base_size: int = 0, ratio: float = 0.0) -> str:
+    """``<pool>/<B>-<R>`` (R as ``%g``: ``50-0.5``, ``200-1``), or ``ceiling``."""
+    return "ceiling" if pool == "ceiling" else f"{pool}/{base_size}-{float(ratio):g}"
+
+
+def gqcnn_seed_dir(seed: int) -> Path:
+    return Path(f"models/gqcnn/s{seed}")
 
 
 def gqcnn_model_dir(pool: str, base_size: int, ratio: float, seed: int) -> Path:
-    return Path(f"models/gqcnn/{pool}/{gqcnn_name(base_size, ratio, seed)}")
+    """One network's folder: ``models/gqcnn/s<seed>/<pool>/<B>-<R>``; ratio 0 of every pool is the targeted network."""
+    return gqcnn_seed_dir(seed) / gqcnn_variant_name("targeted" if pool != "ceiling" and float(ratio) == 0.0 else pool, base_size, ratio)
 
 
-def gqcnn_metrics(pool: str, base_size: int, ratio: float, seed: int) -> Path:
-    return Path(f"metrics/gqcnn/{pool}/{gqcnn_name(base_size, ratio, seed)}.json")
+def gqcnn_seed_metrics(seed: int) -> Path:
+    return Path(f"metrics/gqcnn/s{seed}.json")
 
 
-def gqcnn_live(pool: str, base_size: int, ratio: float, seed: int) -> Path:
-    return Path(f"metrics/gqcnn/{pool}/{gqcnn_name(base_size, ratio, seed)}")
+def gqcnn_val_curves(seed: int) -> Path:
+    """Validation AP vs step of every network of a seed (PNG; the CSV beside it)."""
+    return Path(f"reports/gqcnn/validation/s{seed}.png")
 
 
 AP_METRICS = Path("metrics/ap.json")

@@ -168,6 +168,25 @@ def ap_vs_ratio(curves: dict[str, tuple[Sequence[float], Sequence[float], Sequen
     _save(fig, path)
 
 
+def validation_curves(history, path: str | os.PathLike, title: str) -> None:
+    """Validation AP against SGD step, one line per network (``history``: columns network,
+    step, val_ap), a dot at each network's best evaluation (the weights it keeps)."""
+    plt = _pyplot()
+    fig, ax = plt.subplots(figsize=(7.2, 4.6))
+    for name, rows in history.groupby("network", sort=True):
+        style = "--" if name.startswith("random") else (":" if name.startswith("real") else "-")
+        (line,) = ax.plot(rows.step, rows.val_ap, linestyle=style, linewidth=1.2, label=name)
+        if rows.val_ap.notna().any():
+            best = rows.loc[rows.val_ap.idxmax()]
+            ax.plot([best.step], [best.val_ap], "o", color=line.get_color(), markersize=4)
+    ax.set_xlabel("SGD step")
+    ax.set_ylabel("validation Average Precision")
+    ax.set_title(title, fontsize=9)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=6, ncol=2)
+    _save(fig, path)
+
+
 def improvement_by_interval(panels: list[dict], path: str | os.PathLike, title: str) -> None:
     """The paper's Fig. 8: per panel (a score: rarity or graspness), normalized histograms of
     the selected and the generated shapes and the mean per-object AP improvement of test

@@ -4,7 +4,7 @@ import pytest
 import torch
 
 from graspaug.nets.gqcnn import GQCNN, GQCNNConfig
-from graspaug.training.gqcnn import GraspArrays, NoiseSettings, TrainSettings, augment, classification_metrics, predict, train_gqcnn
+from graspaug.training.gqcnn import GraspArrays, NoiseSettings, TrainSettings, augment, classification_metrics, cosine_lr, predict, train_gqcnn
 
 
 def test_average_precision_matches_a_hand_computed_case():
@@ -61,11 +61,30 @@ def test_a_tiny_gqcnn_learns_a_separable_toy_set():
     torch.manual_seed(0)
     net = GQCNN(GQCNNConfig(filters=8, fc=32, pose_fc=4))
     logged = []
-    settings = TrainSettings(steps=150, batch_size=32, lr=0.01, decay_steps=50, log_every=50)
+    settings = TrainSettings(epochs=1.0, min_steps=150, max_steps=150, batch_size=32, lr=0.01, evals=3)
     speed = train_gqcnn(net, train, test, settings, torch.device("cpu"), torch.Generator().manual_seed(0), lambda step, m: logged.append((step, m)))
-    assert [step for step, _ in logged] == [50, 100, 150]
+    assert [step for step, _ in logged] == [50, 100, 150] and speed["steps"] == 150
     assert set(logged[0][1]) == {"loss", "train_accuracy", "lr", "val_accuracy", "val_ap"}
     assert logged[-1][1]["loss"] < logged[0][1]["loss"]
+    assert logged[-1][1]["lr"] == pytest.approx(0.01 * 0.01, rel=1e-6)  # annealed to final_lr of the start
     scores = classification_metrics(test.labels, predict(net, test, torch.device("cpu")))
     assert scores["ap"] > 0.95
+    # the kept weights are those of the best validation evaluation
+    best = max(logged, key=lambda entry: entry[1]["val_ap"])
+    assert speed["best_step"] == best[0] and scores["ap"] == pytest.approx(best[1]["val_ap"])
     assert speed["samples_per_second"] > 0
+
+
+def test_the_step_budget_follows_the_training_set():
+    settings = TrainSettings(epochs=4.0, min_steps=100, max_steps=1000, batch_size=100)
+    assert settings.steps_for(1000) == 100 and settings.steps_for(5000) == 200 and settings.steps_for(50_000) == 1000
+    assert cosine_lr(0, 11, 0.01) == 1.0 and cosine_lr(10, 11, 0.01) == pytest.approx(0.01) and cosine_lr(5, 11, 0.01) == pytest.approx(0.505)
+    with pytest.raises(ValueError, match="min_steps"):
+        TrainSettings(min_steps=10, max_steps=5)
+
+
+def test_depth_minus_gripper_input_sees_heights_relative_to_the_gripper():
+    images, z = torch.full((3, 1, 32, 32), 0.7), torch.tensor([0.6, 0.65, 0.7])
+    net = GQCNN(GQCNNConfig(filters=4, fc=8, pose_fc=4, image_input="depth_minus_gripper"))
+    assert torch.allclose(net.image_input(images, z)[:, 0, 0, 0], torch.tensor([0.1, 0.05, 0.0]))
+    assert torch.equal(GQCNN(GQCNNConfig(filters=4, fc=8, pose_fc=4)).image_input(images, z), images)

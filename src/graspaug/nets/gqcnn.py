@@ -4,7 +4,8 @@
                   [─ maxpool 2 (2018 config)] ─ fc3 (1024) ─┐
     gripper depth z ─ pc1 (16) ─────────────────────────────┴─ fc4 (1024) ─ fc5 (2 logits)
 
-ReLU after every layer but fc5, SAME padding, LRN over 5 channels (TF depth radius 2,
+With ``image_input = depth_minus_gripper`` the conv layers see the crop minus the gripper
+depth (gqcnn's ``im_depth_sub``). ReLU after every layer but fc5, SAME padding, LRN over 5 channels (TF depth radius 2,
 α 2e-5, β 0.75, bias 1), weights ~ N(0, 2 / fan_in). fc4 sums fc3 and pc1 through their own
 weights (Dex-Net's merge). Paper widths: 64 filters, fc3 = fc4 = 1024; the CPU default is
 narrower (``GQCNNConfig``). Inputs are normalized by the training set's statistics, kept in
@@ -68,6 +69,13 @@ class GQCNN(nn.Module):
         for name in ("image_mean", "image_std", "z_mean", "z_std"):
             self.register_buffer(name, torch.tensor(0.0 if name.endswith("mean") else 1.0))
 
+    def image_input(self, images: torch.Tensor, z: torch.Tensor) -> torch.Tensor:
+        """What the conv layers see before normalization: depth crops (N, 1, S, S), m, or the
+        crops minus the gripper depths z (N,)."""
+        if self.config.image_input == "depth_minus_gripper":
+            return images - z.view(-1, 1, 1, 1)
+        return images
+
     def set_normalization(self, image_mean: float, image_std: float, z_mean: float, z_std: float) -> None:
         """Scalar statistics of the training images and gripper depths (m)."""
         for name, value in (("image_mean", image_mean), ("image_std", image_std), ("z_mean", z_mean), ("z_std", z_std)):
@@ -75,7 +83,7 @@ class GQCNN(nn.Module):
 
     def forward(self, images: torch.Tensor, z: torch.Tensor) -> torch.Tensor:
         """Logits (N, 2) [failure, success] for depth crops (N, 1, S, S) and gripper depths (N,), meters."""
-        x = (images - self.image_mean) / self.image_std
+        x = (self.image_input(images, z) - self.image_mean) / self.image_std
         x = F.relu(self.conv1_1(x))
         x = self.lrn(F.relu(self.conv1_2(x)))
         x = F.max_pool2d(x, 2)

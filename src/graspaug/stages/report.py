@@ -1,13 +1,14 @@
-"""Stage ``report``: the paper's GQ-CNN experiment in one table, three figures and plain words.
+"""Stage ``report``: the paper's GQ-CNN experiment in one table, declared contrasts with
+intervals, three figures and plain words.
 
-Reads every trained network (``models/gqcnn/<pool>/<B>-<R>-s<seed>/``: summary and test
-predictions) that params ask for. Writes ``metrics/ap.json`` (test AP mean / std / n per
-pool, base size and ratio; the best ratio per base size; targeted minus random),
-``reports/gqcnn/ap_table.csv`` and, in ``reports/gqcnn/``: ``report.md``, ``ap_vs_ratio.png``
-(Fig. 7), ``improvement_by_score.png`` (Fig. 8: per-object AP improvement of the largest base
-size's best ratio over ratio 0, by rarity and graspness interval, with the histograms of the
-selected and generated shapes) and ``tsne_graspness.png`` (Fig. 1: t-SNE of the original
-train and generated latents, colored by graspness).
+Reads every network of every seed (``models/gqcnn/s<seed>/``). Writes ``metrics/ap.json``
+(``contrasts``: per declared contrast ``mean``, ``ci_low``/``ci_high`` (95% t over seeds),
+``n_seeds``, ``sd``, ``boot_low``/``boot_high`` (95% bootstrap over test objects); ``networks``:
+test / validation / per-object AP per pool, base size, ratio; ``chosen_ratio`` per base size,
+picked on validation AP), ``reports/gqcnn/ap_table.csv`` and, in ``reports/gqcnn/``:
+``report.md``, ``ap_vs_ratio.png`` (Fig. 7), ``improvement_by_score.png`` (Fig. 8: per-object AP
+change of the chosen ratio over 1:0 at the largest base size, by rarity and graspness interval)
+and ``tsne_graspness.png`` (Fig. 1).
 """
 from __future__ import annotations
 
@@ -18,11 +19,13 @@ import numpy as np
 import pandas as pd
 
 from graspaug.config import Params
-from graspaug.experiments.ap import ap_table, collect, improvement_panels, per_object_ap, predictions, report_markdown, variants, verdicts
+from graspaug.experiments.ap import (choose_ratios, collect, declared_contrasts, evaluate_contrasts, improvement_panels, network_table, per_object_ap,
+                                    report_markdown, test_predictions, test_rows, verdict)
+from graspaug.experiments.networks import seed_variants
 from graspaug.generation import ratio_count
 from graspaug.io.atomic import atomic_path
 from graspaug.io.tables import read_table, write_csv, write_json
-from graspaug.paths import AP_METRICS, LATENTS, REPORT_DIR, SCORES, base_set_table, generated_index, gqcnn_dir, gqcnn_model_dir, grasps_table
+from graspaug.paths import AP_METRICS, LATENTS, REPORT_DIR, SCORES, base_set_table, generated_index, gqcnn_dir, grasps_table
 from graspaug.scores import rarity
 
 log = logging.getLogger(__name__)
@@ -31,61 +34,65 @@ log = logging.getLogger(__name__)
 def run(params: Params) -> None:
     from graspaug.plots import ap_vs_ratio, improvement_by_interval, scatter_colored
 
-    asked = variants(params.generate, params.gqcnn)
-    runs = collect(asked)  # a missing network is a FileNotFoundError, which the CLI prints in one line
-    first = asked[0]
-    positive_share = json.loads((gqcnn_model_dir(*first) / "summary.json").read_text())["test"]["positive_share"]
-    if runs.ap.isna().all():
-        log.warning("report: the test set has only one class, so no network has an AP")
-    table = ap_table(runs)
-    summary, words = verdicts(runs, table)
-    summary["test_positive_share"] = positive_share
-    write_csv(table, REPORT_DIR / "ap_table.csv")
-    wide = table.assign(curve=table.pool + "_" + table.base_size.astype(str)).pivot(index="ratio", columns="curve", values="ap_mean")
-    write_csv(wide.reset_index(), REPORT_DIR / "ap_vs_ratio.csv")  # one column per curve, for `dvc plots`
-    asked = {gqcnn_model_dir(*v) for v in asked}
-    extra = sorted(str(p) for p in gqcnn_model_dir("targeted", 0, 0, 0).parent.parent.glob("*/*") if p.is_dir() and p not in asked)
-    if extra:
-        log.warning("report: models/gqcnn holds %d networks params do not ask for (left out; `dvc gc -w` or delete them): %s", len(extra), extra[:4])
-
-    curves = {}
-    for (pool, base), rows in table.groupby(["pool", "base_size"], sort=False):
-        curves[f"B = {base}, {pool}"] = (rows.ratio.to_numpy(), rows.ap_mean.to_numpy(), np.nan_to_num(rows.ap_std.to_numpy()))
-    ap_vs_ratio(curves, REPORT_DIR / "ap_vs_ratio.png", f"Test AP vs augmentation ratio (seeds: {list(params.gqcnn.seeds)}; error bars: std over seeds)")
-
-    # Fig. 8: the largest base size, its best targeted ratio against ratio 0
-    base = max(params.generate.base_sizes)
-    best = summary.get(str(base), {}).get("best_ratio", 0.0)
-    compare = best if best > 0 else max(params.generate.ratios)
+    gen, cfg, seeds = params.generate, params.gqcnn, list(params.gqcnn.seeds)
+    variants = seed_variants(gen.base_sizes, gen.ratios, cfg.augment_base_sizes, cfg.ceiling)
+    runs = collect(seeds, variants)  # a missing network is a FileNotFoundError, which the CLI prints in one line
+    chosen = choose_ratios(runs, cfg.augment_base_sizes)
+    contrasts = declared_contrasts(gen.base_sizes, gen.ratios, cfg.augment_base_sizes, chosen)
     index = read_table(gqcnn_dir("original") / "index.parquet")
-    changes = []
-    for seed in params.gqcnn.seeds:  # per-object AP change per seed, then the mean over seeds
-        after, rows = predictions("targeted", base, compare, seed)
-        before, _ = predictions("targeted", base, 0.0, seed)
-        labels, shape_ids = index.label.to_numpy()[rows], index.shape_id.to_numpy()[rows]
-        changes.append(per_object_ap(labels, after, shape_ids) - per_object_ap(labels, before, shape_ids))
-    improvement = pd.concat(changes, axis=1).mean(axis=1).dropna()
+    rows = test_rows(seeds[0])
+    labels, object_ids = index.label.to_numpy()[rows], index.shape_id.to_numpy()[rows]
+    results = evaluate_contrasts(contrasts, runs, seeds, labels, object_ids, n_resamples=1000, seed=params.seed)
+    per_object, changes = [], {}
+    for seed in seeds:
+        for v in variants:
+            ap = per_object_ap(labels, test_predictions((v.pool, v.base_size, v.ratio), seed), object_ids)
+            per_object.append({"pool": v.pool, "base_size": v.base_size, "ratio": float(v.ratio), "seed": seed, "per_object_ap": ap.mean()})
+            changes[v.pool, v.base_size, float(v.ratio), seed] = ap
+    table = network_table(runs, pd.DataFrame(per_object))
+    write_csv(table, REPORT_DIR / "ap_table.csv")
+    curves_table = table[table.pool != "ceiling"].assign(curve=lambda t: t.pool + "_" + t.base_size.astype(str))
+    write_csv(curves_table.pivot(index="ratio", columns="curve", values="test_ap").reset_index(), REPORT_DIR / "ap_vs_ratio.csv")  # for `dvc plots`
+    mean_ap = table.set_index(["pool", "base_size", "ratio"]).test_ap
+    extras = []
+    for b in cfg.augment_base_sizes:
+        t, r = results.get(f"targeted_vs_none@{b}"), results.get(f"targeted_vs_real@{b}")
+        real_gain = t["mean"] - r["mean"] if t and r and None not in (t["mean"], r["mean"]) else 0.0  # mean over R of AP(real, B, R) - AP(B, 1:0)
+        if real_gain:
+            extras.append(f"At B = {b}, generated shapes give {t['mean'] / real_gain:.0%} of the gain of the same number of real shapes "
+                          f"({t['mean']:+.4f} vs {real_gain:+.4f} AP, mean over ratios; a ratio of means, no interval).")
+    if cfg.ceiling and ("ceiling", 0, 0.0) in mean_ap:
+        for b, r in chosen.items():
+            none, best, top = mean_ap.get(("targeted", b, 0.0)), mean_ap.get(("targeted", b, r)), mean_ap[("ceiling", 0, 0.0)]
+            if None not in (none, best) and np.isfinite(top - none) and top != none:
+                extras.append(f"B = {b}: the ceiling (all {len(index[index.split == 'train'].shape_id.unique()) - cfg.val_shapes} train shapes "
+                              f"outside validation) reaches {top:.4f}; 1:{r:g} closes {(best - none) / (top - none):.0%} of the gap from 1:0 ({none:.4f}).")
+
+    curves = {f"B = {b}, {pool}": (g.ratio.to_numpy(), g.test_ap.to_numpy(), np.nan_to_num(g.test_ap_ci.to_numpy(dtype=float)))
+              for (pool, b), g in table[table.pool != "ceiling"].groupby(["pool", "base_size"], sort=False)}
+    if cfg.ceiling:
+        curves["ceiling (all train shapes)"] = (np.asarray(gen.ratios), np.full(len(gen.ratios), mean_ap[("ceiling", 0, 0.0)]), np.zeros(len(gen.ratios)))
+    ap_vs_ratio(curves, REPORT_DIR / "ap_vs_ratio.png", f"Test AP vs augmentation ratio (seeds {seeds}; error bars: 95% t-interval)")
+
+    # Fig. 8: the largest augmented base size, its ratio chosen on validation against 1:0
+    base = max(cfg.augment_base_sizes)
+    compare = chosen.get(base, max(gen.ratios))
+    improvement = pd.concat([changes["targeted", base, compare, s] - changes["targeted", base, 0.0, s] for s in seeds], axis=1).mean(axis=1).dropna()
     scores = read_table(SCORES).set_index("shape_id")
-    base_set = read_table(base_set_table(base))
-    generated = read_table(generated_index(base))
+    base_set, generated = read_table(base_set_table(base)), read_table(generated_index(base))
     generated = generated[(generated.pool == "targeted") & (generated.order < ratio_count(compare, base))]
     grasps = read_table(grasps_table(f"gen_{base}"))
     generated_graspness = grasps.groupby("shape_id").success.mean().reindex(generated.shape_id).fillna(0.0).to_numpy()
-    # test objects' rarity on the same scale as the selected and generated shapes': against the base set
-    latents = read_table(LATENTS).set_index("shape_id")
+    latents = read_table(LATENTS).set_index("shape_id")  # test objects' rarity against the base set, as the selected shapes'
     z_base = np.stack(latents.loc[base_set.shape_id, "z"].to_numpy())
-    test_rarity = pd.Series(rarity(z_base, min(params.score.k, len(z_base) - 1), query=np.stack(latents.loc[improvement.index, "z"].to_numpy()))
-                            if len(improvement) else [], index=improvement.index, dtype=float)
-    panels = improvement_panels(base_set, generated, generated_graspness, test_rarity.to_numpy(),
-                                scores.loc[improvement.index, "graspness"].to_numpy(), improvement.to_numpy())
+    test_rarity = rarity(z_base, min(params.score.k, len(z_base) - 1), query=np.stack(latents.loc[improvement.index, "z"].to_numpy())) \
+        if len(improvement) else np.zeros(0)
+    panels = improvement_panels(base_set, generated, generated_graspness, np.asarray(test_rarity), scores.loc[improvement.index, "graspness"].to_numpy(),
+                                improvement.to_numpy())
     improvement_by_interval(panels, REPORT_DIR / "improvement_by_score.png",
-                            f"B = {base}: per-object test AP, ratio 1:{compare:g} minus 1:0 ({len(improvement)} test objects with both labels)")
-    summary["per_object"] = {"base_size": base, "ratio": compare, "objects": int(len(improvement)),
-                             "mean_improvement": round(float(improvement.mean()), 5) if len(improvement) else None,
-                             "improved_share": round(float((improvement > 0).mean()), 4) if len(improvement) else None}
+                            f"B = {base}: per-object test AP, 1:{compare:g} minus 1:0, mean over seeds ({len(improvement)} test objects with both labels)")
 
-    # Fig. 1: t-SNE of original train and generated latents by graspness
-    from sklearn.manifold import TSNE
+    from sklearn.manifold import TSNE  # Fig. 1: t-SNE of original train and generated latents by graspness
 
     latents = latents.reset_index()
     train = latents[latents.split == "train"]
@@ -95,13 +102,17 @@ def run(params: Params) -> None:
     xy = TSNE(n_components=2, perplexity=min(params.embed.perplexity, (len(z) - 1) / 3), init="pca", random_state=params.seed).fit_transform(z)
     scatter_colored(xy, graspness, groups, REPORT_DIR / "tsne_graspness.png", "t-SNE of the AE-Critic latents, colored by graspness (paper Fig. 1)", "graspness")
 
-    ap = {pool: {str(b): {f"{r:g}": {"mean": None if np.isnan(m) else round(m, 5), "std": None if np.isnan(s) else round(s, 5), "n": int(n)}
-                          for r, m, s, n in zip(rows.ratio, rows.ap_mean, rows.ap_std, rows.n)}
-                 for b, rows in frame.groupby("base_size")} for pool, frame in table.groupby("pool")}
-    write_json({"ap": ap, "summary": summary, "seeds": list(params.gqcnn.seeds)}, AP_METRICS)
+    positive_share = float(labels.mean())
+    networks = {pool: {str(b): {f"{r:g}": {k: (None if v is None or not np.isfinite(v) else round(float(v), 5)) for k, v in row.items()}
+                                for r, row in g.set_index("ratio")[["test_ap", "test_ap_ci", "per_object_ap", "val_ap"]].iterrows()}
+                       for b, g in frame.groupby("base_size")} for pool, frame in table.groupby("pool")}
+    write_json({"contrasts": results, "networks": networks, "chosen_ratio": {str(b): r for b, r in chosen.items()},
+                "summary": {str(b): {"best_ratio": r, "chosen_on": "validation AP"} for b, r in chosen.items()},
+                "test_positive_share": round(positive_share, 5), "seeds": seeds}, AP_METRICS)
+    t = cfg.train
+    train_words = (f"Each network trains {t.epochs:g} passes over its own training set ({t.min_steps}-{t.max_steps} steps of {t.batch_size}), "
+                   f"the learning rate annealed to {t.final_lr:g} of its start, and keeps the weights with the best validation AP.")
     with atomic_path(REPORT_DIR / "report.md") as tmp:
-        tmp.write_text(report_markdown(table, words, summary, list(params.gqcnn.seeds), params.gqcnn.train.steps, params.gqcnn.train.batch_size))
-    for line in words:
-        log.info("report: %s", line)
-
-
+        tmp.write_text(report_markdown(table, results, chosen, extras, seeds, positive_share, train_words))
+    for name, c in results.items():
+        log.info("report: %s", verdict(name, c))

@@ -1,90 +1,85 @@
-"""Stage ``train_gqcnn``: one GQ-CNN for one base size B, augmentation ratio R, pool and seed.
+"""Stage ``train_gqcnn``: every GQ-CNN of one training seed, as a paired set.
 
-Training set: the rendered datapoints of the B base shapes (``data/gqcnn/original``, shapes
-of ``data/generated/B/base.parquet``) plus those of the first round(R × B) shapes of B's
-``targeted`` (or ``random``) pool (``data/gqcnn/gen_B``); a ``val_fraction`` of its views is
-held out for the validation curves. Test set: every test-split datapoint of
-``data/gqcnn/original``. Budget rule: ``gqcnn.steps`` SGD steps for every variant.
+Networks (``graspaug.experiments.networks.seed_variants``): targeted at every base size ×
+ratio of ``generate``; random and real at every nonzero ratio of ``gqcnn.augment_base_sizes``;
+the ceiling. All start from the seed's initial weights and noise stream and are validated on
+the same ``gqcnn.val_shapes`` train shapes (``graspaug.training.gqcnn_data``); each keeps the
+weights of its best validation AP. Networks train in parallel (``n_jobs`` processes, one
+thread each on the CPU). Test set: every test-split datapoint of ``data/gqcnn/original``.
 
-Outputs: ``models/gqcnn/<pool>/<B>-<R>-s<seed>/`` (``model.pt``: config, weights, training
-summary; ``summary.json``; ``timing.json``: seconds and samples/s; ``test_predictions.npy``:
-P(success) per test datapoint and ``test_rows.npy``: their rows in the original index),
-``metrics/gqcnn/<pool>/<B>-<R>-s<seed>.json`` (test AP, accuracy, ROC AUC; stable keys for
-``dvc metrics diff``) and the DVCLive curves in ``metrics/gqcnn/<pool>/<B>-<R>-s<seed>/``.
+Outputs: ``models/gqcnn/s<seed>/`` (one folder per network, ``test_rows.npy``,
+``val_rows.npy``, ``split.json``), ``metrics/gqcnn/s<seed>.json`` (validation and test AP per
+network), ``reports/gqcnn/validation/s<seed>.{png,csv}`` (validation AP vs step of every
+network) and ``reports/timing/train_gqcnn/s<seed>.json``.
 """
 from __future__ import annotations
 
-import dataclasses
 import json
 import logging
+import os
 import time
 
 import numpy as np
-import torch
 
 from graspaug.config import Params
 from graspaug.device import resolve_device
+from graspaug.experiments.networks import (NetworkJob, expected_cost, initial_weights, read_history, seed_table, seed_variants,
+                                           stream_seeds, train_network)
 from graspaug.io.atomic import atomic_path
-from graspaug.io.tables import write_json
-from graspaug.nets.gqcnn import GQCNN
-from graspaug.paths import gqcnn_live, gqcnn_metrics, gqcnn_model_dir
+from graspaug.io.tables import write_csv, write_json
+from graspaug.parallel import Workers, parallel_map
+from graspaug.paths import gqcnn_seed_dir, gqcnn_seed_metrics, gqcnn_val_curves, timing_file
 from graspaug.stages import StageError
-from graspaug.training.gqcnn import classification_metrics, predict, train_gqcnn
-from graspaug.training.gqcnn_data import POOLS, held_out_views, test_set, training_set
+from graspaug.training.gqcnn_data import load_split, shapes_datapoints, test_set
 
 log = logging.getLogger(__name__)
 
-def run(params: Params, base_size: int, ratio: float, pool: str = "targeted", seed: int = 0) -> None:
-    cfg = params.gqcnn
-    if pool not in POOLS:
-        raise StageError(f"unknown pool {pool!r}; known: {', '.join(POOLS)}")
-    if base_size not in params.generate.base_sizes:
-        raise StageError(f"base size {base_size} is not in generate.base_sizes {list(params.generate.base_sizes)}")
-    if float(ratio) not in params.generate.ratios:
-        raise StageError(f"ratio {ratio} is not in generate.ratios {list(params.generate.ratios)}")
+
+def run(params: Params, seed: int) -> None:
+    from graspaug.plots import validation_curves
+
+    cfg, gen = params.gqcnn, params.generate
+    if seed not in cfg.seeds:
+        raise StageError(f"seed {seed} is not in gqcnn.seeds {list(cfg.seeds)}")
     start = time.perf_counter()
+    try:
+        split = load_split(list(gen.base_sizes), cfg.val_shapes, params.seed)
+    except ValueError as exc:
+        raise StageError(str(exc)) from None
+    variants = seed_variants(gen.base_sizes, gen.ratios, cfg.augment_base_sizes, cfg.ceiling)
     device = resolve_device(params.device)
-    train, keys, info = training_set(base_size, ratio, pool)
-    if len(train) < 2:
-        raise StageError(f"training set of {base_size}-{ratio} ({pool}) has {len(train)} datapoints; render the corpora first")
-    if train.labels.min() == train.labels.max():
-        log.warning("train_gqcnn %s %d-%s: all %d training datapoints have label %d; the network cannot learn to rank",
-                    pool, base_size, ratio, len(train), int(train.labels[0]))
-    is_val = held_out_views(keys, cfg.val_fraction, params.seed, seed)
-    val, fit = train.subset(np.flatnonzero(is_val)), train.subset(np.flatnonzero(~is_val))
-    test, test_rows = test_set()
-
-    torch.manual_seed(params.seed * 1_000_003 + seed)
-    net = GQCNN(cfg.net)
-    gen = torch.Generator().manual_seed(params.seed * 1_000_003 + seed + 1)
-    from dvclive import Live
-
-    live_dir = gqcnn_live(pool, base_size, ratio, seed)
-    log.info("train_gqcnn %s %d-%s seed %d: %d train / %d val datapoints (%d base + %d generated shapes), %d test, %s on %s",
-             pool, base_size, ratio, seed, len(fit), len(val), info["base_shapes"], info["generated_shapes"], len(test), net.describe(), device)
-    with Live(str(live_dir), dvcyaml=False, save_dvc_exp=False) as live:
-        def on_log(step: int, metrics: dict[str, float]) -> None:
-            live.step = step  # x axis: SGD steps
-            for name, value in metrics.items():
-                live.log_metric(name, value)
-
-        speed = train_gqcnn(net, fit, val if len(val) else None, cfg.train, device, gen, on_log)
-    probability = predict(net, test, device)
-    scores = classification_metrics(test.labels, probability)
-    summary = {  # the metrics file: stable keys, no timings (they would show in every `dvc metrics diff`)
-        "pool": pool, "base_size": base_size, "ratio": float(ratio), "seed": seed,
-        "test": {k: (round(v, 5) if isinstance(v, float) else v) for k, v in scores.items()},
-        "train": {**info, "fit_datapoints": len(fit), "val_datapoints": len(val)},
-        "steps": cfg.train.steps, "batch_size": cfg.train.batch_size, "parameters": net.describe()["parameters"],
-    }
-    timing = {"samples_per_second": round(speed["samples_per_second"], 1), "seconds": round(time.perf_counter() - start, 1)}
-    with atomic_path(gqcnn_model_dir(pool, base_size, ratio, seed), directory=True) as folder:
-        torch.save({"config": dataclasses.asdict(net.config), "state_dict": net.state_dict(), "summary": summary}, folder / "model.pt")
-        (folder / "timing.json").write_text(json.dumps(timing) + "\n")
-        np.save(folder / "test_predictions.npy", probability)
+    workers = params.workers if device.type == "cpu" else Workers(n_jobs=1)
+    n_jobs = (os.cpu_count() or 1) if workers.n_jobs == -1 else workers.n_jobs
+    threads = max(1, (os.cpu_count() or 1) // n_jobs) if workers.executor == "joblib" else 1
+    weight_seed, noise_seed = stream_seeds(params.seed, seed)
+    init = initial_weights(cfg.net, weight_seed)
+    _, val_rows = shapes_datapoints(split.validation)
+    _, test_rows = test_set()
+    log.info("train_gqcnn seed %d: %d networks; validation %d shapes (%d datapoints), test %d datapoints; %d worker(s) × %d thread(s) on %s",
+             seed, len(variants), len(split.validation), len(val_rows), len(test_rows), n_jobs, threads, device)
+    with atomic_path(gqcnn_seed_dir(seed), directory=True) as folder:
+        folder = folder.resolve()  # worker processes may have another working directory
+        jobs = [NetworkJob(v, split, cfg.net, cfg.train, init, noise_seed, seed, str(device), threads, folder) for v in variants]
+        jobs.sort(key=lambda j: -expected_cost(j.variant, split, cfg.train))  # longest first: the workers finish together
+        try:
+            results = parallel_map(train_network, jobs, workers, f"train GQ-CNNs (seed {seed})")
+        except ValueError as exc:
+            raise StageError(str(exc)) from None
         np.save(folder / "test_rows.npy", test_rows)
-        (folder / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
-    write_json(summary, gqcnn_metrics(pool, base_size, ratio, seed))
-    log.info("train_gqcnn %s %d-%s seed %d: test AP %.4f, accuracy %.4f, ROC AUC %.4f; %.0f samples/s, %.1f s", pool, base_size, ratio, seed,
-             scores["ap"] or float("nan"), scores["accuracy"], scores["roc_auc"] or float("nan"), timing["samples_per_second"], timing["seconds"])
-
+        np.save(folder / "val_rows.npy", val_rows)
+        (folder / "split.json").write_text(json.dumps({"validation": split.validation, "real_pool": split.real_pool,
+                                                       "base": {str(b): ids for b, ids in split.base.items()}}, indent=1) + "\n")
+        history = read_history(folder, variants)
+    write_csv(history, gqcnn_val_curves(seed).with_suffix(".csv"))
+    validation_curves(history, gqcnn_val_curves(seed), f"Validation AP of every network of seed {seed} (dots: the kept weights)")
+    write_json({"seed": seed, "networks": seed_table(results)}, gqcnn_seed_metrics(seed))
+    speed = [r["samples_per_second"] for r in results]
+    write_json({"seconds": round(time.perf_counter() - start, 1), "networks": len(results), "workers": n_jobs, "threads": threads,
+                "samples_per_second_median": round(float(np.median(speed)), 1),
+                "train_seconds": {f"{r['pool']}/{r['base_size']}-{r['ratio']:g}": round(r["train_seconds"], 1) for r in results}},
+               timing_file("train_gqcnn", f"s{seed}"))
+    for r in sorted(results, key=lambda r: (r["pool"], r["base_size"], r["ratio"])):
+        log.info("train_gqcnn seed %d %s %d-%g: %d datapoints, %d steps (kept %d); validation AP %.4f, test AP %.4f",
+                 seed, r["pool"], r["base_size"], r["ratio"], r["train"]["datapoints"], r["train"]["steps"], r["train"]["best_step"],
+                 r["validation"]["ap"] or float("nan"), r["test"]["ap"] or float("nan"))
+    log.info("train_gqcnn seed %d: %d networks in %.1f s", seed, len(results), time.perf_counter() - start)

@@ -2,11 +2,14 @@
 
 Datapoints travel as :class:`GraspArrays`: depth crops (N, S, S) float32 (m), gripper depths
 (N,) (m), labels (N,) 0/1. Every random choice (batch order, noise, symmetrization) comes from
-one ``torch.Generator``. The budget rule is a fixed number of SGD steps for every training
-set, so a larger (augmented) set gets no more compute than a smaller one.
+one ``torch.Generator``. The budget rule is a number of passes over each network's own
+training set (with a step cap), the learning rate annealed along a cosine, and the weights
+with the best validation AP kept: every variant is trained to about the same convergence.
 """
 from __future__ import annotations
 
+import copy
+import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -18,8 +21,7 @@ from sklearn.metrics import accuracy_score, average_precision_score, roc_auc_sco
 from tqdm import tqdm
 
 from graspaug.nets.gqcnn import GQCNN
-from graspaug.training.settings import NoiseSettings
-from graspaug.training.settings import TrainSettings
+from graspaug.training.settings import NoiseSettings, TrainSettings
 
 
 @dataclass(frozen=True)
@@ -40,9 +42,10 @@ class GraspArrays:
 LogCallback = Callable[[int, dict[str, float]], None]
 
 
-def normalization(train: GraspArrays) -> tuple[float, float, float, float]:
-    """One scalar image mean / std and z mean / std of the training data (Dex-Net)."""
-    return (float(train.images.mean()), float(train.images.std()) or 1.0, float(train.z.mean()), float(train.z.std()) or 1.0)
+def normalization(net: GQCNN, train: GraspArrays) -> tuple[float, float, float, float]:
+    """One scalar mean / std of what the conv layers see and of z over the training data (Dex-Net)."""
+    images = net.image_input(torch.from_numpy(np.ascontiguousarray(train.images)).unsqueeze(1), torch.from_numpy(train.z.astype(np.float32)))
+    return (float(images.mean()), float(images.std()) or 1.0, float(train.z.mean()), float(train.z.std()) or 1.0)
 
 
 def augment(images: torch.Tensor, z: torch.Tensor, noise: NoiseSettings, gen: torch.Generator) -> tuple[torch.Tensor, torch.Tensor]:
@@ -93,28 +96,39 @@ def classification_metrics(labels: np.ndarray, probability: np.ndarray) -> dict[
     }
 
 
+def cosine_lr(step: int, steps: int, final: float) -> float:
+    """Learning-rate factor at ``step`` (0-based) of ``steps``: 1 at the start, ``final`` at the last step."""
+    return final + (1 - final) * 0.5 * (1 + math.cos(math.pi * step / max(steps - 1, 1)))
+
+
 def train_gqcnn(net: GQCNN, train: GraspArrays, val: GraspArrays | None, settings: TrainSettings, device: torch.device, gen: torch.Generator,
-                on_log: LogCallback | None = None) -> dict[str, float]:
-    """Train ``net`` for ``settings.steps`` SGD steps on batches drawn epoch by epoch from
-    ``train`` (softmax cross-entropy); every ``log_every`` steps report the mean loss and train
-    accuracy since the last report and, if ``val`` is given, its accuracy and AP. Returns
-    throughput figures."""
+                on_log: LogCallback | None = None, progress: bool = True) -> dict:
+    """Train ``net`` for ``settings.steps_for(len(train))`` SGD steps on batches drawn epoch by
+    epoch from ``train`` (softmax cross-entropy), evaluating validation AP ``settings.evals``
+    times; ``net`` ends with the weights of the best evaluation (the last ones without ``val``).
+    ``on_log(step, metrics)`` gets the mean loss and train accuracy since the last evaluation,
+    the learning rate and the validation AP / accuracy. Returns the steps, the best step and
+    validation AP, and throughput."""
     if len(train) < 2:
         raise ValueError(f"need at least 2 training datapoints, got {len(train)}")
-    net.set_normalization(*normalization(train))
+    net.set_normalization(*normalization(net, train))
     net.to(device)
+    steps = settings.steps_for(len(train))
     opt = torch.optim.SGD(net.parameters(), lr=settings.lr, momentum=settings.momentum, weight_decay=settings.weight_decay)
-    schedule = torch.optim.lr_scheduler.StepLR(opt, step_size=settings.decay_steps, gamma=settings.lr_decay)
+    schedule = torch.optim.lr_scheduler.LambdaLR(opt, lambda step: cosine_lr(step, steps, settings.final_lr))
+    eval_at = {int(round(steps * (i + 1) / settings.evals)) for i in range(settings.evals)}
     images = torch.from_numpy(np.ascontiguousarray(train.images)).unsqueeze(1)
     z = torch.from_numpy(np.ascontiguousarray(train.z, dtype=np.float32))
     labels = torch.from_numpy(np.asarray(train.labels, dtype=np.int64))
     order, cursor = torch.randperm(len(train), generator=gen), 0
+    batch_size = min(settings.batch_size, len(train))
+    best = {"step": steps, "val_ap": float("nan"), "state": None}
     loss_sum, correct, seen, start = 0.0, 0, 0, time.perf_counter()
-    for step in tqdm(range(1, settings.steps + 1), desc="train GQ-CNN", unit="step"):
-        if cursor + settings.batch_size > len(order):
+    for step in tqdm(range(1, steps + 1), desc="train GQ-CNN", unit="step", disable=not progress):
+        if cursor + batch_size > len(order):
             order, cursor = torch.randperm(len(train), generator=gen), 0
-        idx = order[cursor : cursor + settings.batch_size]
-        cursor += settings.batch_size
+        idx = order[cursor : cursor + batch_size]
+        cursor += batch_size
         net.train()
         batch, depth = augment(images[idx], z[idx], settings.noise, gen)
         logits = net(batch.to(device), depth.to(device))
@@ -123,16 +137,24 @@ def train_gqcnn(net: GQCNN, train: GraspArrays, val: GraspArrays | None, setting
         opt.zero_grad(set_to_none=True)
         loss.backward()
         opt.step()
+        lr_used = schedule.get_last_lr()[0]
         schedule.step()
         loss_sum += loss.item() * len(idx)
         correct += int((logits.argmax(1) == target).sum())
         seen += len(idx)
-        if on_log is not None and (step % settings.log_every == 0 or step == settings.steps):
-            metrics = {"loss": loss_sum / seen, "train_accuracy": correct / seen, "lr": schedule.get_last_lr()[0]}
+        if step in eval_at:
+            metrics = {"loss": loss_sum / seen, "train_accuracy": correct / seen, "lr": lr_used}
             if val is not None and len(val):
                 scores = classification_metrics(val.labels, predict(net, val, device, settings.eval_batch))
-                metrics.update(val_accuracy=scores["accuracy"], val_ap=scores["ap"] if scores["ap"] is not None else float("nan"))
-            on_log(step, metrics)
+                ap = scores["ap"] if scores["ap"] is not None else float("nan")
+                metrics.update(val_accuracy=scores["accuracy"], val_ap=ap)
+                if best["state"] is None or (math.isfinite(ap) and not ap <= best["val_ap"]):  # ties keep the earlier; a NaN is replaced
+                    best = {"step": step, "val_ap": ap, "state": copy.deepcopy(net.state_dict())}
+            if on_log is not None:
+                on_log(step, metrics)
             loss_sum, correct, seen = 0.0, 0, 0
     seconds = time.perf_counter() - start
-    return {"train_seconds": seconds, "samples_per_second": settings.steps * settings.batch_size / seconds}
+    if best["state"] is not None:
+        net.load_state_dict(best["state"])
+    return {"steps": steps, "best_step": best["step"], "best_val_ap": best["val_ap"], "train_seconds": seconds,
+            "samples_per_second": steps * batch_size / seconds}

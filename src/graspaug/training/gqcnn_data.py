@@ -1,60 +1,125 @@
-"""The GQ-CNN experiment's datasets: training sets (base shapes + a share of a generated pool),
-the validation views held out of them, and the test set, read from the rendered corpora.
+"""The GQ-CNN experiment's datasets, object-wise: which train-split shapes validate, which form
+the `real` pool and the ceiling, and the datapoints of every training set, the validation set
+and the test set, read from the rendered corpora.
 
-Datapoints are :class:`~graspaug.training.gqcnn.GraspArrays`. The training set of base size B,
-ratio R and pool P is the datapoints of the B base shapes (``data/generated/B/base.parquet``)
-in ``data/gqcnn/original`` plus those of the first round(R × B) shapes of pool P in
-``data/gqcnn/gen_B``; the test set is every test-split datapoint of ``data/gqcnn/original``.
+Datapoints are :class:`~graspaug.training.gqcnn.GraspArrays`. A network is a :class:`Variant`:
+
+* ``targeted`` / ``random`` at base size B and ratio R: the datapoints of the B base shapes
+  (``data/generated/B/base.parquet``) in ``data/gqcnn/original`` plus those of the first
+  round(R × B) shapes of that pool in ``data/gqcnn/gen_B``;
+* ``real`` at B and R: the base shapes plus the first round(R × B) shapes of the real pool
+  (more train-split shapes, in a seeded order);
+* ``ceiling``: every train-split shape outside validation.
+
+Validation is a fixed, seeded set of train-split shapes that lie in no base set and in no
+pool: the same for every variant, pool and training seed, never trained on. Ratio 0 of any
+pool is the base set alone (the ``targeted`` network).
 """
 from __future__ import annotations
 
-import zlib
+from dataclasses import dataclass
 
 import numpy as np
+import pandas as pd
 
 from graspaug.generation import ratio_count
 from graspaug.io.gqcnn import GraspImages
 from graspaug.io.tables import read_table
-from graspaug.paths import base_set_table, gqcnn_dir
+from graspaug.paths import base_set_table, gqcnn_dir, gqcnn_variant_name
+from graspaug.rng import shape_rng
 from graspaug.training.gqcnn import GraspArrays
 
-POOLS = ("targeted", "random")
+POOLS = ("targeted", "random", "real")
+
+
+@dataclass(frozen=True, order=True)
+class Variant:
+    """One network of a seed: ``pool`` (targeted, random, real or ceiling), base size, ratio."""
+
+    pool: str
+    base_size: int = 0
+    ratio: float = 0.0
+
+    @property
+    def name(self) -> str:
+        return gqcnn_variant_name(self.pool, self.base_size, self.ratio)
+
+
+@dataclass(frozen=True)
+class ExperimentSplit:
+    """Shape ids (train split, with rendered datapoints) by role; disjoint apart from
+    ``ceiling``, which is every train shape outside ``validation``."""
+
+    base: dict[int, tuple[str, ...]]  # base size → its base shapes (nested: smaller sets lie in larger ones)
+    validation: tuple[str, ...]
+    real_pool: tuple[str, ...]  # in a seeded order; ratio R of base size B takes the first round(R·B)
+    ceiling: tuple[str, ...]
+
+
+def experiment_split(train_ids: list[str], base: dict[int, list[str]], n_validation: int, seed: int) -> ExperimentSplit:
+    """Draw the validation shapes (``n_validation``, seeded by ``seed`` alone) from the train
+    shapes in no base set; the rest of those, shuffled, is the real pool."""
+    in_base = set().union(*map(set, base.values())) if base else set()
+    free = sorted(set(train_ids) - in_base)
+    if n_validation > len(free):
+        raise ValueError(f"gqcnn.val_shapes = {n_validation}, but only {len(free)} train shapes lie outside the base sets")
+    order = [free[i] for i in shape_rng(seed, "gqcnn", "validation-and-real-pool").permutation(len(free))]
+    validation = tuple(sorted(order[:n_validation]))
+    ceiling = tuple(sorted(set(train_ids) - set(validation)))
+    return ExperimentSplit({b: tuple(sorted(ids)) for b, ids in base.items()}, validation, tuple(order[n_validation:]), ceiling)
+
+
+def load_split(base_sizes: list[int], n_validation: int, seed: int) -> ExperimentSplit:
+    """The split of the rendered original corpus and the base sets that ``generate`` drew."""
+    index = read_table(gqcnn_dir("original") / "index.parquet")
+    train_ids = sorted(index.shape_id[index.split == "train"].unique())
+    base = {b: list(read_table(base_set_table(b)).shape_id) for b in base_sizes}
+    return experiment_split(train_ids, base, n_validation, seed)
 
 
 def _arrays(data: GraspImages, rows: np.ndarray) -> GraspArrays:
     return GraspArrays(data.images(rows), data.read("z", rows), data.read("labels", rows))
 
 
-def training_set(base_size: int, ratio: float, pool: str) -> tuple[GraspArrays, np.ndarray, dict]:
-    """The datapoints of the base shapes and of the first round(R·B) shapes of the pool, their
-    view keys (for the validation split) and counts."""
-    base = set(read_table(base_set_table(base_size)).shape_id)
+def _concat(parts: list[GraspArrays]) -> GraspArrays:
+    return GraspArrays(*(np.concatenate([getattr(p, f) for p in parts]) for f in ("images", "z", "labels")))
+
+
+def shapes_datapoints(shape_ids: tuple[str, ...] | list[str]) -> tuple[GraspArrays, np.ndarray]:
+    """The original corpus's datapoints of ``shape_ids`` and their rows in its index."""
     original = GraspImages.open(gqcnn_dir("original"))
-    rows = np.flatnonzero(original.index.shape_id.isin(base).to_numpy())
-    parts = [_arrays(original, rows)]
-    keys = [("o:" + original.index.shape_id.iloc[rows] + ":" + original.index.image_id.iloc[rows].astype(str)).to_numpy()]
-    n_generated, generated_shapes = ratio_count(ratio, base_size), 0
+    rows = np.flatnonzero(original.index.shape_id.isin(set(shape_ids)).to_numpy())
+    return _arrays(original, rows), rows
+
+
+def training_shapes(variant: Variant, split: ExperimentSplit) -> tuple[list[str], int]:
+    """The original shapes a variant trains on and how many generated shapes it asks for."""
+    if variant.pool == "ceiling":
+        return list(split.ceiling), 0
+    shapes, extra = list(split.base[variant.base_size]), ratio_count(variant.ratio, variant.base_size)
+    if variant.pool == "real":
+        if extra > len(split.real_pool):
+            raise ValueError(f"real pool at B = {variant.base_size}, 1:{variant.ratio:g} needs {extra} more train shapes; "
+                             f"{len(split.real_pool)} lie outside the base sets and validation (lower gqcnn.val_shapes or the ratio)")
+        return shapes + list(split.real_pool[:extra]), 0
+    return shapes, extra
+
+
+def training_set(variant: Variant, split: ExperimentSplit) -> tuple[GraspArrays, dict]:
+    """A variant's training datapoints and their counts."""
+    shapes, n_generated = training_shapes(variant, split)
+    data, rows = shapes_datapoints(shapes)
+    parts, generated_shapes = [data], 0
     if n_generated:
-        generated = GraspImages.open(gqcnn_dir(f"gen_{base_size}"))
+        generated = GraspImages.open(gqcnn_dir(f"gen_{variant.base_size}"))
         index = generated.index
-        gen_rows = np.flatnonzero(((index.pool == pool) & (index.order < n_generated)).to_numpy())
+        gen_rows = np.flatnonzero(((index.pool == variant.pool) & (index.order < n_generated)).to_numpy())
         parts.append(_arrays(generated, gen_rows))
-        keys.append(("g:" + index.shape_id.iloc[gen_rows] + ":" + index.image_id.iloc[gen_rows].astype(str)).to_numpy())
         generated_shapes = int(index.shape_id.iloc[gen_rows].nunique())
-    data = GraspArrays(*(np.concatenate([getattr(p, f) for p in parts]) for f in ("images", "z", "labels")))
-    info = {"base_shapes": int(original.index.shape_id.iloc[rows].nunique()), "generated_shapes_asked": n_generated,
-            "generated_shapes": generated_shapes, "datapoints": len(data), "positive_share": round(float(data.labels.mean()), 4) if len(data) else None}
-    return data, np.concatenate(keys), info
-
-
-def held_out_views(keys: np.ndarray, fraction: float, *seeds: int) -> np.ndarray:
-    """(N,) bool: datapoints whose view (key) is held out for validation. Decided per view by a
-    hash of the seeds and the key, so a base shape's view is held out (or not) alike for every
-    ratio and pool: variants differ only by the generated shapes they add."""
-    prefix = ":".join(map(str, seeds)) + ":"
-    unique, inverse = np.unique(keys, return_inverse=True)
-    chosen = np.array([zlib.crc32((prefix + key).encode()) / 2**32 < fraction for key in unique], dtype=bool)
-    return chosen[inverse] if len(unique) else np.zeros(len(keys), dtype=bool)
+    data = _concat(parts)
+    info = {"original_shapes": len(shapes), "generated_shapes_asked": n_generated, "generated_shapes": generated_shapes,
+            "datapoints": len(data), "positive_share": round(float(data.labels.mean()), 4) if len(data) else None}
+    return data, info
 
 
 def test_set() -> tuple[GraspArrays, np.ndarray]:
@@ -62,3 +127,9 @@ def test_set() -> tuple[GraspArrays, np.ndarray]:
     original = GraspImages.open(gqcnn_dir("original"))
     rows = np.flatnonzero((original.index.split == "test").to_numpy())
     return _arrays(original, rows), rows
+
+
+def index_of_rows(rows: np.ndarray) -> pd.DataFrame:
+    """``shape_id`` and ``label`` of rows of the original corpus's index."""
+    index = read_table(gqcnn_dir("original") / "index.parquet")[["shape_id", "label"]]
+    return index.iloc[rows].reset_index(drop=True)

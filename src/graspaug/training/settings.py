@@ -40,15 +40,27 @@ class NoiseSettings:
 
 @settings
 class TrainSettings:
-    """SGD with momentum, L2 weight decay, and lr × ``lr_decay`` every ``decay_steps`` steps (params section ``gqcnn.train``)."""
+    """SGD with momentum and L2 weight decay, the learning rate annealed from ``lr`` to
+    ``lr × final_lr`` along a cosine, for ``epochs`` passes over the network's own training set
+    (at least ``min_steps``, at most ``max_steps`` steps); the checkpoint with the best
+    validation AP of ``evals`` evenly spaced evaluations is kept (params section ``gqcnn.train``)."""
 
-    steps: int = Field(400, ge=1, description="SGD steps per network, the same for every training set (the budget rule).")
-    batch_size: int = Field(64, ge=2, description="Datapoints per step (Dex-Net: 64-128).")
-    lr: float = Field(0.01, gt=0, description="SGD learning rate (Dex-Net: 0.01).")
+    epochs: float = Field(6.0, gt=0, description="Passes over the network's own training set (the budget rule: every variant sees each of its datapoints about as often, so a larger set gets more steps).")
+    min_steps: int = Field(300, ge=1, description="Fewest SGD steps, for the smallest training sets.")
+    max_steps: int = Field(1200, ge=1, description="Most SGD steps, a cap for the largest training sets (the CPU budget).")
+    batch_size: int = Field(128, ge=2, description="Datapoints per step (Dex-Net: 64-128).")
+    lr: float = Field(0.02, gt=0, description="SGD learning rate at the start (Dex-Net: 0.01 at batch 64).")
+    final_lr: float = Field(0.01, gt=0, le=1, description="Learning rate at the last step, as a share of lr (cosine annealing).")
     momentum: float = Field(0.9, ge=0, le=1, description="SGD momentum (Dex-Net: 0.9).")
-    lr_decay: float = Field(0.95, gt=0, le=1, description="Learning rate factor every decay_steps steps (Dex-Net: 0.95).")
-    decay_steps: int = Field(100, ge=1, description="Steps between learning-rate decays (Dex-Net: ~0.66 epoch).")
     weight_decay: float = Field(5e-4, ge=0, description="L2 weight decay (Dex-Net: 5e-4).")
-    log_every: int = Field(100, ge=1, description="Steps between DVCLive points (loss, train/val accuracy, val AP).")
-    eval_batch: int = Field(128, ge=1, description="Datapoints per inference batch (the CPU is fastest on small ones).")
+    evals: int = Field(8, ge=1, description="Validation evaluations per network, evenly spaced over its steps (the last at the last step); the weights with the best validation AP are kept.")
+    eval_batch: int = Field(1024, ge=1, description="Datapoints per inference batch.")
     noise: NoiseSettings = Field(default_factory=NoiseSettings, description="Dex-Net 2.0's train-time image noise.")
+
+    def __post_init__(self) -> None:
+        if self.min_steps > self.max_steps:
+            raise ValueError(f"min_steps ({self.min_steps}) must not exceed max_steps ({self.max_steps})")
+
+    def steps_for(self, n_datapoints: int) -> int:
+        """SGD steps for a training set of ``n_datapoints``: ``epochs`` passes, clipped to [min_steps, max_steps]."""
+        return int(min(self.max_steps, max(self.min_steps, -(-self.epochs * n_datapoints // self.batch_size))))
