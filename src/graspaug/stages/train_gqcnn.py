@@ -4,8 +4,7 @@ Networks (``graspaug.experiments.networks.seed_variants``): targeted at every ba
 ratio of ``generate``; random and real at every nonzero ratio of ``gqcnn.augment_base_sizes``;
 the ceiling. All start from the seed's initial weights and noise stream and are validated on
 the same ``gqcnn.val_shapes`` train shapes (``graspaug.training.gqcnn_data``); each keeps the
-weights of its best validation AP. Networks train in parallel (``n_jobs`` processes, one
-thread each on the CPU). Test set: every test-split datapoint of ``data/gqcnn/original``.
+weights of its best validation AP. Networks train one after another with every thread. Test set: every test-split datapoint of ``data/gqcnn/original``.
 
 Outputs: ``models/gqcnn/s<seed>/`` (one folder per network, ``test_rows.npy``,
 ``val_rows.npy``, ``split.json``), ``metrics/gqcnn/s<seed>.json`` (validation and test AP per
@@ -16,7 +15,6 @@ from __future__ import annotations
 
 import json
 import logging
-import os
 import time
 
 import numpy as np
@@ -48,15 +46,14 @@ def run(params: Params, seed: int) -> None:
         raise StageError(str(exc)) from None
     variants = seed_variants(gen.base_sizes, gen.ratios, cfg.augment_base_sizes, cfg.ceiling)
     device = resolve_device(params.device)
-    workers = params.workers if device.type == "cpu" else Workers(n_jobs=1)
-    n_jobs = (os.cpu_count() or 1) if workers.n_jobs == -1 else workers.n_jobs
-    threads = max(1, (os.cpu_count() or 1) // n_jobs) if workers.executor == "joblib" else 1
+    # one network at a time with every thread: bench/gqcnn_train_speed.py measured two 1-thread workers slower on 2 cores
+    workers, n_jobs, threads = Workers(n_jobs=1), 1, 0
     weight_seed, noise_seed = stream_seeds(params.seed, seed)
     init = initial_weights(cfg.net, weight_seed)
     _, val_rows = shapes_datapoints(split.validation)
     _, test_rows = test_set()
-    log.info("train_gqcnn seed %d: %d networks; validation %d shapes (%d datapoints), test %d datapoints; %d worker(s) × %d thread(s) on %s",
-             seed, len(variants), len(split.validation), len(val_rows), len(test_rows), n_jobs, threads, device)
+    log.info("train_gqcnn seed %d: %d networks; validation %d shapes (%d datapoints), test %d datapoints; one at a time on %s",
+             seed, len(variants), len(split.validation), len(val_rows), len(test_rows), device)
     with atomic_path(gqcnn_seed_dir(seed), directory=True) as folder:
         folder = folder.resolve()  # worker processes may have another working directory
         jobs = [NetworkJob(v, split, cfg.net, cfg.train, init, noise_seed, seed, str(device), threads, folder) for v in variants]

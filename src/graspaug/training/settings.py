@@ -45,9 +45,9 @@ class TrainSettings:
     (at least ``min_steps``, at most ``max_steps`` steps); the checkpoint with the best
     validation AP of ``evals`` evenly spaced evaluations is kept (params section ``gqcnn.train``)."""
 
-    epochs: float = Field(6.0, gt=0, description="Passes over the network's own training set (the budget rule: every variant sees each of its datapoints about as often, so a larger set gets more steps).")
-    min_steps: int = Field(300, ge=1, description="Fewest SGD steps, for the smallest training sets.")
-    max_steps: int = Field(1200, ge=1, description="Most SGD steps, a cap for the largest training sets (the CPU budget).")
+    epochs: float = Field(4.0, gt=0, description="Passes over the network's own training set (the budget rule: every variant sees each of its datapoints about as often, so a larger set gets more steps).")
+    min_steps: int = Field(200, ge=1, description="Fewest SGD steps, for the smallest training sets.")
+    max_steps: int = Field(800, ge=1, description="Most SGD steps, a cap for the largest training sets (the CPU budget).")
     batch_size: int = Field(128, ge=2, description="Datapoints per step (Dex-Net: 64-128).")
     lr: float = Field(0.02, gt=0, description="SGD learning rate at the start (Dex-Net: 0.01 at batch 64).")
     final_lr: float = Field(0.01, gt=0, le=1, description="Learning rate at the last step, as a share of lr (cosine annealing).")
