@@ -12,7 +12,6 @@ and ``tsne_graspness.png`` (Fig. 1).
 """
 from __future__ import annotations
 
-import json
 import logging
 
 import numpy as np
