@@ -114,12 +114,18 @@ def test_dvc_repro_generate_and_its_grasps(tiny_repo):
 
     import trimesh
 
+    from graspaug.generation import draw_base_sets
+
     work, env = tiny_repo
     run(["dvc", "repro", "grasps_generated"], work, env)
     shapes = pd.read_parquet(work / "data/shapes.parquet")
-    base = {b: pd.read_parquet(work / f"data/generated/{b}/base.parquet") for b in (4, 6)}
-    assert set(base[4].shape_id) < set(base[6].shape_id) <= set(shapes.shape_id[shapes.split == "train"])
-    for b in (4, 6):
+    # shapes are generated for gqcnn.augment_base_sizes (6) only; base set 4 (its 1:0 network) is drawn, not augmented
+    assert not (work / "data/generated/4").exists()
+    drawn = draw_base_sets(shapes, (4, 6), seed=0)
+    base = {6: pd.read_parquet(work / "data/generated/6/base.parquet")}
+    assert set(drawn[6]) == set(base[6].shape_id)  # generate draws the base sets the experiment trains on
+    assert set(drawn[4]) < set(base[6].shape_id) <= set(shapes.shape_id[shapes.split == "train"])
+    for b in (6,):
         index = pd.read_parquet(work / f"data/generated/{b}/index.parquet")
         for pool in ("targeted", "random"):
             part = index[index.pool == pool]
@@ -158,7 +164,8 @@ def test_dvc_repro_render(tiny_repo):
     work, env = tiny_repo
     run(["dvc", "repro", "render", "render_generated"], work, env)
     shapes = pd.read_parquet(work / "data/shapes.parquet")
-    for corpus in ("original", "gen_4", "gen_6"):
+    assert not (work / "data/gqcnn/gen_4").exists()
+    for corpus in ("original", "gen_6"):
         data = GraspImages.open(work / f"data/gqcnn/{corpus}")
         summary = json.loads((work / f"metrics/render/{corpus}.json").read_text())
         assert len(data) == summary["n_datapoints"] > 0
@@ -281,7 +288,7 @@ def test_every_declared_plot_renders(tiny_repo):
             if render["type"] == "image":
                 assert (work / render["url"]).exists() if not render["url"].startswith("data:") else True, name
     generated = {name for name in plots if "reports/generate/" in name}
-    assert {f"reports/generate/{b}/pairs.png" for b in (4, 6)} <= generated  # the tiny profile's base sizes, not hard-coded ones
+    assert "reports/generate/6/pairs.png" in generated and not any("generate/4/" in n for n in generated)  # the tiny profile's augmented base size
 
 
 def test_queued_two_point_sweep_lines_up_metrics(tiny_repo):

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 from typing import Protocol, TypeVar
 
 import numpy as np
+import pandas as pd
 from sklearn.neighbors import NearestNeighbors
 
 EXTRA_ALPHAS = (0.4, 0.2, 0.1, 0.05)  # weights a targeted stream adds, in this order, when it runs dry
@@ -48,6 +49,17 @@ def nested_base_sets(shape_ids: np.ndarray, sizes: list[int], rng: np.random.Gen
         raise ValueError(f"base size {max(sizes)} is larger than the {len(shape_ids)} shapes to draw from")
     order = rng.permutation(len(shape_ids))
     return {size: np.asarray(shape_ids)[order[:size]] for size in sizes}
+
+
+BASE_SEED = 0xBA5E  # base sets: their own stream of the seed
+
+
+def draw_base_sets(shapes: pd.DataFrame, sizes, seed: int) -> dict[int, np.ndarray]:
+    """The base sets of every size in ``sizes``, drawn from the train split of ``shapes``
+    (``data/shapes.parquet``) with the global ``seed``: what ``generate`` augments and what the
+    GQ-CNN experiment's 1:0 networks train on, the same wherever they are drawn."""
+    train_ids = shapes.shape_id[shapes.split == "train"].to_numpy()
+    return nested_base_sets(train_ids, sorted(sizes), np.random.default_rng([seed, BASE_SEED]))
 
 
 def above_percentile(scores: np.ndarray, percentile: float) -> np.ndarray:

