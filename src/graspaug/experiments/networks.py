@@ -21,8 +21,8 @@ import torch
 
 from graspaug.nets.gqcnn import GQCNN
 from graspaug.nets.settings import GQCNNConfig
-from graspaug.training.gqcnn import classification_metrics, predict, train_gqcnn
-from graspaug.training.gqcnn_data import ExperimentSplit, Variant, shapes_datapoints, test_set, training_set, training_shapes
+from graspaug.training.gqcnn import GraspArrays, classification_metrics, predict, train_gqcnn
+from graspaug.training.gqcnn_data import ExperimentSplit, Variant, shapes_datapoints, test_set, training_set
 from graspaug.training.settings import TrainSettings
 
 
@@ -75,14 +75,15 @@ def network_dir(seed_dir: Path, variant: Variant) -> Path:
     return seed_dir / variant.name
 
 
-def train_network(job: NetworkJob) -> dict:
-    """Train one network from the seed's initial weights; write its folder; return its summary."""
+def train_network(job: NetworkJob, val: GraspArrays | None = None, test: GraspArrays | None = None) -> dict:
+    """Train one network from the seed's initial weights; write its folder; return its summary.
+    ``val`` / ``test``: the seed's validation and test datapoints (read here when not given)."""
     if job.threads:
         torch.set_num_threads(job.threads)
     device = torch.device(job.device)
     train, info = training_set(job.variant, job.split)
-    val, _ = shapes_datapoints(job.split.validation)
-    test, _ = test_set()
+    val = val if val is not None else shapes_datapoints(job.split.validation)[0]
+    test = test if test is not None else test_set()[0]
     net = GQCNN(job.net)
     net.load_state_dict(job.init)
     gen = torch.Generator().manual_seed(job.noise_seed)
@@ -103,12 +104,6 @@ def train_network(job: NetworkJob) -> dict:
     pd.DataFrame(history).to_csv(folder / "history.csv", index=False)
     (folder / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
     return {**summary, "train_seconds": fit["train_seconds"], "samples_per_second": fit["samples_per_second"]}
-
-
-def expected_cost(variant: Variant, split: ExperimentSplit, train: TrainSettings, datapoints_per_shape: float = 70.0) -> float:
-    """A rough SGD-step count of a variant (for ordering the work longest first)."""
-    shapes, generated = training_shapes(variant, split)
-    return train.steps_for(int((len(shapes) + generated) * datapoints_per_shape))
 
 
 def seed_table(summaries: list[dict]) -> dict:

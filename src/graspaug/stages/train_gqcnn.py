@@ -18,14 +18,14 @@ import logging
 import time
 
 import numpy as np
+import torch
+from tqdm import tqdm
 
 from graspaug.config import Params
 from graspaug.device import resolve_device
-from graspaug.experiments.networks import (NetworkJob, expected_cost, initial_weights, read_history, seed_table, seed_variants,
-                                           stream_seeds, train_network)
+from graspaug.experiments.networks import NetworkJob, initial_weights, read_history, seed_table, seed_variants, stream_seeds, train_network
 from graspaug.io.atomic import atomic_path
 from graspaug.io.tables import write_csv, write_json
-from graspaug.parallel import Workers, parallel_map
 from graspaug.paths import gqcnn_seed_dir, gqcnn_seed_metrics, gqcnn_val_curves, timing_file
 from graspaug.stages import StageError
 from graspaug.training.gqcnn_data import load_split, shapes_datapoints, test_set
@@ -46,22 +46,21 @@ def run(params: Params, seed: int) -> None:
         raise StageError(str(exc)) from None
     variants = seed_variants(gen.base_sizes, gen.ratios, cfg.augment_base_sizes, cfg.ceiling)
     device = resolve_device(params.device)
-    # one network at a time with every thread: bench/gqcnn_train_speed.py measured two 1-thread workers slower on 2 cores
-    workers, n_jobs, threads = Workers(n_jobs=1), 1, 0
     weight_seed, noise_seed = stream_seeds(params.seed, seed)
     init = initial_weights(cfg.net, weight_seed)
-    _, val_rows = shapes_datapoints(split.validation)
-    _, test_rows = test_set()
+    val, val_rows = shapes_datapoints(split.validation)
+    test, test_rows = test_set()
     log.info("train_gqcnn seed %d: %d networks; validation %d shapes (%d datapoints), test %d datapoints; one at a time on %s",
              seed, len(variants), len(split.validation), len(val_rows), len(test_rows), device)
+    # one network at a time with every thread: bench/gqcnn_train_speed.py measured two 1-thread workers slower on 2 cores
     with atomic_path(gqcnn_seed_dir(seed), directory=True) as folder:
-        folder = folder.resolve()  # worker processes may have another working directory
-        jobs = [NetworkJob(v, split, cfg.net, cfg.train, init, noise_seed, seed, str(device), threads, folder) for v in variants]
-        jobs.sort(key=lambda j: -expected_cost(j.variant, split, cfg.train))  # longest first: the workers finish together
-        try:
-            results = parallel_map(train_network, jobs, workers, f"train GQ-CNNs (seed {seed})")
-        except ValueError as exc:
-            raise StageError(str(exc)) from None
+        results = []
+        for variant in tqdm(variants, desc=f"train GQ-CNNs (seed {seed})", unit="network"):
+            job = NetworkJob(variant, split, cfg.net, cfg.train, init, noise_seed, seed, str(device), 0, folder)
+            try:
+                results.append(train_network(job, val, test))
+            except ValueError as exc:
+                raise StageError(str(exc)) from None
         np.save(folder / "test_rows.npy", test_rows)
         np.save(folder / "val_rows.npy", val_rows)
         (folder / "split.json").write_text(json.dumps({"validation": split.validation, "real_pool": split.real_pool,
@@ -71,7 +70,7 @@ def run(params: Params, seed: int) -> None:
     validation_curves(history, gqcnn_val_curves(seed), f"Validation AP of every network of seed {seed} (dots: the kept weights)")
     write_json({"seed": seed, "networks": seed_table(results)}, gqcnn_seed_metrics(seed))
     speed = [r["samples_per_second"] for r in results]
-    write_json({"seconds": round(time.perf_counter() - start, 1), "networks": len(results), "workers": n_jobs, "threads": threads,
+    write_json({"seconds": round(time.perf_counter() - start, 1), "networks": len(results), "threads": torch.get_num_threads(),
                 "samples_per_second_median": round(float(np.median(speed)), 1),
                 "train_seconds": {f"{r['pool']}/{r['base_size']}-{r['ratio']:g}": round(r["train_seconds"], 1) for r in results}},
                timing_file("train_gqcnn", f"s{seed}"))

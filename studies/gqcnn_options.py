@@ -1,0 +1,76 @@
+"""Which GQ-CNN options validate best: width and input, chosen on validation AP, never on test.
+
+Trains the experiment's 1:0 networks (base sets of ``--base-sizes``) under each option, in
+paired seeds (every option of a seed starts from the same noise stream; initial weights are
+drawn per option from the seed, since the shapes differ), and prints validation AP per option:
+mean over seeds, 95% t-interval, and the paired difference to the default with its interval,
+plus training samples/s. Run it in a project where ``render@original`` has run with the
+default params (it reads ``data/shapes.parquet`` and ``data/gqcnn/original``):
+
+    python studies/gqcnn_options.py [--seeds 0 1 2] [--base-sizes 50 200] [--threads 2]
+"""
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import time
+
+import numpy as np
+import torch
+
+from graspaug.config import Params
+from graspaug.experiments.networks import initial_weights, stream_seeds
+from graspaug.experiments.stats import t_interval
+from graspaug.nets.gqcnn import GQCNN
+from graspaug.training.gqcnn import classification_metrics, predict, train_gqcnn
+from graspaug.training.gqcnn_data import Variant, load_split, shapes_datapoints, training_set
+
+OPTIONS = {  # name → changes to gqcnn.net; the first is the default
+    "default (8 filters, FC 64, depth)": {},
+    "FC 256": {"fc": 256},
+    "16 filters": {"filters": 16},
+    "depth minus gripper": {"image_input": "depth_minus_gripper"},
+}
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2])
+    parser.add_argument("--base-sizes", type=int, nargs="+", default=[50, 200])
+    parser.add_argument("--threads", type=int, default=torch.get_num_threads())
+    args = parser.parse_args()
+    torch.set_num_threads(args.threads)
+    params = Params()
+    cfg = params.gqcnn
+    split = load_split(list(params.generate.base_sizes), cfg.val_shapes, params.seed)
+    val, _ = shapes_datapoints(split.validation)
+    sets = {b: training_set(Variant("targeted", b, 0.0), split)[0] for b in args.base_sizes}
+    print(f"validation: {len(split.validation)} shapes, {len(val)} datapoints; training sets: "
+          + ", ".join(f"B = {b}: {len(d)}" for b, d in sets.items()) + f"; seeds {args.seeds}; {args.threads} threads")
+    val_ap: dict = {}
+    speed: dict = {}
+    for name, change in OPTIONS.items():
+        net_cfg = dataclasses.replace(cfg.net, **change)
+        for seed in args.seeds:
+            weight_seed, noise_seed = stream_seeds(params.seed, seed)
+            init = initial_weights(net_cfg, weight_seed)
+            for b, train in sets.items():
+                net = GQCNN(net_cfg)
+                net.load_state_dict(init)
+                start = time.perf_counter()
+                fit = train_gqcnn(net, train, val, cfg.train, torch.device("cpu"), torch.Generator().manual_seed(noise_seed), progress=False)
+                speed.setdefault(name, []).append(fit["steps"] * cfg.train.batch_size / (time.perf_counter() - start))
+                val_ap[name, b, seed] = classification_metrics(val.labels, predict(net, val, torch.device("cpu"), cfg.train.eval_batch))["ap"]
+                print(f"  {name:38s} B = {b:4d} seed {seed}: validation AP {val_ap[name, b, seed]:.4f} ({fit['steps']} steps)", flush=True)
+    default = next(iter(OPTIONS))
+    print("\noption                                 B     validation AP (95% t)          vs default (paired, 95% t)      samples/s")
+    for name in OPTIONS:
+        for b in args.base_sizes:
+            own = t_interval([val_ap[name, b, s] for s in args.seeds])
+            diff = t_interval([val_ap[name, b, s] - val_ap[default, b, s] for s in args.seeds])
+            fmt = lambda t: f"{t['mean']:+.4f} [{t['ci_low']:+.4f}, {t['ci_high']:+.4f}]" if t["ci_low"] is not None else f"{t['mean']:+.4f}"  # noqa: E731
+            print(f"{name:38s} {b:4d}  {fmt(own):30s} {fmt(diff) if name != default else '':30s} {np.median(speed[name]):8.0f}")
+
+
+if __name__ == "__main__":
+    main()
