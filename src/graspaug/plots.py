@@ -301,3 +301,23 @@ def generated_pairs(base: np.ndarray, voxels, decoded: list, path: str | os.Path
         rows.append([parent(base[c.a]), (child, child), parent(base[c.b])])
         labels.append(f"{c.selected_by}, α={c.alpha:g}")
     voxel_rows(rows, labels, ["parent a", "generated", "parent b"], path, title)
+
+
+def planned_grasps(depth: np.ndarray, jaws: Sequence[np.ndarray], labels: Sequence[str], path: str | os.PathLike, title: str) -> None:
+    """The depth image (H, W) m with grasps drawn: each ``jaws`` entry (2, 2) holds the two jaw
+    positions (u, v) px; the first (the best) in red, the others in orange, each labelled."""
+    plt = _pyplot()
+    h, w = depth.shape
+    fig, ax = plt.subplots(figsize=(8, 8 * h / w))
+    low, high = np.percentile(depth, [1, 99])
+    image = ax.imshow(depth, cmap="gray_r", vmin=low, vmax=high)
+    fig.colorbar(image, ax=ax, fraction=0.035, label="depth (m)")
+    for rank, (jaw, label) in reversed(list(enumerate(zip(jaws, labels)))):
+        color = "red" if rank == 0 else "orange"
+        ax.plot(jaw[:, 0], jaw[:, 1], "-", color=color, lw=2.5 if rank == 0 else 1.2)
+        ax.plot(jaw[:, 0], jaw[:, 1], "s", color=color, ms=6 if rank == 0 else 4)
+        ax.annotate(label, jaw.mean(axis=0), color=color, fontsize=8, xytext=(4, -6), textcoords="offset points")
+    ax.set_title(title)
+    ax.set_xlabel("u (px)")
+    ax.set_ylabel("v (px)")
+    _save(fig, path)

@@ -24,6 +24,7 @@ from graspaug.device import resolve_device
 from graspaug.experiments.networks import (NetworkJob, expected_cost, initial_weights, read_history, seed_table, seed_variants,
                                            stream_seeds, train_network)
 from graspaug.io.atomic import atomic_path
+from graspaug.io.checkpoints import gqcnn_card
 from graspaug.io.tables import write_csv, write_json
 from graspaug.parallel import Workers, parallel_map
 from graspaug.paths import gqcnn_seed_dir, gqcnn_seed_metrics, gqcnn_val_curves, timing_file
@@ -56,7 +57,9 @@ def run(params: Params, seed: int) -> None:
              seed, len(variants), len(split.validation), len(val_rows), len(test_rows), device)
     with atomic_path(gqcnn_seed_dir(seed), directory=True) as folder:
         folder = folder.resolve()  # worker processes may have another working directory
-        jobs = [NetworkJob(v, split, cfg.net, cfg.train, init, noise_seed, seed, str(device), threads, folder) for v in variants]
+        card = gqcnn_card(params.render.crop, params.render.intrinsics, params.render.viewpoints, params.grasps.gripper,
+                          params.grasps.threshold, params.seed)
+        jobs = [NetworkJob(v, split, cfg.net, cfg.train, init, noise_seed, seed, str(device), threads, folder, card) for v in variants]
         jobs.sort(key=lambda j: -expected_cost(j.variant, split, cfg.train))  # longest first: the workers finish together
         try:
             results = parallel_map(train_network, jobs, workers, f"train GQ-CNNs (seed {seed})")
