@@ -159,3 +159,20 @@ def test_no_edges_no_grasp_and_old_checkpoints_assume_the_defaults(model_path, t
     planner = load_planner(old)
     assert planner.card.assumed and planner.card == ModelCard(assumed=True)
     assert math.isclose(planner.card.focal_length, 525.0)
+
+
+def test_export_model_gives_the_same_probabilities(model_path, tmp_path):
+    result = CliRunner().invoke(app, ["export-model", str(model_path), str(tmp_path / "export")])
+    assert result.exit_code == 0, result.output
+    card = json.loads((tmp_path / "export/card.json").read_text())
+    assert card["model_card"]["crop_size"] == 96 and card["model_card"]["intrinsics"]["fx"] == 525
+    scripted = torch.jit.load(str(tmp_path / "export/model.ts"))
+    net, _ = read_gqcnn(model_path)
+    generator = torch.Generator().manual_seed(0)
+    images = 0.6 + 0.1 * torch.rand(7, 1, 32, 32, generator=generator)  # another batch size than traced
+    z = 0.6 + 0.1 * torch.rand(7, generator=generator)
+    with torch.inference_mode():
+        expected = net.success_probability(images, z)
+        exported = scripted(images, z)
+    assert exported.shape == (7,) and torch.allclose(exported, expected, atol=1e-6)
+    assert not torch.allclose(expected, expected[:1].expand(7))  # the inputs matter

@@ -292,6 +292,28 @@ def plan_command(
 
 
 @app.command(
+    name="export-model",
+    help="Export a trained GQ-CNN for use without graspaug: `<out>/model.ts` (TorchScript: images (N, 1, 32, 32) and "
+    "gripper depths (N,) in meters → P(success) (N,)), `<out>/card.json` (the model card: training camera, crop sizes, "
+    "gripper, label threshold, training set, AP; and the input contract), and `<out>/model.onnx` when the onnx package "
+    "is installed (it is not a dependency).",
+)
+def export_model_command(
+    model: Path = typer.Argument(..., help="A trained GQ-CNN, e.g. models/gqcnn/s0/targeted/50-0/model.pt."),
+    out: Path = typer.Argument(..., help="Folder to write."),
+) -> None:
+    from graspaug.errors import CheckpointMismatch
+    from graspaug.planning import export_model
+
+    try:
+        info = export_model(model, out)
+    except (FileNotFoundError, CheckpointMismatch) as exc:
+        typer.echo(f"error: {exc}", err=True)
+        raise typer.Exit(code=2) from None
+    typer.echo(f"wrote {', '.join(str(out / f) for f in [*info['files'], 'card.json'])} (ONNX: {info['onnx']})")
+
+
+@app.command(
     name="profile",
     help="Write params.yaml for a profile: the defaults plus the few keys `profiles/<name>.yaml` changes "
     "(`default`: the defaults alone). Profiles: `tiny` (every stage in minutes, for trying changes), `study` "

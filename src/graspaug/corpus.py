@@ -37,7 +37,7 @@ def file_problem(path: Path) -> str | None:
     return f"not a regular file: {'symlink to ' + kind + ' ' + os.path.realpath(path) if link else kind}"
 
 
-NEAR_DUPLICATE_IOU = 0.95  # voxel IoU (32³) above which two shapes of equal extents are the same geometry
+NEAR_DUPLICATE_IOU = 0.99  # voxel IoU (32³) from which two shapes of equal extents are the same geometry (0.95 would pair distinct random_urdfs plates)
 NEAR_DUPLICATE_EXTENT = 0.001  # m: ... and their normalized extents differ by at most this
 
 
@@ -102,7 +102,7 @@ def flag_duplicates(shapes: pd.DataFrame, occupancy: list[bytes]) -> pd.DataFram
     """``shapes`` with ``duplicate_of`` (the shape_id, first in id order, of a shape with the
     same file bytes or the same normalized geometry; "" for none) and ``duplicate_kind``
     (``exact``: same ``source_sha256``; ``geometry``: normalized extents within 1 mm and
-    solid voxel grids (32³, packed in ``occupancy``, one per row) with IoU >= 0.95)."""
+    solid voxel grids (32³, packed in ``occupancy``, one per row) with IoU >= 0.99)."""
     out = shapes.reset_index(drop=True).copy()
     if out.empty:
         return out.assign(duplicate_of=pd.Series(dtype=str), duplicate_kind=pd.Series(dtype=str))

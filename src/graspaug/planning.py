@@ -33,6 +33,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import torch
 from scipy import ndimage
 
 from graspaug.grasping.gripper import ParallelJawGripper
@@ -44,7 +45,7 @@ from graspaug.sim.settings import CEMSettings, SamplerSettings
 log = logging.getLogger(__name__)
 
 __all__ = ["ModelCard", "PlannedGrasp", "Planner", "PlanningError", "NoGraspFound", "load_planner", "plan_grasp", "plan_grasps",
-           "intrinsics_for", "read_depth_image", "read_intrinsics"]
+           "intrinsics_for", "read_depth_image", "read_intrinsics", "export_model"]
 
 MAX_UPSAMPLING = 1.5  # the camera may see the object with at most 1.5× fewer pixels than in training
 MAX_DOWNSAMPLING = 4.0  # ... and with at most 4× more (more only costs time: resample it first)
@@ -422,3 +423,56 @@ def plan_grasp(depth_m: np.ndarray, intrinsics: Intrinsics | dict, model, seed: 
     if not planned:
         raise NoGraspFound("no antipodal pair of depth edges fits the gripper in this image")
     return planned[0]
+
+
+def export_model(path: str | os.PathLike, out: str | os.PathLike) -> dict[str, Any]:
+    """Write a GQ-CNN checkpoint as TorchScript for use without graspaug: ``<out>/model.ts``
+    (``forward(images (N, 1, S, S) m, z (N,) m) → P(success) (N,)``, CPU, raw depths as in
+    :meth:`~graspaug.nets.gqcnn.GQCNN.success_probability`), ``<out>/card.json`` (the model card
+    and the input contract) and, when the ``onnx`` package is installed, ``<out>/model.onnx``.
+    Returns the card JSON written."""
+    import json
+
+    from graspaug.io.atomic import atomic_path
+    from graspaug.io.checkpoints import read_gqcnn
+
+    net, card = read_gqcnn(path)
+    model_card = ModelCard.from_dict(card, net.config.image_input)
+    size = net.config.image_size
+    example = (torch.full((4, 1, size, size), 0.7), torch.full((4,), 0.68))
+    wrapped = SuccessProbability(net).eval()
+    with torch.no_grad():
+        traced = torch.jit.trace(wrapped, example)
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    with atomic_path(out / "model.ts") as tmp, open(tmp, "wb") as f:
+        torch.jit.save(traced, f)
+    files = ["model.ts"]
+    import importlib.util
+
+    if importlib.util.find_spec("onnx") is None:
+        onnx_note = "not written: the onnx package is not installed"
+    else:  # pragma: no cover - onnx is not a dependency
+        torch.onnx.export(wrapped, example, str(out / "model.onnx"), input_names=["images", "z"], output_names=["p_success"],
+                          dynamic_axes={"images": {0: "n"}, "z": {0: "n"}, "p_success": {0: "n"}})
+        files.append("model.onnx")
+        onnx_note = "written"
+    info = {"source": str(path), "files": files, "onnx": onnx_note,
+            "inputs": {"images": f"(N, 1, {size}, {size}) float32: grasp-centered depth crops in meters, jaw axis along the rows "
+                                 f"({model_card.crop_size} px of the image averaged down to {model_card.out_size})",
+                       "z": "(N,) float32: gripper depth in meters (camera frame)"},
+            "output": "(N,) float32: predicted P(success)", "model_card": model_card.to_dict()}
+    with atomic_path(out / "card.json") as tmp:
+        tmp.write_text(json.dumps(info, indent=1) + "\n")
+    return info
+
+
+class SuccessProbability(torch.nn.Module):
+    """P(success) (N,) of a GQ-CNN for crops (N, 1, S, S) m and gripper depths (N,) m (what is exported)."""
+
+    def __init__(self, net) -> None:
+        super().__init__()
+        self.net = net
+
+    def forward(self, images: torch.Tensor, z: torch.Tensor) -> torch.Tensor:
+        return torch.softmax(self.net(images, z), dim=1)[:, 1]
