@@ -9,6 +9,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from graspaug.io.checkpoints import read_gqcnn
 from graspaug.io.voxels import read_voxels
 
 pytestmark = pytest.mark.slow
@@ -202,6 +203,9 @@ def test_dvc_repro_gqcnn_matrix_and_report(tiny_repo):
             assert np.load(folder / "test_predictions.npy").shape == (summary["test"]["datapoints"],)
             assert len(pd.read_csv(folder / "history.csv")) == 2  # evals: 2
             digests.setdefault(seed, set()).add(summary["init_digest"])
+            card = read_gqcnn(folder / "model.pt")[1]  # the model card planning reads
+            assert card["crop_size"] == 96 and card["intrinsics"]["fx"] == 525 and card["camera_distance"] == [0.65, 0.75]
+            assert card["training_set"]["seed"] == seed and card["test_ap"] == summary["test"]["ap"]
             validation.setdefault(seed, set()).add(summary["validation"]["datapoints"])
         assert len(split["validation"]) == 2 and not set(split["validation"]) & set(split["base"]["6"]) and not set(split["validation"]) & set(split["real_pool"])
         assert (work / f"reports/gqcnn/validation/s{seed}.png").stat().st_size > 0

@@ -232,6 +232,88 @@ stage_command(
 
 
 @app.command(
+    name="plan",
+    help="Plan a grasp on one depth image with a trained GQ-CNN (the planner the simulated robot uses: antipodal pairs "
+    "on depth edges, GQ-CNN scores, cross-entropy refinement; a grasp is kept only if the image shows it antipodal "
+    "and reachable). DEPTH is a `.npy` array in meters or a 16-bit PNG in millimeters (0 = no reading), from a camera "
+    "looking (nearly) straight down. The model card in `model.pt` says which camera the network was trained for; "
+    "another focal length or camera distance is resampled to it where that is sound, else refused.\n\n"
+    "Writes `<out>/grasp.json` (the grasps, best first: image center, angle, depth, width; camera-frame pose and "
+    "width in m; quality; the model card) and `<out>/grasp.png` (the image with the grasps drawn).",
+)
+def plan_command(
+    depth: Path = typer.Argument(..., help="Depth image: .npy (meters) or 16-bit .png (millimeters)."),
+    model: Path = typer.Option(..., "--model", "-m", help="A trained GQ-CNN, e.g. models/gqcnn/s0/targeted/50-0/model.pt."),
+    intrinsics: Path | None = typer.Option(None, "--intrinsics", "-i", help="JSON file with fx, fy, cx, cy (px); instead of the flags."),
+    fx: float | None = typer.Option(None, "--fx", help="Focal length along u (px)."),
+    fy: float | None = typer.Option(None, "--fy", help="Focal length along v (px; default: fx)."),
+    cx: float | None = typer.Option(None, "--cx", help="Principal point u (px; default: the image center)."),
+    cy: float | None = typer.Option(None, "--cy", help="Principal point v (px; default: the image center)."),
+    top: int = typer.Option(1, "--top", "-k", min=1, help="List the K best grasps."),
+    seed: int = typer.Option(0, "--seed", help="Seed of the sampler."),
+    camera_distance: float | None = typer.Option(None, "--camera-distance", help="Camera to table along the optical axis (m; default: the image's median depth)."),
+    fill_missing: bool = typer.Option(False, "--fill-missing", help="Give missing pixels (0, NaN) the nearest valid depth instead of stopping."),
+    out: Path = typer.Option(Path("."), "--out", "-o", help="Folder for grasp.json and grasp.png."),
+) -> None:
+    import json
+
+    import numpy as np
+
+    from graspaug.io.atomic import atomic_path
+    from graspaug.planning import PlanningError, load_planner, read_depth_image, read_intrinsics
+    from graspaug.plots import planned_grasps
+
+    try:
+        image = read_depth_image(depth)
+        camera = read_intrinsics(intrinsics, fx, fy, cx, cy, image.shape)
+        planner = load_planner(model)
+        grasps = planner.plan(image, camera, seed, top, camera_distance, fill_missing)
+    except (PlanningError, FileNotFoundError, OSError) as exc:
+        typer.echo(f"error: {exc}", err=True)
+        raise typer.Exit(code=2) from None
+    except Exception as exc:  # noqa: BLE001 — a broken checkpoint is one line too
+        typer.echo(f"error: {model}: {type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else ''}", err=True)
+        raise typer.Exit(code=2) from None
+    out.mkdir(parents=True, exist_ok=True)
+    with atomic_path(out / "grasp.json") as tmp:
+        tmp.write_text(json.dumps({"depth": str(depth), "model": str(model), "grasps": [g.to_dict() for g in grasps],
+                                   "model_card": planner.card.to_dict()}, indent=1) + "\n")
+    labels = [f"#{i + 1} Q = {g.quality:.3f}" for i, g in enumerate(grasps)]
+    shown = np.where(np.isfinite(image) & (image > 0), image, np.nan) if image.dtype.kind == "f" else image
+    planned_grasps(np.nan_to_num(shown, nan=float(np.nanmax(shown))), [g.jaw_pixels for g in grasps], labels, out / "grasp.png",
+                   f"{depth.name}: {len(grasps)} grasp(s), model {model.parent.name}/{model.name}")
+    if not grasps:
+        typer.echo(f"no grasp: no antipodal pair of depth edges in {depth} fits the gripper (wrote {out / 'grasp.json'})")
+        raise typer.Exit(code=1)
+    for i, g in enumerate(grasps):
+        typer.echo(f"#{i + 1}: center ({g.u:.1f}, {g.v:.1f}) px, angle {np.degrees(g.angle):.1f} deg, depth {g.depth:.3f} m, "
+                   f"width {1000 * g.width:.1f} mm, quality {g.quality:.3f}")
+    typer.echo(f"wrote {out / 'grasp.json'} and {out / 'grasp.png'} ({grasps[0].planning_time:.2f} s)")
+
+
+@app.command(
+    name="export-model",
+    help="Export a trained GQ-CNN for use without graspaug: `<out>/model.ts` (TorchScript: images (N, 1, 32, 32) and "
+    "gripper depths (N,) in meters → P(success) (N,)), `<out>/card.json` (the model card: training camera, crop sizes, "
+    "gripper, label threshold, training set, AP; and the input contract), and `<out>/model.onnx` when the onnx package "
+    "is installed (it is not a dependency).",
+)
+def export_model_command(
+    model: Path = typer.Argument(..., help="A trained GQ-CNN, e.g. models/gqcnn/s0/targeted/50-0/model.pt."),
+    out: Path = typer.Argument(..., help="Folder to write."),
+) -> None:
+    from graspaug.errors import CheckpointMismatch
+    from graspaug.planning import export_model
+
+    try:
+        info = export_model(model, out)
+    except (FileNotFoundError, CheckpointMismatch) as exc:
+        typer.echo(f"error: {exc}", err=True)
+        raise typer.Exit(code=2) from None
+    typer.echo(f"wrote {', '.join(str(out / f) for f in [*info['files'], 'card.json'])} (ONNX: {info['onnx']})")
+
+
+@app.command(
     name="profile",
     help="Write params.yaml for a profile: the defaults plus the few keys `profiles/<name>.yaml` changes "
     "(`default`: the defaults alone). Profiles: `tiny` (every stage in minutes, for trying changes), `study` "

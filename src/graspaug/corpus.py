@@ -1,6 +1,9 @@
-"""One source file → one row of the shape table (its mesh written), and the train/test split."""
+"""One source file → one row of the shape table (its mesh written), duplicates, and the train/test split."""
 from __future__ import annotations
 
+import os
+import stat
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -8,21 +11,67 @@ import pandas as pd
 
 from graspaug.geometry.loading import MeshRejected, load_shape, sha256_of
 from graspaug.geometry.prepare import SurfaceSettings, prepare_shape
+from graspaug.geometry.voxelize import fit_grid, pack_bits, voxelize_solid
 from graspaug.io.meshes import mesh_path, write_mesh
 from graspaug.io.sources import Source
 
 
-def ingest_source(source: Source, max_faces: int, max_file_mb: float, settings: SurfaceSettings, out_dir: Path) -> dict:
-    """Process one source: a shapes row (``ok``) or a rejects row (``reason``)."""
-    row: dict = {"shape_id": source.shape_id, "source": source.name}
+_KINDS = ((stat.S_ISDIR, "a directory"), (stat.S_ISFIFO, "a FIFO (named pipe)"), (stat.S_ISCHR, "a character device"),
+          (stat.S_ISBLK, "a block device"), (stat.S_ISSOCK, "a socket"))
+
+
+def file_problem(path: Path) -> str | None:
+    """Why ``path`` cannot be read as a mesh file without opening it (None: a regular file,
+    or a symlink to one): a broken or looping symlink, or a special file (FIFO, device, socket,
+    directory), which could block or never end when read."""
     try:
-        row["source_sha256"] = sha256_of(source.path)
-        loaded = load_shape(source.path, source.unit_scale, max_faces, max_file_mb)
-        prepared = prepare_shape(loaded, settings)
-    except MeshRejected as exc:
-        return {**row, "ok": False, "reason": str(exc)}
+        link = stat.S_ISLNK(os.lstat(path).st_mode)
+        mode = os.stat(path).st_mode
+    except FileNotFoundError:
+        return f"broken symlink: its target {os.readlink(path)} does not exist" if os.path.islink(path) else "file vanished"
     except OSError as exc:
-        return {**row, "ok": False, "reason": f"unreadable: {type(exc).__name__}: {exc.strerror or exc}"}
+        return f"unreadable: {'symlink loop' if exc.errno == 40 else exc.strerror or exc}"
+    if stat.S_ISREG(mode):
+        return None
+    kind = next((name for test, name in _KINDS if test(mode)), "not a regular file")
+    return f"not a regular file: {'symlink to ' + kind + ' ' + os.path.realpath(path) if link else kind}"
+
+
+NEAR_DUPLICATE_IOU = 0.99  # voxel IoU (32³) from which two shapes of equal extents are the same geometry (0.95 would pair distinct random_urdfs plates)
+NEAR_DUPLICATE_EXTENT = 0.001  # m: ... and their normalized extents differ by at most this
+
+
+def occupancy_bits(mesh, resolution: int = 32) -> bytes:
+    """The packed solid voxel grid (R³, fit to the bounds) of a normalized mesh."""
+    grid = fit_grid(mesh.bounds, resolution)
+    return pack_bits(voxelize_solid(np.asarray(mesh.vertices), np.asarray(mesh.faces), grid)).tobytes()
+
+
+def _with_warnings(reason: str, caught: list) -> str:
+    """The reason plus the distinct warnings raised while reading the file (at most two)."""
+    messages = list(dict.fromkeys(f"{w.category.__name__}: {str(w.message).splitlines()[0][:80]}" for w in caught))
+    return f"{reason} (warnings: {'; '.join(messages[:2])}{'; …' if len(messages) > 2 else ''})" if messages else reason
+
+
+def ingest_source(source: Source, max_faces: int, max_file_mb: float, settings: SurfaceSettings, out_dir: Path) -> dict:
+    """Process one source: a shapes row (``ok``) or a rejects row (``reason``). Symlinks to
+    regular files are read; special files and broken links are rejected before opening.
+    Warnings while reading go into the reason of a rejected file, never to the console."""
+    row: dict = {"shape_id": source.shape_id, "source": source.name}
+    problem = file_problem(Path(source.path))
+    if problem is not None:
+        return {**row, "ok": False, "reason": problem}
+    with warnings.catch_warnings(record=True) as caught, np.errstate(all="warn"):
+        warnings.simplefilter("always")
+        try:
+            row["source_sha256"] = sha256_of(source.path)
+            loaded = load_shape(source.path, source.unit_scale, max_faces, max_file_mb)
+            prepared = prepare_shape(loaded, settings)
+            row["_occupancy"] = occupancy_bits(prepared.mesh)
+        except MeshRejected as exc:
+            return {**row, "ok": False, "reason": _with_warnings(str(exc), caught)}
+        except OSError as exc:
+            return {**row, "ok": False, "reason": _with_warnings(f"unreadable: {type(exc).__name__}: {exc.strerror or exc}", caught)}
     mesh, norm = prepared.mesh, prepared.normalization
     write_mesh(mesh, mesh_path(out_dir, source.shape_id))
     extents = mesh.extents
@@ -49,12 +98,49 @@ def ingest_source(source: Source, max_faces: int, max_file_mb: float, settings: 
     }
 
 
-def assign_split(shape_ids: list[str], test_fraction: float, seed: int) -> dict[str, str]:
-    """Seeded shuffle of the sorted ids; the first ``round(test_fraction * n)`` are ``test``."""
-    ids = sorted(shape_ids)
+def flag_duplicates(shapes: pd.DataFrame, occupancy: list[bytes]) -> pd.DataFrame:
+    """``shapes`` with ``duplicate_of`` (the shape_id, first in id order, of a shape with the
+    same file bytes or the same normalized geometry; "" for none) and ``duplicate_kind``
+    (``exact``: same ``source_sha256``; ``geometry``: normalized extents within 1 mm and
+    solid voxel grids (32³, packed in ``occupancy``, one per row) with IoU >= 0.99)."""
+    out = shapes.reset_index(drop=True).copy()
+    if out.empty:
+        return out.assign(duplicate_of=pd.Series(dtype=str), duplicate_kind=pd.Series(dtype=str))
+    order = np.argsort(out["shape_id"].to_numpy(), kind="stable")
+    extents = np.sort(out[["extent_x", "extent_y", "extent_z"]].to_numpy(float), axis=1)
+    grids = np.stack([np.unpackbits(np.frombuffer(b, dtype=np.uint8)) for b in occupancy]).astype(bool)
+    duplicate_of, kind = [""] * len(out), [""] * len(out)
+    originals: list[int] = []  # rows that are nobody's duplicate, in id order
+    first_by_hash: dict[str, int] = {}
+    for row in order:
+        original = first_by_hash.get(out.at[row, "source_sha256"])
+        if original is not None:
+            duplicate_of[row], kind[row] = out.at[original, "shape_id"], "exact"
+            continue
+        near = [o for o in originals if np.abs(extents[o] - extents[row]).max() <= NEAR_DUPLICATE_EXTENT]
+        for o in near:
+            union = np.count_nonzero(grids[o] | grids[row])
+            if union and np.count_nonzero(grids[o] & grids[row]) / union >= NEAR_DUPLICATE_IOU:
+                duplicate_of[row], kind[row] = out.at[o, "shape_id"], "geometry"
+                break
+        if not duplicate_of[row]:
+            originals.append(row)
+        first_by_hash.setdefault(out.at[row, "source_sha256"], row if not duplicate_of[row] else
+                                 int(np.flatnonzero(out["shape_id"] == duplicate_of[row])[0]))
+    out["duplicate_of"], out["duplicate_kind"] = duplicate_of, kind
+    return out
+
+
+def assign_split(shape_ids: list[str], test_fraction: float, seed: int, duplicate_of: dict[str, str] | None = None) -> dict[str, str]:
+    """Seeded shuffle of the sorted ids; the first ``round(test_fraction * n)`` are ``test``.
+    A shape in ``duplicate_of`` (id → the id it duplicates) takes its original's split, so a
+    duplicate never sits on the other side of the split (n counts originals only)."""
+    duplicate_of = {k: v for k, v in (duplicate_of or {}).items() if v}
+    ids = sorted(i for i in shape_ids if i not in duplicate_of)
     order = np.random.default_rng(seed).permutation(len(ids))
     n_test = int(round(test_fraction * len(ids)))
-    return {ids[i]: ("test" if rank < n_test else "train") for rank, i in enumerate(order)}
+    split = {ids[i]: ("test" if rank < n_test else "train") for rank, i in enumerate(order)}
+    return {i: split[duplicate_of.get(i, i)] for i in shape_ids}
 
 
 def closing_summary(shapes: pd.DataFrame) -> str:

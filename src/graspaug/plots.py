@@ -301,3 +301,49 @@ def generated_pairs(base: np.ndarray, voxels, decoded: list, path: str | os.Path
         rows.append([parent(base[c.a]), (child, child), parent(base[c.b])])
         labels.append(f"{c.selected_by}, α={c.alpha:g}")
     voxel_rows(rows, labels, ["parent a", "generated", "parent b"], path, title)
+
+
+def planned_grasps(depth: np.ndarray, jaws: Sequence[np.ndarray], labels: Sequence[str], path: str | os.PathLike, title: str) -> None:
+    """The depth image (H, W) m with grasps drawn: each ``jaws`` entry (2, 2) holds the two jaw
+    positions (u, v) px; the first (the best) in red, the others in orange, each labelled."""
+    plt = _pyplot()
+    h, w = depth.shape
+    fig, ax = plt.subplots(figsize=(8, 8 * h / w))
+    low, high = np.percentile(depth, [1, 99])
+    image = ax.imshow(depth, cmap="gray_r", vmin=low, vmax=high)
+    fig.colorbar(image, ax=ax, fraction=0.035, label="depth (m)")
+    for rank, (jaw, label) in reversed(list(enumerate(zip(jaws, labels)))):
+        color = "red" if rank == 0 else "orange"
+        ax.plot(jaw[:, 0], jaw[:, 1], "-", color=color, lw=2.5 if rank == 0 else 1.2)
+        ax.plot(jaw[:, 0], jaw[:, 1], "s", color=color, ms=6 if rank == 0 else 4)
+        ax.annotate(label, jaw.mean(axis=0), color=color, fontsize=8, xytext=(4, -6), textcoords="offset points")
+    ax.set_title(title)
+    ax.set_xlabel("u (px)")
+    ax.set_ylabel("v (px)")
+    _save(fig, path)
+
+
+def precision_recall_roc(labels: np.ndarray, predictions: dict[str, np.ndarray], path: str | os.PathLike, title: str) -> None:
+    """Precision-recall (left) and ROC (right) curves of several networks' test predictions
+    P(success) (N,) against the same 0/1 ``labels`` (N,); AP and ROC AUC in the legends."""
+    from sklearn.metrics import average_precision_score, precision_recall_curve, roc_auc_score, roc_curve
+
+    plt = _pyplot()
+    fig, (pr, roc) = plt.subplots(1, 2, figsize=(11, 4.5))
+    labels = np.asarray(labels).astype(int)
+    for name, p in predictions.items():
+        precision, recall, _ = precision_recall_curve(labels, p)
+        pr.plot(recall, precision, label=f"{name} (AP {average_precision_score(labels, p):.3f})")
+        fpr, tpr, _ = roc_curve(labels, p)
+        roc.plot(fpr, tpr, label=f"{name} (AUC {roc_auc_score(labels, p):.3f})")
+    pr.axhline(labels.mean(), color="gray", ls=":", label=f"chance ({labels.mean():.3f})")
+    roc.plot([0, 1], [0, 1], color="gray", ls=":", label="chance")
+    for ax, (x, y) in ((pr, ("recall", "precision")), (roc, ("false positive rate", "true positive rate"))):
+        ax.set_xlabel(x)
+        ax.set_ylabel(y)
+        ax.set_xlim(0, 1)
+        ax.set_ylim(0, 1.02)
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8)
+    fig.suptitle(title)
+    _save(fig, path)

@@ -66,7 +66,11 @@ def test_ingest_keeps_good_shapes_and_records_every_reject(tmp_path, corpus_para
         stem = row.source.rsplit("/", 1)[1].rsplit(".", 1)[0]
         assert row.reason.startswith(expected[stem]), row.reason
     assert shapes.watertight.all()
-    assert set(shapes.split) == {"train", "test"} and (shapes.split == "test").sum() == 3
+    # the holed ball, once filled, is the ball again: flagged, and in the ball's split (2 of 6 originals are test)
+    duplicates = shapes[shapes.duplicate_of != ""]
+    assert list(zip(duplicates.shape_id, duplicates.duplicate_of, duplicates.duplicate_kind)) == [("f_good_holed_ball", "f_good_ball", "geometry")]
+    assert set(shapes.split[shapes.shape_id.isin(["f_good_ball", "f_good_holed_ball"])]) in ({"train"}, {"test"})
+    assert set(shapes.split) == {"train", "test"} and (shapes.split[shapes.duplicate_of == ""] == "test").sum() == 2
     assert (shapes.origin == "original").all()
     for col in ("source", "source_sha256", "faces", "vertices", "volume", "extent_x", "scale", "closed_by", "hull_fill"):
         assert col in shapes
@@ -129,3 +133,65 @@ def test_split_sizes_follow_the_paper_ratio():
     assert sum(v == "test" for v in split.values()) == 266
     assert split == assign_split([f"rnd_{i:03d}" for i in reversed(range(999))], 0.2663, seed=0)
     assert split != assign_split([f"rnd_{i:03d}" for i in range(999)], 0.2663, seed=1)
+
+
+def test_links_special_files_and_duplicates(tmp_path, capfd):
+    """Symlinks are read or rejected with a reason (a FIFO or /dev/zero would block or never end
+    if opened), copies are kept but flagged, and a duplicate always shares its original's split."""
+    folder = tmp_path / "meshes"
+    folder.mkdir()
+    ball = trimesh.creation.icosphere(subdivisions=3, radius=0.04)
+    ball.export(folder / "ball.ply")
+    ball.export(folder / "ball_again.obj")  # the same geometry in another format: a near duplicate
+    trimesh.creation.box(extents=(0.1, 0.05, 0.03)).export(folder / "box.stl")
+    (folder / "box_copy.stl").write_bytes((folder / "box.stl").read_bytes())  # byte-identical: an exact duplicate
+    os.symlink(folder / "box.stl", folder / "box_link.stl")  # a link to a regular file is read (and is a duplicate)
+    trimesh.creation.cylinder(radius=0.02, height=0.08).export(folder / "can.obj")
+    for i in range(4):
+        trimesh.creation.box(extents=(0.02 + 0.01 * i, 0.05, 0.04)).export(folder / f"block{i}.stl")
+    os.symlink("/dev/zero", folder / "zero.obj")
+    os.mkfifo(folder / "pipe.ply")
+    os.symlink(folder / "missing.stl", folder / "gone.stl")
+    os.symlink(folder / "loop.obj", folder / "loop.obj")
+    params = {"seed": 3, "n_jobs": 2, "data": {"source": "folder", "path": "meshes"},
+              "ingest": {"max_faces": 50000, "min_shapes": 3, "test_fraction": 0.5}}
+    result = run_stage(tmp_path, "ingest", params)
+    assert result.exit_code == 0, result.output
+    shapes = pd.read_parquet(tmp_path / "data/shapes.parquet").set_index("shape_id")
+    rejects = pd.read_parquet(tmp_path / "data/rejects.parquet").set_index("shape_id")
+    assert dict(rejects.reason) == {
+        "f_zero": "not a regular file: symlink to a character device /dev/zero",
+        "f_pipe": "not a regular file: a FIFO (named pipe)",
+        "f_gone": f"broken symlink: its target {folder / 'missing.stl'} does not exist",
+        "f_loop": "unreadable: symlink loop",
+    }
+    duplicates = shapes[shapes.duplicate_of != ""]
+    assert dict(zip(duplicates.index, zip(duplicates.duplicate_of, duplicates.duplicate_kind))) == {
+        "f_ball_again": ("f_ball", "geometry"), "f_box_copy": ("f_box", "exact"), "f_box_link": ("f_box", "exact")}
+    assert (shapes.loc[duplicates.index, "split"].to_numpy() == shapes.loc[duplicates.duplicate_of, "split"].to_numpy()).all()
+    assert (shapes.split[shapes.duplicate_of == ""] == "test").sum() == 4 and len(shapes) == 10  # round(0.5 × 7 originals)
+    assert "Warning" not in capfd.readouterr().err
+
+
+def test_split_keeps_duplicates_with_their_original():
+    from graspaug.corpus import assign_split
+
+    ids = [f"s{i:02d}" for i in range(40)]
+    plain = assign_split(ids, 0.25, seed=0)
+    assert plain == assign_split(ids, 0.25, seed=0, duplicate_of={i: "" for i in ids})  # no duplicates: the same split
+    with_copies = assign_split(ids + ["s00_copy", "s07_copy"], 0.25, seed=0, duplicate_of={"s00_copy": "s00", "s07_copy": "s07"})
+    assert with_copies["s00_copy"] == plain["s00"] and with_copies["s07_copy"] == plain["s07"]
+    assert {k: v for k, v in with_copies.items() if k in plain} == plain
+
+
+def test_warnings_of_a_broken_file_go_into_its_reason(tmp_path, capfd):
+    from graspaug.corpus import ingest_source
+    from graspaug.geometry.prepare import SurfaceSettings
+    from graspaug.io.sources import Source
+
+    path = tmp_path / "inf.obj"  # overflowing coordinates: numpy warns while checking the mesh
+    path.write_text("v 1e308 0 0\nv -1e308 0 0\nv 0 1e308 0\nv 0 0 1e308\nf 1 2 3\nf 1 3 4\nf 1 4 2\nf 2 4 3\n")
+    row = ingest_source(Source("f_inf", "folder:inf.obj", path, 1.0), 1000, 10.0, SurfaceSettings(), tmp_path)
+    assert not row["ok"] and "\n" not in row["reason"]
+    assert "RuntimeWarning" in row["reason"], row["reason"]
+    assert "Warning" not in capfd.readouterr().err

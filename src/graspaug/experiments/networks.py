@@ -9,7 +9,6 @@ ceiling): ``model.pt`` (config, weights, summary), ``summary.json``, ``history.c
 """
 from __future__ import annotations
 
-import dataclasses
 import hashlib
 import json
 from dataclasses import dataclass
@@ -19,6 +18,7 @@ import numpy as np
 import pandas as pd
 import torch
 
+from graspaug.io.checkpoints import finish_gqcnn_card, save_gqcnn
 from graspaug.nets.gqcnn import GQCNN
 from graspaug.nets.settings import GQCNNConfig
 from graspaug.training.gqcnn import GraspArrays, classification_metrics, predict, train_gqcnn
@@ -69,6 +69,7 @@ class NetworkJob:
     device: str
     threads: int
     out_dir: Path
+    card: dict | None = None  # the model card's data part (graspaug.io.checkpoints.gqcnn_card)
 
 
 def network_dir(seed_dir: Path, variant: Variant) -> Path:
@@ -98,7 +99,7 @@ def train_network(job: NetworkJob, val: GraspArrays | None = None, test: GraspAr
                "parameters": net.describe()["parameters"], "init_digest": weights_digest(job.init), "noise_seed": job.noise_seed}
     folder = network_dir(job.out_dir, job.variant)
     folder.mkdir(parents=True, exist_ok=True)
-    torch.save({"config": dataclasses.asdict(net.config), "state_dict": net.state_dict(), "summary": summary}, folder / "model.pt")
+    save_gqcnn(folder / "model.pt", net, summary, finish_gqcnn_card(job.card, summary))
     np.save(folder / "test_predictions.npy", test_p)
     np.save(folder / "val_predictions.npy", val_p)
     pd.DataFrame(history).to_csv(folder / "history.csv", index=False)

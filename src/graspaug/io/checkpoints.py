@@ -57,11 +57,58 @@ def load_autoencoder(path: str | os.PathLike, expected: AEConfig) -> tuple[AutoE
     return ae, critic, state["train_params"]
 
 
-def load_gqcnn(path: str | os.PathLike):
-    """A trained GQ-CNN from ``models/gqcnn/<pool>/<B>-<R>-s<seed>/model.pt``, on the CPU, in eval mode."""
+GQCNN_CARD_FORMAT = "graspaug.gqcnn-card/1"
+
+
+def gqcnn_card(crop, intrinsics, viewpoints, gripper, label_threshold: float, global_seed: int) -> dict[str, Any]:
+    """The part of a GQ-CNN's model card fixed by the rendered data: crop geometry (px), the
+    training camera (intrinsics in px, distance in m, tilt in degrees), the gripper (m) and the
+    robust-ε label threshold. :func:`finish_gqcnn_card` adds what one network was trained on."""
+    from graspaug import __version__
+
+    return {"format": GQCNN_CARD_FORMAT, "graspaug_version": __version__,
+            "crop_size": int(crop.crop_size), "out_size": int(crop.out_size),
+            "intrinsics": {k: getattr(intrinsics, k) for k in ("width", "height", "fx", "fy", "cx", "cy")},
+            "camera_distance": [float(d) for d in viewpoints.distance], "camera_tilt_deg": [float(t) for t in viewpoints.tilt_deg],
+            "gripper": dataclasses.asdict(gripper), "label_threshold": float(label_threshold), "global_seed": int(global_seed)}
+
+
+def finish_gqcnn_card(card: dict[str, Any] | None, summary: dict[str, Any]) -> dict[str, Any] | None:
+    """``card`` plus the training set (pool, base size, ratio, seed, datapoints, steps) and the
+    validation / test AP of ``summary`` (a network's ``summary.json``); None stays None."""
+    if card is None:
+        return None
+    train = summary["train"]
+    return {**card, "training_set": {"pool": summary["pool"], "base_size": summary["base_size"], "ratio": summary["ratio"],
+                                     "seed": summary["seed"], "datapoints": train.get("datapoints"), "steps": train.get("steps"),
+                                     "best_step": train.get("best_step")},
+            "validation_ap": summary["validation"].get("ap"), "test_ap": summary["test"].get("ap")}
+
+
+def save_gqcnn(path: str | os.PathLike, net, summary: dict[str, Any], card: dict[str, Any] | None) -> None:
+    """Write a GQ-CNN checkpoint (atomic): its config, weights, training summary and model card."""
+    state = {"config": dataclasses.asdict(net.config), "state_dict": {k: v.detach().cpu() for k, v in net.state_dict().items()},
+             "summary": summary, "card": card}
+    with atomic_path(path) as tmp, open(tmp, "wb") as f:
+        torch.save(state, f)
+
+
+def read_gqcnn(path: str | os.PathLike):
+    """A trained GQ-CNN on the CPU in eval mode, and its model card (a dict; None for a
+    checkpoint written before cards existed)."""
     from graspaug.nets.gqcnn import GQCNN, GQCNNConfig
 
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(f"{path}: no GQ-CNN checkpoint (run `dvc repro train_gqcnn`)")
     saved = torch.load(path, map_location="cpu", weights_only=True)
+    if not isinstance(saved, dict) or "state_dict" not in saved or "config" not in saved:
+        raise CheckpointMismatch(f"{path} is not a GQ-CNN checkpoint of graspaug (no config and state_dict)")
     net = GQCNN(GQCNNConfig(**saved["config"]))
     net.load_state_dict(saved["state_dict"])
-    return net.eval()
+    return net.eval(), saved.get("card")
+
+
+def load_gqcnn(path: str | os.PathLike):
+    """A trained GQ-CNN from ``models/gqcnn/s<seed>/<pool>/<B>-<R>/model.pt``, on the CPU, in eval mode."""
+    return read_gqcnn(path)[0]

@@ -6,6 +6,7 @@ for a user's mesh folder, so tables do not depend on where a venv lives.
 """
 from __future__ import annotations
 
+import os
 import re
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
@@ -74,7 +75,10 @@ def folder_sources(folder: str | Path, unit_scale: float = 1.0, limit: int | Non
     folder = Path(folder).resolve()
     if not folder.is_dir():
         raise FileNotFoundError(f"mesh folder not found: {folder}")
-    files = sorted(p for p in folder.rglob("*") if p.is_file() and p.suffix.lower() in MESH_SUFFIXES)
+    # every entry with a mesh suffix, links and special files too (ingest reads or rejects each
+    # with a reason); linked folders are not entered
+    files = sorted(Path(root, name) for root, dirs, names in os.walk(folder) for name in [*names, *dirs]
+                   if Path(name).suffix.lower() in MESH_SUFFIXES and (name in names or os.path.islink(os.path.join(root, name))))
     out, seen = [], set()
     for path in files:
         rel = path.relative_to(folder).as_posix()

@@ -100,18 +100,21 @@ def _policy(model: str | None, layout, sampler, cem, crop_size: int, out_size: i
 
 @functools.lru_cache(maxsize=4)
 def _cached_policy(model: str | None, version, layout, sampler, cem, crop_size: int, out_size: int):
-    from graspaug.sim.policy import RandomAntipodalPolicy
+    """A :class:`graspaug.planning.Planner`: the public planner is the one the robot uses. A
+    checkpoint without a model card gets the render params' crop sizes."""
+    import dataclasses
+
+    from graspaug.planning import Planner, load_planner
 
     if model is None:
-        return RandomAntipodalPolicy(layout.intrinsics, sampler)
+        return Planner(None, sampler=sampler, cem=cem, check_image=False)  # Dex-Net's policy, as it was
     import torch
 
-    from graspaug.io.checkpoints import load_gqcnn
-    from graspaug.render.crops import CropGeometry
-    from graspaug.sim.policy import CrossEntropyGraspPolicy
-
     torch.set_num_threads(1)
-    return CrossEntropyGraspPolicy(load_gqcnn(model), layout.intrinsics, sampler, cem, CropGeometry(crop_size=crop_size, out_size=out_size))
+    planner = load_planner(model, sampler, cem, check_image=False)
+    if planner.card.assumed:
+        planner.card = dataclasses.replace(planner.card, crop_size=crop_size, out_size=out_size)
+    return planner
 
 
 def run_object(job: ObjectJob, layout, hand, sampler, cem, crop_size: int, out_size: int, trial_settings=None) -> list[dict]:
@@ -125,7 +128,8 @@ def run_object(job: ObjectJob, layout, hand, sampler, cem, crop_size: int, out_s
     for attempt, (drop_seed, plan_seed) in enumerate(zip(job.drop_seeds, job.plan_seeds)):
         rng = np.random.default_rng(plan_seed)
         record = job.record and attempt == 0
-        result = run_trial(job.sim_object, drop_seed, planner=lambda depth, camera, k: policy.plan(depth, rng), layout=layout,
+        plan = lambda depth, camera, k: next(iter(policy.plan(depth, k, rng, camera_distance=camera.height)), None)  # noqa: E731
+        result = run_trial(job.sim_object, drop_seed, planner=plan, layout=layout,
                            hand=hand, settings=trial_settings, record=record)
         g = result.image_grasp or {}
         rows.append({

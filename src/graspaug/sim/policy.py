@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -109,6 +110,49 @@ def sample_antipodal_grasps(depth: np.ndarray, intrinsics: Intrinsics, settings:
                        widths=np.linalg.norm(axis, axis=1))
 
 
+def edge_normals(depth: np.ndarray, settings: SamplerSettings) -> tuple[np.ndarray, np.ndarray]:
+    """Edge mask (H, W) of ``depth`` (m) and unit outward normals (H, W, 2) (u, v) there, as
+    :func:`sample_antipodal_grasps` finds them (without the border margin)."""
+    grad_v, grad_u = np.gradient(depth)
+    magnitude = np.hypot(grad_u, grad_v)
+    edges = magnitude > settings.depth_grad_thresh
+    with np.errstate(divide="ignore", invalid="ignore"):
+        normals = np.stack([grad_u, grad_v], axis=2) / magnitude[..., None]
+    return edges, np.nan_to_num(normals)
+
+
+def antipodal_in_image(depth: np.ndarray, grasps: ImageGrasps, settings: SamplerSettings, fingertip_offset: float = 0.0,
+                       search_px: int = 2, clearance_px: tuple[int, int] = (2, 6)) -> np.ndarray:
+    """(N,) bool: each grasp's jaws meet depth edges within ``search_px`` px whose outward
+    normals hold the jaw line inside the friction cone (the sampler's test), and beyond each jaw,
+    ``clearance_px`` px outward along the jaw axis (and 3 px to either side), the image is no
+    nearer than the grasp depth plus ``fingertip_offset`` (m, how far the fingertips reach past
+    the grasp center): the fingers can go down (not into the object's flanks or the table)."""
+    h, w = depth.shape
+    edges, normals = edge_normals(depth, settings)
+    cone = math.cos(math.atan(settings.friction_coef))
+    direction = np.stack([np.cos(grasps.angles), np.sin(grasps.angles)], axis=1)
+    half = 0.5 * grasps.widths[:, None] * direction
+    ok = np.ones(len(grasps), dtype=bool)
+    offsets = np.arange(-search_px, search_px + 1)
+    du, dv = (a.ravel() for a in np.meshgrid(offsets, offsets))
+    across = np.stack([-direction[:, 1], direction[:, 0]], axis=1)
+    steps = np.arange(clearance_px[0], clearance_px[1] + 1)
+    for sign in (-1.0, 1.0):  # jaw 1 at center - half (outward: -direction), jaw 2 at center + half
+        jaw = grasps.centers + sign * half
+        u = np.clip(np.rint(jaw[:, 0, None]).astype(int) + du, 0, w - 1)
+        v = np.clip(np.rint(jaw[:, 1, None]).astype(int) + dv, 0, h - 1)
+        outward = sign * direction
+        facing = np.einsum("nkc,nc->nk", normals[v, u], outward) >= cone
+        ok &= np.any(edges[v, u] & facing, axis=1)
+        points = (jaw[:, None, None, :] + outward[:, None, None, :] * steps[None, :, None, None]
+                  + across[:, None, None, :] * np.array([-3.0, 0.0, 3.0])[None, None, :, None])
+        pu = np.clip(np.rint(points[..., 0]).astype(int), 0, w - 1)
+        pv = np.clip(np.rint(points[..., 1]).astype(int), 0, h - 1)
+        ok &= depth[pv, pu].reshape(len(grasps), -1).min(axis=1) >= grasps.depths + fingertip_offset
+    return ok
+
+
 def grasp_features(grasps: ImageGrasps) -> np.ndarray:
     """(N, 5) Dex-Net's grasp feature vector: both jaw endpoints (u, v) px and the depth in cm."""
     half = 0.5 * grasps.widths[:, None] * np.stack([np.cos(grasps.angles), np.sin(grasps.angles)], axis=1)
@@ -146,14 +190,17 @@ class CrossEntropyGraspPolicy:
         max_px = self.sampler.max_width * self.intrinsics.fx / np.maximum(grasps.depths, 1e-3)
         return (u >= b) & (u < w - b) & (v >= b) & (v < h - b) & (grasps.widths < max_px) & (grasps.depths > 0)
 
-    def plan(self, depth: np.ndarray, rng: np.random.Generator) -> PlannedGrasp | None:
-        """The best grasp after the cross-entropy iterations, or None when the image has no
-        antipodal pair at all."""
-        start = time.perf_counter()
+    def plan_ranked(self, depth: np.ndarray, rng: np.random.Generator, top: int = 1,
+                    accept: Callable[[ImageGrasps], np.ndarray] | None = None) -> tuple[ImageGrasps, np.ndarray, int] | None:
+        """The ``top`` best grasps of the last cross-entropy iteration, best first, their
+        qualities and the number of grasps scored in all; None when the image has no antipodal
+        pair at all. With ``accept`` (grasps → (N,) bool) the ranking holds only accepted grasps
+        of the last iteration and of the seeds (None when none is accepted)."""
         grasps = sample_antipodal_grasps(depth, self.intrinsics, self.sampler, self.cem.num_seed_samples, rng)
         if len(grasps) == 0:
             return None
         q = self.quality(depth, grasps)
+        seeds, seed_q = grasps, q
         scored = len(grasps)
         for _ in range(self.cem.num_iters):
             n_elite = max(1, int(math.ceil(self.cem.elite_fraction * len(grasps))))
@@ -168,9 +215,25 @@ class CrossEntropyGraspPolicy:
                 break
             grasps, q = sampled, self.quality(depth, sampled)
             scored += len(sampled)
-        best = int(np.argmax(q))
-        return PlannedGrasp(grasp=grasps.take([best]), quality=float(q[best]), planning_time=time.perf_counter() - start,
-                            candidates=scored)
+        if accept is not None:
+            grasps = ImageGrasps(*(np.concatenate([getattr(grasps, k), getattr(seeds, k)]) for k in ("centers", "angles", "depths", "widths")))
+            q = np.concatenate([q, seed_q])
+            keep = np.flatnonzero(accept(grasps))
+            if len(keep) == 0:
+                return None
+            grasps, q = grasps.take(keep), q[keep]
+        order = np.argsort(-q, kind="stable")[:top]  # the first is np.argmax(q)
+        return grasps.take(order), q[order], scored
+
+    def plan(self, depth: np.ndarray, rng: np.random.Generator) -> PlannedGrasp | None:
+        """The best grasp after the cross-entropy iterations, or None when the image has no
+        antipodal pair at all."""
+        start = time.perf_counter()
+        ranked = self.plan_ranked(depth, rng)
+        if ranked is None:
+            return None
+        grasps, q, scored = ranked
+        return PlannedGrasp(grasp=grasps, quality=float(q[0]), planning_time=time.perf_counter() - start, candidates=scored)
 
 
 class RandomAntipodalPolicy:
@@ -180,12 +243,23 @@ class RandomAntipodalPolicy:
     def __init__(self, intrinsics: Intrinsics, sampler: SamplerSettings = SamplerSettings()) -> None:
         self.intrinsics, self.sampler = intrinsics, sampler
 
-    def plan(self, depth: np.ndarray, rng: np.random.Generator) -> PlannedGrasp | None:
-        start = time.perf_counter()
-        grasps = sample_antipodal_grasps(depth, self.intrinsics, self.sampler, 1, rng)
+    def plan_ranked(self, depth: np.ndarray, rng: np.random.Generator, top: int = 1,
+                    accept: Callable[[ImageGrasps], np.ndarray] | None = None) -> tuple[ImageGrasps, np.ndarray, int] | None:
+        """``top`` antipodal seed grasps drawn at random (quality NaN), or None; with ``accept``,
+        ``top`` of the accepted ones among up to 20 × ``top`` seeds."""
+        grasps = sample_antipodal_grasps(depth, self.intrinsics, self.sampler, top if accept is None else 20 * top, rng)
+        if accept is not None and len(grasps):
+            grasps = grasps.take(np.flatnonzero(accept(grasps))[:top])
         if len(grasps) == 0:
             return None
-        return PlannedGrasp(grasp=grasps, quality=float("nan"), planning_time=time.perf_counter() - start, candidates=1)
+        return grasps, np.full(len(grasps), np.nan), len(grasps)
+
+    def plan(self, depth: np.ndarray, rng: np.random.Generator) -> PlannedGrasp | None:
+        start = time.perf_counter()
+        ranked = self.plan_ranked(depth, rng)
+        if ranked is None:
+            return None
+        return PlannedGrasp(grasp=ranked[0], quality=float("nan"), planning_time=time.perf_counter() - start, candidates=1)
 
 
 def grasp_in_table_frame(grasps: ImageGrasps, camera: CameraPose, intrinsics: Intrinsics) -> tuple[np.ndarray, np.ndarray]:

@@ -25,6 +25,7 @@ from graspaug.config import Params
 from graspaug.device import resolve_device
 from graspaug.experiments.networks import NetworkJob, initial_weights, read_history, seed_table, seed_variants, stream_seeds, train_network
 from graspaug.io.atomic import atomic_path
+from graspaug.io.checkpoints import gqcnn_card
 from graspaug.io.tables import write_csv, write_json
 from graspaug.paths import gqcnn_seed_dir, gqcnn_seed_metrics, gqcnn_val_curves, timing_file
 from graspaug.stages import StageError
@@ -54,9 +55,11 @@ def run(params: Params, seed: int) -> None:
              seed, len(variants), len(split.validation), len(val_rows), len(test_rows), device)
     # one network at a time with every thread: bench/gqcnn_train_speed.py measured two 1-thread workers slower on 2 cores
     with atomic_path(gqcnn_seed_dir(seed), directory=True) as folder:
+        card = gqcnn_card(params.render.crop, params.render.intrinsics, params.render.viewpoints, params.grasps.gripper,
+                          params.grasps.threshold, params.seed)
         results = []
         for variant in tqdm(variants, desc=f"train GQ-CNNs (seed {seed})", unit="network"):
-            job = NetworkJob(variant, split, cfg.net, cfg.train, init, noise_seed, seed, str(device), 0, folder)
+            job = NetworkJob(variant, split, cfg.net, cfg.train, init, noise_seed, seed, str(device), 0, folder, card)
             try:
                 results.append(train_network(job, val, test))
             except ValueError as exc:

@@ -1,0 +1,178 @@
+"""The public planner on a depth image rendered from a corpus shape: the README's Python
+example and `graspaug plan` both give a grasp that is antipodal on the shape itself."""
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+import torch
+from PIL import Image
+from typer.testing import CliRunner
+
+from graspaug.cli import app
+from graspaug.geometry.loading import load_shape
+from graspaug.geometry.prepare import SurfaceSettings, prepare_shape
+from graspaug.grasping.antipodal import force_closure
+from graspaug.grasping.contacts import close_fingers
+from graspaug.io.checkpoints import gqcnn_card, read_gqcnn, save_gqcnn
+from graspaug.io.sources import pybullet_sources
+from graspaug.grasping.gripper import ParallelJawGripper
+from graspaug.nets.gqcnn import GQCNN
+from graspaug.planning import ModelCard, NoGraspFound, PlanningError, load_planner, plan_grasp, plan_grasps
+from graspaug.render.camera import Intrinsics, ViewpointRanges, look_at
+from graspaug.render.depth import render_depth
+from graspaug.render.settings import CropGeometry
+from graspaug.render.stable_poses import stable_poses
+
+K = {"fx": 525.0, "fy": 525.0, "cx": 319.5, "cy": 239.5}
+FRICTION = 0.8  # the image sampler's friction coefficient (SamplerSettings.friction_coef)
+
+
+@pytest.fixture(scope="module")
+def scene():
+    """rnd_000 of the default corpus, ingested (closed, 6 cm middle extent), in its most
+    probable stable pose, seen from 0.7 m straight above: (mesh in the table frame, camera)."""
+    source = pybullet_sources(1)[0]
+    mesh = prepare_shape(load_shape(source.path, source.unit_scale), SurfaceSettings()).mesh
+    mesh.apply_transform(stable_poses(mesh).transforms[0])
+    return mesh, look_at(np.array([0.02, -0.01, 0.7]), np.zeros(3))
+
+
+def depth_of(scene, intrinsics: Intrinsics = Intrinsics()) -> np.ndarray:
+    mesh, camera = scene
+    return render_depth(mesh, camera, intrinsics)
+
+
+@pytest.fixture(scope="module")
+def model_path(tmp_path_factory):
+    """An untrained GQ-CNN of the default width (seeded) with a model card, saved as train_gqcnn saves it."""
+    torch.manual_seed(0)
+    path = tmp_path_factory.mktemp("model") / "model.pt"
+    card = gqcnn_card(CropGeometry(), Intrinsics(), ViewpointRanges(), ParallelJawGripper(), 0.002, 0)
+    summary = {"pool": "targeted", "base_size": 50, "ratio": 0.0, "seed": 0, "train": {"datapoints": 0, "steps": 0, "best_step": 0},
+               "validation": {"ap": None}, "test": {"ap": None}}
+    from graspaug.io.checkpoints import finish_gqcnn_card
+
+    save_gqcnn(path, GQCNN(), summary, finish_gqcnn_card(card, summary))
+    return path
+
+
+def assert_antipodal(scene, position, rotation, width) -> None:
+    """Close the jaws of the camera-frame grasp on the mesh: both contacts found, each within
+    2 mm of where the plan put the jaw, and the jaw line inside both friction cones."""
+    mesh, camera = scene
+    center = camera.to_table(np.asarray(position)[None])[0]
+    axis = np.asarray(rotation)[:, 0] @ camera.rotation.T
+    contacts = close_fingers(mesh, center[None], axis[None], 0.08)
+    assert contacts.found[0], "a jaw misses the shape"
+    planned = np.stack([center - 0.5 * width * axis, center + 0.5 * width * axis])
+    assert np.linalg.norm(contacts.p1[0] - planned[0]) < 0.002 and np.linalg.norm(contacts.p2[0] - planned[1]) < 0.002
+    assert force_closure(contacts.p1, contacts.n1, contacts.p2, contacts.n2, FRICTION)[0]
+
+
+def test_readme_example_plans_an_antipodal_grasp(scene, model_path, tmp_path):
+    np.save(tmp_path / "depth.npy", depth_of(scene))
+    # the README's example, line for line
+    planner = load_planner(model_path)
+    depth = np.load(tmp_path / "depth.npy")
+    grasp = plan_grasp(depth, {"fx": 525, "fy": 525, "cx": 319.5, "cy": 239.5}, planner)
+    assert grasp.pose.shape == (4, 4) and 0 < grasp.width <= 0.08 and 0 <= grasp.quality <= 1
+    assert np.allclose(grasp.rotation.T @ grasp.rotation, np.eye(3)) and np.isclose(np.linalg.det(grasp.rotation), 1)
+    assert_antipodal(scene, grasp.position, grasp.rotation, grasp.width)
+    assert planner.card.crop_size == 96 and planner.card.camera_distance == (0.65, 0.75) and not planner.card.assumed
+
+
+def test_top_k_is_ranked_and_every_grasp_antipodal(scene, model_path):
+    grasps = plan_grasps(depth_of(scene), K, model_path, top=3)
+    assert len(grasps) == 3
+    assert [g.quality for g in grasps] == sorted((g.quality for g in grasps), reverse=True)
+    for g in grasps:
+        assert_antipodal(scene, g.position, g.rotation, g.width)
+
+
+def test_the_cli_plans_on_a_16_bit_png(scene, model_path, tmp_path):
+    millimeters = np.rint(depth_of(scene) * 1000).astype(np.uint16)
+    Image.fromarray(millimeters).save(tmp_path / "depth.png")
+    out = tmp_path / "plan"
+    result = CliRunner().invoke(app, ["plan", str(tmp_path / "depth.png"), "--model", str(model_path), "--fx", "525", "--fy", "525",
+                                      "--cx", "319.5", "--cy", "239.5", "--top", "2", "--out", str(out)])
+    assert result.exit_code == 0, result.output
+    planned = json.loads((out / "grasp.json").read_text())
+    assert len(planned["grasps"]) == 2 and planned["model_card"]["crop_size"] == 96
+    best = planned["grasps"][0]
+    assert_antipodal(scene, best["position"], best["rotation"], best["width"])
+    assert Image.open(out / "grasp.png").size[0] > 100
+
+
+def test_intrinsics_from_a_json_file_and_one_line_errors(scene, model_path, tmp_path):
+    depth = depth_of(scene)
+    np.save(tmp_path / "depth.npy", depth)
+    (tmp_path / "camera.json").write_text(json.dumps(K))
+    runner = CliRunner()
+    ok = runner.invoke(app, ["plan", str(tmp_path / "depth.npy"), "--model", str(model_path), "--intrinsics", str(tmp_path / "camera.json"),
+                             "--out", str(tmp_path / "a")])
+    assert ok.exit_code == 0, ok.output
+    bad = depth.copy()
+    bad[100:110, 200:210] = np.nan
+    cases = {"shape": np.zeros((480, 640, 3)), "nan": bad, "far": depth + 1.5, "mm": depth * 1000}
+    expected = {"shape": "2-D array", "nan": "100 missing pixels", "far": "far from the network's training range", "mm": "millimeters"}
+    for name, image in cases.items():
+        np.save(tmp_path / f"{name}.npy", image)
+        result = runner.invoke(app, ["plan", str(tmp_path / f"{name}.npy"), "--model", str(model_path), "--intrinsics",
+                                     str(tmp_path / "camera.json"), "--out", str(tmp_path / name)])
+        assert result.exit_code == 2 and expected[name] in result.output and result.output.count("\n") == 1, (name, result.output)
+    filled = runner.invoke(app, ["plan", str(tmp_path / "nan.npy"), "--model", str(model_path), "--intrinsics", str(tmp_path / "camera.json"),
+                                 "--fill-missing", "--out", str(tmp_path / "filled")])
+    assert filled.exit_code == 0, filled.output
+
+
+def test_another_camera_is_resampled_or_refused(scene, model_path):
+    # a sharper camera (f = 700 px): the image is resampled to the training focal length
+    sharp = Intrinsics(width=800, height=600, fx=700, fy=700, cx=399.5, cy=299.5)
+    grasp = plan_grasp(depth_of(scene, sharp), sharp, model_path)
+    assert_antipodal(scene, grasp.position, grasp.rotation, grasp.width)
+    # a coarse camera (f = 300 px) would need the object up-sampled 1.75×: refused
+    coarse = Intrinsics(width=400, height=300, fx=300, fy=300, cx=199.5, cy=149.5)
+    with pytest.raises(PlanningError, match="up-sampled"):
+        plan_grasp(depth_of(scene, coarse), coarse, model_path)
+    with pytest.raises(PlanningError, match="intrinsics are for"):
+        plan_grasp(depth_of(scene), sharp, model_path)
+
+
+def test_a_camera_closer_than_training_shifts_and_scales(scene, model_path):
+    mesh, _ = scene
+    near = look_at(np.array([0.02, -0.01, 0.55]), np.zeros(3))
+    depth = render_depth(mesh, near, Intrinsics())
+    grasp = plan_grasp(depth, K, model_path)
+    assert_antipodal((mesh, near), grasp.position, grasp.rotation, grasp.width)
+
+
+def test_no_edges_no_grasp_and_old_checkpoints_assume_the_defaults(model_path, tmp_path):
+    with pytest.raises(NoGraspFound):
+        plan_grasp(np.full((480, 640), 0.7), K, model_path)
+    net, card = read_gqcnn(model_path)
+    old = tmp_path / "old.pt"
+    config = {k: v for k, v in net.describe().items() if k != "parameters"}
+    torch.save({"config": config, "state_dict": net.state_dict(), "summary": {}}, old)  # a model.pt from before model cards
+    planner = load_planner(old)
+    assert planner.card.assumed and planner.card == ModelCard(assumed=True)
+    assert math.isclose(planner.card.focal_length, 525.0)
+
+
+def test_export_model_gives_the_same_probabilities(model_path, tmp_path):
+    result = CliRunner().invoke(app, ["export-model", str(model_path), str(tmp_path / "export")])
+    assert result.exit_code == 0, result.output
+    card = json.loads((tmp_path / "export/card.json").read_text())
+    assert card["model_card"]["crop_size"] == 96 and card["model_card"]["intrinsics"]["fx"] == 525
+    scripted = torch.jit.load(str(tmp_path / "export/model.ts"))
+    net, _ = read_gqcnn(model_path)
+    generator = torch.Generator().manual_seed(0)
+    images = 0.6 + 0.1 * torch.rand(7, 1, 32, 32, generator=generator)  # another batch size than traced
+    z = 0.6 + 0.1 * torch.rand(7, generator=generator)
+    with torch.inference_mode():
+        expected = net.success_probability(images, z)
+        exported = scripted(images, z)
+    assert exported.shape == (7,) and torch.allclose(exported, expected, atol=1e-6)
+    assert not torch.allclose(expected, expected[:1].expand(7))  # the inputs matter
