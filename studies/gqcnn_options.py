@@ -7,7 +7,9 @@ mean over seeds, 95% t-interval, and the paired difference to the default with i
 plus training samples/s. Run it in a project where ``render@original`` has run with the
 default params (it reads ``data/shapes.parquet`` and ``data/gqcnn/original``):
 
-    python studies/gqcnn_options.py [--seeds 0 1 2] [--base-sizes 50 200] [--threads 2]
+    python studies/gqcnn_options.py [--seeds 0 1 2] [--base-sizes 50 200] [--options NAME ...]
+
+The training budget is the params' (``gqcnn.train``): set it in params.yaml first.
 """
 from __future__ import annotations
 
@@ -25,11 +27,13 @@ from graspaug.nets.gqcnn import GQCNN
 from graspaug.training.gqcnn import classification_metrics, predict, train_gqcnn
 from graspaug.training.gqcnn_data import Variant, load_split, shapes_datapoints, training_set
 
-OPTIONS = {  # name → changes to gqcnn.net; the first is the default
-    "default (8 filters, FC 64, depth)": {},
-    "FC 256": {"fc": 256},
-    "16 filters": {"filters": 16},
-    "depth minus gripper": {"image_input": "depth_minus_gripper"},
+OPTIONS = {  # name → (changes to gqcnn.net, changes to gqcnn.train); the first is the params' own
+    "params as they are": ({}, {}),
+    "lr 0.05": ({}, {"lr": 0.05}),
+    "lr 0.01": ({}, {"lr": 0.01}),
+    "FC 256": ({"fc": 256}, {}),
+    "16 filters": ({"filters": 16}, {}),
+    "depth minus gripper": ({"image_input": "depth_minus_gripper"}, {}),
 }
 
 
@@ -38,6 +42,7 @@ def main() -> None:
     parser.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2])
     parser.add_argument("--base-sizes", type=int, nargs="+", default=[50, 200])
     parser.add_argument("--threads", type=int, default=torch.get_num_threads())
+    parser.add_argument("--options", nargs="+", default=list(OPTIONS), help="Which options, by name (the first is the reference).")
     args = parser.parse_args()
     torch.set_num_threads(args.threads)
     params = Params()
@@ -49,8 +54,9 @@ def main() -> None:
           + ", ".join(f"B = {b}: {len(d)}" for b, d in sets.items()) + f"; seeds {args.seeds}; {args.threads} threads")
     val_ap: dict = {}
     speed: dict = {}
-    for name, change in OPTIONS.items():
-        net_cfg = dataclasses.replace(cfg.net, **change)
+    options = {name: OPTIONS[name] for name in args.options}
+    for name, (net_change, train_change) in options.items():
+        net_cfg, train_cfg = dataclasses.replace(cfg.net, **net_change), dataclasses.replace(cfg.train, **train_change)
         for seed in args.seeds:
             weight_seed, noise_seed = stream_seeds(params.seed, seed)
             init = initial_weights(net_cfg, weight_seed)
@@ -58,13 +64,13 @@ def main() -> None:
                 net = GQCNN(net_cfg)
                 net.load_state_dict(init)
                 start = time.perf_counter()
-                fit = train_gqcnn(net, train, val, cfg.train, torch.device("cpu"), torch.Generator().manual_seed(noise_seed), progress=False)
-                speed.setdefault(name, []).append(fit["steps"] * cfg.train.batch_size / (time.perf_counter() - start))
+                fit = train_gqcnn(net, train, val, train_cfg, torch.device("cpu"), torch.Generator().manual_seed(noise_seed), progress=False)
+                speed.setdefault(name, []).append(fit["steps"] * train_cfg.batch_size / (time.perf_counter() - start))
                 val_ap[name, b, seed] = classification_metrics(val.labels, predict(net, val, torch.device("cpu"), cfg.train.eval_batch))["ap"]
-                print(f"  {name:38s} B = {b:4d} seed {seed}: validation AP {val_ap[name, b, seed]:.4f} ({fit['steps']} steps)", flush=True)
-    default = next(iter(OPTIONS))
+                print(f"  {name:38s} B = {b:4d} seed {seed}: validation AP {val_ap[name, b, seed]:.4f} ({fit['steps']} steps, kept {fit['best_step']})", flush=True)
+    default = next(iter(options))
     print("\noption                                 B     validation AP (95% t)          vs default (paired, 95% t)      samples/s")
-    for name in OPTIONS:
+    for name in options:
         for b in args.base_sizes:
             own = t_interval([val_ap[name, b, s] for s in args.seeds])
             diff = t_interval([val_ap[name, b, s] - val_ap[default, b, s] for s in args.seeds])

@@ -90,7 +90,7 @@ def train_network(job: NetworkJob, val: GraspArrays | None = None, test: GraspAr
     gen = torch.Generator().manual_seed(job.noise_seed)
     history: list[dict] = []
     fit = train_gqcnn(net, train, val, job.train, device, gen, on_log=lambda step, m: history.append({"step": step, **m}), progress=False)
-    val_p = predict(net, val, device, job.train.eval_batch)
+    val_p = fit["val_predictions"] if fit["val_predictions"] is not None else predict(net, val, device, job.train.eval_batch)  # the kept weights
     test_p = predict(net, test, device, job.train.eval_batch)
     rounded = lambda d: {k: (round(v, 5) if isinstance(v, float) else v) for k, v in d.items()}  # noqa: E731
     summary = {"pool": job.variant.pool, "base_size": job.variant.base_size, "ratio": job.variant.ratio, "seed": job.seed,

@@ -107,8 +107,8 @@ def train_gqcnn(net: GQCNN, train: GraspArrays, val: GraspArrays | None, setting
     epoch from ``train`` (softmax cross-entropy), evaluating validation AP ``settings.evals``
     times; ``net`` ends with the weights of the best evaluation (the last ones without ``val``).
     ``on_log(step, metrics)`` gets the mean loss and train accuracy since the last evaluation,
-    the learning rate and the validation AP / accuracy. Returns the steps, the best step and
-    validation AP, and throughput."""
+    the learning rate and the validation AP / accuracy. Returns the steps, the best step, its
+    validation AP and predictions (N_val,) (None without ``val``), and throughput."""
     if len(train) < 2:
         raise ValueError(f"need at least 2 training datapoints, got {len(train)}")
     net.set_normalization(*normalization(net, train))
@@ -145,16 +145,17 @@ def train_gqcnn(net: GQCNN, train: GraspArrays, val: GraspArrays | None, setting
         if step in eval_at:
             metrics = {"loss": loss_sum / seen, "train_accuracy": correct / seen, "lr": lr_used}
             if val is not None and len(val):
-                scores = classification_metrics(val.labels, predict(net, val, device, settings.eval_batch))
+                probability = predict(net, val, device, settings.eval_batch)
+                scores = classification_metrics(val.labels, probability)
                 ap = scores["ap"] if scores["ap"] is not None else float("nan")
                 metrics.update(val_accuracy=scores["accuracy"], val_ap=ap)
                 if best["state"] is None or (math.isfinite(ap) and not ap <= best["val_ap"]):  # ties keep the earlier; a NaN is replaced
-                    best = {"step": step, "val_ap": ap, "state": copy.deepcopy(net.state_dict())}
+                    best = {"step": step, "val_ap": ap, "state": copy.deepcopy(net.state_dict()), "val_predictions": probability}
             if on_log is not None:
                 on_log(step, metrics)
             loss_sum, correct, seen = 0.0, 0, 0
     seconds = time.perf_counter() - start
     if best["state"] is not None:
         net.load_state_dict(best["state"])
-    return {"steps": steps, "best_step": best["step"], "best_val_ap": best["val_ap"], "train_seconds": seconds,
+    return {"steps": steps, "best_step": best["step"], "best_val_ap": best["val_ap"], "val_predictions": best.get("val_predictions"), "train_seconds": seconds,
             "samples_per_second": steps * batch_size / seconds}
