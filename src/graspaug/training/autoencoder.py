@@ -69,8 +69,8 @@ def train_ae_critic(ae: AutoEncoder, critic: Critic | None, voxels: torch.Tensor
 
     Each batch: z = E(x), x̂ = D(z); partner = the reversed batch (ACAI); α = U(0, 1) folded
     to [0, 0.5]; x̂_α = D((1 − α) z + α z_partner). The first ``critic_warmup`` epochs train
-    only the critic (the control arm idles through them), so eq. (2) starts from a critic
-    that has learned something. The decoder's BatchNorm layers stay in eval mode: real and
+    only the critic (the AE in eval mode; the control arm idles through them), so eq. (2)
+    starts from a critic that has learned something. The decoder's BatchNorm layers stay in eval mode: real and
     interpolated latents are decoded with phase 1's running statistics (as every later
     decode is), and interpolated latents never enter those statistics. Returns shapes/s.
     """
@@ -82,12 +82,12 @@ def train_ae_critic(ae: AutoEncoder, critic: Critic | None, voxels: torch.Tensor
     lam = cfg.lam if critic is not None else 0.0
     seen, elapsed = 0, 0.0
     for epoch in tqdm(range(cfg.epochs_critic), desc="train AE-Critic" if critic is not None else "train AE, λ = 0", unit="epoch"):
-        ae.train()
+        train_ae = epoch >= cfg.critic_warmup
+        ae.train(train_ae)  # in the warm-up the AE does not learn, its statistics included
         ae.decoder.eval()  # frozen normalization statistics (weights still learn)
         start = time.perf_counter()
         sums = {"loss_recon": 0.0} | ({"loss_reg": 0.0, "loss_critic": 0.0} if critic is not None else {})
         n = 0
-        train_ae = epoch >= cfg.critic_warmup
         for idx in _batches(len(voxels), cfg.batch_size, gen):
             x = _as_float(voxels[idx], device)
             if cfg.flips:
