@@ -14,7 +14,7 @@ import torch
 from graspaug.experiments.stats import percentile_interval
 from graspaug.geometry.clusters import outlier_percentage
 from graspaug.nets.ae_critic import AutoEncoder
-from graspaug.training.autoencoder import decode, encode
+from graspaug.training.autoencoder import decode
 
 
 def random_pairs(n: int, n_shapes: int, n_pairs: int, rng: np.random.Generator) -> np.ndarray:
@@ -30,9 +30,8 @@ def interpolate(z: np.ndarray, pairs: np.ndarray, alphas: np.ndarray) -> np.ndar
     return (1 - alphas[None, :, None]) * a + alphas[None, :, None] * b
 
 
-def decoded_interpolations(ae: AutoEncoder, grids: torch.Tensor, pairs: np.ndarray, alphas: np.ndarray, threshold: float, device: torch.device) -> np.ndarray:
-    """(P, A, R, R, R) bool: the pairs of ``grids`` (N, 1, R, R, R) interpolated at ``alphas`` (A,), decoded, thresholded."""
-    z = encode(ae, grids, device)
+def decoded_interpolations(ae: AutoEncoder, z: np.ndarray, pairs: np.ndarray, alphas: np.ndarray, threshold: float, device: torch.device) -> np.ndarray:
+    """(P, A, R, R, R) bool: the pairs of latents ``z`` (N, d) interpolated at ``alphas`` (A,), decoded, thresholded."""
     probs = decode(ae, interpolate(z, pairs, alphas).reshape(-1, z.shape[1]), device)
     return (probs > threshold).reshape(len(pairs), len(alphas), *probs.shape[1:])
 

@@ -24,7 +24,7 @@ from graspaug.io.tables import write_csv, write_json
 from graspaug.plots import lines, voxel_rows
 from graspaug.stages import StageError
 from graspaug.paths import AE_CRITIC_MODEL, AE_EXTRA_MODEL, AE_MODEL, CRITIC_EVAL_METRICS, INTERPOLATIONS_PNG, OUTLIERS_CSV, OUTLIERS_PNG, SHAPES_TABLE, VOXELS
-from graspaug.training.autoencoder import critic_separation, grids_by_split
+from graspaug.training.autoencoder import critic_separation, encode, grids_by_split
 
 log = logging.getLogger(__name__)
 
@@ -49,8 +49,9 @@ def run(params: Params) -> None:
     pct, sequences, critic = {}, {}, None
     for name, (path, _) in MODELS.items():
         ae, model_critic, _ = load_autoencoder(path, params.ae.net)
-        pct[name] = outlier_table(decoded_interpolations(ae, grids["train"], pairs, alphas, cfg.threshold, device))
-        sequences[name] = decoded_interpolations(ae, grids["train"], examples, seq_alphas, cfg.threshold, device)
+        z = encode(ae, grids["train"], device)
+        pct[name] = outlier_table(decoded_interpolations(ae, z, pairs, alphas, cfg.threshold, device))
+        sequences[name] = decoded_interpolations(ae, z, examples, seq_alphas, cfg.threshold, device)
         if name == "ae_critic":
             if model_critic is None:
                 raise StageError(f"{path} holds no critic; retrain it with `dvc repro train_ae`")
