@@ -73,8 +73,11 @@ def test_dvc_repro_critic_eval_and_embed(tiny_repo):
         assert (work / path).stat().st_size > 0, path
     result = json.loads((work / "metrics/critic_eval.json").read_text())
     assert result["n_pairs"] == 3 and result["n_decoded_per_model"] == 18
-    assert set(result["outlier_pct"]) == {"ae", "ae_critic"}
+    assert set(result["outlier_pct"]) == {"ae", "ae_extra", "ae_critic"}
     assert list(result["outlier_pct"]["ae"]) == ["0.00", "0.10", "0.20", "0.30", "0.40", "0.50"]
+    assert set(result["contrast"]["critic_vs_control"]["0.50"]) == {"mean", "ci_low", "ci_high"}
+    assert result["critic_auc"] is None or 0 <= result["critic_auc"] <= 1
+    assert (work / "models/ae_extra.pt").stat().st_size > 0
     summary = json.loads((work / "metrics/train_ae.json").read_text())
     assert 0 <= summary["ae_iou_test"] <= 1 and "ae_shapes_per_s" not in summary  # results only: timings go to reports/timing
     assert json.loads((work / "reports/timing/train_ae.json").read_text())["ae_shapes_per_s"] > 0

@@ -73,10 +73,10 @@ stage_command(
 )
 stage_command(
     "train-ae",
-    "Train the AutoEncoder (phase 1, binary cross-entropy) and then the AE-Critic (phase 2, eqs. (1)-(2) "
-    "of the paper) on the train split's voxel grids; test shapes stay unseen.\n\n"
-    "Writes `models/ae.pt`, `models/ae_critic.pt`, DVCLive logs in `metrics/train_ae/`, and `metrics/train_ae.json` "
-    f"(test/train reconstruction IoU, time, shapes/s).\n\nParams `ae`:\n\n{describe(AEParams, 'ae.')}\n\n"
+    "Train the AutoEncoder (phase 1, binary cross-entropy), then from it the AE-Critic (phase 2, eqs. (1)-(2) "
+    "of the paper) and its control (phase 2 with λ = 0) on the train split's voxel grids; test shapes stay unseen.\n\n"
+    "Writes `models/ae.pt`, `models/ae_extra.pt` (control), `models/ae_critic.pt`, DVCLive logs in `metrics/train_ae/`, "
+    f"and `metrics/train_ae.json` (test/train reconstruction IoU, the critic's AUC on held-out shapes).\n\nParams `ae`:\n\n{describe(AEParams, 'ae.')}\n\n"
     "Also `seed`, `device`.",
 )
 stage_command(
@@ -86,8 +86,9 @@ stage_command(
 )
 stage_command(
     "critic-eval",
-    "The paper's critic study: decode interpolations of random train pairs with the AE and the AE-Critic, "
-    "cluster each with DBSCAN, report the mean outlier percentage per α (`metrics/critic_eval.json`) with plots "
+    "The paper's critic study: decode interpolations of random train pairs with the AE, its λ = 0 control and "
+    "the AE-Critic, cluster each with DBSCAN, report the mean outlier percentage per α with bootstrap intervals, "
+    "the paired difference AE-Critic − control and the critic's AUC (`metrics/critic_eval.json`) with plots "
     f"in `reports/critic_eval/`.\n\nParams `critic_eval`:\n\n{describe(CriticEvalParams, 'critic_eval.')}",
 )
 

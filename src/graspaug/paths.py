@@ -13,6 +13,7 @@ REJECTS_TABLE = Path("data/rejects.parquet")
 VOXELS = Path("data/voxels.npz")
 # train_ae
 AE_MODEL = Path("models/ae.pt")
+AE_EXTRA_MODEL = Path("models/ae_extra.pt")  # the critic study's control: phase 2 with λ = 0
 AE_CRITIC_MODEL = Path("models/ae_critic.pt")
 TRAIN_AE_LIVE = Path("metrics/train_ae")
 TRAIN_AE_SUMMARY = Path("metrics/train_ae.json")

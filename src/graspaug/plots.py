@@ -39,12 +39,15 @@ def scatter_2d(xy: np.ndarray, groups: Sequence[str], path: str | os.PathLike, t
     _save(fig, path)
 
 
-def lines(x: Sequence[float], series: dict[str, Sequence[float]], path: str | os.PathLike, xlabel: str, ylabel: str, title: str) -> None:
-    """One line per series over shared x values."""
+def lines(x: Sequence[float], series: dict[str, Sequence[float]], path: str | os.PathLike, xlabel: str, ylabel: str, title: str,
+          intervals: dict[str, tuple[Sequence[float], Sequence[float]]] | None = None) -> None:
+    """One line per series over shared x values; ``intervals`` (low, high) per series are drawn as bands."""
     plt = _pyplot()
     fig, ax = plt.subplots(figsize=(6, 4))
     for name, y in series.items():
-        ax.plot(x, y, marker="o", label=name)
+        (line,) = ax.plot(x, y, marker="o", label=name)
+        if intervals and name in intervals:
+            ax.fill_between(x, *intervals[name], color=line.get_color(), alpha=0.15, linewidth=0)
     ax.set_xlabel(xlabel)
     ax.set_ylabel(ylabel)
     ax.set_title(title)

@@ -1,7 +1,7 @@
 import pytest
 import torch
 
-from graspaug.nets.ae_critic import AEConfig, AutoEncoder, Critic, autoencoder_loss, critic_loss
+from graspaug.nets.ae_critic import AEConfig, AutoEncoder, Critic, autoencoder_loss, critic_loss, folded_alpha, reversed_partners
 
 
 @pytest.mark.parametrize(("resolution", "base", "top"), [(16, 8, 32), (32, 8, 32), (64, 4, 32)])
@@ -91,3 +91,60 @@ def test_autoencoder_loss_matches_eq_2():
     assert bce.item() == pytest.approx(0.693147, abs=1e-6)
     assert reg.item() == pytest.approx((0.04 + 0.16) / 2)
     assert total.item() == pytest.approx(0.693147 + 0.5 * 0.1, abs=1e-6)
+
+
+def test_critic_output_for_a_grid_does_not_depend_on_the_rest_of_the_batch():
+    """No batch statistics: the same grid scores the same in an all-real, a mixed or a one-grid batch, in train mode."""
+    torch.manual_seed(0)
+    cfg = AEConfig(resolution=16, base_width=4, top_width=16)
+    critic = Critic(cfg).train()
+    real = (torch.rand(4, 1, 16, 16, 16) > 0.6).float()
+    soft = torch.rand(4, 1, 16, 16, 16)  # interpolant-like: occupancy probabilities
+    with torch.no_grad():
+        alone = critic(real[:1])
+        among_real = critic(real)[:1]
+        among_soft = critic(torch.cat([real[:1], soft]))[:1]
+    assert torch.allclose(alone, among_real, atol=1e-6) and torch.allclose(alone, among_soft, atol=1e-6)
+    assert not any(isinstance(m, torch.nn.modules.batchnorm._NormBase) for m in critic.modules())
+
+
+@pytest.mark.parametrize("batch_size", range(2, 20))
+def test_the_partner_is_never_the_sample_itself(batch_size):
+    partner = reversed_partners(batch_size)
+    assert partner.shape == (batch_size,)
+    assert not torch.any(partner == torch.arange(batch_size))
+    assert partner.min() >= 0 and partner.max() < batch_size
+    if batch_size % 2 == 0:  # ACAI's reversed batch
+        assert torch.equal(partner, torch.arange(batch_size).flip(0))
+
+
+def test_partners_need_two_samples():
+    with pytest.raises(ValueError, match="at least 2"):
+        reversed_partners(1)
+
+
+def test_folded_alpha_covers_zero_to_one_half_uniformly():
+    alpha = folded_alpha(20000, torch.Generator().manual_seed(0))
+    assert alpha.min() >= 0 and alpha.max() <= 0.5
+    assert alpha.mean().item() == pytest.approx(0.25, abs=0.005)  # U(0, 0.5): mean 0.25
+    assert (alpha < 0.25).float().mean().item() == pytest.approx(0.5, abs=0.01)
+
+
+def test_with_lambda_zero_the_critic_term_sends_no_gradient_to_the_autoencoder():
+    torch.manual_seed(0)
+    cfg = AEConfig(resolution=16, base_width=4, top_width=16)
+    ae, critic = AutoEncoder(cfg), Critic(cfg)
+    x = (torch.rand(4, 1, 16, 16, 16) > 0.6).float()
+
+    def grads(lam: float, with_critic: bool) -> list[torch.Tensor]:
+        z = ae.encoder(x)
+        recon = ae.decoder(z)
+        c_interp = critic(torch.sigmoid(ae.interpolate(z, z[reversed_partners(4)], torch.full((4,), 0.3)))) if with_critic else None
+        loss, _, _ = autoencoder_loss(recon, x, c_interp, lam)
+        return torch.autograd.grad(loss, list(ae.parameters()), allow_unused=True)
+
+    bce_only = grads(0.0, with_critic=False)
+    lam_zero = grads(0.0, with_critic=True)
+    lam_half = grads(0.5, with_critic=True)
+    assert all(torch.equal(a, b) for a, b in zip(bce_only, lam_zero))
+    assert not all(torch.equal(a, b) for a, b in zip(bce_only, lam_half))  # the test can fail: λ > 0 does move them

@@ -6,7 +6,7 @@ import trimesh
 from graspaug.geometry.voxelize import fit_grid, voxelize_solid
 from graspaug.io.checkpoints import CheckpointMismatch, load_autoencoder, save_autoencoder
 from graspaug.nets.ae_critic import AEConfig, AutoEncoder, Critic
-from graspaug.training.autoencoder import AETrainConfig, encode, reconstruction_iou, train_ae_critic, train_autoencoder
+from graspaug.training.autoencoder import AETrainConfig, critic_separation, encode, reconstruction_iou, train_ae_critic, train_autoencoder
 
 CPU = torch.device("cpu")
 
@@ -85,8 +85,69 @@ def test_ae_critic_phase_reports_its_losses_and_trains_the_critic():
     assert rate > 0 and len(seen) == 3
     assert not torch.equal(before["head.weight"], critic.state_dict()["head.weight"])
     assert not torch.equal(ae_before["encoder.fc.weight"], ae.state_dict()["encoder.fc.weight"])
-    assert set(seen[0]) == {"loss_recon", "loss_reg", "loss_critic", "critic_real", "critic_interp"}
+    assert set(seen[0]) == {"loss_recon", "loss_reg", "loss_critic"}
     assert all(np.isfinite(v) for m in seen for v in m.values())
+
+
+def _normalization_buffers(module: torch.nn.Module) -> dict[str, torch.Tensor]:
+    return {k: v.clone() for k, v in module.state_dict().items() if "running_" in k or "num_batches_tracked" in k}
+
+
+def test_phase_2_leaves_the_decoders_normalization_statistics_unchanged():
+    """Interpolated latents (and phase 2 at all) never enter the decoder's BatchNorm statistics; its weights still learn."""
+    torch.manual_seed(0)
+    x = primitive_grids(16)
+    cfg = AEConfig(resolution=16, z_dim=16, base_width=4, top_width=16)
+    ae, critic = AutoEncoder(cfg), Critic(cfg)
+    train_autoencoder(ae, x, train_settings(batch_size=4, epochs_ae=1), CPU, torch.Generator().manual_seed(0))
+    stats_before = _normalization_buffers(ae.decoder)
+    weights_before = ae.decoder.fc.weight.clone()
+    encoder_stats_before = _normalization_buffers(ae.encoder)
+    assert stats_before and encoder_stats_before
+    train_ae_critic(ae, critic, x, train_settings(batch_size=4, epochs_critic=2, critic_warmup=0), CPU, torch.Generator().manual_seed(0))
+    stats_after = _normalization_buffers(ae.decoder)
+    assert all(torch.equal(stats_before[k], stats_after[k]) for k in stats_before)
+    assert not torch.equal(weights_before, ae.decoder.fc.weight)
+    # the encoder sees real grids only: its statistics go on learning
+    assert not all(torch.equal(encoder_stats_before[k], v) for k, v in _normalization_buffers(ae.encoder).items())
+
+
+def _phase_2_weights(critic: Critic | None, lam: float) -> dict[str, torch.Tensor]:
+    torch.manual_seed(3)
+    x = primitive_grids(16)
+    cfg = AEConfig(resolution=16, z_dim=16, base_width=4, top_width=16)
+    ae = AutoEncoder(cfg)
+    if critic is not None:
+        critic = Critic(cfg)
+    train_ae_critic(ae, critic, x, train_settings(batch_size=4, epochs_critic=2, critic_warmup=1, lam=lam), CPU, torch.Generator().manual_seed(3))
+    return ae.state_dict()
+
+
+def test_the_control_arm_is_the_ae_critic_with_lambda_zero():
+    """A critic trained beside the AE with λ = 0 changes nothing in the AE: the same weights as the
+    critic-free control arm, bit for bit (same batches, flips, α draws); with λ > 0 it does."""
+    control = _phase_2_weights(None, lam=0.5)  # critic=None ignores λ
+    lam_zero = _phase_2_weights(Critic(AEConfig(resolution=16, z_dim=16, base_width=4, top_width=16)), lam=0.0)
+    lam_half = _phase_2_weights(Critic(AEConfig(resolution=16, z_dim=16, base_width=4, top_width=16)), lam=0.5)
+    assert all(torch.equal(control[k], lam_zero[k]) for k in control)
+    assert not all(torch.equal(control[k], lam_half[k]) for k in control)
+
+
+def test_critic_separation_puts_interpolants_on_the_positive_side():
+    """A stand-in critic that scores how far a grid is from binary: real 0/1 grids score 0, the soft
+    decodes of an untrained AE score high, so the AUC is 1 and the mean outputs are ordered."""
+    torch.manual_seed(0)
+    x = primitive_grids(16)
+    ae = AutoEncoder(AEConfig(resolution=16, z_dim=16, base_width=4, top_width=16))
+
+    class Softness(torch.nn.Module):
+        def forward(self, v):
+            return (0.5 - (v - 0.5).abs()).mean(dim=(1, 2, 3, 4))
+
+    result = critic_separation(ae, Softness(), x, CPU)
+    assert result["auc"] == 1.0
+    assert result["real_mean"] == 0.0 < result["interp_mean"]
+    assert 0.0 <= result["auc_vs_reconstructions"] <= 1.0
 
 
 def test_checkpoint_roundtrip_and_mismatch(tmp_path):

@@ -17,11 +17,13 @@ from graspaug.io.atomic import atomic_path
 from graspaug.nets.ae_critic import AEConfig, AutoEncoder, Critic
 from graspaug.errors import CheckpointMismatch
 
+FORMAT = "graspaug.autoencoder/2"  # /2: the critic has no normalization layers
+
 
 def save_autoencoder(path: str | os.PathLike, ae: AutoEncoder, critic: Critic | None, train_params: dict[str, Any]) -> None:
     """Write the AE (and critic) weights with the network config and training params (atomic)."""
     state = {
-        "format": "graspaug.autoencoder/1",
+        "format": FORMAT,
         "config": dataclasses.asdict(ae.cfg),
         "train_params": dict(train_params),
         "autoencoder": {k: v.detach().cpu() for k, v in ae.state_dict().items()},
@@ -44,6 +46,8 @@ def load_autoencoder(path: str | os.PathLike, expected: AEConfig) -> tuple[AutoE
     if not path.exists():
         raise FileNotFoundError(f"{path}: no checkpoint (run `dvc repro train_ae`)")
     state = torch.load(path, map_location="cpu", weights_only=True)
+    if "critic" in state and state.get("format") != FORMAT:  # the autoencoder's layout is the same in /1
+        raise CheckpointMismatch(f"{path} holds a critic of format {state.get('format')}, this code reads {FORMAT}; retrain it with `dvc repro train_ae`")
     saved = AEConfig(**state["config"])
     if saved != expected:
         diffs = [f"{k}={getattr(saved, k)} (params: {getattr(expected, k)})" for k in state["config"] if getattr(saved, k) != getattr(expected, k)]

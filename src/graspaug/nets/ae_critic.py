@@ -2,7 +2,10 @@
 
 Encoder: conv3d layers with 4³ kernels, BatchNorm + ReLU between, down to a
 ``top_width × 4 × 4 × 4`` map, flatten, FC → z (128). Decoder mirrors it and
-outputs R³ logits. Critic: the encoder's layout, then FC 128 → 1.
+outputs R³ logits. Critic: the encoder's layout *without normalization* (LeakyReLU
+0.2, as ACAI's critic), then FC 128 → 1. Its output for one grid depends on that grid
+only, never on the rest of the batch: a BatchNorm critic fed batches that are all real
+or all interpolated normalizes the difference away.
 
 The paper's "five conv layers, stride 2" cannot take 64³ to 4³ (five halvings
 give 2³). The nearest consistent design, used here: log2(R/4) stride-2 layers
@@ -24,26 +27,33 @@ from torch import nn
 from graspaug.nets.settings import AEConfig
 
 
-def _down(c_in: int, c_out: int) -> list[nn.Module]:
+def _down(c_in: int, c_out: int, normalize: bool = True) -> list[nn.Module]:
+    if not normalize:
+        return [nn.Conv3d(c_in, c_out, kernel_size=4, stride=2, padding=1), nn.LeakyReLU(0.2, inplace=True)]
     return [nn.Conv3d(c_in, c_out, kernel_size=4, stride=2, padding=1, bias=False), nn.BatchNorm3d(c_out), nn.ReLU(inplace=True)]
 
 
-def _same(c_in: int, c_out: int) -> list[nn.Module]:
+def _same(c_in: int, c_out: int, normalize: bool = True) -> list[nn.Module]:
+    if not normalize:
+        return [nn.Conv3d(c_in, c_out, kernel_size=4, stride=1, padding="same"), nn.LeakyReLU(0.2, inplace=True)]
     return [nn.Conv3d(c_in, c_out, kernel_size=4, stride=1, padding="same", bias=False), nn.BatchNorm3d(c_out), nn.ReLU(inplace=True)]
 
 
 class Encoder(nn.Module):
-    """(B, 1, R, R, R) occupancy in [0, 1] → (B, z_dim) latent."""
+    """(B, 1, R, R, R) occupancy in [0, 1] → (B, z_dim) latent.
 
-    def __init__(self, cfg: AEConfig):
+    ``normalize=False`` drops the BatchNorm layers (and uses LeakyReLU 0.2): the critic's layout.
+    """
+
+    def __init__(self, cfg: AEConfig, normalize: bool = True):
         super().__init__()
         w = cfg.widths
         layers: list[nn.Module] = []
         c = 1
         for width in w[:-1]:
-            layers += _down(c, width)
+            layers += _down(c, width, normalize)
             c = width
-        layers += _same(c, w[-1])
+        layers += _same(c, w[-1], normalize)
         self.features = nn.Sequential(*layers)
         self.fc = nn.Linear(w[-1] * 4**3, cfg.z_dim)  # 512·4³ = 32768 → 128 at the paper's widths
 
@@ -79,11 +89,14 @@ class Decoder(nn.Module):
 
 
 class Critic(nn.Module):
-    """(B, 1, R, R, R) voxel grid → (B,) estimated interpolation weight α."""
+    """(B, 1, R, R, R) voxel grid → (B,) estimated interpolation weight α.
+
+    No normalization layer: each grid's output depends on that grid alone.
+    """
 
     def __init__(self, cfg: AEConfig):
         super().__init__()
-        self.encoder = Encoder(cfg)
+        self.encoder = Encoder(cfg, normalize=False)
         self.head = nn.Linear(cfg.z_dim, 1)
 
     def forward(self, x: torch.Tensor) -> torch.Tensor:
@@ -111,20 +124,49 @@ class AutoEncoder(nn.Module):
         return self.decoder((1 - alpha) * z_a + alpha * z_b)
 
 
+def reversed_partners(batch_size: int) -> torch.Tensor:
+    """(B,) partner index of each sample: ACAI's reversed batch, i ↔ B − 1 − i.
+
+    With an odd B the middle sample would meet itself; it takes sample 0 instead.
+    Batches are shuffled every epoch, so the pairs change from epoch to epoch.
+    """
+    if batch_size < 2:
+        raise ValueError(f"a batch needs at least 2 samples to pair them, got {batch_size}")
+    partner = torch.arange(batch_size - 1, -1, -1)
+    if batch_size % 2:
+        partner[batch_size // 2] = 0
+    return partner
+
+
+def folded_alpha(batch_size: int, gen: torch.Generator) -> torch.Tensor:
+    """(B,) interpolation weights as in ACAI: U(0, 1) folded onto [0, 0.5] by α ↦ 0.5 − |α − 0.5|."""
+    u = torch.rand(batch_size, generator=gen)
+    return 0.5 - (u - 0.5).abs()
+
+
 def critic_loss(critic: Critic, x: torch.Tensor, x_hat: torch.Tensor, x_alpha: torch.Tensor, alpha: torch.Tensor, gamma: float) -> torch.Tensor:
     """Eq. (1): ‖C(x̂_α) − α‖² + ‖C(γx + (1 − γ)x̂)‖², batch means.
 
     x : (B, 1, R, R, R) real grids; x_hat : their reconstructions (probabilities);
     x_alpha : decoded interpolations (probabilities); alpha : (B,) their weights in [0, 0.5].
-    All inputs are detached here: this loss trains the critic only.
+    All inputs are detached here: this loss trains the critic only. Both kinds of input go
+    through the critic in one pass (it has no batch statistics, so this changes nothing).
     """
-    fit = (critic(x_alpha.detach()) - alpha).pow(2).mean()
-    real = critic(gamma * x + (1 - gamma) * x_hat.detach()).pow(2).mean()
-    return fit + real
+    real_mix = gamma * x + (1 - gamma) * x_hat.detach()  # (B, 1, R, R, R): a non-interpolated grid
+    c_interp, c_real = critic(torch.cat([x_alpha.detach(), real_mix])).split(len(x))
+    return (c_interp - alpha).pow(2).mean() + c_real.pow(2).mean()  # eq. (1)
 
 
-def autoencoder_loss(recon_logits: torch.Tensor, x: torch.Tensor, critic_on_interp: torch.Tensor, lam: float) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
-    """Eq. (2): L_B(x̂, x) + λ‖C(x̂_α)‖². Returns (total, reconstruction BCE, regularizer)."""
+def autoencoder_loss(recon_logits: torch.Tensor, x: torch.Tensor, critic_on_interp: torch.Tensor | None, lam: float) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+    """Eq. (2): L_B(x̂, x) + λ‖C(x̂_α)‖². Returns (total, reconstruction BCE, regularizer).
+
+    With λ = 0 (or no critic output) the total is the BCE alone: the critic term sends no
+    gradient to the autoencoder, not even a zero-weighted one.
+    """
     bce = F.binary_cross_entropy_with_logits(recon_logits, x)
+    if critic_on_interp is None:
+        return bce, bce, torch.zeros((), device=bce.device)
     reg = critic_on_interp.pow(2).mean()
+    if lam == 0:
+        return bce, bce, reg.detach()
     return bce + lam * reg, bce, reg

@@ -1,8 +1,8 @@
 """Training the AutoEncoder (phase 1) and the AE-Critic (phase 2), and using them.
 
 Voxel grids travel as ``(N, 1, R, R, R)`` uint8 tensors (0/1) and are turned into
-float batches on the device. Every random choice (batch order, flips, α, the
-partner permutation) comes from one ``torch.Generator``.
+float batches on the device. Every random choice (batch order, flips, α) comes from one
+``torch.Generator``.
 """
 from __future__ import annotations
 
@@ -13,7 +13,7 @@ import numpy as np
 import torch
 from tqdm import tqdm
 
-from graspaug.nets.ae_critic import AutoEncoder, Critic, autoencoder_loss, critic_loss
+from graspaug.nets.ae_critic import AutoEncoder, Critic, autoencoder_loss, critic_loss, folded_alpha, reversed_partners
 from graspaug.training.settings import AETrainConfig
 
 
@@ -60,63 +60,110 @@ def train_autoencoder(ae: AutoEncoder, voxels: torch.Tensor, cfg: AETrainConfig,
     return seen / max(elapsed, 1e-9)
 
 
-def train_ae_critic(ae: AutoEncoder, critic: Critic, voxels: torch.Tensor, cfg: AETrainConfig, device: torch.device, gen: torch.Generator, on_epoch: EpochCallback | None = None) -> float:
+def train_ae_critic(ae: AutoEncoder, critic: Critic | None, voxels: torch.Tensor, cfg: AETrainConfig, device: torch.device, gen: torch.Generator, on_epoch: EpochCallback | None = None) -> float:
     """Phase 2: critic on eq. (1) with Adam(lr_critic), AE on eq. (2) with Adam(lr_ae_critic).
 
-    The first ``critic_warmup`` epochs train only the critic, so the AE's eq. (2) term
-    starts from a critic that has learned something rather than from random outputs.
+    ``critic=None`` is the control arm: the same epochs, learning rate, batches, flips and
+    warm-up with λ = 0, i.e. more reconstruction training and nothing else. Both arms draw
+    the same random numbers, so with the same ``gen`` seed they see the same batches.
 
-    Each batch: x̂ = AE(x); a partner for every shape from a permutation of the batch;
-    α ~ U[0, 0.5]; x̂_α = decode((1 − α) z + α z_partner). Returns shapes/s.
+    Each batch: z = E(x), x̂ = D(z); partner = the reversed batch (ACAI); α = U(0, 1) folded
+    to [0, 0.5]; x̂_α = D((1 − α) z + α z_partner). The first ``critic_warmup`` epochs train
+    only the critic (the AE in eval mode; the control arm idles through them), so eq. (2)
+    starts from a critic that has learned something. The decoder's BatchNorm layers stay in eval mode: real and
+    interpolated latents are decoded with phase 1's running statistics (as every later
+    decode is), and interpolated latents never enter those statistics. Returns shapes/s.
     """
     ae.to(device)
-    critic.to(device)
     opt_ae = torch.optim.Adam(ae.parameters(), lr=cfg.lr_ae_critic)
-    opt_c = torch.optim.Adam(critic.parameters(), lr=cfg.lr_critic)
+    if critic is not None:
+        critic.to(device)
+        opt_c = torch.optim.Adam(critic.parameters(), lr=cfg.lr_critic)
+    lam = cfg.lam if critic is not None else 0.0
     seen, elapsed = 0, 0.0
-    for epoch in tqdm(range(cfg.epochs_critic), desc="train AE-Critic", unit="epoch"):
-        ae.train()
-        critic.train()
+    for epoch in tqdm(range(cfg.epochs_critic), desc="train AE-Critic" if critic is not None else "train AE, λ = 0", unit="epoch"):
+        train_ae = epoch >= cfg.critic_warmup
+        ae.train(train_ae)  # in the warm-up the AE does not learn, its statistics included
+        ae.decoder.eval()  # frozen normalization statistics (weights still learn)
         start = time.perf_counter()
-        sums = {"loss_recon": 0.0, "loss_reg": 0.0, "loss_critic": 0.0, "critic_real": 0.0, "critic_interp": 0.0}
+        sums = {"loss_recon": 0.0} | ({"loss_reg": 0.0, "loss_critic": 0.0} if critic is not None else {})
         n = 0
         for idx in _batches(len(voxels), cfg.batch_size, gen):
             x = _as_float(voxels[idx], device)
             if cfg.flips:
                 x = _flip(x, gen)
             b = len(idx)
-            partner = torch.randperm(b, generator=gen).to(device)
-            alpha = (0.5 * torch.rand(b, generator=gen)).to(device)
+            partner = reversed_partners(b).to(device)
+            alpha = folded_alpha(b, gen).to(device)
+            if critic is None and not train_ae:
+                continue  # the control's warm-up: nothing learns, the same random numbers are drawn
 
-            train_ae = epoch >= cfg.critic_warmup
             with torch.set_grad_enabled(train_ae):
                 z = ae.encoder(x)
                 recon = ae.decoder(z)
-                x_alpha = torch.sigmoid(ae.interpolate(z, z[partner], alpha))
-                c_interp = critic(x_alpha)
-                loss_ae, bce, reg = autoencoder_loss(recon, x, c_interp, cfg.lam)  # eq. (2)
+                c_interp = None
+                if critic is not None:
+                    with torch.set_grad_enabled(train_ae and lam > 0):
+                        x_alpha = torch.sigmoid(ae.interpolate(z, z[partner], alpha))
+                        c_interp = critic(x_alpha)
+                loss_ae, bce, reg = autoencoder_loss(recon, x, c_interp, lam)  # eq. (2)
             if train_ae:
                 opt_ae.zero_grad(set_to_none=True)
                 loss_ae.backward()
                 opt_ae.step()
 
-            loss_c = critic_loss(critic, x, torch.sigmoid(recon), x_alpha, alpha, cfg.gamma)  # eq. (1)
-            opt_c.zero_grad(set_to_none=True)
-            loss_c.backward()
-            opt_c.step()
-
-            with torch.no_grad():
-                sums["critic_real"] += critic(x).mean().item() * b
+            if critic is not None:
+                loss_c = critic_loss(critic, x, torch.sigmoid(recon), x_alpha, alpha, cfg.gamma)  # eq. (1)
+                opt_c.zero_grad(set_to_none=True)
+                loss_c.backward()
+                opt_c.step()
+                sums["loss_critic"] += loss_c.item() * b
+                sums["loss_reg"] += reg.item() * b
             sums["loss_recon"] += bce.item() * b
-            sums["loss_reg"] += reg.item() * b
-            sums["loss_critic"] += loss_c.item() * b
-            sums["critic_interp"] += c_interp.mean().item() * b
             n += b
             seen += b
         elapsed += time.perf_counter() - start
         if on_epoch:
-            on_epoch(epoch, {k: v / max(n, 1) for k, v in sums.items()})
+            on_epoch(epoch, {k: v / n for k, v in sums.items()} if n else {})
     return seen / max(elapsed, 1e-9)
+
+
+@torch.no_grad()
+def critic_separation(ae: AutoEncoder, critic: Critic, voxels: torch.Tensor, device: torch.device, n_shapes: int = 200, batch_size: int = 64) -> dict[str, float]:
+    """How well the critic tells held-out real grids from decoded interpolants.
+
+    The first ``n_shapes`` of ``voxels`` (N, 1, R, R, R) (held-out shapes: the test split) are
+    paired with the reversed list and interpolated at α evenly spaced over [0.1, 0.5]
+    (eval mode). Returns ``auc``: ROC AUC of the critic's output with interpolants as the
+    positive class (1 = perfect, 0.5 = chance); ``auc_vs_reconstructions``: the same against
+    the reconstructions x̂ instead of the real grids (no binary-vs-soft cue); and the mean
+    output on each kind (``real_mean``, ``reconstruction_mean``, ``interp_mean``).
+    """
+    from sklearn.metrics import roc_auc_score
+
+    grids = voxels[:n_shapes]
+    n = len(grids)
+    if n < 2:
+        return {"auc": float("nan"), "auc_vs_reconstructions": float("nan"), "real_mean": float("nan"), "reconstruction_mean": float("nan"), "interp_mean": float("nan")}
+    alpha = torch.linspace(0.1, 0.5, n)
+    z = torch.as_tensor(encode(ae, grids, device))
+    z_mix = (1 - alpha[:, None]) * z + alpha[:, None] * z.flip(0)
+    critic.eval().to(device)
+
+    def scores(batch_of: Callable[[slice], torch.Tensor]) -> np.ndarray:
+        return torch.cat([critic(batch_of(slice(i, i + batch_size)).to(device)).cpu() for i in range(0, n, batch_size)]).numpy()
+
+    real = scores(lambda s: _as_float(grids[s], device))
+    recon = scores(lambda s: torch.from_numpy(decode(ae, z[s].numpy(), device))[:, None])
+    interp = scores(lambda s: torch.from_numpy(decode(ae, z_mix[s].numpy(), device))[:, None])
+    labels = np.r_[np.zeros(n), np.ones(n)]
+    return {
+        "auc": float(roc_auc_score(labels, np.r_[real, interp])),
+        "auc_vs_reconstructions": float(roc_auc_score(labels, np.r_[recon, interp])),
+        "real_mean": float(real.mean()),
+        "reconstruction_mean": float(recon.mean()),
+        "interp_mean": float(interp.mean()),
+    }
 
 
 @torch.no_grad()
