@@ -34,6 +34,7 @@ OPTIONS = {  # name → (changes to gqcnn.net, changes to gqcnn.train); the firs
     "FC 256": ({"fc": 256}, {}),
     "16 filters": ({"filters": 16}, {}),
     "depth minus gripper": ({"image_input": "depth_minus_gripper"}, {}),
+    "depth": ({"image_input": "depth"}, {}),
 }
 
 

@@ -87,4 +87,4 @@ def test_depth_minus_gripper_input_sees_heights_relative_to_the_gripper():
     images, z = torch.full((3, 1, 32, 32), 0.7), torch.tensor([0.6, 0.65, 0.7])
     net = GQCNN(GQCNNConfig(filters=4, fc=8, pose_fc=4, image_input="depth_minus_gripper"))
     assert torch.allclose(net.image_input(images, z)[:, 0, 0, 0], torch.tensor([0.1, 0.05, 0.0]))
-    assert torch.equal(GQCNN(GQCNNConfig(filters=4, fc=8, pose_fc=4)).image_input(images, z), images)
+    assert torch.equal(GQCNN(GQCNNConfig(filters=4, fc=8, pose_fc=4, image_input="depth")).image_input(images, z), images)

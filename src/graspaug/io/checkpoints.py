@@ -108,7 +108,7 @@ def read_gqcnn(path: str | os.PathLike):
     saved = torch.load(path, map_location="cpu", weights_only=True)
     if not isinstance(saved, dict) or "state_dict" not in saved or "config" not in saved:
         raise CheckpointMismatch(f"{path} is not a GQ-CNN checkpoint of graspaug (no config and state_dict)")
-    net = GQCNN(GQCNNConfig(**saved["config"]))
+    net = GQCNN(GQCNNConfig(**{"image_input": "depth", **saved["config"]}))  # checkpoints older than the option saw the depth crop
     net.load_state_dict(saved["state_dict"])
     return net.eval(), saved.get("card")
 

@@ -42,7 +42,7 @@ class GQCNNConfig:
     fc: int = Field(64, ge=1, description="Width of fc3 and fc4 (Dex-Net: 1024).")
     pose_fc: int = Field(16, ge=1, description="Width of the gripper-depth layer pc1 (Dex-Net: 16).")
     pool_after_conv2: bool = Field(True, description="Max pool after conv2_2 (Dex-Net's 2018 config; 2017: none).")
-    image_input: Literal["depth", "depth_minus_gripper"] = Field("depth", description="What the conv layers see: the depth crop (Dex-Net 2.0), or the crop minus the gripper depth (gqcnn's `im_depth_sub`: each pixel's height relative to the fingertips).")
+    image_input: Literal["depth", "depth_minus_gripper"] = Field("depth_minus_gripper", description="What the conv layers see: the crop minus the gripper depth (gqcnn's `im_depth_sub`: each pixel's height relative to the fingertips; the default, 0.52 vs 0.39 validation AP at B = 200 in studies/gqcnn_options.py), or the depth crop itself (Dex-Net 2.0).")
 
     def __post_init__(self) -> None:
         if self.image_size % (4 if self.pool_after_conv2 else 2):
