@@ -328,13 +328,17 @@ def planned_grasps(depth: np.ndarray, jaws: Sequence[np.ndarray], labels: Sequen
 
 def precision_recall_roc(labels: np.ndarray, predictions: dict[str, np.ndarray], path: str | os.PathLike, title: str) -> None:
     """Precision-recall (left) and ROC (right) curves of several networks' test predictions
-    P(success) (N,) against the same 0/1 ``labels`` (N,); AP and ROC AUC in the legends."""
+    P(success) (N,) against the same 0/1 ``labels`` (N,); AP and ROC AUC in the legends. With
+    one class in ``labels`` there are no curves: the panels say so."""
     from sklearn.metrics import average_precision_score, precision_recall_curve, roc_auc_score, roc_curve
 
     plt = _pyplot()
     fig, (pr, roc) = plt.subplots(1, 2, figsize=(11, 4.5))
     labels = np.asarray(labels).astype(int)
-    for name, p in predictions.items():
+    both = 0 < labels.sum() < len(labels)
+    for ax in (pr, roc) if not both else ():
+        ax.text(0.5, 0.5, "one class in the test labels: no curve", ha="center", va="center")
+    for name, p in predictions.items() if both else ():
         precision, recall, _ = precision_recall_curve(labels, p)
         pr.plot(recall, precision, label=f"{name} (AP {average_precision_score(labels, p):.3f})")
         fpr, tpr, _ = roc_curve(labels, p)

@@ -77,9 +77,9 @@ def run(params: Params) -> None:
     base = max(cfg.augment_base_sizes)
     compare = chosen.get(base, max(gen.ratios))
     compared = {f"B = {base}, 1:0": ("targeted", base, 0.0), f"B = {base}, 1:{compare:g}": ("targeted", base, compare), "ceiling": ("ceiling", 0, 0.0)}
-    if len(set(labels)) == 2:  # the networks sim compares (and the ceiling): PR and ROC curves of their test predictions
-        precision_recall_roc(labels, {name: test_predictions(key, seeds[0]) for name, key in compared.items() if cfg.ceiling or key[0] != "ceiling"},
-                             REPORT_DIR / "pr_roc.png", f"Test predictions of training seed {seeds[0]} ({len(labels)} grasps)")
+    # the networks sim compares (and the ceiling): PR and ROC curves of their test predictions
+    precision_recall_roc(labels, {name: test_predictions(key, seeds[0]) for name, key in compared.items() if cfg.ceiling or key[0] != "ceiling"},
+                         REPORT_DIR / "pr_roc.png", f"Test predictions of training seed {seeds[0]} ({len(labels)} grasps)")
     improvement = pd.concat([changes["targeted", base, compare, s] - changes["targeted", base, 0.0, s] for s in seeds], axis=1).mean(axis=1).dropna()
     scores = read_table(SCORES).set_index("shape_id")
     base_set, generated = read_table(base_set_table(base)), read_table(generated_index(base))
