@@ -179,6 +179,12 @@ def _fmt(v, digits: int = 4) -> str:
     return "-" if v is None or (isinstance(v, float) and not np.isfinite(v)) else f"{v:.{digits}f}"
 
 
+def training_words(t) -> str:
+    """The training budget of ``gqcnn.train`` (a TrainSettings) in one sentence, for the report."""
+    return (f"Each network trains {t.epochs:g} passes over its own training set ({t.min_steps}-{t.max_steps} steps of {t.batch_size}), "
+            f"the learning rate annealed to {t.final_lr:g} of its start, and keeps the weights with the best validation AP.")
+
+
 def report_markdown(table: pd.DataFrame, contrasts: dict, chosen: dict[int, float], extras: list[str], seeds, positive_share: float,
                     train_words: str) -> str:
     """report.md: the network table, the contrasts with intervals, the verdicts in words, the figures."""

@@ -67,7 +67,6 @@ class NetworkJob:
     noise_seed: int
     seed: int
     device: str
-    threads: int
     out_dir: Path
     card: dict | None = None  # the model card's data part (graspaug.io.checkpoints.gqcnn_card)
 
@@ -79,8 +78,6 @@ def network_dir(seed_dir: Path, variant: Variant) -> Path:
 def train_network(job: NetworkJob, val: GraspArrays | None = None, test: GraspArrays | None = None) -> dict:
     """Train one network from the seed's initial weights; write its folder; return its summary.
     ``val`` / ``test``: the seed's validation and test datapoints (read here when not given)."""
-    if job.threads:
-        torch.set_num_threads(job.threads)
     device = torch.device(job.device)
     train, info = training_set(job.variant, job.split)
     val = val if val is not None else shapes_datapoints(job.split.validation)[0]

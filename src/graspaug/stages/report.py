@@ -18,7 +18,7 @@ import numpy as np
 import pandas as pd
 
 from graspaug.config import Params
-from graspaug.experiments.ap import (choose_ratios, collect, declared_contrasts, evaluate_contrasts, improvement_panels, network_table, per_object_ap,
+from graspaug.experiments.ap import (choose_ratios, collect, declared_contrasts, evaluate_contrasts, improvement_panels, network_table, per_object_ap, training_words,
                                     report_markdown, test_predictions, test_rows, verdict)
 from graspaug.experiments.networks import seed_variants
 from graspaug.generation import ratio_count
@@ -112,10 +112,7 @@ def run(params: Params) -> None:
     write_json({"contrasts": results, "networks": networks, "chosen_ratio": {str(b): r for b, r in chosen.items()},
                 "summary": {str(b): {"best_ratio": r, "chosen_on": "validation AP"} for b, r in chosen.items()},
                 "test_positive_share": round(positive_share, 5), "seeds": seeds}, AP_METRICS)
-    t = cfg.train
-    train_words = (f"Each network trains {t.epochs:g} passes over its own training set ({t.min_steps}-{t.max_steps} steps of {t.batch_size}), "
-                   f"the learning rate annealed to {t.final_lr:g} of its start, and keeps the weights with the best validation AP.")
     with atomic_path(REPORT_DIR / "report.md") as tmp:
-        tmp.write_text(report_markdown(table, results, chosen, extras, seeds, positive_share, train_words))
+        tmp.write_text(report_markdown(table, results, chosen, extras, seeds, positive_share, training_words(cfg.train)))
     for name, c in results.items():
         log.info("report: %s", verdict(name, c))

@@ -59,7 +59,7 @@ def run(params: Params, seed: int) -> None:
                           params.grasps.threshold, params.seed)
         results = []
         for variant in tqdm(variants, desc=f"train GQ-CNNs (seed {seed})", unit="network"):
-            job = NetworkJob(variant, split, cfg.net, cfg.train, init, noise_seed, seed, str(device), 0, folder, card)
+            job = NetworkJob(variant, split, cfg.net, cfg.train, init, noise_seed, seed, str(device), folder, card)
             try:
                 results.append(train_network(job, val, test))
             except ValueError as exc:
