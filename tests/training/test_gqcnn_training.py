@@ -88,3 +88,24 @@ def test_depth_minus_gripper_input_sees_heights_relative_to_the_gripper():
     net = GQCNN(GQCNNConfig(filters=4, fc=8, pose_fc=4, image_input="depth_minus_gripper"))
     assert torch.allclose(net.image_input(images, z)[:, 0, 0, 0], torch.tensor([0.1, 0.05, 0.0]))
     assert torch.equal(GQCNN(GQCNNConfig(filters=4, fc=8, pose_fc=4, image_input="depth")).image_input(images, z), images)
+
+
+def test_averaged_weights_are_the_exponential_moving_average_of_the_trained_ones():
+    rng = np.random.default_rng(1)
+    data = toy_set(256, rng)
+    cfg = GQCNNConfig(filters=4, fc=8, pose_fc=4)
+    torch.manual_seed(0)
+    init = GQCNN(cfg).state_dict()
+
+    def weights(steps: int, decay: float) -> dict[str, torch.Tensor]:
+        net = GQCNN(cfg)
+        net.load_state_dict(init)
+        settings = TrainSettings(min_steps=steps, max_steps=steps, batch_size=32, evals=1, ema_decay=decay)
+        train_gqcnn(net, data, None, settings, torch.device("cpu"), torch.Generator().manual_seed(5), progress=False)
+        return {k: v.detach().clone() for k, v in net.state_dict().items()}
+
+    # the first step's weights are the same in a 1- and a 2-step run (the cosine starts at 1 in both)
+    w1, w2, averaged = weights(1, 0.0), weights(2, 0.0), weights(2, 0.9)
+    for name in w2:
+        torch.testing.assert_close(averaged[name], 0.9 * w1[name] + 0.1 * w2[name])
+    assert any(not torch.equal(averaged[name], w2[name]) for name in w2)  # the kept weights are the average, not the last
