@@ -96,13 +96,25 @@ def test_shape_ids(shapes: pd.DataFrame, n: int, seed: int) -> list[str]:
     return [test[i] for i in sorted(chosen)]
 
 
+def _prepare_one(item: tuple, physics, seed: int, vhacd_resolution: int, cache: Path) -> PreparedObject:
+    from graspaug.sim.objects import draw_physics, mesh_volume, prepare_object
+
+    name, kind, mesh = item
+    drawn = draw_physics(mesh_volume(mesh), physics, shape_rng(seed, name, "sim-physics"))
+    body = prepare_object(name, mesh, cache, drawn["mass"], drawn["lateral_friction"], vhacd_resolution,
+                          drawn["spinning_friction"], drawn["rolling_friction"])
+    return PreparedObject(name, kind, body, tuple(float(x) for x in mesh.extents), drawn["density"])
+
+
 def prepare_objects(everyday: Sequence[str], test_shapes: Sequence[str], shapes_dir: Path, physics, seed: int, vhacd_resolution: int,
-                    user_meshes: Sequence[tuple[str, object]] = (), cache_dir: Path | None = None) -> list[PreparedObject]:
+                    user_meshes: Sequence[tuple[str, object]] = (), cache_dir: Path | None = None, workers=1) -> list[PreparedObject]:
     """Every object of the trials (everyday, test shapes, the user's meshes), decompositions
-    cached, with mass and friction drawn per object from ``physics`` (``sim.physics``) and the
-    global ``seed`` (the same for every arm)."""
+    cached (computed on ``workers``, a process count or :class:`graspaug.parallel.Workers`), with
+    mass and friction drawn per object from ``physics`` (``sim.physics``) and the global ``seed``
+    (the same for every arm)."""
     from graspaug.io.meshes import mesh_path, read_mesh
-    from graspaug.sim.objects import default_cache_dir, draw_physics, everyday_mesh, mesh_volume, prepare_object
+    from graspaug.parallel import parallel_map
+    from graspaug.sim.objects import default_cache_dir, everyday_mesh
 
     cache = default_cache_dir() if cache_dir is None else Path(cache_dir)
     meshes = [(name, "everyday", everyday_mesh(name)) for name in everyday]
@@ -111,13 +123,8 @@ def prepare_objects(everyday: Sequence[str], test_shapes: Sequence[str], shapes_
     names = [name for name, _, _ in meshes]
     if len(set(names)) != len(names):
         raise StageError(f"sim: two objects share a name: {sorted({n for n in names if names.count(n) > 1})} (rename the user's mesh files)")
-    out = []
-    for name, kind, mesh in meshes:
-        drawn = draw_physics(mesh_volume(mesh), physics, shape_rng(seed, name, "sim-physics"))
-        body = prepare_object(name, mesh, cache, drawn["mass"], drawn["lateral_friction"], vhacd_resolution,
-                              drawn["spinning_friction"], drawn["rolling_friction"])
-        out.append(PreparedObject(name, kind, body, tuple(float(x) for x in mesh.extents), drawn["density"]))
-    return out
+    work = functools.partial(_prepare_one, physics=physics, seed=seed, vhacd_resolution=vhacd_resolution, cache=cache)
+    return parallel_map(work, meshes, workers, "sim objects")
 
 
 def object_jobs(objects: Sequence[PreparedObject], chosen: dict, base_size: int, model_seeds: Sequence[int], attempts: int, seed: int,

@@ -46,7 +46,7 @@ def run(params: Params) -> None:
     test_shapes = test_shape_ids(read_table(SHAPES_TABLE), cfg.n_test_objects, params.seed)
     user, skipped = ([], {}) if cfg.objects_path is None else folder_meshes(
         Path(cfg.objects_path), params.ingest.surface, params.ingest.max_faces, params.ingest.max_file_mb)
-    objects = prepare_objects(cfg.objects, test_shapes, SHAPES_DIR, cfg.physics, params.seed, cfg.vhacd_resolution, user)
+    objects = prepare_objects(cfg.objects, test_shapes, SHAPES_DIR, cfg.physics, params.seed, cfg.vhacd_resolution, user, workers=params.workers)
     jobs = object_jobs(objects, chosen, cfg.base_size, model_seeds, cfg.attempts, params.seed, cfg.n_pictures)
     log.info("sim: %d objects × %d attempts; arms %s × %d training seeds (after = ratio %g); %d skipped meshes", len(objects), cfg.attempts,
              ", ".join(chosen), len(model_seeds), chosen["after"][1], len(skipped))
