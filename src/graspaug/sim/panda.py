@@ -74,14 +74,6 @@ class Panda:
             maxNumIterations=100, residualThreshold=1e-5, physicsClientId=self.client)
         return np.array(angles[:7])
 
-    def place_hand(self, position, jaw_angle: float, fingers: float = FINGER_OPEN) -> float:
-        """Put the hand at ``position`` pointing down at ``jaw_angle`` at once (before any contact:
-        the pre-grasp pose), solving IK from the joint state it reaches; the remaining error (m)."""
-        orientation = self.top_down(jaw_angle)
-        for _ in range(6):
-            self.reset(self.inverse_kinematics(position, orientation), fingers)
-        return float(np.linalg.norm(self.grasp_pose()[0] - np.asarray(position)))
-
     # --- motion ------------------------------------------------------------------------------
     def _command(self, arm: np.ndarray) -> None:
         pybullet.setJointMotorControlArray(self.body, ARM_JOINTS, pybullet.POSITION_CONTROL, targetPositions=arm.tolist(),
@@ -111,16 +103,23 @@ class Panda:
         orientation = self.top_down(jaw_angle)
         distance = float(np.linalg.norm(target - start))
         steps = max(1, int(np.ceil(distance / (speed or self.hand.speed) / self.time_step)))
-        hold = int(round(settle / self.time_step))
-        arm = self.inverse_kinematics(target, orientation)
         largest = 0.0
-        for i in range(1, steps + hold + 1):
-            self._command(self.inverse_kinematics(start + (target - start) * i / steps, orientation) if i <= steps else arm)
+
+        def advance(arm: np.ndarray) -> bool:  # one step toward ``arm``; False once the contacts press too hard
+            nonlocal largest
+            self._command(arm)
             pybullet.stepSimulation(physicsClientId=self.client)
             if max_force is not None:
                 largest = max(largest, self.contact_force())
-                if largest > max_force:
-                    break
+            return max_force is None or largest <= max_force
+
+        for i in range(1, steps + 1):
+            if not advance(self.inverse_kinematics(start + (target - start) * i / steps, orientation)):
+                return largest
+        arm = self.inverse_kinematics(target, orientation)
+        for _ in range(int(round(settle / self.time_step))):
+            if not advance(arm):
+                break
         return largest
 
     def set_fingers(self, gap: float) -> None:
