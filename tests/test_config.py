@@ -130,7 +130,9 @@ def test_profiles_are_small_overlays(repo_root):
     study, paper, tiny = (profile_params(n, folder) for n in ("study", "paper", "tiny"))
     assert len(study.gqcnn.seeds) >= 5 and study.generate.base_sizes == (50, 100, 200) and len(study.generate.ratios) == 5
     assert set(study.gqcnn.augment_base_sizes) == set(study.generate.base_sizes)  # the paper's 15 cells, three pools
-    assert yaml.safe_load((folder / "study.yaml").read_text()).keys() == {"generate", "gqcnn"}
+    assert yaml.safe_load((folder / "study.yaml").read_text()).keys() == {"generate", "gqcnn", "sim"}
+    per_seed = (len(study.sim.objects) + study.sim.n_test_objects) * study.sim.attempts
+    assert per_seed >= 400  # paired attempts per network arm and training seed (issue 18)
     assert paper.voxelize.resolution == paper.ae.net.resolution == 64
     assert (paper.ae.net.base_width, paper.ae.net.top_width, paper.ae.net.z_dim) == (64, 512, 128)
     assert (paper.gqcnn.net.filters, paper.gqcnn.net.fc) == (64, 1024) and len(paper.gqcnn.seeds) >= 3

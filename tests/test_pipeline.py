@@ -249,17 +249,22 @@ def test_dvc_repro_sim(tiny_repo, tmp_path):
     assert metrics["arms"]["before"]["ratio"] == 0.0 and metrics["arms"]["after"]["ratio"] == after_ratio
     assert metrics["setup"]["after_ratio_from_report"] == ("6" in ap["summary"]) and metrics["setup"]["model_seeds"] == [0, 1]
     assert metrics["per_seed"]["0"]["before"]["attempts"] == metrics["per_seed"]["1"]["before"]["attempts"] == 4
-    for arm in ("before", "after"):
+    network_arms = ["before", "after"] + (["real"] if after_ratio > 0 else [])
+    assert list(metrics["arms"]) == [*network_arms, "antipodal"]  # the tiny run trains the real pool at B = 6
+    for arm in network_arms:
         a = metrics["arms"][arm]
         assert a["attempts"] == 8 and 0 <= a["successes"] <= 8  # two training seeds, the same 4 drops each
         assert a["wilson_low"] <= a["success_rate"] <= a["wilson_high"]
-    assert metrics["antipodal_reference"]["attempts"] == 4  # the reference arm without a network
+    assert metrics["arms"]["antipodal"]["attempts"] == 4  # the reference arm without a network runs once
+    for name in ("after_vs_before", "network_vs_antipodal") + (("after_vs_real",) if after_ratio > 0 else ()):
+        c = metrics["contrasts"][name]
+        assert c["n_trials"] == 8 and c["ci_low"] <= c["mean"] <= c["ci_high"]
     trials = pd.read_csv(work / "reports/sim/trials.csv")
-    assert len(trials) == 20 and set(trials.object) == {"cube", metrics["setup"]["test_shapes"][0]}
+    assert len(trials) == 4 * len(network_arms) * 2 + 4 and set(trials.object) == {"cube", metrics["setup"]["test_shapes"][0]}
     planned = (trials.arm != "antipodal") & (trials.outcome != "no_grasp")
     assert trials.quality[trials.arm == "antipodal"].isna().all() and trials.quality[planned].notna().all()
     trials = trials[trials.arm != "antipodal"]
-    # the same seeded drops for both arms
+    # the same seeded drops for every arm
     assert set(trials.seed) == {0, 1}  # both training seeds' networks, on the same drops
     drops = trials.pivot_table(index=["seed", "object", "attempt"], columns="arm", values="drop_seed")
     assert (drops["before"] == drops["after"]).all()
@@ -268,8 +273,11 @@ def test_dvc_repro_sim(tiny_repo, tmp_path):
     assert set(trials.outcome) <= set(OUTCOMES)
     assert (trials.success == (trials.outcome == "success")).all()
     timing = json.loads((work / "reports/sim/timing.json").read_text())
-    assert timing["trials"] == 16 and timing["planning_time_max"] > 0
-    assert "## Verdict" in (work / "reports/sim/report.md").read_text()
+    assert timing["trials"] == len(trials) + 4 and timing["planning_time_max"] > 0
+    report = (work / "reports/sim/report.md").read_text()
+    assert "## Contrasts" in report and "## Calibration" in report and "network_vs_antipodal" in report
+    calibration = pd.read_csv(work / "reports/sim/calibration.csv")
+    assert set(calibration.object) == {"cube", metrics["setup"]["test_shapes"][0]} and calibration.graspness.isna().sum() == 1
     for picture in ("success.png", "trials/before-cube.png", "trials/after-cube.png", "trials/antipodal-cube.png"):
         assert (work / "reports/sim" / picture).stat().st_size > 0
     again = run(["dvc", "repro", "sim"], work, env)

@@ -222,12 +222,15 @@ stage_command(
 
 stage_command(
     "sim",
-    "Simulated robot trials (paper Section IV-E): a pybullet Franka Panda picks each object (eight everyday objects of "
-    "pybullet_data and `sim.n_test_objects` held-out test shapes, dropped from seeded poses) from the table into a bin, "
-    "with grasps planned on an overhead depth image by the GQ-CNN: antipodal seeds on depth edges, cross-entropy "
-    "refinement. Arms: `before` (B-0) and `after` (B at the report's best ratio), the same drops for both.\n\n"
-    "Writes `metrics/sim.json` (success per arm and object, 95% Wilson intervals, paired McNemar test) and `reports/sim/` "
-    "(`report.md`, `trials.csv`, `success.csv/.png`, `objects.csv`, `timing.json`, `trials/<arm>-<object>.png`).\n\n"
+    "Simulated robot trials (paper Section IV-E): a pybullet Franka Panda picks each object (everyday objects of "
+    "pybullet_data, `sim.n_test_objects` held-out test shapes and the meshes of `sim.objects_path`, with mass and friction "
+    "drawn per object, dropped from seeded poses) from the table into a bin, with grasps planned on a D435-like noisy "
+    "overhead depth image: antipodal seeds on depth edges, cross-entropy refinement by the GQ-CNN. Arms: `before` (B-0), "
+    "`after` (B at the ratio chosen on validation AP), `real` (the real pool there, when trained) and `antipodal` (a random "
+    "antipodal grasp, no network), the same drops for all.\n\n"
+    "Writes `metrics/sim.json` (success per arm and object with 95% Wilson intervals; `contrasts` after_vs_before, "
+    "network_vs_antipodal, after_vs_real with bootstrap intervals over objects; calibration) and `reports/sim/` "
+    "(`report.md`, `trials.csv`, `success.csv/.png`, `objects.csv`, `calibration.csv`, `timing.json`, `trials/<arm>-<object>.png`).\n\n"
     f"Params `sim`:\n\n{describe(SimParams, 'sim.')}",
 )
 

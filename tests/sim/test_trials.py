@@ -3,12 +3,14 @@ from __future__ import annotations
 
 import numpy as np
 import pybullet
+import pytest
 import torch
 
 from graspaug.nets.gqcnn import GQCNN, GQCNNConfig
-from graspaug.sim.policy import CEMSettings, CrossEntropyGraspPolicy
+from graspaug.sim.policy import CEMSettings, CrossEntropyGraspPolicy, SamplerSettings
 from graspaug.sim.scene import CellLayout, PickScene
-from graspaug.sim.trials import run_trial
+from graspaug.sim.settings import HandSettings, TrialSettings
+from graspaug.sim.trials import OUTCOMES, run_trial
 
 
 def top_down_across(position, quaternion):
@@ -34,6 +36,66 @@ def test_scripted_top_down_cube_grasp_lands_in_bin(cube):
     assert 0.0 < result.grasp_center[2] < 0.05  # the cube rests on the table, its center ~2 cm up
 
 
+def test_a_blocked_approach_is_a_collision(cube):
+    """A plate 10 cm above the table over the drop area: the hand hits it on the way to the cube
+    (the same grasp without the plate lands the cube in the bin, above)."""
+    plate = ((0.1, 0.1, 0.005), (0.0, 0.0, 0.1))
+    result = run_trial(cube, drop_seed=3, scripted=top_down_across, obstacles=(plate,))
+    assert result.outcome == "collision" and not result.success
+    assert result.contact_force > TrialSettings().collision_force
+
+
+def test_fingers_into_the_table_are_a_collision(cube):
+    def too_low(position, quaternion):
+        center, angle = top_down_across(position, quaternion)
+        return center - [0.0, 0.0, 0.04], angle
+
+    assert run_trial(cube, drop_seed=3, scripted=too_low).outcome == "collision"
+
+
+def test_user_folder_of_meshes_runs_through_the_trials(tmp_path, sim_cache):
+    """Two meshes and a broken file in a folder: the broken one is skipped with its reason, the two
+    are scaled like the corpus's shapes, get drawn physics, and each runs one trial."""
+    import trimesh
+
+    from graspaug.geometry.settings import SurfaceSettings
+    from graspaug.sim.experiment import ObjectJob, prepare_objects, run_object
+    from graspaug.sim.objects import folder_meshes
+    from graspaug.sim.settings import ObjectPhysics
+
+    trimesh.creation.box(extents=[40.0, 60.0, 30.0]).export(tmp_path / "block.stl")  # any units: scaled like the corpus
+    trimesh.creation.cylinder(radius=20.0, height=50.0, sections=24).export(tmp_path / "can.ply")
+    (tmp_path / "broken.obj").write_text("v 0 0 0\nthis is not a mesh\n")
+    (tmp_path / "notes.txt").write_text("not a mesh file")
+    surface = SurfaceSettings()
+    meshes, skipped = folder_meshes(tmp_path, surface)
+    assert [name for name, _ in meshes] == ["block", "can"] and list(skipped) == ["broken.obj"] and skipped["broken.obj"]
+    for _, mesh in meshes:
+        assert sorted(mesh.extents)[1] == pytest.approx(surface.size_m, rel=0.02)  # the middle extent, as ingest sizes shapes
+    physics = ObjectPhysics()
+    objects = prepare_objects([], [], tmp_path, physics, seed=0, vhacd_resolution=10_000, user_meshes=meshes, cache_dir=sim_cache)
+    again = prepare_objects([], [], tmp_path, physics, seed=0, vhacd_resolution=10_000, user_meshes=meshes, cache_dir=sim_cache)
+    assert [o.body.mass for o in objects] == [o.body.mass for o in again]  # drawn from the seed
+    for obj in objects:
+        assert obj.kind == "user" and physics.mass_range[0] <= obj.body.mass <= physics.mass_range[1]
+        assert physics.friction_range[0] <= obj.body.lateral_friction <= physics.friction_range[1]
+        job = ObjectJob("antipodal", -1, None, obj.name, obj.kind, obj.body, (3,), (4,), False)
+        rows = run_object(job, layout=CellLayout(), hand=HandSettings(), sampler=SamplerSettings(), cem=CEMSettings(), crop_size=96, out_size=32)
+        assert len(rows) == 1 and rows[0]["outcome"] in OUTCOMES and rows[0]["object"] == obj.name
+
+
+def test_an_empty_folder_is_a_one_line_error(tmp_path):
+    from graspaug.geometry.settings import SurfaceSettings
+    from graspaug.sim.objects import folder_meshes
+
+    with pytest.raises(ValueError, match=r"holds no mesh file") as caught:
+        folder_meshes(tmp_path, SurfaceSettings())
+    assert "\n" not in str(caught.value)
+    (tmp_path / "bad.stl").write_text("solid nothing\nendsolid nothing\n")
+    with pytest.raises(ValueError, match=r"no usable mesh in .*bad.stl"):
+        folder_meshes(tmp_path, SurfaceSettings())
+
+
 def test_grasp_in_empty_space_fails(cube):
     def beside(position, quaternion):
         return np.asarray(position) + [0.0, 0.15, 0.0], 0.0
@@ -49,9 +111,11 @@ def test_drop_is_seeded_and_object_falls_onto_table(cube):
 
 
 def planner_with(net: GQCNN, layout: CellLayout, seed: int):
+    from graspaug.planning import check_depth
+
     policy = CrossEntropyGraspPolicy(net, layout.intrinsics, cem=CEMSettings(num_seed_samples=100))
     rng = np.random.default_rng(seed)
-    return lambda depth, camera, intrinsics: policy.plan(depth, rng)
+    return lambda depth, camera, intrinsics: policy.plan(check_depth(depth, fill_missing=True), rng)
 
 
 def test_planned_pick_same_seed_same_outcome(duck):
@@ -59,8 +123,10 @@ def test_planned_pick_same_seed_same_outcome(duck):
     net = GQCNN(GQCNNConfig(filters=4, fc=16, pose_fc=4)).eval()
     layout = CellLayout()
     first = run_trial(duck, drop_seed=11, planner=planner_with(net, layout, 7), layout=layout, record=True)
-    second = run_trial(duck, drop_seed=11, planner=planner_with(net, layout, 7), layout=layout)
+    second = run_trial(duck, drop_seed=11, planner=planner_with(net, layout, 7), layout=layout, record=True)
     assert first.image_grasp is not None and first.quality is not None
+    assert first.drop_position == second.drop_position and np.array_equal(first.depth, second.depth)  # the same noisy image
+    assert (first.depth == 0).any()  # the sensor lost pixels (at the duck's edges)
     assert first.outcome == second.outcome and first.image_grasp == second.image_grasp and first.grasp_center == second.grasp_center
     # the planned grasp lies on the duck: its center pixel sees something above the table
     u, v = round(first.image_grasp["u"]), round(first.image_grasp["v"])
@@ -71,7 +137,7 @@ def test_planned_pick_same_seed_same_outcome(duck):
 
 def test_jaw_angle_convention_on_a_long_bar(sim_cache):
     """A 3 × 12 × 3 cm bar: closing across its width lifts it, closing along its length (wider than
-    the 8 cm opening) cannot. A jaw angle off by 90° or a flipped axis would swap the outcomes."""
+    the 8 cm opening) cannot: a finger comes down on the bar. A jaw angle off by 90° or a flipped axis would swap the outcomes."""
     import trimesh
 
     from graspaug.sim.objects import prepare_object
@@ -88,5 +154,5 @@ def test_jaw_angle_convention_on_a_long_bar(sim_cache):
         return scripted
 
     assert run_trial(bar, drop_seed=2, scripted=jaws("across")).outcome == "success"
-    assert run_trial(bar, drop_seed=2, scripted=jaws("along")).outcome == "not_lifted"
+    assert run_trial(bar, drop_seed=2, scripted=jaws("along")).outcome == "collision"  # a finger lands on the bar's end
 

@@ -1,10 +1,11 @@
-"""The simulated robot experiment: arms (which network plans), the objects, one object's
-attempts in one arm, success rates with Wilson intervals, the paired before/after comparison,
-and the report's text (paper Section IV-E).
+"""The simulated robot experiment: arms (which network plans), the objects and their physics, one
+object's attempts in one arm, and the metrics (paper Section IV-E).
 
-Every arm sees the same seeded drops and planner seeds (paired); ``before`` is the targeted
-network of base size B at ratio 0, ``after`` the same B at the report's best ratio, once per
-training seed; the optional ``antipodal`` arm plans without a network.
+Every arm sees the same seeded drops, sensor noise and planner seeds (paired). Arms: ``before``
+= the targeted network of base size B at ratio 0, ``after`` = the same B at the ratio chosen on
+validation AP (``metrics/ap.json``), ``real`` = the ``real`` pool's network at that B and ratio
+(when it was trained), each once per training seed, and ``antipodal`` = a random antipodal seed
+grasp without a network (once: it has no training seed).
 """
 from __future__ import annotations
 
@@ -22,6 +23,7 @@ import pandas as pd
 from graspaug.errors import StageError
 from graspaug.paths import gqcnn_model_dir
 from graspaug.rng import shape_rng
+from graspaug.sim.analysis import CONTRASTS, compare, paired_contrast, rate_summary
 
 log = logging.getLogger(__name__)
 
@@ -31,39 +33,55 @@ class ObjectJob:
     """One object's attempts in one arm (a worker's unit of work)."""
 
     arm: str
-    seed: int  # the network's training seed
+    seed: int  # the network's training seed; -1 for the antipodal arm
     model: str | None  # path of model.pt; None: the antipodal reference arm (no network)
     name: str
-    kind: str  # everyday | test_shape
+    kind: str  # everyday | test_shape | user
     sim_object: object  # graspaug.sim.objects.SimObject
     drop_seeds: tuple[int, ...]
     plan_seeds: tuple[int, ...]
     record: bool
 
 
-def model_path(base_size: int, ratio: float, seed: int) -> Path:
-    """The targeted network of base size B at ratio R and training seed."""
-    return gqcnn_model_dir("targeted", base_size, ratio, seed) / "model.pt"
+@dataclass(frozen=True)
+class PreparedObject:
+    """An object of the trials: its name, kind, physics body, extents (3,) m and drawn density (kg/m³)."""
+
+    name: str
+    kind: str
+    body: object  # graspaug.sim.objects.SimObject
+    extents: tuple[float, float, float]
+    density: float
 
 
-def arms(ap_metrics: Path, base_size: int, ratios: Sequence[float], seeds: Sequence[int]) -> tuple[dict[str, float], bool]:
-    """Arm → ratio: 0 and the report's best ratio for ``base_size`` (from ``metrics/ap.json``),
-    and whether the ratio came from the report (its networks must exist for every training
-    seed). When the report has no test AP for that base size (a test set with one label),
-    "after" is the largest of ``ratios``, with a warning."""
+def model_path(base_size: int, ratio: float, seed: int, pool: str = "targeted") -> Path:
+    """The network of ``pool`` at base size B, ratio R and training seed."""
+    return gqcnn_model_dir(pool, base_size, ratio, seed) / "model.pt"
+
+
+def arms(ap_metrics: Path, base_size: int, ratios: Sequence[float], seeds: Sequence[int]) -> tuple[dict[str, tuple[str | None, float | None]], bool]:
+    """Arm → (pool, ratio): ``before`` (targeted, 0), ``after`` (targeted, the ratio of the best
+    validation AP for ``base_size`` in ``metrics/ap.json``), ``real`` (real, that ratio) when its
+    network exists for every training seed, ``antipodal`` (None, None); and whether the ratio came
+    from the report. Without a ratio in the report "after" is the largest of ``ratios`` (a warning)."""
     if not ap_metrics.exists():
         raise StageError(f"{ap_metrics} is missing: run `dvc repro report` first")
     summary = json.loads(ap_metrics.read_text()).get("summary", {}).get(str(base_size))
     if summary is None:
         best = float(max(ratios))
-        log.warning("sim: %s has no test AP for base size %d; comparing ratio 0 with the largest ratio %g", ap_metrics, base_size, best)
+        log.warning("sim: %s has no AP for base size %d; comparing ratio 0 with the largest ratio %g", ap_metrics, base_size, best)
     else:
         best = float(summary["best_ratio"])
-    chosen = {"before": 0.0, "after": best}
+    chosen: dict[str, tuple[str | None, float | None]] = {"before": ("targeted", 0.0), "after": ("targeted", best)}
     for seed in seeds:
-        for ratio in chosen.values():
-            if not model_path(base_size, ratio, seed).exists():
-                raise StageError(f"{model_path(base_size, ratio, seed)} is missing: run `dvc repro train_gqcnn` first")
+        for pool, ratio in chosen.values():
+            if not model_path(base_size, ratio, seed, pool).exists():
+                raise StageError(f"{model_path(base_size, ratio, seed, pool)} is missing: run `dvc repro train_gqcnn` first")
+    if best > 0 and all(model_path(base_size, best, seed, "real").exists() for seed in seeds):
+        chosen["real"] = ("real", best)
+    else:
+        log.info("sim: no `real` network at B = %d, ratio %g for every training seed: no real arm", base_size, best)
+    chosen["antipodal"] = (None, None)
     return chosen, summary is not None
 
 
@@ -78,15 +96,73 @@ def test_shape_ids(shapes: pd.DataFrame, n: int, seed: int) -> list[str]:
     return [test[i] for i in sorted(chosen)]
 
 
-def prepare_objects(everyday: Sequence[str], test_shapes: Sequence[str], shapes_dir: Path, mass: float, friction: float, vhacd_resolution: int):
-    """(name, kind, SimObject, extents) for every object, decompositions cached."""
-    from graspaug.io.meshes import mesh_path, read_mesh
-    from graspaug.sim.objects import default_cache_dir, everyday_mesh, prepare_object
+def _prepare_one(item: tuple, physics, seed: int, vhacd_resolution: int, cache: Path) -> PreparedObject:
+    from graspaug.sim.objects import draw_physics, mesh_volume, prepare_object
 
-    cache = default_cache_dir()
+    name, kind, mesh = item
+    drawn = draw_physics(mesh_volume(mesh), physics, shape_rng(seed, name, "sim-physics"))
+    body = prepare_object(name, mesh, cache, drawn["mass"], drawn["lateral_friction"], vhacd_resolution,
+                          drawn["spinning_friction"], drawn["rolling_friction"])
+    return PreparedObject(name, kind, body, tuple(float(x) for x in mesh.extents), drawn["density"])
+
+
+def prepare_objects(everyday: Sequence[str], test_shapes: Sequence[str], shapes_dir: Path, physics, seed: int, vhacd_resolution: int,
+                    user_meshes: Sequence[tuple[str, object]] = (), cache_dir: Path | None = None, workers=1) -> list[PreparedObject]:
+    """Every object of the trials (everyday, test shapes, the user's meshes), decompositions
+    cached (computed on ``workers``, a process count or :class:`graspaug.parallel.Workers`), with
+    mass and friction drawn per object from ``physics`` (``sim.physics``) and the global ``seed``
+    (the same for every arm)."""
+    from graspaug.io.meshes import mesh_path, read_mesh
+    from graspaug.parallel import parallel_map
+    from graspaug.sim.objects import default_cache_dir, everyday_mesh
+
+    cache = default_cache_dir() if cache_dir is None else Path(cache_dir)
     meshes = [(name, "everyday", everyday_mesh(name)) for name in everyday]
     meshes += [(shape_id, "test_shape", read_mesh(mesh_path(shapes_dir, shape_id))) for shape_id in test_shapes]
-    return [(name, kind, prepare_object(name, mesh, cache, mass, friction, vhacd_resolution), mesh.extents) for name, kind, mesh in meshes]
+    meshes += [(name, "user", mesh) for name, mesh in user_meshes]
+    names = [name for name, _, _ in meshes]
+    if len(set(names)) != len(names):
+        raise StageError(f"sim: two objects share a name: {sorted({n for n in names if names.count(n) > 1})} (rename the user's mesh files)")
+    work = functools.partial(_prepare_one, physics=physics, seed=seed, vhacd_resolution=vhacd_resolution, cache=cache)
+    return parallel_map(work, meshes, workers, "sim objects")
+
+
+def object_jobs(objects: Sequence[PreparedObject], chosen: dict, base_size: int, model_seeds: Sequence[int], attempts: int, seed: int,
+                n_pictures: int) -> list[ObjectJob]:
+    """A job per object, arm and training seed (the antipodal arm once per object); the drops and
+    planner seeds of an object are drawn from the global ``seed`` and its name, the same in every arm."""
+    jobs = []
+    for index, obj in enumerate(objects):
+        drops = tuple(int(shape_rng(seed, obj.name, f"sim-drop-{a}").integers(2**31 - 1)) for a in range(attempts))
+        plans = tuple(int(shape_rng(seed, obj.name, f"sim-plan-{a}").integers(2**31 - 1)) for a in range(attempts))
+        record = index < n_pictures
+        for arm, (pool, ratio) in chosen.items():
+            if pool is None:
+                jobs.append(ObjectJob(arm, -1, None, obj.name, obj.kind, obj.body, drops, plans, record))
+                continue
+            for s in model_seeds:
+                jobs.append(ObjectJob(arm, s, str(model_path(base_size, ratio, s, pool)), obj.name, obj.kind, obj.body, drops, plans,
+                                      record and s == model_seeds[0]))
+    return jobs
+
+
+def summarize(trials: pd.DataFrame, objects: Sequence[PreparedObject], chosen: dict, setup: dict, n_boot: int, seed: int) -> dict:
+    """``metrics/sim.json``: setup, per-arm rates (Wilson), the contrasts (paired, bootstrap over
+    objects), before vs after per training seed, per-object rates."""
+    model_seeds = setup["model_seeds"]
+    metrics = {
+        "setup": setup,
+        "arms": {arm: {"pool": pool, "ratio": ratio, **rate_summary(trials.success[trials.arm == arm])} for arm, (pool, ratio) in chosen.items()},
+        "contrasts": {name: paired_contrast(trials, arm, ref, n_boot, seed) for name, (arm, ref) in CONTRASTS.items() if arm in chosen and ref in chosen},
+        "same_network": chosen["before"] == chosen["after"],
+        "per_seed": {str(s): compare(trials[trials.seed == s]) for s in model_seeds},
+        "per_object": {},
+    }
+    for obj in objects:
+        sel = trials.object == obj.name
+        metrics["per_object"][obj.name] = {"kind": obj.kind, "mass": round(obj.body.mass, 4), "friction": round(obj.body.lateral_friction, 4),
+                                          **{arm: rate_summary(trials.success[sel & (trials.arm == arm)]) for arm in chosen}}
+    return metrics
 
 
 def _policy(model: str | None, layout, sampler, cem, crop_size: int, out_size: int):
@@ -117,20 +193,22 @@ def _cached_policy(model: str | None, version, layout, sampler, cem, crop_size: 
     return planner
 
 
-def run_object(job: ObjectJob, layout, hand, sampler, cem, crop_size: int, out_size: int, trial_settings=None) -> list[dict]:
+def run_object(job: ObjectJob, layout, hand, sampler, cem, crop_size: int, out_size: int, trial_settings=None, sensor=None) -> list[dict]:
     """Every attempt of one object in one arm: a row per attempt (plus depth and frames for the
-    first attempt when ``job.record``)."""
+    first attempt when ``job.record``). The planner fills the sensor's missing pixels from the
+    nearest valid one."""
+    from graspaug.sim.settings import DepthNoise
     from graspaug.sim.trials import TrialSettings, run_trial
 
-    trial_settings = trial_settings or TrialSettings()
+    trial_settings, sensor = trial_settings or TrialSettings(), sensor or DepthNoise()
     policy = _policy(job.model, layout, sampler, cem, crop_size, out_size)
     rows = []
     for attempt, (drop_seed, plan_seed) in enumerate(zip(job.drop_seeds, job.plan_seeds)):
         rng = np.random.default_rng(plan_seed)
         record = job.record and attempt == 0
-        plan = lambda depth, camera, k: next(iter(policy.plan(depth, k, rng, camera_distance=camera.height)), None)  # noqa: E731
-        result = run_trial(job.sim_object, drop_seed, planner=plan, layout=layout,
-                           hand=hand, settings=trial_settings, record=record)
+        plan = lambda depth, camera, k: next(iter(policy.plan(depth, k, rng, camera_distance=camera.height, fill_missing=True)), None)  # noqa: E731
+        result = run_trial(job.sim_object, drop_seed, planner=plan, layout=layout, hand=hand, settings=trial_settings, sensor=sensor,
+                           record=record)
         g = result.image_grasp or {}
         rows.append({
             "arm": job.arm, "seed": job.seed, "object": job.name, "kind": job.kind, "attempt": attempt, "drop_seed": drop_seed,
@@ -139,24 +217,16 @@ def run_object(job: ObjectJob, layout, hand, sampler, cem, crop_size: int, out_s
             "grasp_x": None if result.grasp_center is None else result.grasp_center[0],
             "grasp_y": None if result.grasp_center is None else result.grasp_center[1],
             "grasp_z": None if result.grasp_center is None else result.grasp_center[2],
-            "jaw_angle": result.jaw_angle, "planning_time": result.planning_time,
+            "jaw_angle": result.jaw_angle, "contact_force": round(result.contact_force, 3), "planning_time": result.planning_time,
             "_depth": result.depth, "_frames": result.frames,
         })
     return rows
 
 
-def rate_summary(outcomes: pd.Series) -> dict:
-    from graspaug.sim.stats import wilson_interval
-
-    k, n = int(outcomes.sum()), int(len(outcomes))
-    low, high = wilson_interval(k, n)
-    return {"successes": k, "attempts": n, "success_rate": round(k / n, 5) if n else None, "wilson_low": round(low, 5), "wilson_high": round(high, 5)}
-
-
 def picture(row: dict, ratio: float | None, path) -> None:
     from graspaug.plots import pick_story
 
-    depth = row["_depth"]
+    depth = np.where(row["_depth"] > 0, row["_depth"], np.nan)  # missing pixels (0) left blank
     h, w = depth.shape
     jaw = None
     if row["u"] is not None:
@@ -172,96 +242,3 @@ def picture(row: dict, ratio: float | None, path) -> None:
     network = "random antipodal grasp, no network" if ratio is None else f"ratio {ratio:g}, training seed {row['seed']}"
     title = f"{row['object']}, arm {row['arm']} ({network}), attempt 0: {quality} → {row['outcome']}"
     pick_story(depth, jaw, (u0, v0, u0 + 2 * r, v0 + 2 * r), row["_frames"], path, title)
-
-
-def mean_or_none(values: pd.Series) -> float | None:
-    values = values.dropna()
-    return float(values.mean()) if len(values) else None
-
-
-def compare(trials: pd.DataFrame) -> dict:
-    """Before vs after on the attempts of ``trials``: both rates, the difference, and the exact
-    McNemar test on the attempts paired by seed, object and drop."""
-    from graspaug.sim.stats import paired_test
-
-    out = {arm: rate_summary(trials.success[trials.arm == arm]) for arm in ("before", "after")}
-    paired = trials.pivot_table(index=["seed", "object", "attempt"], columns="arm", values="success", aggfunc="first")
-    if paired.isna().any().any():
-        raise StageError("sim: an attempt is missing from one arm; the arms cannot be paired")
-    out["difference"] = round(out["after"]["success_rate"] - out["before"]["success_rate"], 5)
-    out["paired"] = paired_test(paired["before"].to_numpy(bool), paired["after"].to_numpy(bool))
-    return out
-
-
-def report_text(metrics: dict, trials: pd.DataFrame) -> str:
-    setup, seeds = metrics["setup"], metrics["per_seed"]
-    before, after, test, diff = metrics["arms"]["before"], metrics["arms"]["after"], metrics["paired"], metrics["difference"]
-    lines = [
-        "# Simulated robot trials: GQ-CNN before vs after augmentation",
-        "",
-        f"Franka Panda in pybullet, overhead depth camera {setup['camera_height']} m above the table, {setup['objects']} objects × "
-        f"{setup['attempts']} seeded drops, the same drops for every network; networks of training seeds {setup['model_seeds']}. "
-        "Success = the object ends inside the bin.",
-        "",
-        "| arm | network | successes | rate | 95% Wilson interval |",
-        "|---|---|---|---|---|",
-    ]
-    for arm in ("before", "after"):
-        a = metrics["arms"][arm]
-        lines.append(f"| {arm} | B = {setup['base_size']}, ratio {a['ratio']:g} | {a['successes']}/{a['attempts']} | "
-                     f"{a['success_rate']:.2f} | [{a['wilson_low']:.2f}, {a['wilson_high']:.2f}] |")
-    if "antipodal_reference" in metrics:
-        r = metrics["antipodal_reference"]
-        lines.append(f"| reference | none: a random antipodal seed grasp | {r['successes']}/{r['attempts']} | {r['success_rate']:.2f} | "
-                     f"[{r['wilson_low']:.2f}, {r['wilson_high']:.2f}] |")
-    if len(seeds) > 1:
-        lines += ["", "| training seed | before | after | difference | McNemar p |", "|---|---|---|---|---|"]
-        for seed, row in seeds.items():
-            lines.append(f"| {seed} | {row['before']['successes']}/{row['before']['attempts']} | {row['after']['successes']}/"
-                         f"{row['after']['attempts']} | {row['difference']:+.2f} | {row['paired']['p_value']:.3g} |")
-    lines += ["", "| object | kind | before | after |", "|---|---|---|---|"]
-    for name, row in metrics["per_object"].items():
-        b, a = row["before"], row["after"]
-        lines.append(f"| {name} | {row['kind']} | {b['successes']}/{b['attempts']} | {a['successes']}/{a['attempts']} |")
-    counts = trials.groupby(["arm", "outcome"]).size().unstack(fill_value=0)
-    lines += ["", "Outcomes (no_grasp: no antipodal pair on the image; not_lifted: the object stayed on the table; "
-              "dropped: lost on the way; outside_bin: released but not in the bin):", "",
-              "| arm | " + " | ".join(counts.columns) + " |", "|---|" + "---|" * len(counts.columns)]
-    for arm, row in counts.iterrows():
-        lines.append(f"| {arm} | " + " | ".join(str(int(v)) for v in row) + " |")
-    lines += ["", "## Verdict", ""]
-    if metrics["same_network"]:
-        lines.append(f"The report's best ratio for B = {setup['base_size']} is 0, so \"after\" is the same network as "
-                     "\"before\": augmentation brought nothing to test here.")
-        return "\n".join(lines) + "\n"
-    word = "rose" if diff > 0 else ("fell" if diff < 0 else "did not change")
-    lines.append(f"The success rate {word} after augmentation ({before['success_rate']:.2f} → {after['success_rate']:.2f}, {diff:+.2f}). "
-                 f"On the same drops \"after\" alone succeeded {test['only_after']} times and \"before\" alone "
-                 f"{test['only_before']} times (exact McNemar p = {test['p_value']:.3g}).")
-    if test["p_value"] >= 0.05:
-        lines.append("The difference is within chance at the 5% level: no evidence either way.")
-    elif diff > 0:
-        lines.append("Augmentation helped the simulated robot beyond chance (5% level).")
-    else:
-        lines.append("Augmentation made the simulated robot worse, beyond chance (5% level); the paper's 68% → 86% "
-                     "(real Panda) does not reproduce here.")
-    signs = {np.sign(row["difference"]) for row in seeds.values()}
-    if len(seeds) == 1:
-        lines.append("These are two particular networks (one training seed): how much the comparison changes with the seed is "
-                     "not measured here; `gqcnn.seeds: [0, 1, 2]` (profiles/study.yaml) repeats it per seed.")
-    elif len(signs - {0.0}) > 1:
-        lines.append("The sign of the difference changes with the training seed: the networks' seed-to-seed spread is larger "
-                     "than the effect of augmentation on the robot.")
-    return "\n".join(lines) + "\n"
-
-
-def planning_timing(trials: pd.DataFrame, arms: list[str]) -> dict:
-    """Planning time per grasp (s): mean, median, max over the trials, mean per arm; the stage
-    fills in ``stage_seconds``."""
-    planning = trials.planning_time.dropna()
-    return {"planning_time_mean": float(planning.mean()) if len(planning) else None,
-            "planning_time_median": float(planning.median()) if len(planning) else None,
-            "planning_time_max": float(planning.max()) if len(planning) else None,
-            "planning_time_by_arm": {arm: mean_or_none(trials.planning_time[trials.arm == arm]) for arm in arms},
-            "trials": int(len(trials)), "stage_seconds": None}
-

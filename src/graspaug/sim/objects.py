@@ -1,5 +1,6 @@
-"""Objects for the simulated trials: the everyday objects of ``pybullet_data`` and held-out test
-shapes, as meshes in meters with a cached convex decomposition for collisions.
+"""Objects for the simulated trials: the everyday objects of ``pybullet_data``, held-out test
+shapes and the meshes of a user's folder, as meshes in meters with a cached convex
+decomposition for collisions, and each object's mass and friction drawn from a seed.
 
 Every object is a visual mesh (what the camera sees) plus its convex decomposition by pybullet's
 V-HACD (what collides); the decomposition is cached per mesh under the cache folder, keyed by the
@@ -9,16 +10,23 @@ from __future__ import annotations
 
 import contextlib
 import hashlib
+import logging
 import os
 import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
+import numpy as np
 import pybullet
 import pybullet_data
 import trimesh
 
 from graspaug.sim.catalog import EVERYDAY_OBJECTS
+from graspaug.sim.settings import ObjectPhysics
+
+log = logging.getLogger(__name__)
+
+MESH_SUFFIXES = (".obj", ".stl", ".ply")  # what a user's object folder may hold
 
 
 @dataclass(frozen=True)
@@ -31,7 +39,7 @@ class SimObject:
     collision: Path
     mass: float
     lateral_friction: float
-    spinning_friction: float = 0.001
+    spinning_friction: float = 0.0
     rolling_friction: float = 0.0
 
 
@@ -90,8 +98,51 @@ def default_cache_dir() -> Path:
     return Path(root) / "sim"
 
 
+def mesh_volume(mesh: trimesh.Trimesh) -> float:
+    """Volume (m³) of a closed mesh, or of its convex hull when it is open."""
+    return float(mesh.volume) if mesh.is_volume else float(mesh.convex_hull.volume)
+
+
+def draw_physics(volume: float, settings: ObjectPhysics, rng: np.random.Generator) -> dict[str, float]:
+    """One object's ``density`` (kg/m³, uniform in the range), ``mass`` (kg: density × ``volume``
+    m³, clipped), ``lateral_friction`` (uniform in the range), ``spinning_friction`` and
+    ``rolling_friction`` (m)."""
+    density = float(rng.uniform(*settings.density_range))
+    friction = float(rng.uniform(*settings.friction_range))
+    mass = float(np.clip(density * volume, *settings.mass_range))
+    return {"density": density, "mass": mass, "lateral_friction": friction, "spinning_friction": settings.spinning_friction,
+            "rolling_friction": settings.rolling_friction}
+
+
+def folder_meshes(folder: Path, surface, max_faces: int = 1_000_000, max_file_mb: float = 100.0) -> tuple[list[tuple[str, trimesh.Trimesh]], dict[str, str]]:
+    """The meshes (.obj, .stl, .ply) of ``folder``, named by file stem, each loaded, closed and
+    scaled as the corpus's shapes are (:func:`graspaug.geometry.prepare.prepare_shape` with
+    ``surface``, the ``ingest.surface`` settings), and {file name: reason} for those skipped.
+    Raises ValueError (one line) when the folder is missing or holds no mesh file, or when no
+    mesh survives."""
+    from graspaug.geometry.loading import MeshRejected, load_shape
+    from graspaug.geometry.prepare import prepare_shape
+
+    folder = Path(folder)
+    if not folder.is_dir():
+        raise ValueError(f"sim.objects_path: {folder} is not a folder")
+    files = sorted(p for p in folder.iterdir() if p.is_file() and p.suffix.lower() in MESH_SUFFIXES)
+    if not files:
+        raise ValueError(f"sim.objects_path: {folder} holds no mesh file ({', '.join(MESH_SUFFIXES)})")
+    meshes, skipped = [], {}
+    for path in files:
+        try:
+            meshes.append((path.stem, prepare_shape(load_shape(path, 1.0, max_faces, max_file_mb), surface).mesh))
+        except (MeshRejected, OSError, ValueError) as exc:
+            skipped[path.name] = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+            log.warning("sim: skipping %s: %s", path, skipped[path.name])
+    if not meshes:
+        raise ValueError(f"sim.objects_path: no usable mesh in {folder} ({len(skipped)} skipped: {'; '.join(f'{k}: {v}' for k, v in skipped.items())})")
+    return meshes, skipped
+
+
 def prepare_object(name: str, mesh: trimesh.Trimesh, cache_dir: Path, mass: float, lateral_friction: float,
-                   resolution: int = 100_000) -> SimObject:
+                   resolution: int = 100_000, spinning_friction: float = 0.0, rolling_friction: float = 0.0) -> SimObject:
     """Write ``mesh`` (m) to the cache as ``<name>-<sha256>.obj``, decompose it, and return the
     :class:`SimObject` for the trials. The mesh is centered on its center of mass when it is a
     closed volume, else on its bounding-box center (several pybullet_data meshes are open); the
@@ -108,4 +159,4 @@ def prepare_object(name: str, mesh: trimesh.Trimesh, cache_dir: Path, mass: floa
             f.write(data)
         os.replace(tmp, visual)
     return SimObject(name=name, visual=visual, collision=convex_decomposition(visual, cache_dir, resolution),
-                     mass=mass, lateral_friction=lateral_friction)
+                     mass=mass, lateral_friction=lateral_friction, spinning_friction=spinning_friction, rolling_friction=rolling_friction)

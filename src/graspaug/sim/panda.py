@@ -35,7 +35,7 @@ class Panda:
                                          [0, 0, 0], [0, 0, 0], physicsClientId=client)
         pybullet.changeConstraint(gear, gearRatio=-1, erp=0.1, maxForce=50, physicsClientId=client)
         for link in FINGER_JOINTS:
-            pybullet.changeDynamics(self.body, link, lateralFriction=hand.finger_friction, spinningFriction=0.001, physicsClientId=client)
+            pybullet.changeDynamics(self.body, link, lateralFriction=hand.finger_friction, spinningFriction=hand.finger_spinning_friction, physicsClientId=client)
         self.finger_target = FINGER_OPEN
         self.reset(REST_POSE)
 
@@ -74,14 +74,6 @@ class Panda:
             maxNumIterations=100, residualThreshold=1e-5, physicsClientId=self.client)
         return np.array(angles[:7])
 
-    def place_hand(self, position, jaw_angle: float, fingers: float = FINGER_OPEN) -> float:
-        """Put the hand at ``position`` pointing down at ``jaw_angle`` at once (before any contact:
-        the pre-grasp pose), solving IK from the joint state it reaches; the remaining error (m)."""
-        orientation = self.top_down(jaw_angle)
-        for _ in range(6):
-            self.reset(self.inverse_kinematics(position, orientation), fingers)
-        return float(np.linalg.norm(self.grasp_pose()[0] - np.asarray(position)))
-
     # --- motion ------------------------------------------------------------------------------
     def _command(self, arm: np.ndarray) -> None:
         pybullet.setJointMotorControlArray(self.body, ARM_JOINTS, pybullet.POSITION_CONTROL, targetPositions=arm.tolist(),
@@ -96,19 +88,39 @@ class Panda:
         for _ in range(n):
             pybullet.stepSimulation(physicsClientId=self.client)
 
-    def move_line(self, target, jaw_angle: float, speed: float | None = None, settle: float = 0.1) -> None:
+    def contact_force(self) -> float:
+        """Total normal force (N) of the robot's contacts with other bodies now."""
+        return float(sum(c[9] for c in pybullet.getContactPoints(bodyA=self.body, physicsClientId=self.client) if c[2] != self.body))
+
+    def move_line(self, target, jaw_angle: float, speed: float | None = None, settle: float = 0.1, max_force: float | None = None) -> float:
         """Move the grasp center in a straight line to ``target`` (3,) m at ``speed`` m/s, the hand
-        pointing down at ``jaw_angle``, then hold the last target for ``settle`` s."""
+        pointing down at ``jaw_angle``, then hold the last target for ``settle`` s. With
+        ``max_force`` (N) the robot's contacts with other bodies are watched and the motion stops
+        at the first step where they press harder; returns the largest contact force seen (N),
+        0 when not watched."""
         start, _ = self.grasp_pose()
         target = np.asarray(target, dtype=float)
         orientation = self.top_down(jaw_angle)
         distance = float(np.linalg.norm(target - start))
         steps = max(1, int(np.ceil(distance / (speed or self.hand.speed) / self.time_step)))
-        for i in range(1, steps + 1):
-            self._command(self.inverse_kinematics(start + (target - start) * i / steps, orientation))
+        largest = 0.0
+
+        def advance(arm: np.ndarray) -> bool:  # one step toward ``arm``; False once the contacts press too hard
+            nonlocal largest
+            self._command(arm)
             pybullet.stepSimulation(physicsClientId=self.client)
+            if max_force is not None:
+                largest = max(largest, self.contact_force())
+            return max_force is None or largest <= max_force
+
+        for i in range(1, steps + 1):
+            if not advance(self.inverse_kinematics(start + (target - start) * i / steps, orientation)):
+                return largest
         arm = self.inverse_kinematics(target, orientation)
-        self.step(int(round(settle / self.time_step)), arm)
+        for _ in range(int(round(settle / self.time_step))):
+            if not advance(arm):
+                break
+        return largest
 
     def set_fingers(self, gap: float) -> None:
         """Drive the fingers toward a jaw gap of ``gap`` m for the hand's close time."""

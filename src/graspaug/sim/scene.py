@@ -52,6 +52,13 @@ class PickScene:
                                 rollingFriction=obj.rolling_friction, physicsClientId=c)
         return self.object
 
+    def add_box(self, half_extents, position) -> int:
+        """A static box with ``half_extents`` (3,) m centered at ``position`` (3,) m."""
+        c = self.client
+        shape = pybullet.createCollisionShape(pybullet.GEOM_BOX, halfExtents=list(half_extents), physicsClientId=c)
+        visual = pybullet.createVisualShape(pybullet.GEOM_BOX, halfExtents=list(half_extents), rgbaColor=[0.6, 0.2, 0.2, 1], physicsClientId=c)
+        return pybullet.createMultiBody(0, shape, visual, basePosition=list(position), physicsClientId=c)
+
     def move_object(self, position, orientation) -> None:
         """Put the object at ``position`` (3,) m with quaternion (x, y, z, w) at once, at rest."""
         pybullet.resetBasePositionAndOrientation(self.object, list(position), list(orientation), physicsClientId=self.client)

@@ -39,9 +39,11 @@ class CellLayout:
 class HandSettings:
     """How the hand moves and holds (SI units; params section ``sim.hand``)."""
 
-    grip_force: float = Field(20.0, gt=0, description="Closing force limit per finger (N; the URDF's effort limit is 20).")
-    finger_friction: float = Field(1.0, gt=0, description="Lateral friction of the finger pads.")
-    speed: float = Field(0.25, gt=0, description="Cartesian speed of the grasp center (m/s).")
+    grip_force: float = Field(70.0, gt=0, description="Closing force limit per finger motor (N). With both fingers on the object each presses with this force, so it is the grasp's clamping force: the Franka Hand's spec sheet gives 70 N continuous (140 N peak).")
+    finger_friction: float = Field(1.0, gt=0, description="Lateral friction of the finger pads (pybullet multiplies it by the object's: the pad-object coefficient is the object's friction).")
+    finger_spinning_friction: float = Field(0.0033, ge=0, description="Torsional (spinning) friction of the finger pads (m): the friction torque a pad can resist is this × the object's lateral friction × the normal force (Bullet's combination). 0.0033 = (2/3)·5 mm, a uniformly pressed contact disc of 5 mm radius (a rubber pad on a rigid object).")
+    speed: float = Field(0.25, gt=0, description="Cartesian speed of the grasp center on the way down and up (m/s).")
+    transit_speed: float = Field(0.5, gt=0, description="Cartesian speed from the rest pose to the pre-grasp pose (m/s).")
     close_time: float = Field(0.5, gt=0, description="Time given to close the fingers (s).")
 
 
@@ -57,6 +59,56 @@ class TrialSettings:
     carry_height: float = Field(0.25, gt=0, description="Grasp center above the bin floor when released (m).")
     carry_speed: float = Field(0.5, gt=0, description="Carrying speed (m/s).")
     release_time: float = Field(1.0, gt=0, description="Wait after opening, before the bin check (s).")
+    collision_force: float = Field(10.0, gt=0, description="A contact of the robot with anything (object, table, obstacle) pressing harder than this (N) on the way to the grasp, before the fingers close, ends the trial as `collision` (a fingertip brushing the object's side on the way down measured up to 3 N).")
+
+
+@settings
+class DepthNoise:
+    """The overhead depth sensor, modelled on an Intel RealSense D435 at 0.65 m (params section ``sim.sensor``).
+
+    Axial noise: SD = ``sd_coefficient`` × z² (stereo depth error grows with the square of the
+    distance: RMS ≈ z² · subpixel / (focal length · baseline); the D435 with 0.08 px subpixel,
+    a 50 mm baseline and 424 px focal length at 848 × 480 gives 0.0038 / m, i.e. 1.6 mm at
+    0.65 m), spatially correlated over ``correlation_px`` (stereo matching windows). Missing
+    pixels (read as 0, as the camera reports them): within ``edge_band_px`` of a depth jump
+    above ``edge_jump`` each pixel is lost with probability ``edge_dropout`` (occlusion and
+    matching failure at object borders), and pixels of surfaces steeper than ``steep_angle``
+    to the view ray with probability ``steep_dropout``. Depths are rounded to ``quantization``
+    (the D435's default depth unit: 1 mm).
+    """
+
+    enabled: bool = Field(True, description="Add the noise (false: the renderer's exact depth, as before).")
+    sd_coefficient: float = Field(0.0038, ge=0, description="Noise SD per squared depth (1/m): SD(z) = this × z² (0.0038: 1.6 mm at 0.65 m, the D435's RMS error).")
+    correlation_px: float = Field(2.0, ge=0, description="Gaussian smoothing (px) of the noise field: stereo matching windows correlate neighbouring pixels (0: independent pixels).")
+    edge_jump: float = Field(0.005, gt=0, description="A depth difference to a 4-neighbour above this (m) marks a depth edge.")
+    edge_band_px: int = Field(2, ge=0, description="Pixels this close to a depth edge (both sides) form the edge band.")
+    edge_dropout: float = Field(0.3, ge=0, le=1, description="Share of edge-band pixels lost (read 0).")
+    steep_angle: float = Field(70.0, gt=0, lt=90, description="Surfaces tilted more than this from facing the camera (degrees) are steep.")
+    steep_dropout: float = Field(0.5, ge=0, le=1, description="Share of steep-surface pixels (outside the edge band) lost (read 0).")
+    quantization: float = Field(0.001, ge=0, description="Depth step (m; D435 depth unit 1 mm; 0: none).")
+
+
+@settings
+class ObjectPhysics:
+    """Mass and friction of each object, drawn per object from the global seed (params section ``sim.physics``).
+
+    Mass = density × volume (the closed mesh's volume, or its convex hull's for an open mesh),
+    clipped to ``mass_range``. The default densities span household things: foam and hollow
+    plastic toys (~150 kg/m³ over their enclosed volume), packaged food and wood (~500-700),
+    to solid plastic and fruit (~900).
+    """
+
+    density_range: tuple[float, float] = Field((150.0, 900.0), description="Density drawn uniformly per object (kg/m³).")
+    mass_range: tuple[float, float] = Field((0.03, 1.0), description="The mass is clipped to this range (kg; the Panda hand and arm carry 3 kg).")
+    friction_range: tuple[float, float] = Field((0.3, 0.7), description="Lateral friction drawn uniformly per object (pybullet multiplies it by the partner's: 1.0 for the pads, the table's 0.8).")
+    spinning_friction: float = Field(0.0, ge=0, description="The object's own torsional friction (m); the pads' is sim.hand.finger_spinning_friction.")
+    rolling_friction: float = Field(0.0001, ge=0, description="Rolling friction of the object (m): small, so round objects still roll.")
+
+    def __post_init__(self) -> None:
+        for name in ("density_range", "mass_range", "friction_range"):
+            low, high = getattr(self, name)
+            if not 0 < low <= high:
+                raise ValueError(f"sim.physics.{name}: must be (low, high) with 0 < low <= high; got {[low, high]}")
 
 
 @settings

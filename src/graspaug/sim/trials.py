@@ -2,7 +2,10 @@
 
 A trial runs in a fresh :class:`~graspaug.sim.scene.PickScene` so that its outcome depends only
 on the object, the drop seed and the grasp: the same seed gives the same drop (and the same
-depth image) to every planner. The grasp comes from a planner callable (depth image → image
+noisy depth image: the sensor noise is drawn from the drop seed too) to every planner. The hand
+travels from its rest pose to the pre-grasp pose and down to the grasp along straight lines;
+a contact pressing harder than ``collision_force`` on the way, before the fingers close, ends
+the trial as ``collision``. The grasp comes from a planner callable (depth image → image
 grasp) or, for scripted tests, directly as a table-frame pose.
 """
 from __future__ import annotations
@@ -17,9 +20,13 @@ from graspaug.sim.objects import SimObject
 from graspaug.sim.panda import FINGER_OPEN, HandSettings
 from graspaug.sim.policy import ImageGrasps, PlannedGrasp, grasp_in_table_frame
 from graspaug.sim.scene import CellLayout, PickScene
-from graspaug.sim.settings import TrialSettings
+from graspaug.sim.sensor import sense_depth
+from graspaug.sim.settings import DepthNoise, TrialSettings
 
-OUTCOMES = ("success", "no_grasp", "not_lifted", "dropped", "outside_bin")
+OUTCOMES = ("success", "no_grasp", "collision", "not_lifted", "dropped", "outside_bin")
+
+#: A static box in the cell: half extents (3,) m and center (3,) m, table frame (tests block the approach with one).
+Obstacle = tuple[tuple[float, float, float], tuple[float, float, float]]
 
 
 @dataclass
@@ -35,6 +42,7 @@ class TrialResult:
     quality: float | None = None  # GQ-CNN P(success)
     planning_time: float | None = None  # s
     candidates: int = 0
+    contact_force: float = 0.0  # largest contact force (N) of the robot before the fingers closed
     depth: np.ndarray | None = None
     frames: list[tuple[str, np.ndarray]] = field(default_factory=list)
 
@@ -53,10 +61,11 @@ ScriptedGrasp = Callable[[np.ndarray, np.ndarray], "tuple[np.ndarray, float]"]
 
 def run_trial(obj: SimObject, drop_seed: int, planner: Planner | None = None, scripted: ScriptedGrasp | None = None,
               layout: CellLayout = CellLayout(), hand: HandSettings = HandSettings(), settings: TrialSettings = TrialSettings(),
-              record: bool = False) -> TrialResult:
+              sensor: DepthNoise = DepthNoise(), record: bool = False, obstacles: tuple[Obstacle, ...] = ()) -> TrialResult:
     """Drop ``obj`` at the pose drawn from ``drop_seed``, then pick it with ``planner``'s grasp
-    (or the ``scripted`` one: the object's resting position (3,) m and quaternion (x, y, z, w)
-    → table-frame grasp center (3,) m and jaw angle rad) and carry it to the bin."""
+    on the ``sensor``'s depth image (or the ``scripted`` one: the object's resting position (3,) m
+    and quaternion (x, y, z, w) → table-frame grasp center (3,) m and jaw angle rad) and carry
+    it to the bin. ``obstacles`` are static boxes added once the object rests."""
     rng = np.random.default_rng(drop_seed)
     with PickScene(layout, hand) as scene:
         xy = rng.uniform(-settings.drop_offset, settings.drop_offset, size=2)
@@ -66,12 +75,14 @@ def run_trial(obj: SimObject, drop_seed: int, planner: Planner | None = None, sc
         drop = np.array([xy[0], xy[1], 1.0 - low[2] + settings.drop_clearance])
         scene.move_object(drop, orientation)
         scene.settle(settings.settle_time)
+        for half_extents, position in obstacles:
+            scene.add_box(half_extents, position)
         result = TrialResult(outcome="no_grasp", success=False, drop_position=tuple(float(x) for x in drop))
         frames = result.frames
         if record:
             frames.append(("object dropped", scene.color_frame()))
         if scripted is None:
-            depth = scene.depth_image()
+            depth = sense_depth(scene.depth_image(), layout.intrinsics, sensor, np.random.default_rng([drop_seed, 1]))
             if record:
                 result.depth = depth
             planned = planner(depth, layout.camera, layout.intrinsics) if planner is not None else None
@@ -90,11 +101,17 @@ def run_trial(obj: SimObject, drop_seed: int, planner: Planner | None = None, sc
         start_height = scene.object_pose()[0][2]
 
         robot = scene.robot
-        robot.place_hand(center + [0, 0, settings.pregrasp_height], jaw_angle)
-        robot.step(int(0.1 / layout.time_step))
+        limit = settings.collision_force
+        result.contact_force = robot.move_line(center + [0, 0, settings.pregrasp_height], jaw_angle, speed=hand.transit_speed, max_force=limit)
         if record:
             frames.append(("pre-grasp", scene.color_frame()))
-        robot.move_line(center, jaw_angle)
+        if result.contact_force <= limit:
+            result.contact_force = max(result.contact_force, robot.move_line(center, jaw_angle, max_force=limit))
+        if result.contact_force > limit:
+            result.outcome = "collision"
+            if record:
+                frames.append(("collision", scene.color_frame()))
+            return result
         robot.set_fingers(0.0)
         if record:
             frames.append(("closed", scene.color_frame()))

@@ -1,0 +1,179 @@
+"""What the simulated trials show: success rates with Wilson intervals, paired contrasts between
+arms with a bootstrap interval over objects, the calibration of the cell against the labels'
+graspness, and the report's text.
+
+A trials table has a row per attempt: ``arm``, ``seed`` (the network's training seed; −1 for the
+``antipodal`` arm, which has no network and runs once), ``object``, ``kind``, ``attempt``,
+``outcome``, ``success``. Attempts pair up by (seed, object, attempt): every arm sees the same
+drops and planner seeds; the antipodal arm's attempt pairs with that attempt of every seed.
+"""
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from graspaug.errors import StageError
+from graspaug.sim.stats import paired_test, wilson_interval
+
+#: The contrasts of ``metrics/sim.json``: name → (arm, reference arm); success(arm) − success(reference).
+CONTRASTS = {"after_vs_before": ("after", "before"), "network_vs_antipodal": ("before", "antipodal"), "after_vs_real": ("after", "real")}
+
+
+def rate_summary(outcomes: pd.Series) -> dict:
+    """Successes, attempts, the rate and its 95 % Wilson interval of boolean ``outcomes``."""
+    k, n = int(outcomes.sum()), int(len(outcomes))
+    low, high = wilson_interval(k, n)
+    return {"successes": k, "attempts": n, "success_rate": round(k / n, 5) if n else None, "wilson_low": round(low, 5), "wilson_high": round(high, 5)}
+
+
+def paired_outcomes(trials: pd.DataFrame, arm: str, reference: str) -> pd.DataFrame:
+    """One row per paired attempt: ``seed``, ``object``, ``attempt``, ``a`` and ``b`` (success of
+    ``arm`` and ``reference``); an arm run once (seed −1) pairs with every seed of the other."""
+    a = trials.loc[trials.arm == arm, ["seed", "object", "attempt", "success"]].rename(columns={"success": "a"})
+    b = trials.loc[trials.arm == reference, ["seed", "object", "attempt", "success"]].rename(columns={"success": "b"})
+    keys = ["seed", "object", "attempt"]
+    if set(b.seed) == {-1}:
+        b, keys = b.drop(columns="seed"), ["object", "attempt"]
+    elif set(a.seed) == {-1}:
+        a, keys = a.drop(columns="seed"), ["object", "attempt"]
+    paired = a.merge(b, on=keys, how="outer")
+    if paired[["a", "b"]].isna().any().any():
+        raise StageError(f"sim: an attempt of {arm!r} or {reference!r} has no partner; the arms cannot be paired")
+    return paired.assign(a=paired.a.astype(bool), b=paired.b.astype(bool))
+
+
+def bootstrap_over_objects(diff: np.ndarray, objects: np.ndarray, n_boot: int, rng: np.random.Generator, level: float = 0.95) -> tuple[float, float]:
+    """Percentile interval of the mean of ``diff`` (N,) when the objects (N,) labels are
+    resampled with replacement (each drawn object brings all its attempts)."""
+    names, index = np.unique(objects, return_inverse=True)
+    sums = np.bincount(index, weights=diff, minlength=len(names))
+    counts = np.bincount(index, minlength=len(names))
+    draws = rng.integers(0, len(names), size=(n_boot, len(names)))
+    means = sums[draws].sum(axis=1) / counts[draws].sum(axis=1)
+    alpha = (1 - level) / 2
+    return float(np.quantile(means, alpha)), float(np.quantile(means, 1 - alpha))
+
+
+def paired_contrast(trials: pd.DataFrame, arm: str, reference: str, n_boot: int = 2000, seed: int = 0) -> dict:
+    """success(arm) − success(reference) on the paired attempts: ``mean``, the 95 % bootstrap
+    interval over objects (``ci_low``, ``ci_high``), ``n_trials`` (pairs), ``n_objects``, and the
+    exact McNemar counts and p-value."""
+    paired = paired_outcomes(trials, arm, reference)
+    diff = paired.a.to_numpy(float) - paired.b.to_numpy(float)
+    low, high = bootstrap_over_objects(diff, paired.object.to_numpy(), n_boot, np.random.default_rng(seed))
+    test = paired_test(paired.b.to_numpy(), paired.a.to_numpy())
+    return {"mean": round(float(diff.mean()), 5), "ci_low": round(low, 5), "ci_high": round(high, 5), "n_trials": int(len(diff)),
+            "n_objects": int(paired.object.nunique()), f"only_{arm}": test["only_after"], f"only_{reference}": test["only_before"],
+            "mcnemar_p": test["p_value"]}
+
+
+def compare(trials: pd.DataFrame) -> dict:
+    """Before vs after on the attempts of ``trials``: both rates, the difference, and the exact
+    McNemar test on the attempts paired by seed, object and drop."""
+    out = {arm: rate_summary(trials.success[trials.arm == arm]) for arm in ("before", "after")}
+    paired = paired_outcomes(trials, "after", "before")
+    out["difference"] = round(out["after"]["success_rate"] - out["before"]["success_rate"], 5)
+    out["paired"] = paired_test(paired.b.to_numpy(), paired.a.to_numpy())
+    return out
+
+
+def calibration(trials: pd.DataFrame, graspness: pd.Series) -> tuple[pd.DataFrame, dict]:
+    """Per object: the antipodal arm's success rate beside its labels' ``graspness`` (a Series by
+    object name; objects without labels get NaN), and their Spearman correlation over the
+    objects with labels (None with fewer than 3)."""
+    from scipy.stats import spearmanr
+
+    antipodal = trials[trials.arm == "antipodal"]
+    table = antipodal.groupby("object", sort=False).agg(kind=("kind", "first"), attempts=("success", "size"), sim_success=("success", "mean"))
+    table["graspness"] = graspness.reindex(table.index).to_numpy(float)
+    labelled = table.dropna(subset=["graspness"])
+    summary = {"n_objects": int(len(labelled)), "spearman": None, "p_value": None}
+    if len(labelled) >= 3 and labelled.sim_success.nunique() > 1 and labelled.graspness.nunique() > 1:
+        result = spearmanr(labelled.sim_success, labelled.graspness)
+        summary["spearman"], summary["p_value"] = round(float(result.statistic), 4), round(float(result.pvalue), 5)
+    return table.reset_index(), summary
+
+
+def _interval(c: dict) -> str:
+    return f"{c['mean']:+.3f} [{c['ci_low']:+.3f}, {c['ci_high']:+.3f}]"
+
+
+def _verdict(name: str, c: dict) -> str:
+    arm, reference = CONTRASTS[name]
+    if c["ci_low"] > 0:
+        return f"`{name}` excludes zero: {arm} succeeds more often than {reference} ({_interval(c)}, {c['n_trials']} paired attempts)."
+    if c["ci_high"] < 0:
+        return f"`{name}` excludes zero: {arm} succeeds less often than {reference} ({_interval(c)}, {c['n_trials']} paired attempts)."
+    return f"`{name}` includes zero: no difference shown between {arm} and {reference} ({_interval(c)}, {c['n_trials']} paired attempts)."
+
+
+def report_text(metrics: dict, trials: pd.DataFrame, calibration_table: pd.DataFrame) -> str:
+    """``reports/sim/report.md``: rates, contrasts with their verdicts, per seed and per object,
+    outcomes, and the calibration table."""
+    setup, arms = metrics["setup"], metrics["arms"]
+    lines = [
+        "# Simulated robot trials",
+        "",
+        f"Franka Panda in pybullet, overhead depth camera {setup['camera_height']} m above the table "
+        f"({'D435-like noise, missing pixels and 1 mm steps' if setup['sensor_noise'] else 'exact depth'}), "
+        f"{setup['objects']} objects × {setup['attempts']} seeded drops, the same drops and planner seeds for every arm; networks of "
+        f"training seeds {setup['model_seeds']} (B = {setup['base_size']}). Success = the object ends inside the bin.",
+        "",
+        "| arm | planner | successes | rate | 95% Wilson interval |",
+        "|---|---|---|---|---|",
+    ]
+    for arm, a in arms.items():
+        planner = "a random antipodal seed grasp, no network" if arm == "antipodal" else f"{a['pool']} B = {setup['base_size']}, ratio {a['ratio']:g}"
+        lines.append(f"| {arm} | {planner} | {a['successes']}/{a['attempts']} | {a['success_rate']:.2f} | [{a['wilson_low']:.2f}, {a['wilson_high']:.2f}] |")
+    lines += ["", "## Contrasts", "", "Paired success difference (arm − reference) over the attempts of every training seed; "
+              "95% percentile bootstrap interval with the objects as the unit (each resampled object brings all its attempts).", "",
+              "| contrast | difference | 95% interval | paired attempts | objects | McNemar p |", "|---|---|---|---|---|---|"]
+    for name, c in metrics["contrasts"].items():
+        lines.append(f"| {name} | {c['mean']:+.3f} | [{c['ci_low']:+.3f}, {c['ci_high']:+.3f}] | {c['n_trials']} | {c['n_objects']} | {c['mcnemar_p']:.3g} |")
+    lines += [""] + [f"- {_verdict(name, c)}" for name, c in metrics["contrasts"].items()]
+    if metrics["same_network"]:
+        lines.append(f"- The best ratio on validation AP for B = {setup['base_size']} is 0: \"after\" is the same network as \"before\".")
+    seeds = metrics["per_seed"]
+    if len(seeds) > 1:
+        lines += ["", "| training seed | before | after | difference | McNemar p |", "|---|---|---|---|---|"]
+        for seed, row in seeds.items():
+            lines.append(f"| {seed} | {row['before']['successes']}/{row['before']['attempts']} | {row['after']['successes']}/"
+                         f"{row['after']['attempts']} | {row['difference']:+.2f} | {row['paired']['p_value']:.3g} |")
+        if len({np.sign(row["difference"]) for row in seeds.values()} - {0.0}) > 1:
+            lines.append("\nThe sign of after − before changes with the training seed.")
+    names = list(arms)
+    lines += ["", "| object | kind | mass (kg) | friction | " + " | ".join(names) + " |", "|---|---|---|---|" + "---|" * len(names)]
+    for name, row in metrics["per_object"].items():
+        lines.append(f"| {name} | {row['kind']} | {row['mass']:.3f} | {row['friction']:.2f} | "
+                     + " | ".join(f"{row[arm]['successes']}/{row[arm]['attempts']}" for arm in names) + " |")
+    counts = trials.groupby(["arm", "outcome"]).size().unstack(fill_value=0)
+    lines += ["", "Outcomes (no_grasp: no antipodal pair on the image; collision: the hand pressed on the object, the table or the "
+              "bin before closing; not_lifted: the object stayed on the table; dropped: lost on the way; outside_bin: released but "
+              "not in the bin):", "", "| arm | " + " | ".join(counts.columns) + " |", "|---|" + "---|" * len(counts.columns)]
+    for arm, row in counts.iterrows():
+        lines.append(f"| {arm} | " + " | ".join(str(int(v)) for v in row) + " |")
+    cal = metrics["calibration"]
+    rho = "not computed (fewer than 3 labelled objects or no spread)" if cal["spearman"] is None else f"{cal['spearman']:+.2f} (p = {cal['p_value']:.3g})"
+    lines += ["", "## Calibration", "", "Does the cell reward what the labels call a good grasp? The random antipodal arm's success per "
+              "object against the object's graspness (share of its sampled grasps with robust ε above the grasp threshold, "
+              f"`data/scores.parquet`; n/a for objects without labels). Spearman correlation over {cal['n_objects']} labelled objects: {rho}.",
+              "", "| object | kind | attempts | sim success (antipodal) | graspness |", "|---|---|---|---|---|"]
+    for row in calibration_table.itertuples():
+        label = "n/a" if np.isnan(row.graspness) else f"{row.graspness:.2f}"
+        lines.append(f"| {row.object} | {row.kind} | {row.attempts} | {row.sim_success:.2f} | {label} |")
+    return "\n".join(lines) + "\n"
+
+
+def planning_timing(trials: pd.DataFrame, arms: list[str]) -> dict:
+    """Planning time per grasp (s): mean, median, max over the trials, mean per arm; the stage
+    fills in ``stage_seconds``."""
+    planning = trials.planning_time.dropna()
+
+    def mean(values: pd.Series) -> float | None:
+        values = values.dropna()
+        return float(values.mean()) if len(values) else None
+
+    return {"planning_time_mean": mean(planning), "planning_time_median": float(planning.median()) if len(planning) else None,
+            "planning_time_max": float(planning.max()) if len(planning) else None,
+            "planning_time_by_arm": {arm: mean(trials.planning_time[trials.arm == arm]) for arm in arms},
+            "trials": int(len(trials)), "stage_seconds": None}

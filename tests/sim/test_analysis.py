@@ -1,0 +1,69 @@
+"""The sim experiment's statistics and words, on hand-made trial tables."""
+import numpy as np
+import pandas as pd
+import pytest
+
+from graspaug.sim.analysis import bootstrap_over_objects, calibration, compare, paired_contrast, report_text, rate_summary
+
+
+def trials_table(outcomes: dict[tuple[str, int, str], list[bool]]) -> pd.DataFrame:
+    """(arm, seed, object) → success per attempt."""
+    rows = [{"arm": arm, "seed": seed, "object": obj, "kind": "test_shape", "attempt": i, "success": ok,
+             "outcome": "success" if ok else "not_lifted"}
+            for (arm, seed, obj), oks in outcomes.items() for i, ok in enumerate(oks)]
+    return pd.DataFrame(rows)
+
+
+def test_antipodal_pairs_with_every_training_seed():
+    trials = trials_table({("before", 0, "a"): [True, True], ("before", 1, "a"): [True, False], ("antipodal", -1, "a"): [False, False]})
+    c = paired_contrast(trials, "before", "antipodal", n_boot=200)
+    assert c["n_trials"] == 4 and c["n_objects"] == 1 and c["mean"] == 0.75
+    assert c["only_before"] == 3 and c["only_antipodal"] == 0
+
+
+def test_bootstrap_over_objects_covers_the_mean_and_sees_object_spread():
+    rng = np.random.default_rng(0)
+    objects = np.repeat(np.arange(30), 6)
+    same = np.tile([1.0, 0.0, 0.0, 0.0, 0.0, 0.0], 30)  # every object +1/6
+    low, high = bootstrap_over_objects(same, objects, 1000, rng)
+    assert low == pytest.approx(1 / 6) and high == pytest.approx(1 / 6)  # no spread between objects: no width
+    mixed = np.where(objects % 2 == 0, 1.0, -0.5)  # half the objects gain, half lose
+    low, high = bootstrap_over_objects(mixed, objects, 2000, rng)
+    assert low < 0.25 < high and 0.35 < high - low < 0.7  # 2 × 1.96 × 0.75 / √30 = 0.54
+
+
+def test_contrast_interval_excludes_zero_for_a_clear_effect_and_report_says_so():
+    outcomes = {}
+    for k in range(12):
+        obj = f"o{k}"
+        outcomes[("before", 0, obj)] = [True, True, k % 3 != 0]
+        outcomes[("after", 0, obj)] = [True, k % 2 == 0, False]
+        outcomes[("antipodal", -1, obj)] = [False, k % 4 == 0, False]
+    trials = trials_table(outcomes)
+    c = paired_contrast(trials, "before", "antipodal", n_boot=1000)
+    assert c["ci_low"] > 0 and c["mean"] == pytest.approx(np.mean([1, 1, 2 / 3]) - 1 / 12, abs=1e-4)
+    chosen = {"before": ("targeted", 0.0), "after": ("targeted", 1.0), "antipodal": (None, None)}
+    metrics = {
+        "setup": {"camera_height": 0.65, "sensor_noise": True, "objects": 12, "attempts": 3, "model_seeds": [0], "base_size": 50},
+        "arms": {arm: {"pool": pool, "ratio": ratio, **rate_summary(trials.success[trials.arm == arm])} for arm, (pool, ratio) in chosen.items()},
+        "contrasts": {"after_vs_before": paired_contrast(trials, "after", "before", n_boot=1000), "network_vs_antipodal": c},
+        "same_network": False, "per_seed": {"0": compare(trials)},
+        "per_object": {f"o{k}": {"kind": "test_shape", "mass": 0.2, "friction": 0.5,
+                                 **{arm: rate_summary(trials.success[(trials.object == f"o{k}") & (trials.arm == arm)]) for arm in chosen}}
+                       for k in range(12)},
+    }
+    table, metrics["calibration"] = calibration(trials, pd.Series({f"o{k}": k / 12 for k in range(10)}))
+    text = report_text(metrics, trials, table)
+    assert "`network_vs_antipodal` excludes zero: before succeeds more often than antipodal" in text
+    assert "`after_vs_before` excludes zero: after succeeds less often than before" in text
+    assert "| o11 | test_shape | 3 | 0.00 | n/a |" in text  # no labels for o10, o11
+
+
+def test_calibration_correlates_sim_success_with_graspness():
+    outcomes = {("antipodal", -1, f"o{k}"): [i < k for i in range(5)] for k in range(6)}  # o_k succeeds k of 5 (capped)
+    trials = trials_table(outcomes)
+    table, summary = calibration(trials, pd.Series({f"o{k}": 0.1 * k for k in range(6)}))
+    assert summary["n_objects"] == 6 and summary["spearman"] == pytest.approx(1.0)
+    assert list(table.columns) == ["object", "kind", "attempts", "sim_success", "graspness"]
+    _, none = calibration(trials, pd.Series(dtype=float))
+    assert none == {"n_objects": 0, "spearman": None, "p_value": None}
