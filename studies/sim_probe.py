@@ -9,7 +9,7 @@ physically plausible setting separates the arms. Run it in a project where
 ``render@original`` has run with the default params (it reads ``data/shapes.parquet``,
 ``data/shapes`` and, with ``--train``, ``data/gqcnn/original``):
 
-    python studies/sim_probe.py [--seeds 0 1 2] [--n-test 26] [--attempts 2] [--models DIR] [--train]
+    python studies/sim_probe.py [--seeds 0 1 2 3] [--n-test 20] [--attempts 2] [--models DIR] [--train]
                                 [--set hand.grip_force=20 --set physics.friction_range=[0.3,0.5] ...]
 
 ``--models`` holds ``s<seed>/targeted/<B>-0/model.pt`` (default ``models/gqcnn``); with ``--train``
@@ -71,7 +71,7 @@ def with_changes(sim, changes: list[str]):
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2])
+    parser.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2, 3])
     parser.add_argument("--base-size", type=int, default=50)
     parser.add_argument("--n-test", type=int, default=None, help="test shapes (default: sim.n_test_objects)")
     parser.add_argument("--attempts", type=int, default=None, help="drops per object (default: sim.attempts)")

@@ -258,7 +258,9 @@ def test_dvc_repro_sim(tiny_repo, tmp_path):
     assert metrics["arms"]["antipodal"]["attempts"] == 4  # the reference arm without a network runs once
     for name in ("after_vs_before", "network_vs_antipodal") + (("after_vs_real",) if after_ratio > 0 else ()):
         c = metrics["contrasts"][name]
-        assert c["n_trials"] == 8 and c["ci_low"] <= c["mean"] <= c["ci_high"]
+        # against the antipodal arm (one run per drop) each of the 4 drops counts once; network arms pair 2 seeds × 4 drops
+        assert c["n_trials"] == (4 if name == "network_vs_antipodal" else 8) and c["ci_low"] <= c["mean"] <= c["ci_high"]
+        assert c["n_seeds"] == 2 and c["t_ci_low"] <= c["mean"] <= c["t_ci_high"]
     trials = pd.read_csv(work / "reports/sim/trials.csv")
     assert len(trials) == 4 * len(network_arms) * 2 + 4 and set(trials.object) == {"cube", metrics["setup"]["test_shapes"][0]}
     planned = (trials.arm != "antipodal") & (trials.outcome != "no_grasp")

@@ -17,8 +17,24 @@ def trials_table(outcomes: dict[tuple[str, int, str], list[bool]]) -> pd.DataFra
 def test_antipodal_pairs_with_every_training_seed():
     trials = trials_table({("before", 0, "a"): [True, True], ("before", 1, "a"): [True, False], ("antipodal", -1, "a"): [False, False]})
     c = paired_contrast(trials, "before", "antipodal", n_boot=200)
-    assert c["n_trials"] == 4 and c["n_objects"] == 1 and c["mean"] == 0.75
-    assert c["only_before"] == 3 and c["only_antipodal"] == 0
+    # each antipodal drop counts once, against the network's outcomes averaged over the seeds (1 and 0.5)
+    assert c["n_trials"] == 2 and c["n_objects"] == 1 and c["mean"] == 0.75
+    assert c["mcnemar_p"] is None and c["only_before"] is None  # McNemar needs 0/1 pairs
+    assert c["n_seeds"] == 2 and c["per_seed"] == {"0": 1.0, "1": 0.5}
+    assert c["t_ci_low"] < 0.75 < c["t_ci_high"]  # t(0.975, 1) = 12.7 × 0.25 / √2 on each side
+
+
+def test_contrast_between_network_arms_keeps_mcnemar_and_gives_a_t_interval_over_seeds():
+    outcomes = {}
+    for seed, gain in ((0, 1), (1, 2), (2, 1)):  # after wins `gain` more of 4 drops per object than before
+        for k in range(5):
+            outcomes[("before", seed, f"o{k}")] = [False] * gain + [True] * (4 - gain)
+            outcomes[("after", seed, f"o{k}")] = [True] * 4
+    c = paired_contrast(trials_table(outcomes), "after", "before", n_boot=200)
+    assert c["n_trials"] == 60 and c["only_after"] == 20 and c["only_before"] == 0 and c["mcnemar_p"] < 1e-5
+    assert c["per_seed"] == {"0": 0.25, "1": 0.5, "2": 0.25} and c["mean"] == pytest.approx(1 / 3, abs=1e-4)
+    half = 4.302653 * np.std([0.25, 0.5, 0.25], ddof=1) / np.sqrt(3)
+    assert c["t_ci_low"] == pytest.approx(1 / 3 - half, abs=1e-4) and c["t_ci_high"] == pytest.approx(1 / 3 + half, abs=1e-4)
 
 
 def test_bootstrap_over_objects_covers_the_mean_and_sees_object_spread():

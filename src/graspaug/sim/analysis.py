@@ -36,9 +36,13 @@ def paired_outcomes(trials: pd.DataFrame, arm: str, reference: str) -> pd.DataFr
         b, keys = b.drop(columns="seed"), ["object", "attempt"]
     elif set(a.seed) == {-1}:
         a, keys = a.drop(columns="seed"), ["object", "attempt"]
+    if a.empty or b.empty:
+        raise StageError(f"sim: arm {arm if a.empty else reference!r} has no attempts; the arms cannot be paired")
     paired = a.merge(b, on=keys, how="outer")
-    if paired[["a", "b"]].isna().any().any():
-        raise StageError(f"sim: an attempt of {arm!r} or {reference!r} has no partner; the arms cannot be paired")
+    lonely = paired[paired[["a", "b"]].isna().any(axis=1)]
+    if len(lonely):
+        first = ", ".join(f"{k} {lonely.iloc[0][k]}" for k in keys)
+        raise StageError(f"sim: {len(lonely)} attempts of {arm!r} or {reference!r} have no partner (first: {first}); the arms cannot be paired")
     return paired.assign(a=paired.a.astype(bool), b=paired.b.astype(bool))
 
 
@@ -55,16 +59,34 @@ def bootstrap_over_objects(diff: np.ndarray, objects: np.ndarray, n_boot: int, r
 
 
 def paired_contrast(trials: pd.DataFrame, arm: str, reference: str, n_boot: int = 2000, seed: int = 0) -> dict:
-    """success(arm) − success(reference) on the paired attempts: ``mean``, the 95 % bootstrap
-    interval over objects (``ci_low``, ``ci_high``), ``n_trials`` (pairs), ``n_objects``, and the
-    exact McNemar counts and p-value."""
+    """success(arm) − success(reference) on the paired attempts: ``mean``; the 95 % bootstrap
+    interval over objects (``ci_low``, ``ci_high``; each resampled object brings all its
+    attempts); ``n_trials`` (paired drops), ``n_objects``; the 95 % t-interval over training
+    seeds of the per-seed differences (``t_ci_low``, ``t_ci_high``, ``n_seeds``, ``per_seed``);
+    and, when both arms ran once per training seed, the exact McNemar counts and p-value.
+
+    An arm without a network (seed −1) ran each drop once: the other arm's outcomes of that
+    drop are averaged over the training seeds first, so a drop counts once (its differences
+    are then not 0/1, and McNemar does not apply: ``mcnemar_p`` is None)."""
+    from graspaug.experiments.stats import t_interval
+
     paired = paired_outcomes(trials, arm, reference)
-    diff = paired.a.to_numpy(float) - paired.b.to_numpy(float)
-    low, high = bootstrap_over_objects(diff, paired.object.to_numpy(), n_boot, np.random.default_rng(seed))
-    test = paired_test(paired.b.to_numpy(), paired.a.to_numpy())
+    per_seed = paired.groupby("seed").apply(lambda d: float(d.a.mean() - d.b.mean()), include_groups=False)
+    over_seeds = t_interval(per_seed.to_numpy())
+    once = -1 in set(trials.seed[trials.arm.isin([arm, reference])])
+    if once:
+        drops = paired.groupby(["object", "attempt"], sort=False).agg(a=("a", "mean"), b=("b", "mean")).reset_index()
+        diff, objects = (drops.a - drops.b).to_numpy(float), drops.object.to_numpy()
+        counts = {f"only_{arm}": None, f"only_{reference}": None, "mcnemar_p": None}
+    else:
+        diff, objects = paired.a.to_numpy(float) - paired.b.to_numpy(float), paired.object.to_numpy()
+        test = paired_test(paired.b.to_numpy(), paired.a.to_numpy())
+        counts = {f"only_{arm}": test["only_after"], f"only_{reference}": test["only_before"], "mcnemar_p": test["p_value"]}
+    low, high = bootstrap_over_objects(diff, objects, n_boot, np.random.default_rng(seed))
+    rounded = lambda x: None if x is None else round(float(x), 5)  # noqa: E731
     return {"mean": round(float(diff.mean()), 5), "ci_low": round(low, 5), "ci_high": round(high, 5), "n_trials": int(len(diff)),
-            "n_objects": int(paired.object.nunique()), f"only_{arm}": test["only_after"], f"only_{reference}": test["only_before"],
-            "mcnemar_p": test["p_value"]}
+            "n_objects": int(len(set(objects))), "t_ci_low": rounded(over_seeds["ci_low"]), "t_ci_high": rounded(over_seeds["ci_high"]),
+            "n_seeds": over_seeds["n_seeds"], "per_seed": {str(k): round(v, 5) for k, v in per_seed.items()}, **counts}
 
 
 def compare(trials: pd.DataFrame) -> dict:
@@ -101,10 +123,10 @@ def _interval(c: dict) -> str:
 def _verdict(name: str, c: dict) -> str:
     arm, reference = CONTRASTS[name]
     if c["ci_low"] > 0:
-        return f"`{name}` excludes zero: {arm} succeeds more often than {reference} ({_interval(c)}, {c['n_trials']} paired attempts)."
+        return f"`{name}` excludes zero: {arm} succeeds more often than {reference} ({_interval(c)}, {c['n_trials']} paired drops)."
     if c["ci_high"] < 0:
-        return f"`{name}` excludes zero: {arm} succeeds less often than {reference} ({_interval(c)}, {c['n_trials']} paired attempts)."
-    return f"`{name}` includes zero: no difference shown between {arm} and {reference} ({_interval(c)}, {c['n_trials']} paired attempts)."
+        return f"`{name}` excludes zero: {arm} succeeds less often than {reference} ({_interval(c)}, {c['n_trials']} paired drops)."
+    return f"`{name}` includes zero: no difference shown between {arm} and {reference} ({_interval(c)}, {c['n_trials']} paired drops)."
 
 
 def report_text(metrics: dict, trials: pd.DataFrame, calibration_table: pd.DataFrame) -> str:
@@ -126,10 +148,14 @@ def report_text(metrics: dict, trials: pd.DataFrame, calibration_table: pd.DataF
         planner = "a random antipodal seed grasp, no network" if arm == "antipodal" else f"{a['pool']} B = {setup['base_size']}, ratio {a['ratio']:g}"
         lines.append(f"| {arm} | {planner} | {a['successes']}/{a['attempts']} | {a['success_rate']:.2f} | [{a['wilson_low']:.2f}, {a['wilson_high']:.2f}] |")
     lines += ["", "## Contrasts", "", "Paired success difference (arm − reference) over the attempts of every training seed; "
-              "95% percentile bootstrap interval with the objects as the unit (each resampled object brings all its attempts).", "",
-              "| contrast | difference | 95% interval | paired attempts | objects | McNemar p |", "|---|---|---|---|---|---|"]
+              "95% percentile bootstrap interval with the objects as the unit (each resampled object brings all its attempts), and "
+              "the 95% t-interval over training seeds of the per-seed differences. Against the antipodal arm (one run per drop) "
+              "a drop counts once, the network's outcomes averaged over the seeds; McNemar's test applies only to 0/1 pairs.", "",
+              "| contrast | difference | 95% bootstrap (objects) | 95% t (seeds) | paired drops | objects | McNemar p |", "|---|---|---|---|---|---|---|"]
     for name, c in metrics["contrasts"].items():
-        lines.append(f"| {name} | {c['mean']:+.3f} | [{c['ci_low']:+.3f}, {c['ci_high']:+.3f}] | {c['n_trials']} | {c['n_objects']} | {c['mcnemar_p']:.3g} |")
+        t = "–" if c["t_ci_low"] is None else f"[{c['t_ci_low']:+.3f}, {c['t_ci_high']:+.3f}]"
+        p = "–" if c["mcnemar_p"] is None else f"{c['mcnemar_p']:.3g}"
+        lines.append(f"| {name} | {c['mean']:+.3f} | [{c['ci_low']:+.3f}, {c['ci_high']:+.3f}] | {t} | {c['n_trials']} | {c['n_objects']} | {p} |")
     lines += [""] + [f"- {_verdict(name, c)}" for name, c in metrics["contrasts"].items()]
     if metrics["same_network"]:
         lines.append(f"- The best ratio on validation AP for B = {setup['base_size']} is 0: \"after\" is the same network as \"before\".")

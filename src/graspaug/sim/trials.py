@@ -103,7 +103,7 @@ def run_trial(obj: SimObject, drop_seed: int, planner: Planner | None = None, sc
         robot = scene.robot
         limit = settings.collision_force
         result.contact_force = robot.move_line(center + [0, 0, settings.pregrasp_height], jaw_angle, speed=hand.transit_speed, max_force=limit)
-        if record:
+        if record and result.contact_force <= limit:  # a collision on the way is drawn once, below
             frames.append(("pre-grasp", scene.color_frame()))
         if result.contact_force <= limit:
             result.contact_force = max(result.contact_force, robot.move_line(center, jaw_angle, max_force=limit))

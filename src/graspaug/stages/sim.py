@@ -33,6 +33,7 @@ from graspaug.paths import AP_METRICS, SCORES, SHAPES_DIR, SHAPES_TABLE, SIM_MET
 from graspaug.sim.analysis import calibration, planning_timing, report_text
 from graspaug.sim.experiment import arms, object_jobs, picture, prepare_objects, run_object, summarize, test_shape_ids
 from graspaug.sim.objects import folder_meshes
+from graspaug.stages import StageError
 
 log = logging.getLogger(__name__)
 
@@ -44,8 +45,11 @@ def run(params: Params) -> None:
     cfg, model_seeds = params.sim, list(params.gqcnn.seeds)
     chosen, from_report = arms(AP_METRICS, cfg.base_size, params.generate.ratios, model_seeds)
     test_shapes = test_shape_ids(read_table(SHAPES_TABLE), cfg.n_test_objects, params.seed)
-    user, skipped = ([], {}) if cfg.objects_path is None else folder_meshes(
-        Path(cfg.objects_path), params.ingest.surface, params.ingest.max_faces, params.ingest.max_file_mb)
+    try:
+        user, skipped = ([], {}) if cfg.objects_path is None else folder_meshes(
+            Path(cfg.objects_path), params.ingest.surface, params.ingest.max_faces, params.ingest.max_file_mb)
+    except ValueError as exc:  # an empty or unreadable folder: one line, not a traceback
+        raise StageError(str(exc)) from None
     objects = prepare_objects(cfg.objects, test_shapes, SHAPES_DIR, cfg.physics, params.seed, cfg.vhacd_resolution, user, workers=params.workers)
     jobs = object_jobs(objects, chosen, cfg.base_size, model_seeds, cfg.attempts, params.seed, cfg.n_pictures)
     log.info("sim: %d objects × %d attempts; arms %s × %d training seeds (after = ratio %g); %d skipped meshes", len(objects), cfg.attempts,
@@ -60,7 +64,7 @@ def run(params: Params) -> None:
              "test_shapes": [o.name for o in objects if o.kind == "test_shape"], "user_objects": [o.name for o in objects if o.kind == "user"],
              "skipped_meshes": skipped, "camera_height": cfg.cell.camera_height, "sensor_noise": cfg.sensor.enabled, "model_seeds": model_seeds}
     metrics = summarize(trials, objects, chosen, setup, cfg.n_bootstrap, params.seed)
-    scores = read_table(SCORES).set_index("shape_id").graspness if SCORES.exists() else pd.Series(dtype=float)
+    scores = read_table(SCORES).set_index("shape_id").graspness
     calibration_table, metrics["calibration"] = calibration(trials, scores)
     timing = planning_timing(trials, list(chosen))
 
