@@ -29,7 +29,9 @@ import pandas as pd
 import yaml
 
 from graspaug.config import Params
+from graspaug.io.tables import read_table
 from graspaug.parallel import parallel_map
+from graspaug.paths import SHAPES_DIR, SHAPES_TABLE
 from graspaug.sim.analysis import paired_contrast, rate_summary
 from graspaug.sim.experiment import object_jobs, prepare_objects, run_object, test_shape_ids
 
@@ -86,8 +88,8 @@ def main() -> None:
         train_before(args.models, args.seeds, args.base_size, params)
     n_test = sim.n_test_objects if args.n_test is None else args.n_test
     attempts = sim.attempts if args.attempts is None else args.attempts
-    tests = test_shape_ids(pd.read_parquet("data/shapes.parquet"), n_test, params.seed)
-    objects = prepare_objects(sim.objects, tests, Path("data/shapes"), sim.physics, params.seed, sim.vhacd_resolution, workers=args.workers)
+    tests = test_shape_ids(read_table(SHAPES_TABLE), n_test, params.seed)
+    objects = prepare_objects(sim.objects, tests, SHAPES_DIR, sim.physics, params.seed, sim.vhacd_resolution, workers=args.workers)
     arms = {"before": ("targeted", 0.0), "antipodal": (None, None)}
     jobs = [job if job.model is None else dataclasses.replace(job, model=str(args.models / Path(job.model).relative_to("models/gqcnn")))
             for job in object_jobs(objects, arms, args.base_size, args.seeds, attempts, params.seed, 0)]
