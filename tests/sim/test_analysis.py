@@ -38,13 +38,12 @@ def test_contrast_between_network_arms_keeps_mcnemar_and_gives_a_t_interval_over
 
 
 def test_bootstrap_over_objects_covers_the_mean_and_sees_object_spread():
-    rng = np.random.default_rng(0)
     objects = np.repeat(np.arange(30), 6)
     same = np.tile([1.0, 0.0, 0.0, 0.0, 0.0, 0.0], 30)  # every object +1/6
-    low, high = bootstrap_over_objects(same, objects, 1000, rng)
+    low, high = bootstrap_over_objects(same, objects, 1000, 0)
     assert low == pytest.approx(1 / 6) and high == pytest.approx(1 / 6)  # no spread between objects: no width
     mixed = np.where(objects % 2 == 0, 1.0, -0.5)  # half the objects gain, half lose
-    low, high = bootstrap_over_objects(mixed, objects, 2000, rng)
+    low, high = bootstrap_over_objects(mixed, objects, 2000, 1)
     assert low < 0.25 < high and 0.35 < high - low < 0.7  # 2 × 1.96 × 0.75 / √30 = 0.54
 
 

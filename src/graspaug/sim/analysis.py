@@ -13,6 +13,7 @@ import numpy as np
 import pandas as pd
 
 from graspaug.errors import StageError
+from graspaug.experiments.stats import ObjectBootstrap, percentile_interval, t_interval
 from graspaug.sim.stats import paired_test, wilson_interval
 
 #: The contrasts of ``metrics/sim.json``: name → (arm, reference arm); success(arm) − success(reference).
@@ -46,16 +47,15 @@ def paired_outcomes(trials: pd.DataFrame, arm: str, reference: str) -> pd.DataFr
     return paired.assign(a=paired.a.astype(bool), b=paired.b.astype(bool))
 
 
-def bootstrap_over_objects(diff: np.ndarray, objects: np.ndarray, n_boot: int, rng: np.random.Generator, level: float = 0.95) -> tuple[float, float]:
+def bootstrap_over_objects(diff: np.ndarray, objects: np.ndarray, n_boot: int, seed: int, level: float = 0.95) -> tuple[float, float]:
     """Percentile interval of the mean of ``diff`` (N,) when the objects (N,) labels are
-    resampled with replacement (each drawn object brings all its attempts)."""
-    names, index = np.unique(objects, return_inverse=True)
-    sums = np.bincount(index, weights=diff, minlength=len(names))
-    counts = np.bincount(index, minlength=len(names))
-    draws = rng.integers(0, len(names), size=(n_boot, len(names)))
-    means = sums[draws].sum(axis=1) / counts[draws].sum(axis=1)
-    alpha = (1 - level) / 2
-    return float(np.quantile(means, alpha)), float(np.quantile(means, 1 - alpha))
+    resampled with replacement (each drawn object brings all its attempts): the resamples of
+    :class:`~graspaug.experiments.stats.ObjectBootstrap`, the AP experiment's."""
+    boot = ObjectBootstrap(objects, n_boot, seed)
+    sums = np.bincount(boot.object_index, weights=diff, minlength=boot.n_objects)
+    counts = np.bincount(boot.object_index, minlength=boot.n_objects)
+    means = (boot.object_counts @ sums) / (boot.object_counts @ counts)
+    return percentile_interval(means, level)
 
 
 def paired_contrast(trials: pd.DataFrame, arm: str, reference: str, n_boot: int = 2000, seed: int = 0) -> dict:
@@ -68,8 +68,6 @@ def paired_contrast(trials: pd.DataFrame, arm: str, reference: str, n_boot: int 
     An arm without a network (seed −1) ran each drop once: the other arm's outcomes of that
     drop are averaged over the training seeds first, so a drop counts once (its differences
     are then not 0/1, and McNemar does not apply: ``mcnemar_p`` is None)."""
-    from graspaug.experiments.stats import t_interval
-
     paired = paired_outcomes(trials, arm, reference)
     per_seed = paired.groupby("seed").apply(lambda d: float(d.a.mean() - d.b.mean()), include_groups=False)
     over_seeds = t_interval(per_seed.to_numpy())
@@ -82,7 +80,7 @@ def paired_contrast(trials: pd.DataFrame, arm: str, reference: str, n_boot: int 
         diff, objects = paired.a.to_numpy(float) - paired.b.to_numpy(float), paired.object.to_numpy()
         test = paired_test(paired.b.to_numpy(), paired.a.to_numpy())
         counts = {f"only_{arm}": test["only_after"], f"only_{reference}": test["only_before"], "mcnemar_p": test["p_value"]}
-    low, high = bootstrap_over_objects(diff, objects, n_boot, np.random.default_rng(seed))
+    low, high = bootstrap_over_objects(diff, objects, n_boot, seed)
     rounded = lambda x: None if x is None else round(float(x), 5)  # noqa: E731
     return {"mean": round(float(diff.mean()), 5), "ci_low": round(low, 5), "ci_high": round(high, 5), "n_trials": int(len(diff)),
             "n_objects": int(len(set(objects))), "t_ci_low": rounded(over_seeds["ci_low"]), "t_ci_high": rounded(over_seeds["ci_high"]),

@@ -64,8 +64,8 @@ def run(params: Params) -> None:
              "test_shapes": [o.name for o in objects if o.kind == "test_shape"], "user_objects": [o.name for o in objects if o.kind == "user"],
              "skipped_meshes": skipped, "camera_height": cfg.cell.camera_height, "sensor_noise": cfg.sensor.enabled, "model_seeds": model_seeds}
     metrics = summarize(trials, objects, chosen, setup, cfg.n_bootstrap, params.seed)
-    scores = read_table(SCORES).set_index("shape_id").graspness
-    calibration_table, metrics["calibration"] = calibration(trials, scores)
+    scores = read_table(SCORES).set_index("shape_id")
+    calibration_table, metrics["calibration"] = calibration(trials, scores.graspness[scores.n_grasps > 0])  # no grasp sampled: n/a, not 0
     timing = planning_timing(trials, list(chosen))
 
     with atomic_path(SIM_REPORT_DIR, directory=True) as out:
