@@ -5,6 +5,7 @@ import os
 from collections.abc import Sequence
 
 import numpy as np
+import pandas as pd
 
 from graspaug.io.atomic import atomic_path
 
@@ -156,18 +157,39 @@ def crop_grid(images: np.ndarray, titles: Sequence[str], jaw_half_widths: Sequen
     _save(fig, path)
 
 
-def ap_vs_ratio(curves: dict[str, tuple[Sequence[float], Sequence[float], Sequence[float]]], path: str | os.PathLike, title: str) -> None:
-    """AP over augmentation ratio, one line per label with error bars: label → (ratios, mean, std)
-    (the paper's Fig. 7). Labels containing "random" are drawn dashed."""
+def ap_vs_ratio(table, path: str | os.PathLike, title: str) -> None:
+    """The paper's Fig. 7: test AP against the augmentation ratio, one panel per base size, one
+    line per pool (targeted solid, random dashed, real dotted), each starting from the base
+    set alone at ratio 0, with 95% t-interval error bars; the ceiling (every train shape) as a
+    grey band. ``table``: :func:`graspaug.experiments.ap.network_table` (columns ``pool``,
+    ``base_size``, ``ratio``, ``test_ap``, ``test_ap_ci``)."""
     plt = _pyplot()
-    fig, ax = plt.subplots(figsize=(6.4, 4.2))
-    for label, (ratios, mean, std) in curves.items():
-        ax.errorbar(ratios, mean, yerr=std, marker="o", capsize=3, linestyle="--" if "random" in label else "-", label=label)
-    ax.set_xlabel("augmentation ratio R (generated : base)")
-    ax.set_ylabel("test Average Precision")
-    ax.set_title(title, fontsize=9)
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=8)
+    networks = table[table.pool != "ceiling"]
+    bases = sorted(networks.base_size.unique())
+    fig, axes = plt.subplots(1, max(len(bases), 1), figsize=(3.6 * max(len(bases), 1) + 0.8, 3.8), sharey=True, squeeze=False)
+    styles = {"targeted": ("-", "tab:blue"), "random": ("--", "tab:orange"), "real": (":", "tab:green")}
+    ceiling = table[table.pool == "ceiling"]
+    for ax, base in zip(axes[0], bases):
+        rows = networks[networks.base_size == base]
+        alone = rows[rows.ratio == 0]
+        for pool, (style, color) in styles.items():
+            curve = pd.concat([alone, rows[(rows.pool == pool) & (rows.ratio > 0)]]).sort_values("ratio")
+            if len(curve) > len(alone):
+                ax.errorbar(curve.ratio, curve.test_ap, yerr=np.nan_to_num(curve.test_ap_ci.to_numpy(dtype=float)), marker="o", markersize=4,
+                            capsize=3, linestyle=style, color=color, label=pool)
+        if len(alone) and len(rows) == len(alone):
+            ax.errorbar(alone.ratio, alone.test_ap, yerr=np.nan_to_num(alone.test_ap_ci.to_numpy(dtype=float)), marker="o", capsize=3, color="tab:blue",
+                        label="base set alone")
+        if len(ceiling):
+            top, half = float(ceiling.test_ap.iloc[0]), float(np.nan_to_num(ceiling.test_ap_ci.iloc[0]))
+            ax.axhline(top, color="grey", linewidth=1, label="ceiling (all train shapes)")
+            ax.axhspan(top - half, top + half, color="grey", alpha=0.15, linewidth=0)
+        ax.set_title(f"B = {base}", fontsize=9)
+        ax.set_xlabel("ratio R (generated : base)")
+        ax.grid(alpha=0.3)
+    axes[0, 0].set_ylabel("test Average Precision")
+    axes[0, 0].legend(fontsize=7, loc="upper left")
+    fig.suptitle(title, fontsize=9)
     _save(fig, path)
 
 

@@ -95,3 +95,19 @@ def test_the_declared_contrasts():
     assert sum(w for w, _ in contrasts["targeted_vs_none@50"].terms) == pytest.approx(0)
     assert [v.name for v in seed_variants([50, 200], [0.0, 1.0], [50], ceiling=True)] == [
         "targeted/50-0", "targeted/200-0", "targeted/50-1", "random/50-1", "real/50-1", "ceiling"]
+
+
+def test_gain_sentences_give_shares_and_call_a_gap_within_the_ceilings_interval_no_gap():
+    import pandas as pd
+
+    from graspaug.experiments.ap import gain_sentences
+
+    table = pd.DataFrame([("targeted", 50, 0.0, 0.40, 0.02), ("targeted", 50, 1.0, 0.42, 0.02), ("targeted", 200, 0.0, 0.495, 0.01),
+                          ("targeted", 200, 1.0, 0.50, 0.01), ("ceiling", 0, 0.0, 0.50, 0.01)],
+                         columns=["pool", "base_size", "ratio", "test_ap", "test_ap_ci"])
+    results = {"targeted_vs_none@50": {"mean": 0.02}, "targeted_vs_real@50": {"mean": -0.06}}  # real shapes: +0.08
+    lines = gain_sentences(results, table, {50: 1.0, 200: 1.0}, [50], ceiling_shapes=600)
+    assert "give 25% of the gain of the same number of real shapes" in lines[0]
+    assert "1:1 closes 20% of the gap" in lines[1]  # (0.42 - 0.40) / (0.50 - 0.40)
+    assert "no gap for augmentation to close" in lines[2] and "%" not in lines[2].split("(")[0]  # 0.005 < ±0.01: not "100%"
+    assert gain_sentences(results, table, {50: 1.0}, [50], ceiling_shapes=None) == lines[:1]

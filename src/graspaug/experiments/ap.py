@@ -144,6 +144,35 @@ def network_table(runs: pd.DataFrame, per_object: pd.DataFrame) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
+def gain_sentences(results: dict, table: pd.DataFrame, chosen: dict[int, float], augment_base_sizes, ceiling_shapes: int | None) -> list[str]:
+    """The report's sentences on scale: per augmented base size, targeted augmentation's gain as
+    a share of the same number of real shapes' gain (mean over ratios), and, with the ceiling
+    (``ceiling_shapes`` train shapes; None without it), the share of the gap from 1:0 to the
+    ceiling that the chosen ratio closes. A gap within the ceiling's 95% t half-width is
+    reported as no gap rather than as a share of noise. Ratios of means: no intervals."""
+    out = []
+    for b in augment_base_sizes:
+        t, r = results.get(f"targeted_vs_none@{b}"), results.get(f"targeted_vs_real@{b}")
+        real_gain = t["mean"] - r["mean"] if t and r and None not in (t["mean"], r["mean"]) else 0.0  # mean over R of AP(real, B, R) - AP(B, 1:0)
+        if real_gain:
+            out.append(f"At B = {b}, generated shapes give {t['mean'] / real_gain:.0%} of the gain of the same number of real shapes "
+                       f"({t['mean']:+.4f} vs {real_gain:+.4f} AP, mean over ratios; a ratio of means, no interval).")
+    nets = table.set_index(["pool", "base_size", "ratio"])
+    if ceiling_shapes is None or ("ceiling", 0, 0.0) not in nets.index:
+        return out
+    top, half = nets.test_ap[("ceiling", 0, 0.0)], np.nan_to_num(nets.test_ap_ci[("ceiling", 0, 0.0)])
+    for b, ratio in chosen.items():
+        none, best = nets.test_ap.get(("targeted", b, 0.0)), nets.test_ap.get(("targeted", b, ratio))
+        if none is None or best is None or not np.isfinite(top - none):
+            continue
+        head = f"B = {b}: the ceiling (all {ceiling_shapes} train shapes outside validation) reaches {top:.4f}"
+        if top - none <= half:
+            out.append(f"{head}, within its 95% interval (±{half:.4f}) of 1:0 ({none:.4f}): no gap for augmentation to close at this budget.")
+        else:
+            out.append(f"{head}; 1:{ratio:g} closes {(best - none) / (top - none):.0%} of the gap from 1:0 ({none:.4f}).")
+    return out
+
+
 def verdict(name: str, c: dict) -> str:
     """One sentence: does the contrast's interval exclude zero, by both intervals."""
     if c["mean"] is None:

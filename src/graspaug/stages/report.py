@@ -18,7 +18,7 @@ import numpy as np
 import pandas as pd
 
 from graspaug.config import Params
-from graspaug.experiments.ap import (choose_ratios, collect, declared_contrasts, evaluate_contrasts, improvement_panels, network_table, per_object_ap, training_words,
+from graspaug.experiments.ap import (choose_ratios, collect, declared_contrasts, evaluate_contrasts, gain_sentences, improvement_panels, network_table, per_object_ap, training_words,
                                     report_markdown, test_predictions, test_rows, verdict)
 from graspaug.experiments.networks import seed_variants
 from graspaug.generation import ratio_count
@@ -52,26 +52,9 @@ def run(params: Params) -> None:
     write_csv(table, REPORT_DIR / "ap_table.csv")
     curves_table = table[table.pool != "ceiling"].assign(curve=lambda t: t.pool + "_" + t.base_size.astype(str))
     write_csv(curves_table.pivot(index="ratio", columns="curve", values="test_ap").reset_index(), REPORT_DIR / "ap_vs_ratio.csv")  # for `dvc plots`
-    mean_ap = table.set_index(["pool", "base_size", "ratio"]).test_ap
-    extras = []
-    for b in cfg.augment_base_sizes:
-        t, r = results.get(f"targeted_vs_none@{b}"), results.get(f"targeted_vs_real@{b}")
-        real_gain = t["mean"] - r["mean"] if t and r and None not in (t["mean"], r["mean"]) else 0.0  # mean over R of AP(real, B, R) - AP(B, 1:0)
-        if real_gain:
-            extras.append(f"At B = {b}, generated shapes give {t['mean'] / real_gain:.0%} of the gain of the same number of real shapes "
-                          f"({t['mean']:+.4f} vs {real_gain:+.4f} AP, mean over ratios; a ratio of means, no interval).")
-    if cfg.ceiling and ("ceiling", 0, 0.0) in mean_ap:
-        for b, r in chosen.items():
-            none, best, top = mean_ap.get(("targeted", b, 0.0)), mean_ap.get(("targeted", b, r)), mean_ap[("ceiling", 0, 0.0)]
-            if None not in (none, best) and np.isfinite(top - none) and top != none:
-                extras.append(f"B = {b}: the ceiling (all {len(index[index.split == 'train'].shape_id.unique()) - cfg.val_shapes} train shapes "
-                              f"outside validation) reaches {top:.4f}; 1:{r:g} closes {(best - none) / (top - none):.0%} of the gap from 1:0 ({none:.4f}).")
-
-    curves = {f"B = {b}, {pool}": (g.ratio.to_numpy(), g.test_ap.to_numpy(), np.nan_to_num(g.test_ap_ci.to_numpy(dtype=float)))
-              for (pool, b), g in table[table.pool != "ceiling"].groupby(["pool", "base_size"], sort=False)}
-    if cfg.ceiling:
-        curves["ceiling (all train shapes)"] = (np.asarray(gen.ratios), np.full(len(gen.ratios), mean_ap[("ceiling", 0, 0.0)]), np.zeros(len(gen.ratios)))
-    ap_vs_ratio(curves, REPORT_DIR / "ap_vs_ratio.png", f"Test AP vs augmentation ratio (seeds {seeds}; error bars: 95% t-interval)")
+    n_ceiling = len(index[index.split == "train"].shape_id.unique()) - cfg.val_shapes
+    extras = gain_sentences(results, table, chosen, cfg.augment_base_sizes, n_ceiling if cfg.ceiling else None)
+    ap_vs_ratio(table, REPORT_DIR / "ap_vs_ratio.png", f"Test AP vs augmentation ratio (seeds {seeds}; error bars: 95% t-interval)")
 
     # Fig. 8: the largest augmented base size, its ratio chosen on validation against 1:0
     base = max(cfg.augment_base_sizes)
