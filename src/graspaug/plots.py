@@ -180,7 +180,7 @@ def ap_vs_ratio(table, path: str | os.PathLike, title: str) -> None:
         if len(alone) and len(rows) == len(alone):
             ax.errorbar(alone.ratio, alone.test_ap, yerr=np.nan_to_num(alone.test_ap_ci.to_numpy(dtype=float)), marker="o", capsize=3, color="tab:blue",
                         label="base set alone")
-        if len(ceiling):
+        if len(ceiling) and np.isfinite(ceiling.test_ap.iloc[0]):
             top, half = float(ceiling.test_ap.iloc[0]), float(np.nan_to_num(ceiling.test_ap_ci.iloc[0]))
             ax.axhline(top, color="grey", linewidth=1, label="ceiling (all train shapes)")
             ax.axhspan(top - half, top + half, color="grey", alpha=0.15, linewidth=0)
@@ -188,7 +188,11 @@ def ap_vs_ratio(table, path: str | os.PathLike, title: str) -> None:
         ax.set_xlabel("ratio R (generated : base)")
         ax.grid(alpha=0.3)
     axes[0, 0].set_ylabel("test Average Precision")
-    axes[0, 0].legend(fontsize=7, loc="upper left")
+    legend = {}  # every label once, from whichever panel has it (the smallest base size may have no augmented lines)
+    for ax in axes[0]:
+        for handle, label in zip(*ax.get_legend_handles_labels()):
+            legend.setdefault(label, handle)
+    axes[0, 0].legend(legend.values(), legend.keys(), fontsize=7, loc="upper left")
     fig.suptitle(title, fontsize=9)
     _save(fig, path)
 

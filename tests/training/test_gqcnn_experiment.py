@@ -109,5 +109,7 @@ def test_gain_sentences_give_shares_and_call_a_gap_within_the_ceilings_interval_
     lines = gain_sentences(results, table, {50: 1.0, 200: 1.0}, [50], ceiling_shapes=600)
     assert "give 25% of the gain of the same number of real shapes" in lines[0]
     assert "1:1 closes 20% of the gap" in lines[1]  # (0.42 - 0.40) / (0.50 - 0.40)
-    assert "no gap for augmentation to close" in lines[2] and "%" not in lines[2].split("(")[0]  # 0.005 < ±0.01: not "100%"
+    assert "no gap for augmentation to close" in lines[2] and "closes" not in lines[2]  # 0.005 < ±0.01: not "100%"
     assert gain_sentences(results, table, {50: 1.0}, [50], ceiling_shapes=None) == lines[:1]
+    below = table.assign(test_ap=table.test_ap.where(table.pool != "ceiling", 0.30))
+    assert "below 1:0" in gain_sentences(results, below, {50: 1.0}, [], ceiling_shapes=600)[0]

@@ -163,11 +163,13 @@ def gain_sentences(results: dict, table: pd.DataFrame, chosen: dict[int, float],
     top, half = nets.test_ap[("ceiling", 0, 0.0)], np.nan_to_num(nets.test_ap_ci[("ceiling", 0, 0.0)])
     for b, ratio in chosen.items():
         none, best = nets.test_ap.get(("targeted", b, 0.0)), nets.test_ap.get(("targeted", b, ratio))
-        if none is None or best is None or not np.isfinite(top - none):
+        if none is None or best is None or not np.isfinite(top - none) or not np.isfinite(best):
             continue
         head = f"B = {b}: the ceiling (all {ceiling_shapes} train shapes outside validation) reaches {top:.4f}"
-        if top - none <= half:
+        if abs(top - none) <= half:
             out.append(f"{head}, within its 95% interval (±{half:.4f}) of 1:0 ({none:.4f}): no gap for augmentation to close at this budget.")
+        elif top < none:
+            out.append(f"{head}, below 1:0 ({none:.4f}): at this budget more shapes do not raise AP beyond B = {b}; no gap to close.")
         else:
             out.append(f"{head}; 1:{ratio:g} closes {(best - none) / (top - none):.0%} of the gap from 1:0 ({none:.4f}).")
     return out
