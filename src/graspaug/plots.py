@@ -157,7 +157,7 @@ def crop_grid(images: np.ndarray, titles: Sequence[str], jaw_half_widths: Sequen
     _save(fig, path)
 
 
-def ap_vs_ratio(table, path: str | os.PathLike, title: str) -> None:
+def ap_vs_ratio(table: pd.DataFrame, path: str | os.PathLike, title: str) -> None:
     """The paper's Fig. 7: test AP against the augmentation ratio, one panel per base size, one
     line per pool (targeted solid, random dashed, real dotted), each starting from the base
     set alone at ratio 0, with 95% t-interval error bars; the ceiling (every train shape) as a

@@ -47,7 +47,7 @@ def paired_outcomes(trials: pd.DataFrame, arm: str, reference: str) -> pd.DataFr
     return paired.assign(a=paired.a.astype(bool), b=paired.b.astype(bool))
 
 
-def bootstrap_over_objects(diff: np.ndarray, objects: np.ndarray, n_boot: int, seed: int, level: float = 0.95) -> tuple[float, float]:
+def bootstrap_over_objects(diff: np.ndarray, objects: np.ndarray, n_boot: int, seed: int, level: float = 0.95) -> tuple[float | None, float | None]:
     """Percentile interval of the mean of ``diff`` (N,) when the objects (N,) labels are
     resampled with replacement (each drawn object brings all its attempts): the resamples of
     :class:`~graspaug.experiments.stats.ObjectBootstrap`, the AP experiment's."""
@@ -82,7 +82,7 @@ def paired_contrast(trials: pd.DataFrame, arm: str, reference: str, n_boot: int 
         counts = {f"only_{arm}": test["only_after"], f"only_{reference}": test["only_before"], "mcnemar_p": test["p_value"]}
     low, high = bootstrap_over_objects(diff, objects, n_boot, seed)
     rounded = lambda x: None if x is None else round(float(x), 5)  # noqa: E731
-    return {"mean": round(float(diff.mean()), 5), "ci_low": round(low, 5), "ci_high": round(high, 5), "n_trials": int(len(diff)),
+    return {"mean": round(float(diff.mean()), 5), "ci_low": rounded(low), "ci_high": rounded(high), "n_trials": int(len(diff)),
             "n_objects": int(len(set(objects))), "t_ci_low": rounded(over_seeds["ci_low"]), "t_ci_high": rounded(over_seeds["ci_high"]),
             "n_seeds": over_seeds["n_seeds"], "per_seed": {str(k): round(v, 5) for k, v in per_seed.items()}, **counts}
 
