@@ -55,7 +55,7 @@ def train_before(models: Path, seeds: list[int], base_size: int, params: Params)
         weight_seed, noise_seed = stream_seeds(params.seed, seed)
         folder = models / f"s{seed}"
         folder.mkdir(parents=True, exist_ok=True)
-        job = NetworkJob(Variant("targeted", base_size, 0.0), split, cfg.net, cfg.train, initial_weights(cfg.net, weight_seed), noise_seed,
+        job = NetworkJob(Variant("targeted", base_size, 0.0), split, cfg.net, cfg.train, (initial_weights(cfg.net, weight_seed),), (noise_seed,),
                          seed, "cpu", folder, card)
         result = train_network(job, val, test)
         print(f"# trained s{seed} targeted {base_size}-0: validation AP {result['validation']['ap']:.4f}", flush=True)

@@ -10,6 +10,7 @@ import pandas as pd
 import pytest
 
 from graspaug.io.checkpoints import read_gqcnn
+from graspaug.nets.gqcnn import GQCNNEnsemble
 from graspaug.io.voxels import read_voxels
 
 pytestmark = pytest.mark.slow
@@ -202,11 +203,16 @@ def test_dvc_repro_gqcnn_matrix_and_report(tiny_repo):
             folder = work / f"models/gqcnn/s{seed}/{name}"
             summary = json.loads((folder / "summary.json").read_text())
             assert set(summary["test"]) == {"ap", "accuracy", "roc_auc", "positive_share", "datapoints"}
-            assert 4 <= summary["train"]["steps"] <= 6 and 1 <= summary["train"]["best_step"] <= summary["train"]["steps"]
-            assert np.load(folder / "test_predictions.npy").shape == (summary["test"]["datapoints"],)
-            assert len(pd.read_csv(folder / "history.csv")) == 2  # evals: 2
+            # the tiny profile's networks are ensembles of 2 members, each with its own kept step
+            assert 4 <= summary["train"]["steps"] <= 6 and summary["train"]["members"] == 2
+            assert len(summary["train"]["best_step"]) == 2 and all(1 <= b <= summary["train"]["steps"] for b in summary["train"]["best_step"])
+            test_p, members_p = np.load(folder / "test_predictions.npy"), np.load(folder / "test_predictions_members.npy")
+            assert test_p.shape == (summary["test"]["datapoints"],) and members_p.shape == (2, len(test_p))
+            assert np.allclose(test_p, members_p.mean(axis=0)) and not np.allclose(members_p[0], members_p[1])
+            assert sorted(pd.read_csv(folder / "history.csv").member) == [0, 0, 1, 1]  # evals: 2 per member
             digests.setdefault(seed, set()).add(summary["init_digest"])
-            card = read_gqcnn(folder / "model.pt")[1]  # the model card planning reads
+            net, card = read_gqcnn(folder / "model.pt")  # the model and card planning reads
+            assert isinstance(net, GQCNNEnsemble) and len(net.members) == 2
             assert card["crop_size"] == 96 and card["intrinsics"]["fx"] == 525 and card["camera_distance"] == [0.65, 0.75]
             assert card["training_set"]["seed"] == seed and card["test_ap"] == summary["test"]["ap"]
             validation.setdefault(seed, set()).add(summary["validation"]["datapoints"])

@@ -162,6 +162,7 @@ class GQCNNParams:
     seeds: tuple[int, ...] = Field((0, 1, 2, 3), description="Training seeds, the replicates of the paired design; intervals need at least 2 (4 by default: with 3 the 95% t-interval is 4.30 standard errors wide on each side, with 4 3.18; study profile: 5).")
     augment_base_sizes: tuple[int, ...] = Field((50,), description="Base sizes that get augmented networks: targeted, random and real at every nonzero ratio of generate.ratios (the others get their 1:0 network only; study profile: all).")
     ceiling: bool = Field(False, description="Also train one network per seed on every train shape outside validation (how much of the gap augmentation closes; study and paper profiles: on).")
+    members: int = Field(1, ge=1, le=64, description="GQ-CNNs trained per network, each from its own initial weights and noise stream (member m of every network of a seed shares them, so the design stays paired); the network's P(success) is their mean (an ensemble, validated, tested and planned with). More members lower the seed-to-seed spread of small training sets and cost as many times the training and planning time.")
 
     def __post_init__(self) -> None:
         if not self.seeds or len(set(self.seeds)) != len(self.seeds) or min(self.seeds) < 0:

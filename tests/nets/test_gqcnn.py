@@ -42,3 +42,27 @@ def test_local_response_norm_equals_torchs(size):
     x = torch.randn(3, 7, 5, 6, dtype=torch.float64)
     expected = torch.nn.LocalResponseNorm(size, alpha=0.3, beta=0.75, k=1.0)(x)
     torch.testing.assert_close(LocalResponseNorm(size, alpha=0.3, beta=0.75, k=1.0)(x), expected, rtol=1e-12, atol=1e-12)
+
+
+def test_an_ensemble_averages_its_members_and_survives_a_checkpoint(tmp_path):
+    from graspaug.io.checkpoints import read_gqcnn, save_gqcnn
+    from graspaug.nets.gqcnn import GQCNNEnsemble
+
+    config = GQCNNConfig(filters=4, fc=8, pose_fc=4)
+    torch.manual_seed(0)
+    members = [GQCNN(config).eval() for _ in range(3)]
+    ensemble = GQCNNEnsemble(members).eval()
+    images, z = torch.rand(6, 1, 32, 32) * 0.05 + 0.65, torch.rand(6) * 0.05 + 0.65
+    each = torch.stack([m.success_probability(images, z) for m in members])
+    assert not torch.allclose(each[0], each[1])  # the members differ
+    torch.testing.assert_close(ensemble.success_probability(images, z), each.mean(0))
+    torch.testing.assert_close(torch.softmax(ensemble(images, z), dim=1)[:, 1], each.mean(0))  # what export_model traces
+    assert ensemble.describe()["members"] == 3 and ensemble.describe()["parameters"] == 3 * sum(p.numel() for p in members[0].parameters())
+    save_gqcnn(tmp_path / "model.pt", ensemble, {"pool": "targeted"}, None)
+    loaded, card = read_gqcnn(tmp_path / "model.pt")
+    assert isinstance(loaded, GQCNNEnsemble) and len(loaded.members) == 3 and card is None
+    torch.testing.assert_close(loaded.success_probability(images, z), each.mean(0))
+    save_gqcnn(tmp_path / "single.pt", members[0], {}, None)  # a single network stays a GQCNN
+    assert type(read_gqcnn(tmp_path / "single.pt")[0]) is GQCNN
+    with pytest.raises(ValueError, match="one config"):
+        GQCNNEnsemble([GQCNN(config), GQCNN(GQCNNConfig(filters=8, fc=8, pose_fc=4))])

@@ -7,7 +7,7 @@ from scipy import stats as scipy_stats
 from sklearn.metrics import average_precision_score
 
 from graspaug.experiments.ap import declared_contrasts
-from graspaug.experiments.networks import initial_weights, seed_variants, stream_seeds, weights_digest
+from graspaug.experiments.networks import initial_weights, seed_members, seed_variants, stream_seeds, weights_digest
 from graspaug.experiments.stats import ObjectBootstrap, t_interval, weighted_average_precision
 from graspaug.nets.settings import GQCNNConfig
 from graspaug.training.gqcnn_data import experiment_split, training_shapes
@@ -51,6 +51,15 @@ def test_the_networks_of_a_seed_share_initial_weights_and_seeds_differ():
     assert weights_digest(first) == weights_digest(again) != weights_digest(other)
     assert all(torch.equal(first[k], again[k]) for k in first)
     assert len({*stream_seeds(0, 1), *stream_seeds(0, 2), *stream_seeds(1, 1)}) == 6  # init and noise streams never collide
+
+
+def test_members_of_a_seed_start_apart_and_member_zero_is_the_seeds_own_network():
+    config = GQCNNConfig(filters=4, fc=8, pose_fc=4)
+    inits, noise_seeds = seed_members(config, 0, 1, 3)
+    assert weights_digest(inits[0]) == weights_digest(initial_weights(config, stream_seeds(0, 1)[0])) and noise_seeds[0] == stream_seeds(0, 1)[1]
+    assert len({weights_digest(w) for w in inits}) == 3 and seed_members(config, 0, 1, 3)[1] == noise_seeds  # distinct, reproducible
+    streams = {s for seed in range(4) for m in range(8) for s in stream_seeds(0, seed, m)}
+    assert len(streams) == 4 * 8 * 2  # no member's stream is another seed's or member's
 
 
 def test_t_interval_on_a_hand_made_table():

@@ -6,6 +6,9 @@ A seed's networks live in ``models/gqcnn/s<seed>/<pool>/<B>-<R>/`` (``ceiling/``
 ceiling): ``model.pt`` (config, weights, summary), ``summary.json``, ``history.csv``
 (validation AP per evaluation), ``test_predictions.npy`` and ``val_predictions.npy``
 (P(success) per datapoint, rows in ``test_rows.npy`` / ``val_rows.npy`` of the seed folder).
+With ``gqcnn.members`` = K > 1 every network is an ensemble of K members (member m of every
+variant starts from the same weights and noise stream) whose mean P(success) is validated and
+tested; ``*_predictions_members.npy`` (K, N) keep each member's.
 """
 from __future__ import annotations
 
@@ -19,7 +22,7 @@ import pandas as pd
 import torch
 
 from graspaug.io.checkpoints import finish_gqcnn_card, save_gqcnn
-from graspaug.nets.gqcnn import GQCNN
+from graspaug.nets.gqcnn import GQCNN, GQCNNEnsemble
 from graspaug.nets.settings import GQCNNConfig
 from graspaug.training.gqcnn import GraspArrays, classification_metrics, predict, train_gqcnn
 from graspaug.training.gqcnn_data import ExperimentSplit, Variant, shapes_datapoints, test_set, training_set
@@ -34,9 +37,10 @@ def seed_variants(base_sizes, ratios, augment_base_sizes, ceiling: bool) -> list
     return out + ([Variant("ceiling")] if ceiling else [])
 
 
-def stream_seeds(global_seed: int, seed: int) -> tuple[int, int]:
-    """(initial-weights seed, noise-and-batch-order seed) of training seed ``seed``."""
-    base = global_seed * 1_000_003 + 7919 * seed
+def stream_seeds(global_seed: int, seed: int, member: int = 0) -> tuple[int, int]:
+    """(initial-weights seed, noise-and-batch-order seed) of member ``member`` (< 3959) of
+    training seed ``seed``; member 0's are the seed's own."""
+    base = global_seed * 1_000_003 + 7919 * seed + 2 * member
     return base, base + 1
 
 
@@ -44,6 +48,13 @@ def initial_weights(config: GQCNNConfig, weight_seed: int) -> dict[str, torch.Te
     """The weights every network of a seed starts from."""
     torch.manual_seed(weight_seed)
     return GQCNN(config).state_dict()
+
+
+def seed_members(config: GQCNNConfig, global_seed: int, seed: int, members: int) -> tuple[tuple[dict, ...], tuple[int, ...]]:
+    """Initial weights and noise seeds of the ``members`` members of every network of a seed:
+    member m starts from the same weights and noise stream in every variant (paired)."""
+    streams = [stream_seeds(global_seed, seed, m) for m in range(members)]
+    return tuple(initial_weights(config, w) for w, _ in streams), tuple(n for _, n in streams)
 
 
 def weights_digest(state: dict[str, torch.Tensor]) -> str:
@@ -57,14 +68,15 @@ def weights_digest(state: dict[str, torch.Tensor]) -> str:
 
 @dataclass(frozen=True)
 class NetworkJob:
-    """One network of a seed (a worker's unit of work)."""
+    """One network of a seed (a worker's unit of work): one member per initial weights and
+    noise seed (:func:`seed_members`), their P(success) averaged."""
 
     variant: Variant
     split: ExperimentSplit
     net: GQCNNConfig
     train: TrainSettings
-    init: dict
-    noise_seed: int
+    inits: tuple[dict, ...]
+    noise_seeds: tuple[int, ...]
     seed: int
     device: str
     out_dir: Path
@@ -76,32 +88,48 @@ def network_dir(seed_dir: Path, variant: Variant) -> Path:
 
 
 def train_network(job: NetworkJob, val: GraspArrays | None = None, test: GraspArrays | None = None) -> dict:
-    """Train one network from the seed's initial weights; write its folder; return its summary.
-    ``val`` / ``test``: the seed's validation and test datapoints (read here when not given)."""
+    """Train one network (each of its members from its initial weights); write its folder;
+    return its summary. ``val`` / ``test``: the seed's validation and test datapoints (read
+    here when not given). With several members the network is their
+    :class:`~graspaug.nets.gqcnn.GQCNNEnsemble` and every member's predictions are kept too
+    (``*_predictions_members.npy``, (K, N))."""
     device = torch.device(job.device)
     train, info = training_set(job.variant, job.split)
     val = val if val is not None else shapes_datapoints(job.split.validation)[0]
     test = test if test is not None else test_set()[0]
-    net = GQCNN(job.net)
-    net.load_state_dict(job.init)
-    gen = torch.Generator().manual_seed(job.noise_seed)
-    history: list[dict] = []
-    fit = train_gqcnn(net, train, val, job.train, device, gen, on_log=lambda step, m: history.append({"step": step, **m}), progress=False)
-    val_p = fit["val_predictions"] if fit["val_predictions"] is not None else predict(net, val, device, job.train.eval_batch)  # the kept weights
-    test_p = predict(net, test, device, job.train.eval_batch)
+    members, fits, val_ps, test_ps, history = [], [], [], [], []
+    for m, (init, noise_seed) in enumerate(zip(job.inits, job.noise_seeds, strict=True)):
+        net = GQCNN(job.net)
+        net.load_state_dict(init)
+        gen = torch.Generator().manual_seed(noise_seed)
+        fit = train_gqcnn(net, train, val, job.train, device, gen, on_log=lambda step, metrics, m=m: history.append({"member": m, "step": step, **metrics}),
+                          progress=False)
+        val_ps.append(fit["val_predictions"] if fit["val_predictions"] is not None else predict(net, val, device, job.train.eval_batch))  # the kept weights
+        test_ps.append(predict(net, test, device, job.train.eval_batch))
+        members.append(net)
+        fits.append(fit)
+    single = len(members) == 1
+    net = members[0] if single else GQCNNEnsemble(members)
+    val_p, test_p = np.mean(val_ps, axis=0, dtype=np.float32), np.mean(test_ps, axis=0, dtype=np.float32)
+    init_digest = weights_digest(job.inits[0] if single else {f"members.{m}.{k}": v for m, init in enumerate(job.inits) for k, v in init.items()})
     rounded = lambda d: {k: (round(v, 5) if isinstance(v, float) else v) for k, v in d.items()}  # noqa: E731
     summary = {"pool": job.variant.pool, "base_size": job.variant.base_size, "ratio": job.variant.ratio, "seed": job.seed,
                "validation": rounded(classification_metrics(val.labels, val_p)), "test": rounded(classification_metrics(test.labels, test_p)),
-               "train": {**info, "steps": fit["steps"], "best_step": fit["best_step"], "batch_size": job.train.batch_size},
-               "parameters": net.describe()["parameters"], "init_digest": weights_digest(job.init), "noise_seed": job.noise_seed}
+               "train": {**info, "steps": fits[0]["steps"], "best_step": fits[0]["best_step"] if single else [f["best_step"] for f in fits],
+                         "batch_size": job.train.batch_size, **({} if single else {"members": len(members)})},
+               "parameters": net.describe()["parameters"], "init_digest": init_digest, "noise_seed": job.noise_seeds[0] if single else list(job.noise_seeds)}
     folder = network_dir(job.out_dir, job.variant)
     folder.mkdir(parents=True, exist_ok=True)
     save_gqcnn(folder / "model.pt", net, summary, finish_gqcnn_card(job.card, summary))
     np.save(folder / "test_predictions.npy", test_p)
     np.save(folder / "val_predictions.npy", val_p)
+    if not single:
+        np.save(folder / "test_predictions_members.npy", np.stack(test_ps))
+        np.save(folder / "val_predictions_members.npy", np.stack(val_ps))
     pd.DataFrame(history).to_csv(folder / "history.csv", index=False)
     (folder / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
-    return {**summary, "train_seconds": fit["train_seconds"], "samples_per_second": fit["samples_per_second"]}
+    seconds = sum(f["train_seconds"] for f in fits)
+    return {**summary, "train_seconds": seconds, "samples_per_second": len(fits) * fits[0]["steps"] * min(job.train.batch_size, len(train)) / seconds}
 
 
 def seed_table(summaries: list[dict]) -> dict:
@@ -116,6 +144,11 @@ def seed_table(summaries: list[dict]) -> dict:
 
 
 def read_history(seed_dir: Path, variants: list[Variant]) -> pd.DataFrame:
-    """Validation AP per evaluation of every network of a seed: step, network, val_ap."""
-    frames = [pd.read_csv(network_dir(seed_dir, v) / "history.csv").assign(network=v.name) for v in variants]
+    """Validation AP per evaluation of every network of a seed: network (``<name> #<m>`` for
+    member m > 0 of an ensemble), step, val_ap, loss, lr."""
+    def named(frame: pd.DataFrame, name: str) -> pd.DataFrame:
+        member = frame["member"] if "member" in frame else pd.Series(0, index=frame.index)
+        return frame.assign(network=[name if m == 0 else f"{name} #{m}" for m in member])
+
+    frames = [named(pd.read_csv(network_dir(seed_dir, v) / "history.csv"), v.name) for v in variants]
     return pd.concat(frames, ignore_index=True)[["network", "step", "val_ap", "loss", "lr"]] if frames else pd.DataFrame()

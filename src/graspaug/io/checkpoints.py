@@ -90,17 +90,21 @@ def finish_gqcnn_card(card: dict[str, Any] | None, summary: dict[str, Any]) -> d
 
 
 def save_gqcnn(path: str | os.PathLike, net, summary: dict[str, Any], card: dict[str, Any] | None) -> None:
-    """Write a GQ-CNN checkpoint (atomic): its config, weights, training summary and model card."""
+    """Write a GQ-CNN checkpoint (atomic): its config, weights, training summary and model card;
+    for a :class:`~graspaug.nets.gqcnn.GQCNNEnsemble` also its number of members."""
     state = {"config": dataclasses.asdict(net.config), "state_dict": {k: v.detach().cpu() for k, v in net.state_dict().items()},
              "summary": summary, "card": card}
+    if hasattr(net, "members"):
+        state["members"] = len(net.members)
     with atomic_path(path) as tmp, open(tmp, "wb") as f:
         torch.save(state, f)
 
 
 def read_gqcnn(path: str | os.PathLike):
-    """A trained GQ-CNN on the CPU in eval mode, and its model card (a dict; None for a
+    """A trained GQ-CNN (a :class:`~graspaug.nets.gqcnn.GQCNNEnsemble` for a checkpoint of
+    several members) on the CPU in eval mode, and its model card (a dict; None for a
     checkpoint written before cards existed)."""
-    from graspaug.nets.gqcnn import GQCNN, GQCNNConfig
+    from graspaug.nets.gqcnn import GQCNN, GQCNNConfig, GQCNNEnsemble
 
     path = Path(path)
     if not path.is_file():
@@ -108,7 +112,9 @@ def read_gqcnn(path: str | os.PathLike):
     saved = torch.load(path, map_location="cpu", weights_only=True)
     if not isinstance(saved, dict) or "state_dict" not in saved or "config" not in saved:
         raise CheckpointMismatch(f"{path} is not a GQ-CNN checkpoint of graspaug (no config and state_dict)")
-    net = GQCNN(GQCNNConfig(**{"image_input": "depth", **saved["config"]}))  # checkpoints older than the option saw the depth crop
+    config = GQCNNConfig(**{"image_input": "depth", **saved["config"]})  # checkpoints older than the option saw the depth crop
+    members = saved.get("members")  # only an ensemble's checkpoint has it
+    net = GQCNN(config) if members is None else GQCNNEnsemble([GQCNN(config) for _ in range(int(members))])
     net.load_state_dict(saved["state_dict"])
     return net.eval(), saved.get("card")
 

@@ -8,7 +8,8 @@ With ``image_input = depth_minus_gripper`` the conv layers see the crop minus th
 depth (gqcnn's ``im_depth_sub``). ReLU after every layer but fc5, SAME padding, LRN over 5 channels (TF depth radius 2,
 α 2e-5, β 0.75, bias 1), weights ~ N(0, 2 / fan_in). fc4 sums fc3 and pc1 through their own
 weights (Dex-Net's merge). Paper widths: 64 filters, fc3 = fc4 = 1024; the CPU default is
-narrower (``GQCNNConfig``). Inputs are normalized by the training set's statistics, kept in
+narrower (``GQCNNConfig``). :class:`GQCNNEnsemble` averages the P(success) of several
+GQ-CNNs of one config (``gqcnn.members``). Inputs are normalized by the training set's statistics, kept in
 the model (``image_mean``, ``image_std``, ``z_mean``, ``z_std``) so a saved model takes raw
 depths in meters.
 """
@@ -103,3 +104,27 @@ class GQCNN(nn.Module):
 
     def describe(self) -> dict:
         return {**asdict(self.config), "parameters": sum(p.numel() for p in self.parameters())}
+
+
+class GQCNNEnsemble(nn.Module):
+    """K trained GQ-CNNs of one config as one model: P(success) is the mean of the members'
+    (``gqcnn.members``). Same interface as :class:`GQCNN`: ``forward`` gives logits
+    [log(1 − p), log p] (N, 2), whose softmax is that mean."""
+
+    def __init__(self, members: list[GQCNN]) -> None:
+        super().__init__()
+        if not members or any(m.config != members[0].config for m in members):
+            raise ValueError("an ensemble needs at least one member and one config for all")
+        self.config = members[0].config
+        self.members = nn.ModuleList(members)
+
+    def success_probability(self, images: torch.Tensor, z: torch.Tensor) -> torch.Tensor:
+        """Mean P(success) (N,) of the members for crops (N, 1, S, S) and gripper depths (N,), meters."""
+        return torch.stack([m.success_probability(images, z) for m in self.members]).mean(0)
+
+    def forward(self, images: torch.Tensor, z: torch.Tensor) -> torch.Tensor:
+        p = self.success_probability(images, z).clamp(1e-12, 1 - 1e-7)
+        return torch.stack([torch.log1p(-p), torch.log(p)], dim=1)
+
+    def describe(self) -> dict:
+        return {**asdict(self.config), "members": len(self.members), "parameters": sum(p.numel() for p in self.parameters())}

@@ -4,7 +4,8 @@ Networks (``graspaug.experiments.networks.seed_variants``): targeted at every ba
 ratio of ``generate``; random and real at every nonzero ratio of ``gqcnn.augment_base_sizes``;
 the ceiling. All start from the seed's initial weights and noise stream and are validated on
 the same ``gqcnn.val_shapes`` train shapes (``graspaug.training.gqcnn_data``); each keeps the
-weights of its best validation AP. Networks train one after another with every thread. Test set: every test-split datapoint of ``data/gqcnn/original``.
+weights of its best validation AP. With ``gqcnn.members`` > 1 each network is an ensemble of
+that many members, member m starting from the same weights in every variant. Networks train one after another with every thread. Test set: every test-split datapoint of ``data/gqcnn/original``.
 
 Outputs: ``models/gqcnn/s<seed>/`` (one folder per network, ``test_rows.npy``,
 ``val_rows.npy``, ``split.json``), ``metrics/gqcnn/s<seed>.json`` (validation and test AP per
@@ -23,7 +24,7 @@ from tqdm import tqdm
 
 from graspaug.config import Params
 from graspaug.device import resolve_device
-from graspaug.experiments.networks import NetworkJob, initial_weights, read_history, seed_table, seed_variants, stream_seeds, train_network
+from graspaug.experiments.networks import NetworkJob, read_history, seed_members, seed_table, seed_variants, train_network
 from graspaug.io.atomic import atomic_path
 from graspaug.io.checkpoints import gqcnn_card
 from graspaug.io.tables import write_csv, write_json
@@ -47,19 +48,18 @@ def run(params: Params, seed: int) -> None:
         raise StageError(str(exc)) from None
     variants = seed_variants(gen.base_sizes, gen.ratios, cfg.augment_base_sizes, cfg.ceiling)
     device = resolve_device(params.device)
-    weight_seed, noise_seed = stream_seeds(params.seed, seed)
-    init = initial_weights(cfg.net, weight_seed)
+    inits, noise_seeds = seed_members(cfg.net, params.seed, seed, cfg.members)
     val, val_rows = shapes_datapoints(split.validation)
     test, test_rows = test_set()
-    log.info("train_gqcnn seed %d: %d networks; validation %d shapes (%d datapoints), test %d datapoints; one at a time on %s",
-             seed, len(variants), len(split.validation), len(val_rows), len(test_rows), device)
+    log.info("train_gqcnn seed %d: %d networks of %d member(s); validation %d shapes (%d datapoints), test %d datapoints; one at a time on %s",
+             seed, len(variants), cfg.members, len(split.validation), len(val_rows), len(test_rows), device)
     # one network at a time with every thread: bench/gqcnn_train_speed.py measured two 1-thread workers slower on 2 cores
     with atomic_path(gqcnn_seed_dir(seed), directory=True) as folder:
         card = gqcnn_card(params.render.crop, params.render.intrinsics, params.render.viewpoints, params.grasps.gripper,
                           params.grasps.threshold, params.seed)
         results = []
         for variant in tqdm(variants, desc=f"train GQ-CNNs (seed {seed})", unit="network"):
-            job = NetworkJob(variant, split, cfg.net, cfg.train, init, noise_seed, seed, str(device), folder, card)
+            job = NetworkJob(variant, split, cfg.net, cfg.train, inits, noise_seeds, seed, str(device), folder, card)
             try:
                 results.append(train_network(job, val, test))
             except ValueError as exc:
@@ -78,7 +78,7 @@ def run(params: Params, seed: int) -> None:
                 "train_seconds": {f"{r['pool']}/{r['base_size']}-{r['ratio']:g}": round(r["train_seconds"], 1) for r in results}},
                timing_file("train_gqcnn", f"s{seed}"))
     for r in sorted(results, key=lambda r: (r["pool"], r["base_size"], r["ratio"])):
-        log.info("train_gqcnn seed %d %s %d-%g: %d datapoints, %d steps (kept %d); validation AP %.4f, test AP %.4f",
+        log.info("train_gqcnn seed %d %s %d-%g: %d datapoints, %d steps (kept %s); validation AP %.4f, test AP %.4f",
                  seed, r["pool"], r["base_size"], r["ratio"], r["train"]["datapoints"], r["train"]["steps"], r["train"]["best_step"],
                  r["validation"]["ap"] or float("nan"), r["test"]["ap"] or float("nan"))
     log.info("train_gqcnn seed %d: %d networks in %.1f s", seed, len(results), time.perf_counter() - start)
