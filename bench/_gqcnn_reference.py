@@ -1,6 +1,7 @@
 """The GQ-CNN training loop as it was before the bench's speed work (a frozen copy, for
 ``bench/gqcnn_train_speed.py`` only): batch 64, StepLR, torch's default threads, one network
-per process, the last step's weights."""
+per process, the contiguous layout, the last step's weights; and the network's LRN as it was
+then (its power as ``pow``; ``reference_network``). The function computed is the same."""
 from __future__ import annotations
 
 import time
@@ -10,7 +11,27 @@ import torch
 import torch.nn.functional as F
 from tqdm import tqdm
 
+from graspaug.nets.gqcnn import GQCNN, LocalResponseNorm
 from graspaug.training.gqcnn import augment, classification_metrics, predict
+
+
+class PowLocalResponseNorm(LocalResponseNorm):
+    """The LRN of the network when the speed work began: the same function, the power as ``pow``."""
+
+    def forward(self, x: torch.Tensor) -> torch.Tensor:
+        channels = x.shape[1]
+        offset = torch.arange(channels, device=x.device)
+        diff = offset[None, :] - offset[:, None]  # input channel - output channel
+        band = ((diff >= -(self.size // 2)) & (diff <= (self.size - 1) // 2)).to(x.dtype)
+        window = F.conv2d(x * x, band.view(channels, channels, 1, 1))
+        return x * (self.k + self.alpha / self.size * window).pow(-self.beta)
+
+
+def reference_network(config) -> GQCNN:
+    """A GQ-CNN of ``config`` with the reference LRN."""
+    net = GQCNN(config)
+    net.lrn = PowLocalResponseNorm(net.lrn.size, net.lrn.alpha, net.lrn.beta, net.lrn.k)
+    return net
 
 
 def normalization(train):

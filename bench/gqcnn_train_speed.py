@@ -1,79 +1,126 @@
-"""GQ-CNN training throughput on the CPU: the loop as it was (``_gqcnn_reference.py``: batch 64,
-torch's default threads, one network per process) against the current one (batch 128, and the
-stage's layout: ``n_jobs`` networks at once, one thread each), on the same rendered datapoints,
-the same network (default ``gqcnn.net``) and the same number of SGD steps.
+"""GQ-CNN training throughput on the CPU: the loop as it was when the speed work began
+(``_gqcnn_reference.py``: batch 64, contiguous layout, the LRN power as ``pow``, glibc's default
+allocator settings) against the current one (``graspaug.training.gqcnn.train_gqcnn`` as the
+``train_gqcnn`` stage runs it: batch 128, channels-last, ``graspaug.device.keep_freed_memory``),
+on the same rendered datapoints, the same network (default ``gqcnn.net``), the same number of
+SGD steps and torch's default threads.
 
-Needs ``data/gqcnn/original`` (``dvc repro render@original`` with the default params).
+Each measurement runs in a fresh process (the allocator setting is process-wide), and the two
+alternate over ``--rounds`` rounds (reference first in odd rounds, current first in even ones),
+so a machine that speeds up or slows down during the run shifts both; the ratio printed is the
+median of the rounds' ratios. Needs ``data/gqcnn/original`` (``dvc repro render@original`` with
+the default params).
 
-    python bench/gqcnn_train_speed.py [--steps 300] [--datapoints 20000] [--jobs 2]
-
-Prints samples/s of each and the ratio to the reference.
+    python bench/gqcnn_train_speed.py [--steps 300] [--datapoints 20000] [--rounds 3]
 """
 from __future__ import annotations
 
 import argparse
+import json
 import os
+import subprocess
 import sys
 import time
 from pathlib import Path
-from types import SimpleNamespace
 
 import numpy as np
-import torch
-from joblib import Parallel, delayed
-
-sys.path.insert(0, str(Path(__file__).parent))
-from _gqcnn_reference import train_gqcnn_reference  # noqa: E402
-
-from graspaug.io.gqcnn import GraspImages  # noqa: E402
-from graspaug.nets.gqcnn import GQCNN  # noqa: E402
-from graspaug.nets.settings import GQCNNConfig  # noqa: E402
-from graspaug.paths import gqcnn_dir  # noqa: E402
-from graspaug.training.gqcnn import GraspArrays, train_gqcnn  # noqa: E402
-from graspaug.training.settings import NoiseSettings, TrainSettings  # noqa: E402
 
 
-def load(n: int) -> GraspArrays:
+def load(n: int):
+    from graspaug.io.gqcnn import GraspImages
+    from graspaug.paths import gqcnn_dir
+    from graspaug.training.gqcnn import GraspArrays
+
     data = GraspImages.open(gqcnn_dir("original"))
     rows = np.flatnonzero((data.index.split == "train").to_numpy())[:n]
     return GraspArrays(data.images(rows), data.read("z", rows), data.read("labels", rows))
 
 
-def reference_run(train: GraspArrays, steps: int) -> float:
-    settings = SimpleNamespace(steps=steps, batch_size=64, lr=0.01, momentum=0.9, weight_decay=5e-4, lr_decay=0.95, decay_steps=100,
-                               log_every=steps, eval_batch=128, noise=NoiseSettings())
+def measure(which: str, steps: int, datapoints: int) -> dict:
+    """Train one network for ``steps`` steps in this process; samples/s and page faults per step."""
+    import resource
+    from types import SimpleNamespace
+
+    import torch
+
+    from graspaug.nets.gqcnn import GQCNN
+    from graspaug.nets.settings import GQCNNConfig
+    from graspaug.training.settings import NoiseSettings, TrainSettings
+
+    train = load(datapoints)
     torch.manual_seed(0)
-    start = time.perf_counter()
-    train_gqcnn_reference(GQCNN(GQCNNConfig()), train, None, settings, torch.device("cpu"), torch.Generator().manual_seed(0))
-    return steps * 64 / (time.perf_counter() - start)
+    gen = torch.Generator().manual_seed(0)
+    faults = resource.getrusage(resource.RUSAGE_SELF).ru_minflt
+    if which == "reference":
+        sys.path.insert(0, str(Path(__file__).parent))
+        from _gqcnn_reference import reference_network, train_gqcnn_reference
+
+        settings = SimpleNamespace(steps=steps, batch_size=64, lr=0.01, momentum=0.9, weight_decay=5e-4, lr_decay=0.95, decay_steps=100,
+                                   log_every=steps, eval_batch=128, noise=NoiseSettings())
+        net, batch = reference_network(GQCNNConfig()), 64
+        start = time.perf_counter()
+        train_gqcnn_reference(net, train, None, settings, torch.device("cpu"), gen)
+    else:
+        from graspaug.device import keep_freed_memory
+        from graspaug.training.gqcnn import train_gqcnn
+
+        keep_freed_memory()  # as every stage does (graspaug.cli)
+        settings = TrainSettings(min_steps=steps, max_steps=steps, evals=1)
+        net, batch = GQCNN(GQCNNConfig()), settings.batch_size
+        start = time.perf_counter()
+        train_gqcnn(net, train, None, settings, torch.device("cpu"), gen, progress=False)
+    seconds = time.perf_counter() - start
+    return {"samples_per_second": steps * batch / seconds, "faults_per_step": (resource.getrusage(resource.RUSAGE_SELF).ru_minflt - faults) / steps,
+            "threads": torch.get_num_threads(), "parameters": sum(p.numel() for p in net.parameters())}
 
 
-def current_one(train: GraspArrays, steps: int, threads: int, seed: int) -> float:
-    torch.set_num_threads(threads)
-    settings = TrainSettings(min_steps=steps, max_steps=steps, evals=1)
-    torch.manual_seed(seed)
-    start = time.perf_counter()
-    train_gqcnn(GQCNN(GQCNNConfig()), train, None, settings, torch.device("cpu"), torch.Generator().manual_seed(seed), progress=False)
-    return steps * settings.batch_size / (time.perf_counter() - start)
+def same_function() -> None:
+    """The reference network computes what the current one does (same weights, same outputs)."""
+    import torch
+
+    from graspaug.nets.gqcnn import GQCNN
+    from graspaug.nets.settings import GQCNNConfig
+
+    sys.path.insert(0, str(Path(__file__).parent))
+    from _gqcnn_reference import reference_network
+
+    torch.manual_seed(0)
+    current = GQCNN(GQCNNConfig()).eval()
+    reference = reference_network(GQCNNConfig()).eval()
+    reference.load_state_dict(current.state_dict())
+    images, z = torch.rand(16, 1, 32, 32) * 0.05 + 0.6, torch.rand(16) * 0.05 + 0.6
+    with torch.no_grad():
+        torch.testing.assert_close(reference(images, z), current(images, z), rtol=1e-5, atol=1e-6)
+
+
+def run(which: str, args) -> dict:
+    out = subprocess.run([sys.executable, __file__, "--measure", which, "--steps", str(args.steps), "--datapoints", str(args.datapoints)],
+                         check=True, capture_output=True, text=True)
+    return json.loads(out.stdout.strip().splitlines()[-1])
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--steps", type=int, default=300)
     parser.add_argument("--datapoints", type=int, default=20000)
-    parser.add_argument("--jobs", type=int, default=2)
+    parser.add_argument("--rounds", type=int, default=3)
+    parser.add_argument("--measure", choices=["reference", "current"], help=argparse.SUPPRESS)  # one measurement (a child process)
     args = parser.parse_args()
-    train = load(args.datapoints)
-    cores = os.cpu_count()
-    print(f"{len(train)} datapoints, {args.steps} steps per network, {GQCNN(GQCNNConfig()).describe()['parameters']} parameters, {cores} cores")
-    reference = reference_run(train, args.steps)
-    print(f"reference (batch 64, {torch.get_num_threads()} threads, one network):   {reference:8.0f} samples/s")
-    one = current_one(train, args.steps, torch.get_num_threads(), 0)
-    print(f"current, one network (batch 128, {torch.get_num_threads()} threads):     {one:8.0f} samples/s  ({one / reference:.2f}x)")
-    start = time.perf_counter()
-    Parallel(n_jobs=args.jobs)(delayed(current_one)(train, args.steps, 1, seed) for seed in range(args.jobs))  # the stage's layout
-    both = args.jobs * args.steps * TrainSettings().batch_size / (time.perf_counter() - start)
-    print(f"current, {args.jobs} networks at once (1 thread each, worker start-up included): {both:8.0f} samples/s  ({both / reference:.2f}x)")
+    if args.measure:
+        print(json.dumps(measure(args.measure, args.steps, args.datapoints)))
+        return
+    same_function()
+    print(f"{args.datapoints} datapoints, {args.steps} steps per network, {os.cpu_count()} cores, {args.rounds} rounds, one fresh process per run")
+    ratios = []
+    for r in range(args.rounds):
+        order = ("reference", "current") if r % 2 == 0 else ("current", "reference")
+        got = {which: run(which, args) for which in order}
+        ref, cur = got["reference"], got["current"]
+        ratios.append(cur["samples_per_second"] / ref["samples_per_second"])
+        print(f"round {r + 1}: reference (batch 64, {ref['threads']} threads) {ref['samples_per_second']:6.0f} samples/s, "
+              f"{ref['faults_per_step']:5.0f} page faults/step; current (batch 128) {cur['samples_per_second']:6.0f} samples/s, "
+              f"{cur['faults_per_step']:5.0f} page faults/step: {ratios[-1]:.2f}x", flush=True)
+    print(f"median ratio over {args.rounds} rounds: {np.median(ratios):.2f}x (rounds: {', '.join(f'{x:.2f}' for x in ratios)})")
 
 
 if __name__ == "__main__":

@@ -37,8 +37,10 @@ def _load(path: Path) -> Params:
 
 
 def _run(stage_run, params: Params) -> None:
+    from graspaug.device import keep_freed_memory
     from graspaug.errors import CheckpointMismatch, StageError
 
+    keep_freed_memory()  # no page faults for every freed tensor (GQ-CNN training: bench/gqcnn_train_speed.py)
     try:
         stage_run(params)
     except (StageError, CheckpointMismatch, FileNotFoundError) as exc:
