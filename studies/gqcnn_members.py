@@ -1,10 +1,11 @@
 """How many members per GQ-CNN (``gqcnn.members``) make the paired contrasts tight: the
 seed-to-seed SD of every declared contrast for ensembles of 1 … K members.
 
-Trains members 1 … K−1 of every network of every seed in ``params.yaml`` (member 0 is the
-network ``train_gqcnn`` already wrote to ``models/gqcnn/s<seed>/``: the same initial weights and
-noise stream, checked by its ``init_digest``) into ``studies/out/members/s<seed>/m<m>/``
-(resumable: a member already there is read, not retrained). Then for k = 1 … K the network is
+Members 0 … M−1 are the ``gqcnn.members`` = M members ``train_gqcnn`` already trained into
+``models/gqcnn/s<seed>/`` (the same initial weights and noise streams, checked by their
+``init_digest``); this trains members M … K−1 of every network of every seed in ``params.yaml``
+into ``studies/out/members/s<seed>/m<m>/`` (resumable: a member already there is read, not
+retrained). Then for k = 1 … K the network is
 the ensemble of members 0 … k−1 (mean P(success)), and per k it prints each declared contrast
 of :mod:`graspaug.experiments.ap` (the ratio chosen on the ensembles' mean validation AP):
 mean over seeds, 95% t-interval, SD over seeds; and each network's test AP, the ensemble's
@@ -12,7 +13,7 @@ against its members' mean. Run where ``dvc repro train_gqcnn`` has run with thes
 
     python studies/gqcnn_members.py [--members 4] [--out studies/out/members]
 
-Members 1 … K−1 cost (K−1) times ``train_gqcnn``'s time (one network at a time, every thread).
+Members M … K−1 cost (K−M) / M times ``train_gqcnn``'s time (one network at a time, every thread).
 """
 from __future__ import annotations
 
@@ -26,25 +27,25 @@ from sklearn.metrics import average_precision_score
 
 from graspaug.config import load_params
 from graspaug.experiments.ap import choose_ratios, declared_contrasts
-from graspaug.experiments.networks import NetworkJob, initial_weights, network_dir, seed_variants, stream_seeds, train_network, weights_digest
+from graspaug.experiments.networks import NetworkJob, initial_weights, members_digest, network_dir, seed_members, seed_variants, stream_seeds, train_network
 from graspaug.experiments.stats import t_interval
 from graspaug.paths import gqcnn_seed_dir
 from graspaug.training.gqcnn_data import load_split, shapes_datapoints, test_set
 
 
 def train_members(params, members: int, out: Path) -> None:
-    """Members 1 … ``members``−1 of every network of every seed, one at a time (skipping those on disk)."""
+    """Members ``gqcnn.members`` … ``members``−1 of every network of every seed, one at a time (skipping those on disk)."""
     cfg = params.gqcnn
     split = load_split(list(params.generate.base_sizes), cfg.val_shapes, params.seed)
     variants = seed_variants(params.generate.base_sizes, params.generate.ratios, cfg.augment_base_sizes, cfg.ceiling)
     val, test = shapes_datapoints(split.validation)[0], test_set()[0]
     for seed in cfg.seeds:
-        weight_seed, _ = stream_seeds(params.seed, seed)
-        for v in variants:  # member 0 must be the pipeline's network
+        expected = members_digest(seed_members(cfg.net, params.seed, seed, cfg.members)[0])
+        for v in variants:  # members 0 … M−1 must be the pipeline's
             saved = json.loads((network_dir(gqcnn_seed_dir(seed), v) / "summary.json").read_text())["init_digest"]
-            if saved != weights_digest(initial_weights(cfg.net, weight_seed)):
-                raise SystemExit(f"models/gqcnn/s{seed}/{v.name} was not trained from member 0's weights: rerun `dvc repro train_gqcnn`")
-        for m in range(1, members):
+            if saved != expected:
+                raise SystemExit(f"models/gqcnn/s{seed}/{v.name} was not trained with these params' members: rerun `dvc repro train_gqcnn`")
+        for m in range(cfg.members, members):
             weight_seed, noise_seed = stream_seeds(params.seed, seed, m)
             init, folder = initial_weights(cfg.net, weight_seed), out / f"s{seed}" / f"m{m}"
             for v in variants:
@@ -55,9 +56,12 @@ def train_members(params, members: int, out: Path) -> None:
                       f"({r['train_seconds']:.0f} s)", flush=True)
 
 
-def member_predictions(seed: int, m: int, v, kind: str, out: Path) -> np.ndarray:
-    folder = gqcnn_seed_dir(seed) if m == 0 else out / f"s{seed}" / f"m{m}"
-    return np.load(network_dir(folder, v) / f"{kind}_predictions.npy")
+def member_predictions(seed: int, m: int, v, kind: str, out: Path, pipeline_members: int) -> np.ndarray:
+    """Member m's P(success) on the validation or test datapoints (``kind``: val, test)."""
+    if m >= pipeline_members:
+        return np.load(network_dir(out / f"s{seed}" / f"m{m}", v) / f"{kind}_predictions.npy")
+    folder = network_dir(gqcnn_seed_dir(seed), v)
+    return np.load(folder / f"{kind}_predictions.npy") if pipeline_members == 1 else np.load(folder / f"{kind}_predictions_members.npy")[m]
 
 
 def main() -> None:
@@ -67,6 +71,8 @@ def main() -> None:
     args = parser.parse_args()
     params = load_params("params.yaml")
     cfg, gen = params.gqcnn, params.generate
+    if args.members < cfg.members:
+        parser.error(f"--members {args.members} is below gqcnn.members ({cfg.members}) of params.yaml")
     train_members(params, args.members, args.out)
     split = load_split(list(gen.base_sizes), cfg.val_shapes, params.seed)
     val_labels, test_labels = shapes_datapoints(split.validation)[0].labels, test_set()[0].labels
@@ -74,8 +80,8 @@ def main() -> None:
     rows = []
     for seed in cfg.seeds:
         for v in variants:
-            val_p = [member_predictions(seed, m, v, "val", args.out) for m in range(args.members)]
-            test_p = [member_predictions(seed, m, v, "test", args.out) for m in range(args.members)]
+            val_p = [member_predictions(seed, m, v, "val", args.out, cfg.members) for m in range(args.members)]
+            test_p = [member_predictions(seed, m, v, "test", args.out, cfg.members) for m in range(args.members)]
             for k in range(1, args.members + 1):
                 rows.append({"pool": v.pool, "base_size": v.base_size, "ratio": float(v.ratio), "seed": seed, "members": k,
                              "val_ap": average_precision_score(val_labels, np.mean(val_p[:k], axis=0)),

@@ -196,7 +196,9 @@ def export_dexnet_command(
     "ratio of `gqcnn.augment_base_sizes`, and the `ceiling` (every train shape outside validation). Every network of the "
     "seed starts from the same weights and noise stream and is validated on the same `gqcnn.val_shapes` train shapes; it "
     "trains `gqcnn.train.epochs` passes over its own set (within min/max steps), the learning rate annealed along a "
-    "cosine, and keeps the weights with the best validation AP. Test = every test-split grasp of the original corpus.\n\n"
+    "cosine, and keeps the weights with the best validation AP. With `gqcnn.members` K > 1 each network is an ensemble of "
+    "K such GQ-CNNs (member m starts from the same weights in every network of the seed) whose mean P(success) is "
+    "validated, tested and planned with. Test = every test-split grasp of the original corpus.\n\n"
     "Writes `models/gqcnn/s<seed>/<pool>/<B>-<R>/` (model.pt, predictions, history.csv), `metrics/gqcnn/s<seed>.json` "
     "(validation and test AP per network) and `reports/gqcnn/validation/s<seed>.png` (validation AP vs step).\n\n"
     f"Params `gqcnn`:\n\n{describe(GQCNNParams, 'gqcnn.')}\n\nAlso `seed`, `device`, `n_jobs`.",

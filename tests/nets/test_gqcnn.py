@@ -62,6 +62,10 @@ def test_an_ensemble_averages_its_members_and_survives_a_checkpoint(tmp_path):
     loaded, card = read_gqcnn(tmp_path / "model.pt")
     assert isinstance(loaded, GQCNNEnsemble) and len(loaded.members) == 3 and card is None
     torch.testing.assert_close(loaded.success_probability(images, z), each.mean(0))
+    from graspaug.planning import export_model
+
+    export_model(tmp_path / "model.pt", tmp_path / "export")  # TorchScript of the ensemble's P(success)
+    torch.testing.assert_close(torch.jit.load(str(tmp_path / "export" / "model.ts"))(images, z), each.mean(0))
     save_gqcnn(tmp_path / "single.pt", members[0], {}, None)  # a single network stays a GQCNN
     assert type(read_gqcnn(tmp_path / "single.pt")[0]) is GQCNN
     with pytest.raises(ValueError, match="one config"):

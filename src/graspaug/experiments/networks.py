@@ -66,6 +66,14 @@ def weights_digest(state: dict[str, torch.Tensor]) -> str:
     return digest.hexdigest()[:16]
 
 
+def members_digest(inits: tuple[dict, ...]) -> str:
+    """``init_digest`` of a network: :func:`weights_digest` of its one member's initial
+    weights, or of all members' as one ensemble state dict."""
+    if len(inits) == 1:
+        return weights_digest(inits[0])
+    return weights_digest({f"members.{m}.{k}": v for m, init in enumerate(inits) for k, v in init.items()})
+
+
 @dataclass(frozen=True)
 class NetworkJob:
     """One network of a seed (a worker's unit of work): one member per initial weights and
@@ -111,7 +119,7 @@ def train_network(job: NetworkJob, val: GraspArrays | None = None, test: GraspAr
     single = len(members) == 1
     net = members[0] if single else GQCNNEnsemble(members)
     val_p, test_p = np.mean(val_ps, axis=0, dtype=np.float32), np.mean(test_ps, axis=0, dtype=np.float32)
-    init_digest = weights_digest(job.inits[0] if single else {f"members.{m}.{k}": v for m, init in enumerate(job.inits) for k, v in init.items()})
+    init_digest = members_digest(job.inits)
     rounded = lambda d: {k: (round(v, 5) if isinstance(v, float) else v) for k, v in d.items()}  # noqa: E731
     summary = {"pool": job.variant.pool, "base_size": job.variant.base_size, "ratio": job.variant.ratio, "seed": job.seed,
                "validation": rounded(classification_metrics(val.labels, val_p)), "test": rounded(classification_metrics(test.labels, test_p)),
