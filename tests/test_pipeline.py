@@ -10,8 +10,8 @@ import pandas as pd
 import pytest
 
 from graspaug.io.checkpoints import read_gqcnn
-from graspaug.nets.gqcnn import GQCNNEnsemble
 from graspaug.io.voxels import read_voxels
+from graspaug.nets.gqcnn import GQCNN, GQCNNEnsemble
 
 pytestmark = pytest.mark.slow
 
@@ -241,6 +241,29 @@ def test_dvc_repro_gqcnn_matrix_and_report(tiny_repo):
     assert "metrics/gqcnn/s1.json" in shown.stdout and "real_data" in shown.stdout
     again = run(["dvc", "repro", "report"], work, env)
     assert "Running stage" not in again.stdout
+
+
+def test_a_one_member_network_is_a_plain_gqcnn(tiny_repo, tmp_path, monkeypatch):
+    """gqcnn.members = 1 (the study and paper profiles) writes one GQ-CNN, as before ensembles existed."""
+    from graspaug.config import load_params
+    from graspaug.experiments.networks import NetworkJob, seed_members, train_network, weights_digest
+    from graspaug.training.gqcnn_data import Variant, load_split
+
+    work, env = tiny_repo
+    run(["dvc", "repro", "render@original"], work, env)
+    monkeypatch.chdir(work)  # the library reads data/ relative to the project
+    params = load_params(work / "params.yaml")
+    cfg = params.gqcnn
+    split = load_split(list(params.generate.base_sizes), cfg.val_shapes, params.seed)
+    inits, noise_seeds = seed_members(cfg.net, params.seed, 0, 1)
+    assert weights_digest(inits[0]) == weights_digest(seed_members(cfg.net, params.seed, 0, 2)[0][0])  # member 0 whatever K
+    summary = train_network(NetworkJob(Variant("targeted", 6, 0.0), split, cfg.net, cfg.train, inits, noise_seeds, 0, "cpu", tmp_path))
+    folder = tmp_path / "targeted" / "6-0"
+    assert isinstance(summary["train"]["best_step"], int) and isinstance(summary["noise_seed"], int) and "members" not in summary["train"]
+    assert summary["init_digest"] == weights_digest(inits[0]) and not list(folder.glob("*_members.npy"))
+    assert "member" not in pd.read_csv(folder / "history.csv").columns
+    net, card = read_gqcnn(folder / "model.pt")
+    assert type(net) is GQCNN and card is None
 
 
 def test_dvc_repro_sim(tiny_repo, tmp_path):

@@ -210,9 +210,10 @@ def _fmt(v, digits: int = 4) -> str:
     return "-" if v is None or (isinstance(v, float) and not np.isfinite(v)) else f"{v:.{digits}f}"
 
 
-def training_words(t) -> str:
-    """The training budget of ``gqcnn.train`` (a TrainSettings) in one sentence, for the report."""
-    return (f"Each network trains {t.epochs:g} passes over its own training set ({t.min_steps}-{t.max_steps} steps of {t.batch_size}), "
+def training_words(t, members: int = 1) -> str:
+    """The training budget of ``gqcnn.train`` (a TrainSettings) and ``gqcnn.members`` in words, for the report."""
+    what = "Each network" if members == 1 else f"Each network is an ensemble of {members} GQ-CNNs (their mean P(success)); each member"
+    return (f"{what} trains {t.epochs:g} passes over its own training set ({t.min_steps}-{t.max_steps} steps of {t.batch_size}), "
             f"the learning rate annealed to {t.final_lr:g} of its start, and keeps the weights with the best validation AP.")
 
 

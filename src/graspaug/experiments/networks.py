@@ -110,7 +110,7 @@ def train_network(job: NetworkJob, val: GraspArrays | None = None, test: GraspAr
         net = GQCNN(job.net)
         net.load_state_dict(init)
         gen = torch.Generator().manual_seed(noise_seed)
-        fit = train_gqcnn(net, train, val, job.train, device, gen, on_log=lambda step, metrics, m=m: history.append({"member": m, "step": step, **metrics}),
+        fit = train_gqcnn(net, train, val, job.train, device, gen, on_log=lambda step, metrics, m=m: history.append({**({"member": m} if len(job.inits) > 1 else {}), "step": step, **metrics}),
                           progress=False)
         val_ps.append(fit["val_predictions"] if fit["val_predictions"] is not None else predict(net, val, device, job.train.eval_batch))  # the kept weights
         test_ps.append(predict(net, test, device, job.train.eval_batch))
@@ -140,14 +140,20 @@ def train_network(job: NetworkJob, val: GraspArrays | None = None, test: GraspAr
     return {**summary, "train_seconds": seconds, "samples_per_second": len(fits) * fits[0]["steps"] * min(job.train.batch_size, len(train)) / seconds}
 
 
+def _by_member(value):
+    """A per-member list as {"m0": …, "m1": …} (``dvc metrics`` shows dicts and numbers, not lists); a number as it is."""
+    return {f"m{m}": v for m, v in enumerate(value)} if isinstance(value, list) else value
+
+
 def seed_table(summaries: list[dict]) -> dict:
-    """The seed's metrics file: pool → base size → ratio → validation / test AP and ROC AUC, steps."""
+    """The seed's metrics file: pool → base size → ratio → validation / test AP and ROC AUC, steps,
+    the kept step (per member of an ensemble: ``{"m0": …}``)."""
     out: dict = {}
     for s in summaries:
         key = ("ceiling", "all", "-") if s["pool"] == "ceiling" else (s["pool"], str(s["base_size"]), f"{s['ratio']:g}")
         out.setdefault(key[0], {}).setdefault(key[1], {})[key[2]] = {
             "val_ap": s["validation"]["ap"], "test_ap": s["test"]["ap"], "test_roc_auc": s["test"]["roc_auc"],
-            "datapoints": s["train"]["datapoints"], "steps": s["train"]["steps"], "best_step": s["train"]["best_step"]}
+            "datapoints": s["train"]["datapoints"], "steps": s["train"]["steps"], "best_step": _by_member(s["train"]["best_step"])}
     return out
 
 

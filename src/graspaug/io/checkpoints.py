@@ -78,14 +78,14 @@ def gqcnn_card(crop, intrinsics, viewpoints, gripper, label_threshold: float, gl
 
 
 def finish_gqcnn_card(card: dict[str, Any] | None, summary: dict[str, Any]) -> dict[str, Any] | None:
-    """``card`` plus the training set (pool, base size, ratio, seed, datapoints, steps) and the
+    """``card`` plus the training set (pool, base size, ratio, seed, datapoints, steps, kept step, members) and the
     validation / test AP of ``summary`` (a network's ``summary.json``); None stays None."""
     if card is None:
         return None
     train = summary["train"]
     return {**card, "training_set": {"pool": summary["pool"], "base_size": summary["base_size"], "ratio": summary["ratio"],
                                      "seed": summary["seed"], "datapoints": train.get("datapoints"), "steps": train.get("steps"),
-                                     "best_step": train.get("best_step")},
+                                     "best_step": train.get("best_step"), "members": train.get("members", 1)},
             "validation_ap": summary["validation"].get("ap"), "test_ap": summary["test"].get("ap")}
 
 
@@ -120,5 +120,5 @@ def read_gqcnn(path: str | os.PathLike):
 
 
 def load_gqcnn(path: str | os.PathLike):
-    """A trained GQ-CNN from ``models/gqcnn/s<seed>/<pool>/<B>-<R>/model.pt``, on the CPU, in eval mode."""
+    """A trained GQ-CNN (or ensemble) from ``models/gqcnn/s<seed>/<pool>/<B>-<R>/model.pt``, on the CPU, in eval mode."""
     return read_gqcnn(path)[0]

@@ -17,7 +17,7 @@ import numpy as np
 import torch
 from sklearn.mixture import GaussianMixture
 
-from graspaug.nets.gqcnn import GQCNN
+from graspaug.nets.gqcnn import GQCNN, GQCNNEnsemble
 from graspaug.render.camera import CameraPose, Intrinsics
 from graspaug.render.crops import CropGeometry, crops_from_depth_image
 from graspaug.sim.settings import SamplerSettings
@@ -170,7 +170,7 @@ def grasps_from_features(features: np.ndarray) -> ImageGrasps:
 class CrossEntropyGraspPolicy:
     """Plans one grasp per depth image with a trained GQ-CNN (CPU, one thread is enough)."""
 
-    def __init__(self, net: GQCNN, intrinsics: Intrinsics, sampler: SamplerSettings = SamplerSettings(),
+    def __init__(self, net: GQCNN | GQCNNEnsemble, intrinsics: Intrinsics, sampler: SamplerSettings = SamplerSettings(),
                  cem: CEMSettings = CEMSettings(), geometry: CropGeometry = CropGeometry()) -> None:
         self.net, self.intrinsics, self.sampler, self.cem, self.geometry = net.eval(), intrinsics, sampler, cem, geometry
 

@@ -96,6 +96,6 @@ def run(params: Params) -> None:
                 "summary": {str(b): {"best_ratio": r, "chosen_on": "validation AP"} for b, r in chosen.items()},
                 "test_positive_share": round(positive_share, 5), "seeds": seeds}, AP_METRICS)
     with atomic_path(REPORT_DIR / "report.md") as tmp:
-        tmp.write_text(report_markdown(table, results, chosen, extras, seeds, positive_share, training_words(cfg.train)))
+        tmp.write_text(report_markdown(table, results, chosen, extras, seeds, positive_share, training_words(cfg.train, cfg.members)))
     for name, c in results.items():
         log.info("report: %s", verdict(name, c))

@@ -53,7 +53,7 @@ def run(params: Params, seed: int) -> None:
     test, test_rows = test_set()
     log.info("train_gqcnn seed %d: %d networks of %d member(s); validation %d shapes (%d datapoints), test %d datapoints; one at a time on %s",
              seed, len(variants), cfg.members, len(split.validation), len(val_rows), len(test_rows), device)
-    # one network at a time with every thread: bench/gqcnn_train_speed.py measured two 1-thread workers slower on 2 cores
+    # one network at a time with every thread: two 1-thread workers were slower on 2 cores (docs/results.md#benchmarks)
     with atomic_path(gqcnn_seed_dir(seed), directory=True) as folder:
         card = gqcnn_card(params.render.crop, params.render.intrinsics, params.render.viewpoints, params.grasps.gripper,
                           params.grasps.threshold, params.seed)
