@@ -110,7 +110,8 @@ def train_network(job: NetworkJob, val: GraspArrays | None = None, test: GraspAr
         net = GQCNN(job.net)
         net.load_state_dict(init)
         gen = torch.Generator().manual_seed(noise_seed)
-        fit = train_gqcnn(net, train, val, job.train, device, gen, on_log=lambda step, metrics, m=m: history.append({**({"member": m} if len(job.inits) > 1 else {}), "step": step, **metrics}),
+        member = {"member": m} if len(job.inits) > 1 else {}  # history.csv names members only in an ensemble
+        fit = train_gqcnn(net, train, val, job.train, device, gen, on_log=lambda step, metrics, member=member: history.append({**member, "step": step, **metrics}),
                           progress=False)
         val_ps.append(fit["val_predictions"] if fit["val_predictions"] is not None else predict(net, val, device, job.train.eval_batch))  # the kept weights
         test_ps.append(predict(net, test, device, job.train.eval_batch))

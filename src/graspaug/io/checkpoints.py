@@ -94,7 +94,9 @@ def save_gqcnn(path: str | os.PathLike, net, summary: dict[str, Any], card: dict
     for a :class:`~graspaug.nets.gqcnn.GQCNNEnsemble` also its number of members."""
     state = {"config": dataclasses.asdict(net.config), "state_dict": {k: v.detach().cpu() for k, v in net.state_dict().items()},
              "summary": summary, "card": card}
-    if hasattr(net, "members"):
+    from graspaug.nets.gqcnn import GQCNNEnsemble
+
+    if isinstance(net, GQCNNEnsemble):
         state["members"] = len(net.members)
     with atomic_path(path) as tmp, open(tmp, "wb") as f:
         torch.save(state, f)
