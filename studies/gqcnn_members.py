@@ -33,12 +33,10 @@ from graspaug.paths import gqcnn_seed_dir
 from graspaug.training.gqcnn_data import load_split, shapes_datapoints, test_set
 
 
-def train_members(params, members: int, out: Path) -> None:
-    """Members ``gqcnn.members`` … ``members``−1 of every network of every seed, one at a time (skipping those on disk)."""
+def train_members(params, split, variants, val, test, members: int, out: Path) -> None:
+    """Members ``gqcnn.members`` … ``members``−1 of every network (``variants``) of every seed, one
+    at a time (skipping those on disk); ``val`` / ``test``: the experiment's datapoints."""
     cfg = params.gqcnn
-    split = load_split(list(params.generate.base_sizes), cfg.val_shapes, params.seed)
-    variants = seed_variants(params.generate.base_sizes, params.generate.ratios, cfg.augment_base_sizes, cfg.ceiling)
-    val, test = shapes_datapoints(split.validation)[0], test_set()[0]
     for seed in cfg.seeds:
         expected = members_digest(seed_members(cfg.net, params.seed, seed, cfg.members)[0])
         for v in variants:  # members 0 … M−1 must be the pipeline's
@@ -73,10 +71,11 @@ def main() -> None:
     cfg, gen = params.gqcnn, params.generate
     if args.members < cfg.members:
         parser.error(f"--members {args.members} is below gqcnn.members ({cfg.members}) of params.yaml")
-    train_members(params, args.members, args.out)
     split = load_split(list(gen.base_sizes), cfg.val_shapes, params.seed)
-    val_labels, test_labels = shapes_datapoints(split.validation)[0].labels, test_set()[0].labels
     variants = seed_variants(gen.base_sizes, gen.ratios, cfg.augment_base_sizes, cfg.ceiling)
+    val, test = shapes_datapoints(split.validation)[0], test_set()[0]  # read once
+    train_members(params, split, variants, val, test, args.members, args.out)
+    val_labels, test_labels = val.labels, test.labels
     rows = []
     for seed in cfg.seeds:
         for v in variants:
