@@ -1,7 +1,8 @@
 """GQ-CNN training throughput on the CPU: the loop as it was when the speed work began
 (``_gqcnn_reference.py``: batch 64, contiguous layout, the LRN power as ``pow``, glibc's default
 allocator settings) against the current one (``graspaug.training.gqcnn.train_gqcnn`` as the
-``train_gqcnn`` stage runs it: batch 128, channels-last, ``graspaug.device.keep_freed_memory``),
+``train_gqcnn`` stage runs it: batch 128, channels-last, bfloat16 mixed precision,
+``graspaug.device.keep_freed_memory``),
 on the same rendered datapoints, the same network (default ``gqcnn.net``), the same number of
 SGD steps and torch's default threads.
 
@@ -71,7 +72,8 @@ def measure(which: str, steps: int, datapoints: int) -> dict:
         train_gqcnn(net, train, None, settings, torch.device("cpu"), gen, progress=False)
     seconds = time.perf_counter() - start
     return {"samples_per_second": steps * batch / seconds, "faults_per_step": (resource.getrusage(resource.RUSAGE_SELF).ru_minflt - faults) / steps,
-            "threads": torch.get_num_threads(), "parameters": sum(p.numel() for p in net.parameters())}
+            "threads": torch.get_num_threads(), "parameters": sum(p.numel() for p in net.parameters()),
+            "precision": getattr(settings, "precision", "float32")}
 
 
 def same_function() -> None:
@@ -110,7 +112,11 @@ def main() -> None:
         print(json.dumps(measure(args.measure, args.steps, args.datapoints)))
         return
     same_function()
-    print(f"{args.datapoints} datapoints, {args.steps} steps per network, {os.cpu_count()} cores, {args.rounds} rounds, one fresh process per run")
+    import torch
+
+    bf16 = "with" if torch.backends.mkldnn.is_available() and torch.ops.mkldnn._is_mkldnn_bf16_supported() else "WITHOUT (bfloat16 is emulated, slow)"
+    print(f"{args.datapoints} datapoints, {args.steps} steps per network, {os.cpu_count()} cores {bf16} bfloat16 instructions, "
+          f"{args.rounds} rounds, one fresh process per run")
     ratios = []
     for r in range(args.rounds):
         order = ("reference", "current") if r % 2 == 0 else ("current", "reference")
@@ -118,7 +124,7 @@ def main() -> None:
         ref, cur = got["reference"], got["current"]
         ratios.append(cur["samples_per_second"] / ref["samples_per_second"])
         print(f"round {r + 1}: reference (batch 64, {ref['threads']} threads) {ref['samples_per_second']:6.0f} samples/s, "
-              f"{ref['faults_per_step']:5.0f} page faults/step; current (batch 128) {cur['samples_per_second']:6.0f} samples/s, "
+              f"{ref['faults_per_step']:5.0f} page faults/step; current (batch 128, {cur['precision']}) {cur['samples_per_second']:6.0f} samples/s, "
               f"{cur['faults_per_step']:5.0f} page faults/step: {ratios[-1]:.2f}x", flush=True)
     print(f"median ratio over {args.rounds} rounds: {np.median(ratios):.2f}x (rounds: {', '.join(f'{x:.2f}' for x in ratios)})")
 

@@ -43,6 +43,8 @@ OPTIONS = {  # name → (changes to gqcnn.net, changes to gqcnn.train); the firs
     "min_steps 800": ({}, {"min_steps": 800}),
     "16 passes": ({}, {"epochs": 16.0}),
     "EMA off": ({}, {"ema_decay": 0.0}),
+    "bfloat16": ({}, {"precision": "bfloat16"}),
+    "float32": ({}, {"precision": "float32"}),
 }
 
 

@@ -109,3 +109,24 @@ def test_averaged_weights_are_the_exponential_moving_average_of_the_trained_ones
     for name in w2:
         torch.testing.assert_close(averaged[name], 0.9 * w1[name] + 0.1 * w2[name])
     assert any(not torch.equal(averaged[name], w2[name]) for name in w2)  # the kept weights are the average, not the last
+
+
+def test_bfloat16_mixed_precision_learns_and_keeps_float32_weights():
+    rng = np.random.default_rng(2)
+    train, test = toy_set(1500, rng), toy_set(500, rng)
+    torch.manual_seed(0)
+    init = GQCNN(GQCNNConfig(filters=8, fc=32, pose_fc=4)).state_dict()
+
+    def trained(precision: str) -> GQCNN:
+        net = GQCNN(GQCNNConfig(filters=8, fc=32, pose_fc=4))
+        net.load_state_dict(init)
+        settings = TrainSettings(min_steps=150, max_steps=150, batch_size=32, lr=0.01, evals=1, precision=precision)
+        train_gqcnn(net, train, None, settings, torch.device("cpu"), torch.Generator().manual_seed(0), progress=False)
+        return net
+
+    half, again, full = trained("bfloat16"), trained("bfloat16"), trained("float32")
+    assert all(p.dtype == torch.float32 for p in half.parameters())
+    assert all(torch.equal(a, b) for a, b in zip(half.state_dict().values(), again.state_dict().values()))  # same seed, same weights
+    assert any(not torch.equal(a, b) for a, b in zip(half.state_dict().values(), full.state_dict().values()))  # the setting acts
+    probability = predict(half, test, torch.device("cpu"))
+    assert probability.dtype == np.float32 and classification_metrics(test.labels, probability)["ap"] > 0.95

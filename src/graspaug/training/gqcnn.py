@@ -107,7 +107,9 @@ def train_gqcnn(net: GQCNN, train: GraspArrays, val: GraspArrays | None, setting
     """Train ``net`` for ``settings.steps_for(len(train))`` SGD steps on batches drawn epoch by
     epoch from ``train`` (softmax cross-entropy), evaluating validation AP ``settings.evals``
     times; ``net`` ends with the weights of the best evaluation (the last ones without ``val``).
-    With ``settings.ema_decay > 0`` the evaluated and kept weights are an exponential moving
+    With ``settings.precision = "bfloat16"`` the training steps' forward and backward run in
+    bfloat16 mixed precision (``torch.autocast``); the weights, the optimizer, the loss and every
+    evaluation stay float32. With ``settings.ema_decay > 0`` the evaluated and kept weights are an exponential moving
     average of the trained ones (``torch.optim.swa_utils.AveragedModel``), updated every step.
     ``on_log(step, metrics)`` gets the mean loss and train accuracy since the last evaluation,
     the learning rate and the validation AP / accuracy. Returns the steps, the best step, its
@@ -137,7 +139,8 @@ def train_gqcnn(net: GQCNN, train: GraspArrays, val: GraspArrays | None, setting
         cursor += batch_size
         net.train()
         batch, depth = augment(images[idx], z[idx], settings.noise, gen)
-        logits = net(batch.to(device, memory_format=torch.channels_last), depth.to(device))
+        with torch.autocast(device.type, dtype=torch.bfloat16, enabled=settings.precision == "bfloat16"):
+            logits = net(batch.to(device, memory_format=torch.channels_last), depth.to(device)).float()
         target = labels[idx].to(device)
         loss = F.cross_entropy(logits, target)
         opt.zero_grad(set_to_none=True)

@@ -1,6 +1,8 @@
 """Training settings of the AutoEncoder-Critic and the GQ-CNN."""
 from __future__ import annotations
 
+from typing import Literal
+
 from graspaug.settings import Field, settings
 
 
@@ -54,6 +56,7 @@ class TrainSettings:
     momentum: float = Field(0.9, ge=0, le=1, description="SGD momentum (Dex-Net: 0.9).")
     weight_decay: float = Field(5e-4, ge=0, description="L2 weight decay (Dex-Net: 5e-4).")
     ema_decay: float = Field(0.0, ge=0, lt=1, description="Decay of an exponential moving average of the weights (Polyak averaging), updated after every step; validation, the kept checkpoint and the test use the averaged weights (0: off, the raw weights).")
+    precision: Literal["float32", "bfloat16"] = Field("bfloat16", description="Arithmetic of the training steps' convolutions and matrix products: bfloat16 mixed precision (torch.autocast; weights, optimizer, loss, validation and test stay float32; the default: 1.33x the samples/s of float32 in the stage on a CPU with AVX512-BF16, validation AP -0.001 [-0.009, +0.007] over 8 paired seeds, studies/gqcnn_options.py), or float32 (for CPUs without bfloat16 instructions, where autocast is slower).")
     evals: int = Field(5, ge=1, description="Validation evaluations per network, evenly spaced over its steps (the last at the last step); the weights with the best validation AP are kept.")
     eval_batch: int = Field(256, ge=1, description="Datapoints per inference batch (on the CPU 128-256 run ~2× faster than 1024).")
     noise: NoiseSettings = Field(default_factory=NoiseSettings, description="Dex-Net 2.0's train-time image noise.")
