@@ -1,16 +1,16 @@
 """GQ-CNN training throughput on the CPU: the loop as it was when the speed work began
 (``_gqcnn_reference.py``: batch 64, contiguous layout, the LRN power as ``pow``, glibc's default
 allocator settings) against the current one (``graspaug.training.gqcnn.train_gqcnn`` as the
-``train_gqcnn`` stage runs it: batch 128, channels-last, bfloat16 mixed precision,
-``graspaug.device.keep_freed_memory``),
-on the same rendered datapoints, the same network (default ``gqcnn.net``), the same number of
-SGD steps and torch's default threads.
+``train_gqcnn`` stage runs it: batch 128, channels-last, ``graspaug.device.keep_freed_memory``)
+in each of its two precisions (``gqcnn.train.precision``: float32, and bfloat16 mixed
+precision), on the same rendered datapoints, the same network (default ``gqcnn.net``), the same
+number of SGD steps and torch's default threads.
 
-Each measurement runs in a fresh process (the allocator setting is process-wide), and the two
-alternate over ``--rounds`` rounds (reference first in odd rounds, current first in even ones),
-so a machine that speeds up or slows down during the run shifts both; the ratio printed is the
-median of the rounds' ratios. Needs ``data/gqcnn/original`` (``dvc repro render@original`` with
-the default params).
+Each measurement runs in a fresh process (the allocator setting is process-wide), and the three
+loops take turns over ``--rounds`` rounds (each round starts with another), so a machine that
+speeds up or slows down during the run shifts all; the ratios printed are the medians of the
+rounds' ratios. Needs ``data/gqcnn/original`` (``dvc repro render@original`` with the default
+params).
 
     python bench/gqcnn_train_speed.py [--steps 300] [--datapoints 20000] [--rounds 3]
 """
@@ -25,6 +25,8 @@ import time
 from pathlib import Path
 
 import numpy as np
+
+LOOPS = ["reference", "float32", "bfloat16"]
 
 
 def load(n: int):
@@ -66,14 +68,13 @@ def measure(which: str, steps: int, datapoints: int) -> dict:
         from graspaug.training.gqcnn import train_gqcnn
 
         keep_freed_memory()  # as every stage does (graspaug.cli)
-        settings = TrainSettings(min_steps=steps, max_steps=steps, evals=1)
+        settings = TrainSettings(min_steps=steps, max_steps=steps, evals=1, precision=which)
         net, batch = GQCNN(GQCNNConfig()), settings.batch_size
         start = time.perf_counter()
         train_gqcnn(net, train, None, settings, torch.device("cpu"), gen, progress=False)
     seconds = time.perf_counter() - start
     return {"samples_per_second": steps * batch / seconds, "faults_per_step": (resource.getrusage(resource.RUSAGE_SELF).ru_minflt - faults) / steps,
-            "threads": torch.get_num_threads(), "parameters": sum(p.numel() for p in net.parameters()),
-            "precision": getattr(settings, "precision", "float32")}
+            "threads": torch.get_num_threads(), "parameters": sum(p.numel() for p in net.parameters())}
 
 
 def same_function() -> None:
@@ -106,7 +107,7 @@ def main() -> None:
     parser.add_argument("--steps", type=int, default=300)
     parser.add_argument("--datapoints", type=int, default=20000)
     parser.add_argument("--rounds", type=int, default=3)
-    parser.add_argument("--measure", choices=["reference", "current"], help=argparse.SUPPRESS)  # one measurement (a child process)
+    parser.add_argument("--measure", choices=LOOPS, help=argparse.SUPPRESS)  # one measurement (a child process)
     args = parser.parse_args()
     if args.measure:
         print(json.dumps(measure(args.measure, args.steps, args.datapoints)))
@@ -117,16 +118,18 @@ def main() -> None:
     bf16 = "with" if torch.backends.mkldnn.is_available() and torch.ops.mkldnn._is_mkldnn_bf16_supported() else "WITHOUT (bfloat16 is emulated, slow)"
     print(f"{args.datapoints} datapoints, {args.steps} steps per network, {os.cpu_count()} cores {bf16} bfloat16 instructions, "
           f"{args.rounds} rounds, one fresh process per run")
-    ratios = []
+    ratios: dict[str, list[float]] = {"float32": [], "bfloat16": []}
     for r in range(args.rounds):
-        order = ("reference", "current") if r % 2 == 0 else ("current", "reference")
+        order = LOOPS[r % 3:] + LOOPS[:r % 3]
         got = {which: run(which, args) for which in order}
-        ref, cur = got["reference"], got["current"]
-        ratios.append(cur["samples_per_second"] / ref["samples_per_second"])
-        print(f"round {r + 1}: reference (batch 64, {ref['threads']} threads) {ref['samples_per_second']:6.0f} samples/s, "
-              f"{ref['faults_per_step']:5.0f} page faults/step; current (batch 128, {cur['precision']}) {cur['samples_per_second']:6.0f} samples/s, "
-              f"{cur['faults_per_step']:5.0f} page faults/step: {ratios[-1]:.2f}x", flush=True)
-    print(f"median ratio over {args.rounds} rounds: {np.median(ratios):.2f}x (rounds: {', '.join(f'{x:.2f}' for x in ratios)})")
+        ref = got["reference"]
+        line = f"round {r + 1}: reference (batch 64, {ref['threads']} threads) {ref['samples_per_second']:6.0f} samples/s, {ref['faults_per_step']:4.0f} page faults/step"
+        for precision in ratios:
+            ratios[precision].append(got[precision]["samples_per_second"] / ref["samples_per_second"])
+            line += f"; current {precision} {got[precision]['samples_per_second']:6.0f} ({got[precision]['faults_per_step']:4.0f}): {ratios[precision][-1]:.2f}x"
+        print(line, flush=True)
+    for precision, values in ratios.items():
+        print(f"current loop, {precision}: median ratio over {args.rounds} rounds {np.median(values):.2f}x (rounds: {', '.join(f'{x:.2f}' for x in values)})")
 
 
 if __name__ == "__main__":
