@@ -115,7 +115,9 @@ def main() -> None:
     same_function()
     import torch
 
-    bf16 = "with" if torch.backends.mkldnn.is_available() and torch.ops.mkldnn._is_mkldnn_bf16_supported() else "WITHOUT (bfloat16 is emulated, slow)"
+    from graspaug.device import has_native_bfloat16
+
+    bf16 = "with" if has_native_bfloat16(torch.device("cpu")) else "WITHOUT (bfloat16 is emulated, slow)"
     print(f"{args.datapoints} datapoints, {args.steps} steps per network, {os.cpu_count()} cores {bf16} bfloat16 instructions, "
           f"{args.rounds} rounds, one fresh process per run")
     ratios: dict[str, list[float]] = {"float32": [], "bfloat16": []}

@@ -1,4 +1,5 @@
-"""The process setting every stage makes: freed tensors are reused, not faulted in again."""
+"""The process setting every stage makes (freed tensors are reused, not faulted in again) and
+what the device computes natively."""
 import subprocess
 import sys
 
@@ -37,3 +38,13 @@ def faults_per_step(mode: str) -> float:
 def test_a_training_step_reuses_freed_memory():
     plain, kept = faults_per_step("plain"), faults_per_step("keep")
     assert kept < plain / 4, (plain, kept)  # measured: ~3,300 → ~400 page faults per step of the default GQ-CNN
+
+
+def test_native_bfloat16_is_a_property_of_the_device():
+    import torch
+
+    from graspaug.device import has_native_bfloat16
+
+    assert has_native_bfloat16(torch.device("meta")) is False  # no hardware behind it
+    cpu = has_native_bfloat16(torch.device("cpu"))
+    assert cpu is bool(torch.ops.mkldnn._is_mkldnn_bf16_supported())  # what oneDNN dispatches on

@@ -39,3 +39,12 @@ def keep_freed_memory() -> bool:
     m_trim_threshold, m_mmap_threshold = -1, -3  # glibc's malloc.h
     mmap_set = mallopt(m_mmap_threshold, _HEAP_KEPT) or mallopt(m_mmap_threshold, 32 << 20)  # glibc < 2.35 caps it at 32 MiB
     return bool(mmap_set) and bool(mallopt(m_trim_threshold, _HEAP_KEPT))
+
+
+def has_native_bfloat16(device: torch.device) -> bool:
+    """Whether ``device`` computes bfloat16 convolutions and matrix products in hardware (a
+    CUDA GPU that supports it; a CPU with AVX512-BF16 or AMX, as oneDNN reports); elsewhere
+    ``torch.autocast`` emulates bfloat16, slower than float32."""
+    if device.type == "cuda":
+        return torch.cuda.is_bf16_supported()
+    return device.type == "cpu" and torch.backends.mkldnn.is_available() and bool(torch.ops.mkldnn._is_mkldnn_bf16_supported())

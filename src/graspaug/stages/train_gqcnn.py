@@ -23,7 +23,7 @@ import torch
 from tqdm import tqdm
 
 from graspaug.config import Params
-from graspaug.device import resolve_device
+from graspaug.device import has_native_bfloat16, resolve_device
 from graspaug.experiments.networks import NetworkJob, read_history, seed_members, seed_table, seed_variants, train_network
 from graspaug.io.atomic import atomic_path
 from graspaug.io.checkpoints import gqcnn_card
@@ -53,6 +53,9 @@ def run(params: Params, seed: int) -> None:
     test, test_rows = test_set()
     log.info("train_gqcnn seed %d: %d networks of %d member(s); validation %d shapes (%d datapoints), test %d datapoints; one at a time on %s",
              seed, len(variants), cfg.members, len(split.validation), len(val_rows), len(test_rows), device)
+    if cfg.train.precision == "bfloat16" and not has_native_bfloat16(device):
+        log.warning("gqcnn.train.precision: bfloat16, but this %s has no bfloat16 instructions: training is emulated and slower than "
+                    "float32 (-S gqcnn.train.precision=float32)", device.type.upper())
     # one network at a time with every thread: two 1-thread workers were slower on 2 cores (docs/results.md#benchmarks)
     with atomic_path(gqcnn_seed_dir(seed), directory=True) as folder:
         card = gqcnn_card(params.render.crop, params.render.intrinsics, params.render.viewpoints, params.grasps.gripper,

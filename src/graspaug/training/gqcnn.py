@@ -109,8 +109,9 @@ def train_gqcnn(net: GQCNN, train: GraspArrays, val: GraspArrays | None, setting
     times; ``net`` ends with the weights of the best evaluation (the last ones without ``val``).
     With ``settings.precision = "bfloat16"`` the training steps' forward and backward run in
     bfloat16 mixed precision (``torch.autocast``); the weights, the optimizer, the loss and every
-    evaluation stay float32. With ``settings.ema_decay > 0`` the evaluated and kept weights are an exponential moving
-    average of the trained ones (``torch.optim.swa_utils.AveragedModel``), updated every step.
+    evaluation stay float32. With ``settings.ema_decay > 0`` the evaluated and kept weights are
+    an exponential moving average of the trained ones (``torch.optim.swa_utils.AveragedModel``),
+    updated every step.
     ``on_log(step, metrics)`` gets the mean loss and train accuracy since the last evaluation,
     the learning rate and the validation AP / accuracy. Returns the steps, the best step, its
     validation AP and predictions (N_val,) (None without ``val``), and throughput."""
