@@ -215,6 +215,7 @@ def test_dvc_repro_gqcnn_matrix_and_report(tiny_repo):
             assert isinstance(net, GQCNNEnsemble) and len(net.members) == 2
             assert card["crop_size"] == 96 and card["intrinsics"]["fx"] == 525 and card["camera_distance"] == [0.65, 0.75]
             assert card["training_set"]["seed"] == seed and card["test_ap"] == summary["test"]["ap"]
+            assert card["training_set"]["precision"] == summary["train"]["precision"] == "bfloat16"  # the tiny profile's
             validation.setdefault(seed, set()).add(summary["validation"]["datapoints"])
         assert len(split["validation"]) == 2 and not set(split["validation"]) & set(split["base"]["6"]) and not set(split["validation"]) & set(split["real_pool"])
         assert (work / f"reports/gqcnn/validation/s{seed}.png").stat().st_size > 0

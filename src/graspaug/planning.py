@@ -68,8 +68,8 @@ class ModelCard:
     ``intrinsics`` (px) and ``camera_distance`` (m, the camera's distance to the table along
     its axis) are the training camera; ``crop_size`` → ``out_size`` (px) the crops; ``gripper``
     the hand (m); ``label_threshold`` the robust ε above which a training grasp counted as a
-    success; ``training_set`` its pool, base size, ratio, seed and size; ``validation_ap`` /
-    ``test_ap`` its Average Precision. ``assumed`` is True for a checkpoint without a card
+    success; ``training_set`` its pool, base size, ratio, seed, size, members and training
+    precision; ``validation_ap`` / ``test_ap`` its Average Precision. ``assumed`` is True for a checkpoint without a card
     (written before cards existed): the defaults are then assumed.
     """
 

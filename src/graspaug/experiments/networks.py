@@ -125,7 +125,7 @@ def train_network(job: NetworkJob, val: GraspArrays | None = None, test: GraspAr
     summary = {"pool": job.variant.pool, "base_size": job.variant.base_size, "ratio": job.variant.ratio, "seed": job.seed,
                "validation": rounded(classification_metrics(val.labels, val_p)), "test": rounded(classification_metrics(test.labels, test_p)),
                "train": {**info, "steps": fits[0]["steps"], "best_step": fits[0]["best_step"] if single else [f["best_step"] for f in fits],
-                         "batch_size": job.train.batch_size, **({} if single else {"members": len(members)})},
+                         "batch_size": job.train.batch_size, "precision": job.train.precision, **({} if single else {"members": len(members)})},
                "parameters": net.describe()["parameters"], "init_digest": init_digest, "noise_seed": job.noise_seeds[0] if single else list(job.noise_seeds)}
     folder = network_dir(job.out_dir, job.variant)
     folder.mkdir(parents=True, exist_ok=True)
