@@ -176,7 +176,7 @@ class SimParams:
     objects: tuple[str, ...] = Field(tuple(EVERYDAY_OBJECTS), description=f"Everyday objects of pybullet_data to pick (any of {', '.join(EVERYDAY_OBJECTS)}).")
     n_test_objects: int = Field(20, ge=0, description="Held-out test shapes (test split of data/shapes, a seeded choice) picked as well.")
     objects_path: str | None = Field(None, description="A folder of mesh files (.obj, .stl, .ply; one object each, named by file stem) picked as well, loaded and scaled as the corpus's shapes (ingest.surface); a broken mesh is skipped with its reason logged. Relative to the project or absolute; DVC tracks this value, not the folder's files.")
-    attempts: int = Field(2, ge=1, description="Attempts per object and arm (paper: 10); each attempt drops the object anew from a seeded pose, the same for every arm. Default: 28 objects × 2 attempts × 5 training seeds = 280 paired attempts per network arm.")
+    attempts: int = Field(2, ge=1, description="Attempts per object and arm (paper: 10); each attempt drops the object anew from a seeded pose, the same for every arm. Default: 28 objects × 2 attempts × 4 training seeds = 224 paired attempts per network arm.")
     base_size: int = Field(50, ge=2, description="Base size B of the networks compared: B-0 (before) and B at the ratio chosen on validation AP (after, and the `real` pool's network at that ratio); one of gqcnn.augment_base_sizes.")
     n_bootstrap: int = Field(2000, ge=100, description="Bootstrap resamples of the objects for the contrasts' 95% intervals.")
     n_pictures: int = Field(3, ge=0, description="Trials per arm (first attempts of the first objects) drawn with their depth image, grasp and pick frames.")
