@@ -262,6 +262,11 @@ def test_a_one_member_network_is_a_plain_gqcnn(tiny_repo, tmp_path, monkeypatch)
     folder = tmp_path / "targeted" / "6-0"
     assert isinstance(summary["train"]["best_step"], int) and isinstance(summary["noise_seed"], int) and "members" not in summary["train"]
     assert summary["init_digest"] == weights_digest(inits[0]) and not list(folder.glob("*_members.npy"))
+    from graspaug.io.checkpoints import finish_gqcnn_card
+
+    assert summary["train"]["precision"] == cfg.train.precision == "bfloat16"  # recorded for the model card
+    before = {**summary, "train": {k: v for k, v in summary["train"].items() if k != "precision"}}
+    assert finish_gqcnn_card({}, before)["training_set"]["precision"] is None  # a network from before it was recorded
     assert "member" not in pd.read_csv(folder / "history.csv").columns
     net, card = read_gqcnn(folder / "model.pt")
     assert type(net) is GQCNN and card is None

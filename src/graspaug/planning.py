@@ -69,8 +69,9 @@ class ModelCard:
     its axis) are the training camera; ``crop_size`` → ``out_size`` (px) the crops; ``gripper``
     the hand (m); ``label_threshold`` the robust ε above which a training grasp counted as a
     success; ``training_set`` its pool, base size, ratio, seed, size, members and training
-    precision; ``validation_ap`` / ``test_ap`` its Average Precision. ``assumed`` is True for a checkpoint without a card
-    (written before cards existed): the defaults are then assumed.
+    precision (None where not recorded); ``validation_ap`` / ``test_ap`` its Average Precision.
+    ``assumed`` is True for a checkpoint without a card (written before cards existed): the
+    defaults are then assumed.
     """
 
     crop_size: int = 96

@@ -79,15 +79,15 @@ def gqcnn_card(crop, intrinsics, viewpoints, gripper, label_threshold: float, gl
 
 def finish_gqcnn_card(card: dict[str, Any] | None, summary: dict[str, Any]) -> dict[str, Any] | None:
     """``card`` plus the training set (pool, base size, ratio, seed, datapoints, steps, kept step, members, and
-    ``gqcnn.train.precision`` as ``precision``) and the validation / test AP of ``summary`` (a network's
-    ``summary.json``); None stays None."""
+    ``gqcnn.train.precision`` as ``precision``: None for a summary written before it was recorded) and the
+    validation / test AP of ``summary`` (a network's ``summary.json``); None stays None."""
     if card is None:
         return None
     train = summary["train"]
     return {**card, "training_set": {"pool": summary["pool"], "base_size": summary["base_size"], "ratio": summary["ratio"],
                                      "seed": summary["seed"], "datapoints": train.get("datapoints"), "steps": train.get("steps"),
                                      "best_step": train.get("best_step"), "members": train.get("members", 1),
-                                     "precision": train.get("precision", "float32")},
+                                     "precision": train.get("precision")},
             "validation_ap": summary["validation"].get("ap"), "test_ap": summary["test"].get("ap")}
 
 
