@@ -38,12 +38,12 @@ def _load(path: Path) -> Params:
 
 def _run(stage_run, params: Params) -> None:
     from graspaug.device import keep_freed_memory
-    from graspaug.errors import CheckpointMismatch, StageError
+    from graspaug.errors import CheckpointMismatch, DataError, StageError
 
     keep_freed_memory()  # no page faults for every freed tensor (GQ-CNN training: bench/gqcnn_train_speed.py)
     try:
         stage_run(params)
-    except (StageError, CheckpointMismatch, FileNotFoundError) as exc:
+    except (StageError, DataError, CheckpointMismatch, FileNotFoundError) as exc:
         typer.echo(f"error: {exc}", err=True)
         raise typer.Exit(code=1) from None
 
