@@ -1,4 +1,5 @@
 """Shared by the bench scripts: the first N default shapes, ingested in memory with the library."""
+
 from __future__ import annotations
 
 from dataclasses import dataclass

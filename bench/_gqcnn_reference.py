@@ -2,6 +2,7 @@
 ``bench/gqcnn_train_speed.py`` only): batch 64, StepLR, torch's default threads, one network
 per process, the contiguous layout, the last step's weights; and the network's LRN as it was
 then (its power as ``pow``; ``reference_network``). The function computed is the same."""
+
 from __future__ import annotations
 
 import time
@@ -35,7 +36,12 @@ def reference_network(config) -> GQCNN:
 
 
 def normalization(train):
-    return (float(train.images.mean()), float(train.images.std()) or 1.0, float(train.z.mean()), float(train.z.std()) or 1.0)
+    return (
+        float(train.images.mean()),
+        float(train.images.std()) or 1.0,
+        float(train.z.mean()),
+        float(train.z.std()) or 1.0,
+    )
 
 
 def train_gqcnn_reference(net, train, val, settings, device, gen, on_log=None) -> dict[str, float]:
@@ -47,7 +53,9 @@ def train_gqcnn_reference(net, train, val, settings, device, gen, on_log=None) -
         raise ValueError(f"need at least 2 training datapoints, got {len(train)}")
     net.set_normalization(*normalization(train))
     net.to(device)
-    opt = torch.optim.SGD(net.parameters(), lr=settings.lr, momentum=settings.momentum, weight_decay=settings.weight_decay)
+    opt = torch.optim.SGD(
+        net.parameters(), lr=settings.lr, momentum=settings.momentum, weight_decay=settings.weight_decay
+    )
     schedule = torch.optim.lr_scheduler.StepLR(opt, step_size=settings.decay_steps, gamma=settings.lr_decay)
     images = torch.from_numpy(np.ascontiguousarray(train.images)).unsqueeze(1)
     z = torch.from_numpy(np.ascontiguousarray(train.z, dtype=np.float32))
@@ -75,7 +83,9 @@ def train_gqcnn_reference(net, train, val, settings, device, gen, on_log=None) -
             metrics = {"loss": loss_sum / seen, "train_accuracy": correct / seen, "lr": schedule.get_last_lr()[0]}
             if val is not None and len(val):
                 scores = classification_metrics(val.labels, predict(net, val, device, settings.eval_batch))
-                metrics.update(val_accuracy=scores["accuracy"], val_ap=scores["ap"] if scores["ap"] is not None else float("nan"))
+                metrics.update(
+                    val_accuracy=scores["accuracy"], val_ap=scores["ap"] if scores["ap"] is not None else float("nan")
+                )
             on_log(step, metrics)
             loss_sum, correct, seen = 0.0, 0, 0
     seconds = time.perf_counter() - start

@@ -14,6 +14,7 @@ params).
 
     python bench/gqcnn_train_speed.py [--steps 300] [--datapoints 20000] [--rounds 3]
 """
+
 from __future__ import annotations
 
 import argparse
@@ -58,8 +59,18 @@ def measure(which: str, steps: int, datapoints: int) -> dict:
         sys.path.insert(0, str(Path(__file__).parent))
         from _gqcnn_reference import reference_network, train_gqcnn_reference
 
-        settings = SimpleNamespace(steps=steps, batch_size=64, lr=0.01, momentum=0.9, weight_decay=5e-4, lr_decay=0.95, decay_steps=100,
-                                   log_every=steps, eval_batch=128, noise=NoiseSettings())
+        settings = SimpleNamespace(
+            steps=steps,
+            batch_size=64,
+            lr=0.01,
+            momentum=0.9,
+            weight_decay=5e-4,
+            lr_decay=0.95,
+            decay_steps=100,
+            log_every=steps,
+            eval_batch=128,
+            noise=NoiseSettings(),
+        )
         net, batch = reference_network(GQCNNConfig()), 64
         start = time.perf_counter()
         train_gqcnn_reference(net, train, None, settings, torch.device("cpu"), gen)
@@ -73,8 +84,12 @@ def measure(which: str, steps: int, datapoints: int) -> dict:
         start = time.perf_counter()
         train_gqcnn(net, train, None, settings, torch.device("cpu"), gen, progress=False)
     seconds = time.perf_counter() - start
-    return {"samples_per_second": steps * batch / seconds, "faults_per_step": (resource.getrusage(resource.RUSAGE_SELF).ru_minflt - faults) / steps,
-            "threads": torch.get_num_threads(), "parameters": sum(p.numel() for p in net.parameters())}
+    return {
+        "samples_per_second": steps * batch / seconds,
+        "faults_per_step": (resource.getrusage(resource.RUSAGE_SELF).ru_minflt - faults) / steps,
+        "threads": torch.get_num_threads(),
+        "parameters": sum(p.numel() for p in net.parameters()),
+    }
 
 
 def same_function() -> None:
@@ -97,8 +112,21 @@ def same_function() -> None:
 
 
 def run(which: str, args) -> dict:
-    out = subprocess.run([sys.executable, __file__, "--measure", which, "--steps", str(args.steps), "--datapoints", str(args.datapoints)],
-                         check=True, capture_output=True, text=True)
+    out = subprocess.run(
+        [
+            sys.executable,
+            __file__,
+            "--measure",
+            which,
+            "--steps",
+            str(args.steps),
+            "--datapoints",
+            str(args.datapoints),
+        ],
+        check=True,
+        capture_output=True,
+        text=True,
+    )
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 
@@ -118,11 +146,13 @@ def main() -> None:
     from graspaug.device import has_native_bfloat16
 
     bf16 = "with" if has_native_bfloat16(torch.device("cpu")) else "WITHOUT (bfloat16 is emulated, slow)"
-    print(f"{args.datapoints} datapoints, {args.steps} steps per network, {os.cpu_count()} cores {bf16} bfloat16 instructions, "
-          f"{args.rounds} rounds, one fresh process per run")
+    print(
+        f"{args.datapoints} datapoints, {args.steps} steps per network, {os.cpu_count()} cores {bf16} bfloat16 instructions, "
+        f"{args.rounds} rounds, one fresh process per run"
+    )
     ratios: dict[str, list[float]] = {"float32": [], "bfloat16": []}
     for r in range(args.rounds):
-        order = LOOPS[r % 3:] + LOOPS[:r % 3]
+        order = LOOPS[r % 3 :] + LOOPS[: r % 3]
         got = {which: run(which, args) for which in order}
         ref = got["reference"]
         line = f"round {r + 1}: reference (batch 64, {ref['threads']} threads) {ref['samples_per_second']:6.0f} samples/s, {ref['faults_per_step']:4.0f} page faults/step"
@@ -131,7 +161,9 @@ def main() -> None:
             line += f"; current {precision} {got[precision]['samples_per_second']:6.0f} ({got[precision]['faults_per_step']:4.0f}): {ratios[precision][-1]:.2f}x"
         print(line, flush=True)
     for precision, values in ratios.items():
-        print(f"current loop, {precision}: median ratio over {args.rounds} rounds {np.median(values):.2f}x (rounds: {', '.join(f'{x:.2f}' for x in values)})")
+        print(
+            f"current loop, {precision}: median ratio over {args.rounds} rounds {np.median(values):.2f}x (rounds: {', '.join(f'{x:.2f}' for x in values)})"
+        )
 
 
 if __name__ == "__main__":

@@ -14,20 +14,20 @@ and ε alone), the speed ratio, and the largest difference of ε and of robust �
 
     python bench/grasp_quality_speed.py --grasps 2000
 """
+
 from __future__ import annotations
 
 import argparse
 import time
 
 import numpy as np
+from _corpus import default_shapes
 
 from graspaug.config import GraspsParams
 from graspaug.grasping.antipodal import sample_antipodal_grasps
 from graspaug.grasping.quality import ferrari_canny, ferrari_canny_qhull
 from graspaug.grasping.robust import robust_ferrari_canny
 from graspaug.rng import shape_rng
-
-from _corpus import default_shapes
 
 
 class Timed:
@@ -65,22 +65,40 @@ def main() -> None:
         grasps = grasps.take(np.arange(min(len(grasps), args.grasps - total)))
         jobs.append((shape, grasps))
         total += len(grasps)
-    print(f"{total} grasps on {len(jobs)} default shapes, {noise.n_samples} perturbed samples each ({total * noise.n_samples} wrench sets)")
+    print(
+        f"{total} grasps on {len(jobs)} default shapes, {noise.n_samples} perturbed samples each ({total * noise.n_samples} wrench sets)"
+    )
 
     ferrari_canny(np.zeros((1, 2 * cfg.quality.cone_faces + 4, 6)))  # compile (cached on disk) before timing
     results = {}
     for name, fn in (("plain qhull loop", qhull_loop), ("ours", ferrari_canny)):
         timed = Timed(fn)
         start = time.perf_counter()
-        robust = [robust_ferrari_canny(s.mesh, g.center, g.axis, hand, quality, noise, shape_rng(args.seed + 1, s.shape_id), epsilon=timed)[0] for s, g in jobs]
-        results[name] = (time.perf_counter() - start, timed.seconds, np.concatenate(robust), np.concatenate(timed.values))
-        print(f"{name:>16}: robust ε in {results[name][0]:7.2f} s, of which ε {timed.seconds:7.2f} s "
-              f"({1e6 * timed.seconds / len(results[name][3]):.0f} µs per wrench set, {len(results[name][3])} not slipping)")
+        robust = [
+            robust_ferrari_canny(
+                s.mesh, g.center, g.axis, hand, quality, noise, shape_rng(args.seed + 1, s.shape_id), epsilon=timed
+            )[0]
+            for s, g in jobs
+        ]
+        results[name] = (
+            time.perf_counter() - start,
+            timed.seconds,
+            np.concatenate(robust),
+            np.concatenate(timed.values),
+        )
+        print(
+            f"{name:>16}: robust ε in {results[name][0]:7.2f} s, of which ε {timed.seconds:7.2f} s "
+            f"({1e6 * timed.seconds / len(results[name][3]):.0f} µs per wrench set, {len(results[name][3])} not slipping)"
+        )
     (t_ref, e_ref, robust_ref, eps_ref), (t_ours, e_ours, robust_ours, eps_ours) = results.values()
     print(f"speed ratio: {t_ref / t_ours:.1f}x on the whole robust metric, {e_ref / e_ours:.1f}x on ε alone")
-    print(f"largest difference: ε {np.abs(eps_ref - eps_ours).max():.2e}, robust ε {np.abs(robust_ref - robust_ours).max():.2e}")
-    print(f"robust ε > {cfg.threshold}: {np.mean(robust_ours > cfg.threshold):.1%} of grasps (same label for "
-          f"{np.mean((robust_ours > cfg.threshold) == (robust_ref > cfg.threshold)):.2%})")
+    print(
+        f"largest difference: ε {np.abs(eps_ref - eps_ours).max():.2e}, robust ε {np.abs(robust_ref - robust_ours).max():.2e}"
+    )
+    print(
+        f"robust ε > {cfg.threshold}: {np.mean(robust_ours > cfg.threshold):.1%} of grasps (same label for "
+        f"{np.mean((robust_ours > cfg.threshold) == (robust_ref > cfg.threshold)):.2%})"
+    )
 
 
 if __name__ == "__main__":

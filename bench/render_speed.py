@@ -17,6 +17,7 @@ the same shapes against ``trimesh.poses.compute_stable_poses`` (the reference th
 
     python bench/render_speed.py --shapes 20
 """
+
 from __future__ import annotations
 
 import argparse
@@ -24,6 +25,7 @@ import time
 
 import numpy as np
 import trimesh
+from _corpus import default_shapes
 
 from graspaug.config import GraspsParams, RenderParams
 from graspaug.grasping.antipodal import sample_antipodal_grasps
@@ -33,8 +35,6 @@ from graspaug.render.depth import render_depth
 from graspaug.render.pybullet_depth import PybulletDepthScene
 from graspaug.render.stable_poses import stable_poses
 from graspaug.rng import shape_rng
-
-from _corpus import default_shapes
 
 
 def main() -> None:
@@ -49,18 +49,36 @@ def main() -> None:
     jobs = []
     for shape in shapes:
         grasps = sample_antipodal_grasps(shape.mesh, hand, grasp_cfg.sampler, shape_rng(args.seed, shape.shape_id))
-        scenes, _ = plan_scenes(shape.mesh, grasps.center, grasps.axis, hand.max_width, settings, shape_rng(args.seed, shape.shape_id, "render"))
+        scenes, _ = plan_scenes(
+            shape.mesh,
+            grasps.center,
+            grasps.axis,
+            hand.max_width,
+            settings,
+            shape_rng(args.seed, shape.shape_id, "render"),
+        )
         jobs += [(shape.mesh, scene) for scene in scenes]
     n_grasps = sum(len(scene.grasp_index) for _, scene in jobs)
-    print(f"{len(shapes)} shapes, {len(jobs)} scenes, {n_grasps} crops ({settings.intrinsics.width}x{settings.intrinsics.height}, "
-          f"{settings.crop.crop_size}->{settings.crop.out_size} px)")
+    print(
+        f"{len(shapes)} shapes, {len(jobs)} scenes, {n_grasps} crops ({settings.intrinsics.width}x{settings.intrinsics.height}, "
+        f"{settings.crop.crop_size}->{settings.crop.out_size} px)"
+    )
 
     def grasp_pixels(scene):
         return np.stack([scene.image["center_u"], scene.image["center_v"]], axis=1), scene.image["angle"]
 
     for shape in shapes:
-        shape.mesh.ray.intersects_first(np.zeros((1, 3)), np.ones((1, 3)))  # embree's build per mesh (set-up), not timed
-    crops_by_ray_casting(jobs[0][0], jobs[0][1].camera, settings.intrinsics, *grasp_pixels(jobs[0][1]), settings.crop, pose=jobs[0][1].pose)
+        shape.mesh.ray.intersects_first(
+            np.zeros((1, 3)), np.ones((1, 3))
+        )  # embree's build per mesh (set-up), not timed
+    crops_by_ray_casting(
+        jobs[0][0],
+        jobs[0][1].camera,
+        settings.intrinsics,
+        *grasp_pixels(jobs[0][1]),
+        settings.crop,
+        pose=jobs[0][1].pose,
+    )
 
     reference, reference_time = [], 0.0
     with PybulletDepthScene() as pybullet_scene:
@@ -77,7 +95,9 @@ def main() -> None:
     ours, ours_time, rays = [], 0.0, 0
     for mesh, scene in jobs:
         start = time.perf_counter()
-        crops, n_rays = crops_by_ray_casting(mesh, scene.camera, settings.intrinsics, *grasp_pixels(scene), settings.crop, pose=scene.pose)
+        crops, n_rays = crops_by_ray_casting(
+            mesh, scene.camera, settings.intrinsics, *grasp_pixels(scene), settings.crop, pose=scene.pose
+        )
         ours_time += time.perf_counter() - start
         ours.append(crops)
         rays += n_rays
@@ -88,14 +108,25 @@ def main() -> None:
     start = time.perf_counter()
     got = [stable_poses(shape.mesh) for shape in shapes]
     poses_time = time.perf_counter() - start
-    same = all(len(g) == len(p) and np.allclose(np.sort(g.probabilities), np.sort(p), atol=1e-12) for g, (_, p) in zip(got, expected))
+    same = all(
+        len(g) == len(p) and np.allclose(np.sort(g.probabilities), np.sort(p), atol=1e-12)
+        for g, (_, p) in zip(got, expected)
+    )
 
     raycast_reference, table_only = [], []
     for mesh, scene in jobs:
         moved = mesh.copy()
         moved.apply_transform(scene.pose)
-        raycast_reference.append(crops_from_depth_image(render_depth(moved, scene.camera, settings.intrinsics), *grasp_pixels(scene), settings.crop))
-        table_only.append(crops_from_depth_image(render_depth(None, scene.camera, settings.intrinsics), *grasp_pixels(scene), settings.crop))
+        raycast_reference.append(
+            crops_from_depth_image(
+                render_depth(moved, scene.camera, settings.intrinsics), *grasp_pixels(scene), settings.crop
+            )
+        )
+        table_only.append(
+            crops_from_depth_image(
+                render_depth(None, scene.camera, settings.intrinsics), *grasp_pixels(scene), settings.crop
+            )
+        )
     ours_all, pybullet_all = np.concatenate(ours), np.concatenate(reference)
     raycast_all, table_all = np.concatenate(raycast_reference), np.concatenate(table_only)
     # table pixels: where no object pixel is within one output pixel (in our crops)
@@ -104,17 +135,25 @@ def main() -> None:
     object_mask = np.abs(ours_all - table_all) > 1e-9
     table_mask = ~ndimage.binary_dilation(object_mask, structure=np.ones((1, 3, 3), bool))
 
-    print(f"full-image reference (TinyRenderer + rotate/crop/resize): {reference_time:.2f} s ({1e3 * reference_time / len(jobs):.1f} ms per scene)")
-    print(f"ours (ray-cast crops): {ours_time:.2f} s ({1e3 * ours_time / len(jobs):.2f} ms per scene, {rays / n_grasps:.0f} rays per crop "
-          f"vs {settings.intrinsics.width * settings.intrinsics.height / (n_grasps / len(jobs)):.0f} pixels per crop for a full image)")
+    print(
+        f"full-image reference (TinyRenderer + rotate/crop/resize): {reference_time:.2f} s ({1e3 * reference_time / len(jobs):.1f} ms per scene)"
+    )
+    print(
+        f"ours (ray-cast crops): {ours_time:.2f} s ({1e3 * ours_time / len(jobs):.2f} ms per scene, {rays / n_grasps:.0f} rays per crop "
+        f"vs {settings.intrinsics.width * settings.intrinsics.height / (n_grasps / len(jobs)):.0f} pixels per crop for a full image)"
+    )
     print(f"speed ratio: {reference_time / ours_time:.1f}x (target >= 20x)")
     diff = np.abs(ours_all - pybullet_all)
-    print(f"vs TinyRenderer crops: mean |diff| {1e3 * diff.mean():.3f} mm (target <= 1 mm), table pixels max {1e3 * diff[table_mask].max():.4f} mm "
-          f"({table_mask.mean():.0%} of pixels; target <= 0.1 mm)")
+    print(
+        f"vs TinyRenderer crops: mean |diff| {1e3 * diff.mean():.3f} mm (target <= 1 mm), table pixels max {1e3 * diff[table_mask].max():.4f} mm "
+        f"({table_mask.mean():.0%} of pixels; target <= 0.1 mm)"
+    )
     diff = np.abs(ours_all - raycast_all)
     print(f"vs full ray-cast crops: mean |diff| {1e3 * diff.mean():.2e} mm, max {1e3 * diff.max():.2e} mm")
-    print(f"stable poses of the {len(shapes)} shapes: trimesh {trimesh_time:.2f} s, ours {poses_time:.3f} s, {trimesh_time / poses_time:.0f}x; "
-          f"same poses and probabilities: {same}")
+    print(
+        f"stable poses of the {len(shapes)} shapes: trimesh {trimesh_time:.2f} s, ours {poses_time:.3f} s, {trimesh_time / poses_time:.0f}x; "
+        f"same poses and probabilities: {same}"
+    )
 
 
 if __name__ == "__main__":

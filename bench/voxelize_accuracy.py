@@ -7,18 +7,18 @@ outer surface that ingest rebuilds. Prints mean / min / percentiles of IoU.
 
     python bench/voxelize_accuracy.py --n 1000 --resolution 64
 """
+
 from __future__ import annotations
 
 import argparse
 import time
 
 import numpy as np
+from _corpus import default_shapes
 from joblib import Parallel, delayed
 
 from graspaug.geometry.solid import union_contains
 from graspaug.geometry.voxelize import fit_grid, iou, voxelize_solid
-
-from _corpus import default_shapes
 
 
 def shape_iou(shape, resolution: int) -> float:
@@ -41,8 +41,10 @@ def main() -> None:
     ious = np.array(Parallel(n_jobs=args.n_jobs)(delayed(shape_iou)(s, args.resolution) for s in shapes))
     worst = np.argsort(ious)[:5]
     print(f"shapes: {len(shapes)} (ingested in {t1 - t0:.1f} s), resolution {args.resolution}³")
-    print(f"IoU vs half-space reference: mean {ious.mean():.4f}, median {np.median(ious):.4f}, "
-          f"p5 {np.percentile(ious, 5):.4f}, min {ious.min():.4f}; share >= 0.97: {(ious >= 0.97).mean():.3f}")
+    print(
+        f"IoU vs half-space reference: mean {ious.mean():.4f}, median {np.median(ious):.4f}, "
+        f"p5 {np.percentile(ious, 5):.4f}, min {ious.min():.4f}; share >= 0.97: {(ious >= 0.97).mean():.3f}"
+    )
     print("worst: " + ", ".join(f"{shapes[i].shape_id} {ious[i]:.3f}" for i in worst))
 
 

@@ -10,17 +10,17 @@ half-space reference of the source's convex parts.
 
     python bench/voxelize_speed.py --n 100 --resolution 64
 """
+
 from __future__ import annotations
 
 import argparse
 import time
 
 import numpy as np
+from _corpus import default_shapes
 
 from graspaug.geometry.solid import union_contains
 from graspaug.geometry.voxelize import fit_grid, iou, voxelize_solid
-
-from _corpus import default_shapes
 
 
 def trimesh_at(vg, grid) -> np.ndarray:
@@ -53,17 +53,23 @@ def main() -> None:
     t_ref = time.perf_counter() - t0
 
     theirs = [trimesh_at(vg, g) for vg, g in zip(ref, grids)]
-    refs = [union_contains(s.parts, g.centers().reshape(-1, 3)).reshape(o.shape) for s, g, o in zip(shapes, grids, ours)]
+    refs = [
+        union_contains(s.parts, g.centers().reshape(-1, 3)).reshape(o.shape) for s, g, o in zip(shapes, grids, ours)
+    ]
     ious = np.array([iou(o, t) for o, t in zip(ours, theirs)])
     ours_ref = np.array([iou(o, r) for o, r in zip(ours, refs)])
     theirs_ref = np.array([iou(t, r) for t, r in zip(theirs, refs)])
-    print(f"{len(shapes)} default shapes at {args.resolution}³ (median {int(np.median([len(s.mesh.faces) for s in shapes]))} faces), one process")
+    print(
+        f"{len(shapes)} default shapes at {args.resolution}³ (median {int(np.median([len(s.mesh.faces) for s in shapes]))} faces), one process"
+    )
     print(f"trimesh voxelized(pitch).fill(): {t_ref:.2f} s ({1000 * t_ref / len(shapes):.1f} ms/shape)")
     print(f"graspaug voxelize_solid:        {t_ours:.3f} s ({1000 * t_ours / len(shapes):.2f} ms/shape)")
     print(f"speed ratio: {t_ref / t_ours:.1f}x")
     print(f"IoU ours vs trimesh: mean {ious.mean():.4f}, min {ious.min():.4f}")
-    print(f"IoU vs the half-space reference (source convex parts): ours mean {ours_ref.mean():.4f} (min {ours_ref.min():.4f}), "
-          f"trimesh mean {theirs_ref.mean():.4f} (min {theirs_ref.min():.4f})")
+    print(
+        f"IoU vs the half-space reference (source convex parts): ours mean {ours_ref.mean():.4f} (min {ours_ref.min():.4f}), "
+        f"trimesh mean {theirs_ref.mean():.4f} (min {theirs_ref.min():.4f})"
+    )
 
 
 if __name__ == "__main__":

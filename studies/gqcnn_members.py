@@ -15,6 +15,7 @@ against its members' mean. Run where ``dvc repro train_gqcnn`` has run with thes
 
 Members M … K−1 cost (K−M) / M times ``train_gqcnn``'s time (one network at a time, every thread).
 """
+
 from __future__ import annotations
 
 import argparse
@@ -27,31 +28,47 @@ from sklearn.metrics import average_precision_score
 
 from graspaug.config import load_params
 from graspaug.experiments.ap import choose_ratios, declared_contrasts
-from graspaug.experiments.networks import NetworkJob, initial_weights, members_digest, network_dir, seed_members, seed_variants, stream_seeds, train_network
+from graspaug.experiments.networks import (
+    NetworkJob,
+    initial_weights,
+    members_digest,
+    network_dir,
+    seed_members,
+    seed_variants,
+    stream_seeds,
+    train_network,
+)
 from graspaug.experiments.stats import t_interval
-from graspaug.paths import gqcnn_seed_dir
-from graspaug.training.gqcnn_data import load_split, shapes_datapoints, test_set
+from graspaug.io.tables import read_table
+from graspaug.paths import SHAPES_TABLE, gqcnn_dir, gqcnn_seed_dir
+from graspaug.training.gqcnn_data import Corpora, load_split, shapes_datapoints, test_set
 
 
-def train_members(params, split, variants, val, test, members: int, out: Path) -> None:
+def train_members(params, split, variants, val, test, members: int, out: Path, corpora: Corpora) -> None:
     """Members ``gqcnn.members`` … ``members``−1 of every network (``variants``) of every seed, one
-    at a time (skipping those on disk); ``val`` / ``test``: the experiment's datapoints."""
+    at a time (skipping those on disk); ``val`` / ``test``: the experiment's datapoints, read from ``corpora``."""
     cfg = params.gqcnn
     for seed in cfg.seeds:
         expected = members_digest(seed_members(cfg.net, params.seed, seed, cfg.members)[0])
         for v in variants:  # members 0 … M−1 must be the pipeline's
             saved = json.loads((network_dir(gqcnn_seed_dir(seed), v) / "summary.json").read_text())["init_digest"]
             if saved != expected:
-                raise SystemExit(f"models/gqcnn/s{seed}/{v.name} was not trained with these params' members: rerun `dvc repro train_gqcnn`")
+                raise SystemExit(
+                    f"models/gqcnn/s{seed}/{v.name} was not trained with these params' members: rerun `dvc repro train_gqcnn`"
+                )
         for m in range(cfg.members, members):
             weight_seed, noise_seed = stream_seeds(params.seed, seed, m)
             init, folder = initial_weights(cfg.net, weight_seed), out / f"s{seed}" / f"m{m}"
             for v in variants:
                 if (network_dir(folder, v) / "summary.json").exists():
                     continue
-                r = train_network(NetworkJob(v, split, cfg.net, cfg.train, (init,), (noise_seed,), seed, "cpu", folder), val, test)
-                print(f"  s{seed} m{m} {v.name}: validation AP {r['validation']['ap']:.4f}, test AP {r['test']['ap']:.4f} "
-                      f"({r['train_seconds']:.0f} s)", flush=True)
+                job = NetworkJob(v, split, cfg.net, cfg.train, (init,), (noise_seed,), seed, "cpu", folder, corpora)
+                r = train_network(job, val, test)
+                print(
+                    f"  s{seed} m{m} {v.name}: validation AP {r['validation']['ap']:.4f}, test AP {r['test']['ap']:.4f} "
+                    f"({r['train_seconds']:.0f} s)",
+                    flush=True,
+                )
 
 
 def member_predictions(seed: int, m: int, v, kind: str, out: Path, pipeline_members: int) -> np.ndarray:
@@ -59,7 +76,11 @@ def member_predictions(seed: int, m: int, v, kind: str, out: Path, pipeline_memb
     if m >= pipeline_members:
         return np.load(network_dir(out / f"s{seed}" / f"m{m}", v) / f"{kind}_predictions.npy")
     folder = network_dir(gqcnn_seed_dir(seed), v)
-    return np.load(folder / f"{kind}_predictions.npy") if pipeline_members == 1 else np.load(folder / f"{kind}_predictions_members.npy")[m]
+    return (
+        np.load(folder / f"{kind}_predictions.npy")
+        if pipeline_members == 1
+        else np.load(folder / f"{kind}_predictions_members.npy")[m]
+    )
 
 
 def main() -> None:
@@ -71,10 +92,11 @@ def main() -> None:
     cfg, gen = params.gqcnn, params.generate
     if args.members < cfg.members:
         parser.error(f"--members {args.members} is below gqcnn.members ({cfg.members}) of params.yaml")
-    split = load_split(list(gen.base_sizes), cfg.val_shapes, params.seed)
+    corpora = Corpora(gqcnn_dir("original"), {b: gqcnn_dir(f"gen_{b}") for b in cfg.augment_base_sizes})
+    split = load_split(corpora.original, read_table(SHAPES_TABLE), list(gen.base_sizes), cfg.val_shapes, params.seed)
     variants = seed_variants(gen.base_sizes, gen.ratios, cfg.augment_base_sizes, cfg.ceiling)
-    val, test = shapes_datapoints(split.validation)[0], test_set()[0]  # read once
-    train_members(params, split, variants, val, test, args.members, args.out)
+    val, test = shapes_datapoints(corpora.original, split.validation)[0], test_set(corpora.original)[0]  # read once
+    train_members(params, split, variants, val, test, args.members, args.out, corpora)
     val_labels, test_labels = val.labels, test.labels
     rows = []
     for seed in cfg.seeds:
@@ -82,10 +104,18 @@ def main() -> None:
             val_p = [member_predictions(seed, m, v, "val", args.out, cfg.members) for m in range(args.members)]
             test_p = [member_predictions(seed, m, v, "test", args.out, cfg.members) for m in range(args.members)]
             for k in range(1, args.members + 1):
-                rows.append({"pool": v.pool, "base_size": v.base_size, "ratio": float(v.ratio), "seed": seed, "members": k,
-                             "val_ap": average_precision_score(val_labels, np.mean(val_p[:k], axis=0)),
-                             "test_ap": average_precision_score(test_labels, np.mean(test_p[:k], axis=0)),
-                             "member_test_ap": average_precision_score(test_labels, test_p[k - 1])})
+                rows.append(
+                    {
+                        "pool": v.pool,
+                        "base_size": v.base_size,
+                        "ratio": float(v.ratio),
+                        "seed": seed,
+                        "members": k,
+                        "val_ap": average_precision_score(val_labels, np.mean(val_p[:k], axis=0)),
+                        "test_ap": average_precision_score(test_labels, np.mean(test_p[:k], axis=0)),
+                        "member_test_ap": average_precision_score(test_labels, test_p[k - 1]),
+                    }
+                )
     table = pd.DataFrame(rows)
     args.out.mkdir(parents=True, exist_ok=True)
     table.to_csv(args.out / "ap_by_members.csv", index=False)
@@ -100,8 +130,13 @@ def main() -> None:
             print(f"k = {k}  {c.name:30s} {fmt(t_interval(per_seed)):32s} SD {np.std(per_seed, ddof=1):.4f}")
     print("\nnetwork test AP by k: ensemble mean over seeds (SD over seeds); the k-th member alone (mean over seeds)")
     for (pool, base, ratio), g in table.groupby(["pool", "base_size", "ratio"], sort=False):
-        cells = [f"k={k}: {g[g.members == k].test_ap.mean():.4f} ({g[g.members == k].test_ap.std():.4f})" for k in range(1, args.members + 1)]
-        print(f"{pool:9s} {base:4d}-{ratio:g}  " + "  ".join(cells) + f"  | members alone {g.member_test_ap.mean():.4f}")
+        cells = [
+            f"k={k}: {g[g.members == k].test_ap.mean():.4f} ({g[g.members == k].test_ap.std():.4f})"
+            for k in range(1, args.members + 1)
+        ]
+        print(
+            f"{pool:9s} {base:4d}-{ratio:g}  " + "  ".join(cells) + f"  | members alone {g.member_test_ap.mean():.4f}"
+        )
 
 
 if __name__ == "__main__":

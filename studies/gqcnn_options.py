@@ -11,6 +11,7 @@ default params (it reads ``data/shapes.parquet`` and ``data/gqcnn/original``):
 
 The training budget is the params' (``gqcnn.train``): set it in params.yaml first.
 """
+
 from __future__ import annotations
 
 import argparse
@@ -23,9 +24,12 @@ import torch
 from graspaug.config import Params
 from graspaug.experiments.networks import initial_weights, stream_seeds
 from graspaug.experiments.stats import t_interval
+from graspaug.experiments.variants import Variant
+from graspaug.io.tables import read_table
 from graspaug.nets.gqcnn import GQCNN
+from graspaug.paths import SHAPES_TABLE, gqcnn_dir
 from graspaug.training.gqcnn import classification_metrics, predict, train_gqcnn
-from graspaug.training.gqcnn_data import Variant, load_split, shapes_datapoints, training_set
+from graspaug.training.gqcnn_data import Corpora, load_split, shapes_datapoints, training_set
 
 OPTIONS = {  # name → (changes to gqcnn.net, changes to gqcnn.train); the first is the params' own
     "params as they are": ({}, {}),
@@ -53,16 +57,24 @@ def main() -> None:
     parser.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2])
     parser.add_argument("--base-sizes", type=int, nargs="+", default=[50, 200])
     parser.add_argument("--threads", type=int, default=torch.get_num_threads())
-    parser.add_argument("--options", nargs="+", default=list(OPTIONS), help="Which options, by name (the first is the reference).")
+    parser.add_argument(
+        "--options", nargs="+", default=list(OPTIONS), help="Which options, by name (the first is the reference)."
+    )
     args = parser.parse_args()
     torch.set_num_threads(args.threads)
     params = Params()
     cfg = params.gqcnn
-    split = load_split(list(params.generate.base_sizes), cfg.val_shapes, params.seed)
-    val, _ = shapes_datapoints(split.validation)
-    sets = {b: training_set(Variant("targeted", b, 0.0), split)[0] for b in args.base_sizes}
-    print(f"validation: {len(split.validation)} shapes, {len(val)} datapoints; training sets: "
-          + ", ".join(f"B = {b}: {len(d)}" for b, d in sets.items()) + f"; seeds {args.seeds}; {args.threads} threads")
+    corpora = Corpora(gqcnn_dir("original"))
+    split = load_split(
+        corpora.original, read_table(SHAPES_TABLE), list(params.generate.base_sizes), cfg.val_shapes, params.seed
+    )
+    val, _ = shapes_datapoints(corpora.original, split.validation)
+    sets = {b: training_set(Variant("targeted", b, 0.0), split, corpora)[0] for b in args.base_sizes}
+    print(
+        f"validation: {len(split.validation)} shapes, {len(val)} datapoints; training sets: "
+        + ", ".join(f"B = {b}: {len(d)}" for b, d in sets.items())
+        + f"; seeds {args.seeds}; {args.threads} threads"
+    )
     val_ap: dict = {}
     speed: dict = {}
     options = {name: OPTIONS[name] for name in args.options}
@@ -75,25 +87,50 @@ def main() -> None:
                 net = GQCNN(net_cfg)
                 net.load_state_dict(init)
                 start = time.perf_counter()
-                fit = train_gqcnn(net, train, val, train_cfg, torch.device("cpu"), torch.Generator().manual_seed(noise_seed), progress=False)
+                fit = train_gqcnn(
+                    net,
+                    train,
+                    val,
+                    train_cfg,
+                    torch.device("cpu"),
+                    torch.Generator().manual_seed(noise_seed),
+                    progress=False,
+                )
                 speed.setdefault(name, []).append(fit["steps"] * train_cfg.batch_size / (time.perf_counter() - start))
-                val_ap[name, b, seed] = classification_metrics(val.labels, predict(net, val, torch.device("cpu"), cfg.train.eval_batch))["ap"]
-                print(f"  {name:38s} B = {b:4d} seed {seed}: validation AP {val_ap[name, b, seed]:.4f} ({fit['steps']} steps, kept {fit['best_step']})", flush=True)
+                val_ap[name, b, seed] = classification_metrics(
+                    val.labels, predict(net, val, torch.device("cpu"), cfg.train.eval_batch)
+                )["ap"]
+                print(
+                    f"  {name:38s} B = {b:4d} seed {seed}: validation AP {val_ap[name, b, seed]:.4f} ({fit['steps']} steps, kept {fit['best_step']})",
+                    flush=True,
+                )
     default = next(iter(options))
-    fmt = lambda t: f"{t['mean']:+.4f} [{t['ci_low']:+.4f}, {t['ci_high']:+.4f}]" if t["ci_low"] is not None else f"{t['mean']:+.4f}"  # noqa: E731
-    print("\noption                                 B     validation AP (95% t)          vs default (paired, 95% t)      samples/s")
+    fmt = lambda t: (
+        f"{t['mean']:+.4f} [{t['ci_low']:+.4f}, {t['ci_high']:+.4f}]"
+        if t["ci_low"] is not None
+        else f"{t['mean']:+.4f}"
+    )  # noqa: E731
+    print(
+        "\noption                                 B     validation AP (95% t)          vs default (paired, 95% t)      samples/s"
+    )
     for name in options:
         for b in args.base_sizes:
             own = t_interval([val_ap[name, b, s] for s in args.seeds])
             diff = t_interval([val_ap[name, b, s] - val_ap[default, b, s] for s in args.seeds])
-            print(f"{name:38s} {b:4d}  {fmt(own):30s} {fmt(diff) if name != default else '':30s} {np.median(speed[name]):8.0f}")
+            print(
+                f"{name:38s} {b:4d}  {fmt(own):30s} {fmt(diff) if name != default else '':30s} {np.median(speed[name]):8.0f}"
+            )
     if len(args.base_sizes) > 1:  # the positive control on validation: largest minus smallest base set, per seed
         small, large = min(args.base_sizes), max(args.base_sizes)
-        print(f"\noption                                 validation AP(B = {large}) - AP(B = {small}): mean [95% t], SD over seeds")
+        print(
+            f"\noption                                 validation AP(B = {large}) - AP(B = {small}): mean [95% t], SD over seeds"
+        )
         for name in options:
             gains = [val_ap[name, large, s] - val_ap[name, small, s] for s in args.seeds]
-            print(f"{name:38s} {fmt(t_interval(gains)):30s} SD {np.std(gains, ddof=1) if len(gains) > 1 else float('nan'):.4f}  "
-                  f"SD of AP(B = {small}) {np.std([val_ap[name, small, s] for s in args.seeds], ddof=1) if len(args.seeds) > 1 else float('nan'):.4f}")
+            print(
+                f"{name:38s} {fmt(t_interval(gains)):30s} SD {np.std(gains, ddof=1) if len(gains) > 1 else float('nan'):.4f}  "
+                f"SD of AP(B = {small}) {np.std([val_ap[name, small, s] for s in args.seeds], ddof=1) if len(args.seeds) > 1 else float('nan'):.4f}"
+            )
 
 
 if __name__ == "__main__":

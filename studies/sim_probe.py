@@ -16,6 +16,7 @@ physically plausible setting separates the arms. Run it in a project where
 the missing networks are trained there first with the default ``gqcnn`` params, as
 ``train_gqcnn`` trains them.
 """
+
 from __future__ import annotations
 
 import argparse
@@ -29,34 +30,55 @@ import pandas as pd
 import yaml
 
 from graspaug.config import Params
+from graspaug.experiments.sim import object_jobs, prepare_objects, run_object, test_shape_ids
+from graspaug.experiments.sim_report import rate_summary, trial_contrast
 from graspaug.io.tables import read_table
 from graspaug.parallel import parallel_map
-from graspaug.paths import SHAPES_DIR, SHAPES_TABLE
-from graspaug.sim.analysis import paired_contrast, rate_summary
-from graspaug.sim.experiment import object_jobs, prepare_objects, run_object, test_shape_ids
+from graspaug.paths import SHAPES_DIR, SHAPES_TABLE, gqcnn_dir
 
 
 def train_before(models: Path, seeds: list[int], base_size: int, params: Params) -> None:
     """Train the targeted B-0 network of every seed that ``models`` lacks."""
-    from graspaug.experiments.networks import NetworkJob, Variant, initial_weights, stream_seeds, train_network
+    from graspaug.experiments.networks import NetworkJob, initial_weights, stream_seeds, train_network
+    from graspaug.experiments.variants import Variant
     from graspaug.io.checkpoints import gqcnn_card
-    from graspaug.training.gqcnn_data import load_split, shapes_datapoints, test_set
+    from graspaug.training.gqcnn_data import Corpora, load_split, shapes_datapoints, test_set
 
     missing = [s for s in seeds if not (models / f"s{s}/targeted/{base_size}-0/model.pt").exists()]
     if not missing:
         return
     cfg = params.gqcnn
-    split = load_split(list(params.generate.base_sizes), cfg.val_shapes, params.seed)
-    val, _ = shapes_datapoints(split.validation)
-    test, _ = test_set()
-    card = gqcnn_card(params.render.crop, params.render.intrinsics, params.render.viewpoints, params.grasps.gripper,
-                      params.grasps.threshold, params.seed)
+    corpora = Corpora(gqcnn_dir("original"))
+    split = load_split(
+        corpora.original, read_table(SHAPES_TABLE), list(params.generate.base_sizes), cfg.val_shapes, params.seed
+    )
+    val, _ = shapes_datapoints(corpora.original, split.validation)
+    test, _ = test_set(corpora.original)
+    card = gqcnn_card(
+        params.render.crop,
+        params.render.intrinsics,
+        params.render.viewpoints,
+        params.grasps.gripper,
+        params.grasps.threshold,
+        params.seed,
+    )
     for seed in missing:
         weight_seed, noise_seed = stream_seeds(params.seed, seed)
         folder = models / f"s{seed}"
         folder.mkdir(parents=True, exist_ok=True)
-        job = NetworkJob(Variant("targeted", base_size, 0.0), split, cfg.net, cfg.train, (initial_weights(cfg.net, weight_seed),), (noise_seed,),
-                         seed, "cpu", folder, card)
+        job = NetworkJob(
+            Variant("targeted", base_size, 0.0),
+            split,
+            cfg.net,
+            cfg.train,
+            (initial_weights(cfg.net, weight_seed),),
+            (noise_seed,),
+            seed,
+            "cpu",
+            folder,
+            corpora,
+            card,
+        )
         result = train_network(job, val, test)
         print(f"# trained s{seed} targeted {base_size}-0: validation AP {result['validation']['ap']:.4f}", flush=True)
 
@@ -89,24 +111,44 @@ def main() -> None:
     n_test = sim.n_test_objects if args.n_test is None else args.n_test
     attempts = sim.attempts if args.attempts is None else args.attempts
     tests = test_shape_ids(read_table(SHAPES_TABLE), n_test, params.seed)
-    objects = prepare_objects(sim.objects, tests, SHAPES_DIR, sim.physics, params.seed, sim.vhacd_resolution, workers=args.workers)
+    objects = prepare_objects(
+        sim.objects, tests, SHAPES_DIR, sim.physics, params.seed, sim.vhacd_resolution, workers=args.workers
+    )
     arms = {"before": ("targeted", 0.0), "antipodal": (None, None)}
-    jobs = [job if job.model is None else dataclasses.replace(job, model=str(args.models / Path(job.model).relative_to("models/gqcnn")))
-            for job in object_jobs(objects, arms, args.base_size, args.seeds, attempts, params.seed, 0)]
+    seed_dirs = {s: args.models / f"s{s}" for s in args.seeds}
+    jobs = object_jobs(objects, arms, args.base_size, seed_dirs, attempts, params.seed, 0)
     start = time.perf_counter()
-    work = functools.partial(run_object, layout=sim.cell, hand=sim.hand, sampler=sim.sampler, cem=sim.cem, crop_size=params.render.crop.crop_size,
-                             out_size=params.render.crop.out_size, trial_settings=sim.trial, sensor=sim.sensor)
+    work = functools.partial(
+        run_object,
+        layout=sim.cell,
+        hand=sim.hand,
+        sampler=sim.sampler,
+        cem=sim.cem,
+        crop_size=params.render.crop.crop_size,
+        out_size=params.render.crop.out_size,
+        trial_settings=sim.trial,
+        sensor=sim.sensor,
+    )
     rows = [row for rows in parallel_map(work, jobs, args.workers, "sim probe") for row in rows]
     trials = pd.DataFrame([{k: v for k, v in row.items() if not k.startswith("_")} for row in rows])
     seconds = time.perf_counter() - start
-    print(json.dumps({
-        "changes": args.changes, "seeds": args.seeds, "objects": len(objects), "attempts": attempts, "trials": len(trials),
-        "seconds": round(seconds, 1), "seconds_per_trial_and_worker": round(seconds * args.workers / len(trials), 2),
-        "planning_time_before": round(float(trials.planning_time[trials.arm == "before"].mean()), 3),
-        **{arm: rate_summary(trials.success[trials.arm == arm]) for arm in arms},
-        "network_vs_antipodal": paired_contrast(trials, "before", "antipodal", sim.n_bootstrap, params.seed),
-        "outcomes": trials.groupby(["arm", "outcome"]).size().unstack(fill_value=0).to_dict("index"),
-    }))
+    print(
+        json.dumps(
+            {
+                "changes": args.changes,
+                "seeds": args.seeds,
+                "objects": len(objects),
+                "attempts": attempts,
+                "trials": len(trials),
+                "seconds": round(seconds, 1),
+                "seconds_per_trial_and_worker": round(seconds * args.workers / len(trials), 2),
+                "planning_time_before": round(float(trials.planning_time[trials.arm == "before"].mean()), 3),
+                **{arm: rate_summary(trials.success[trials.arm == arm]) for arm in arms},
+                "network_vs_antipodal": trial_contrast(trials, "before", "antipodal", sim.n_bootstrap, params.seed),
+                "outcomes": trials.groupby(["arm", "outcome"]).size().unstack(fill_value=0).to_dict("index"),
+            }
+        )
+    )
 
 
 if __name__ == "__main__":

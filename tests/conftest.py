@@ -1,4 +1,5 @@
 """Shared fixtures: real meshes from trimesh primitives and pybullet_data."""
+
 from __future__ import annotations
 
 import os

@@ -25,20 +25,40 @@ def test_schema_file_is_up_to_date(repo_root):
     assert (repo_root / "params.schema.json").read_text() == json_schema()
     schema = json.loads(json_schema())
     steps = schema["$defs"]["TrainSettings"]["properties"]["max_steps"]
-    assert steps["default"] == TrainSettings().max_steps and steps["minimum"] == 1 and "SGD steps" in steps["description"]
+    assert (
+        steps["default"] == TrainSettings().max_steps and steps["minimum"] == 1 and "SGD steps" in steps["description"]
+    )
 
 
 @pytest.mark.parametrize(
     ("raw", "message"),
     [
-        ({"ingest": {"max_facez": 3}}, "ingest.max_facez: unknown key; allowed here: max_faces, max_file_mb, min_shapes, test_fraction, surface"),
+        (
+            {"ingest": {"max_facez": 3}},
+            "ingest.max_facez: unknown key; allowed here: max_faces, max_file_mb, min_shapes, test_fraction, surface",
+        ),
         ({"colour": 1}, "colour: unknown key; allowed here: seed,"),
-        ({"sim": {"cell": {"intrinsics": {"fz": 1}}}}, "sim.cell.intrinsics.fz: unknown key; allowed here: width, height, fx, fy, cx, cy"),
-        ({"ingest": {"max_faces": "many"}}, "ingest.max_faces: Input should be a valid integer, unable to parse string as an integer; got 'many'"),
-        ({"ingest": {"max_faces": 2.5}}, "ingest.max_faces: Input should be a valid integer, got a number with a fractional part; got 2.5"),
+        (
+            {"sim": {"cell": {"intrinsics": {"fz": 1}}}},
+            "sim.cell.intrinsics.fz: unknown key; allowed here: width, height, fx, fy, cx, cy",
+        ),
+        (
+            {"ingest": {"max_faces": "many"}},
+            "ingest.max_faces: Input should be a valid integer, unable to parse string as an integer; got 'many'",
+        ),
+        (
+            {"ingest": {"max_faces": 2.5}},
+            "ingest.max_faces: Input should be a valid integer, got a number with a fractional part; got 2.5",
+        ),
         ({"ingest": {"max_faces": 0}}, "ingest.max_faces: Input should be greater than or equal to 1; got 0"),
-        ({"ingest": {"test_fraction": 1.5}}, "ingest.test_fraction: Input should be less than or equal to 0.9; got 1.5"),
-        ({"ingest": {"surface": {"size_rule": "median"}}}, "ingest.surface.size_rule: Input should be 'min', 'mid' or 'max'; got 'median'"),
+        (
+            {"ingest": {"test_fraction": 1.5}},
+            "ingest.test_fraction: Input should be less than or equal to 0.9; got 1.5",
+        ),
+        (
+            {"ingest": {"surface": {"size_rule": "median"}}},
+            "ingest.surface.size_rule: Input should be 'min', 'mid' or 'max'; got 'median'",
+        ),
         ({"voxelize": {"resolution": 48}}, "voxelize.resolution: Input should be 16, 32, 64 or 128; got 48"),
         ({"voxelize": {"resolution": 16}}, "ae.net.resolution: must equal voxelize.resolution (16); got 32"),
         ({"device": "tpu"}, "device: Input should be 'auto', 'cpu' or 'cuda'; got 'tpu'"),
@@ -48,15 +68,24 @@ def test_schema_file_is_up_to_date(repo_root):
         ({"executor": "dask"}, "scheduler: required when executor is dask"),
         ({"executor": "ray"}, "executor: Input should be 'joblib' or 'dask'; got 'ray'"),
         ({"ae": {"train": {"lambda": -1}}}, "ae.train.lambda: Input should be greater than or equal to 0; got -1"),
-        ({"critic_eval": {"alphas": [0.1, 0.104]}}, "critic_eval.alphas: weights must differ in the first two decimals"),
+        (
+            {"critic_eval": {"alphas": [0.1, 0.104]}},
+            "critic_eval.alphas: weights must differ in the first two decimals",
+        ),
         ({"critic_eval": {"alphas": [0.1, 1.5]}}, "critic_eval.alphas: must be a non-empty list of weights in [0, 1]"),
         ({"generate": {"ratios": [0, 1.0]}}, "generate.ratios: write every ratio as a float (1.0, not 1)"),
-        ({"grasps": {"gripper": {"max_width": 0.1}}}, "sim.sampler.max_width: must equal grasps.gripper.max_width (0.1); got 0.08"),
+        (
+            {"grasps": {"gripper": {"max_width": 0.1}}},
+            "sim.sampler.max_width: must equal grasps.gripper.max_width (0.1); got 0.08",
+        ),
         ({"render": {"crop": {"out_size": 16}}}, "gqcnn.net.image_size: must equal render.crop.out_size (16); got 32"),
         ({"sim": {"objects": ["mug", "teapot"]}}, "sim.objects: must be distinct names among mug, duck,"),
         ({"sim": {"objects": [], "n_test_objects": 0}}, "sim.objects: no objects to pick"),
         ({"sim": {"base_size": 300}}, "sim.base_size: must be one of gqcnn.augment_base_sizes [50]; got 300"),
-        ({"sim": {"sampler": {"min_depth_offset": 0.05}}}, "sim.sampler.max_depth_offset: must be >= sim.sampler.min_depth_offset (0.05); got 0.04"),
+        (
+            {"sim": {"sampler": {"min_depth_offset": 0.05}}},
+            "sim.sampler.max_depth_offset: must be >= min_depth_offset (0.05); got 0.04",
+        ),
         ({"sim": {"attempts": 0}}, "sim.attempts: Input should be greater than or equal to 1; got 0"),
     ],
 )
@@ -128,7 +157,9 @@ def test_every_overlay_names_only_real_keys(repo_root):
 def test_profiles_are_small_overlays(repo_root):
     folder = repo_root / "profiles"
     study, paper, tiny = (profile_params(n, folder) for n in ("study", "paper", "tiny"))
-    assert len(study.gqcnn.seeds) >= 5 and study.generate.base_sizes == (50, 100, 200) and len(study.generate.ratios) == 5
+    assert (
+        len(study.gqcnn.seeds) >= 5 and study.generate.base_sizes == (50, 100, 200) and len(study.generate.ratios) == 5
+    )
     assert set(study.gqcnn.augment_base_sizes) == set(study.generate.base_sizes)  # the paper's 15 cells, three pools
     assert yaml.safe_load((folder / "study.yaml").read_text()).keys() == {"generate", "gqcnn", "sim"}
     per_seed = (len(study.sim.objects) + study.sim.n_test_objects) * study.sim.attempts
@@ -145,6 +176,8 @@ def test_profile_command_writes_a_complete_params_file(repo_root, tmp_path):
     result = CliRunner().invoke(app, ["profile", "study", "--out", str(out), "--profiles", str(repo_root / "profiles")])
     assert result.exit_code == 0, result.output
     assert load_params(out) == profile_params("study", repo_root / "profiles")
-    assert yaml.safe_load(out.read_text())["gqcnn"]["train"]["max_steps"] == TrainSettings().max_steps  # every key written, for DVC
+    assert (
+        yaml.safe_load(out.read_text())["gqcnn"]["train"]["max_steps"] == TrainSettings().max_steps
+    )  # every key written, for DVC
     missing = CliRunner().invoke(app, ["profile", "nope", "--out", str(out), "--profiles", str(repo_root / "profiles")])
     assert missing.exit_code == 2 and "profile 'nope' not found" in missing.output

@@ -1,5 +1,6 @@
 """The process setting every stage makes (freed tensors are reused, not faulted in again) and
 what the device computes natively."""
+
 import subprocess
 import sys
 

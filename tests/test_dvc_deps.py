@@ -4,6 +4,7 @@ A stage's code is the import closure (found with ``ast``, nothing is imported) o
 plus the stage module that its ``cmd`` names: ``graspaug x-y ...`` runs ``graspaug.stages.x_y``.
 ``python tests/test_dvc_deps.py`` prints each stage's expected ``src/`` deps, ready to paste.
 """
+
 from __future__ import annotations
 
 import ast
@@ -33,9 +34,12 @@ def _with_packages(module: str) -> set[str]:
 
 def _is_inert(tree: ast.Module) -> bool:
     """Only a docstring and dunder metadata (``__version__ = "0.1.0"``): editing it changes no result."""
-    return all(isinstance(node, (ast.Expr, ast.Assign)) and isinstance(node.value, ast.Constant)
-               and all(isinstance(t, ast.Name) and t.id.startswith("__") for t in getattr(node, "targets", []))
-               for node in tree.body)
+    return all(
+        isinstance(node, (ast.Expr, ast.Assign))
+        and isinstance(node.value, ast.Constant)
+        and all(isinstance(t, ast.Name) and t.id.startswith("__") for t in getattr(node, "targets", []))
+        for node in tree.body
+    )
 
 
 def module_imports(module: str, src: Path) -> set[str]:
@@ -112,7 +116,9 @@ def dvc_stages(dvc: dict) -> dict[str, dict]:
 
 def expected_code_deps(dvc_yaml: Path = DVC_YAML, src: Path = SRC) -> dict[str, set[str]]:
     """Stage name -> the ``src/`` files it must list as deps."""
-    return {name: stage_code(body["cmd"], src) for name, body in dvc_stages(yaml.safe_load(dvc_yaml.read_text())).items()}
+    return {
+        name: stage_code(body["cmd"], src) for name, body in dvc_stages(yaml.safe_load(dvc_yaml.read_text())).items()
+    }
 
 
 def compare_code_deps(dvc: dict, src: Path = SRC) -> dict[str, dict[str, set[str]]]:
@@ -120,7 +126,11 @@ def compare_code_deps(dvc: dict, src: Path = SRC) -> dict[str, dict[str, set[str
     always)}, for stages where either is non-empty."""
     problems = {}
     for name, body in dvc_stages(dvc).items():
-        listed = {d for d in (d if isinstance(d, str) else next(iter(d)) for d in body.get("deps", [])) if d.startswith("src/")}
+        listed = {
+            d
+            for d in (d if isinstance(d, str) else next(iter(d)) for d in body.get("deps", []))
+            if d.startswith("src/")
+        }
         expected = stage_code(body["cmd"], src)
         missing, extra = expected - listed, listed - expected
         if missing or extra:
@@ -135,13 +145,30 @@ def _yaml_lists(deps: dict[str, set[str]]) -> str:
 def _real_dvc() -> dict:
     return yaml.safe_load(DVC_YAML.read_text())
 
+
 def test_every_stage_lists_exactly_its_code():
     """dvc.yaml's src/ deps equal each stage's import closure."""
     problems = compare_code_deps(_real_dvc())
-    report = "".join(f"\n{name}:\n" + "".join(f"  {kind}: {p}\n" for kind in ("missing", "extra") for p in sorted(d[kind]))
-                     for name, d in problems.items())
+    report = "".join(
+        f"\n{name}:\n" + "".join(f"  {kind}: {p}\n" for kind in ("missing", "extra") for p in sorted(d[kind]))
+        for name, d in problems.items()
+    )
     expected = {name: paths for name, paths in expected_code_deps().items() if name in problems}
-    assert not problems, f"dvc.yaml code deps differ from the imports:{report}\nExpected src/ deps:\n{_yaml_lists(expected)}"
+    assert not problems, (
+        f"dvc.yaml code deps differ from the imports:{report}\nExpected src/ deps:\n{_yaml_lists(expected)}"
+    )
+
+
+def test_a_stage_depends_only_on_the_settings_it_reads():
+    """Settings modules are plain data and the CLI loads a stage's params lazily: the robot cell's
+    settings are code of the `sim` stage alone, so editing them re-runs nothing before it."""
+    deps = expected_code_deps()
+    assert {name for name, files in deps.items() if "src/graspaug/sim/settings.py" in files} == {"sim"}
+    assert {name for name, files in deps.items() if "src/graspaug/config.py" in files} == set()
+    early = deps["ingest"] | deps["voxelize"]
+    assert not {
+        f for f in early if f.startswith(("src/graspaug/sim/", "src/graspaug/planning/", "src/graspaug/render/"))
+    }
 
 
 def test_a_planted_missing_dep_is_caught():
@@ -190,7 +217,9 @@ def test_stages_are_thin_adapters_that_import_no_stage():
             continue
         assert len(path.read_text().splitlines()) <= 125, f"{path.name} is {len(path.read_text().splitlines())} lines"
         imported = module_imports(f"graspaug.stages.{path.stem}", SRC)
-        assert not {m for m in imported if m.startswith(STAGES)}, f"{path.name} imports a stage: {sorted(m for m in imported if m.startswith(STAGES))}"
+        assert not {m for m in imported if m.startswith(STAGES)}, (
+            f"{path.name} imports a stage: {sorted(m for m in imported if m.startswith(STAGES))}"
+        )
 
 
 if __name__ == "__main__":

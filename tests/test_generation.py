@@ -1,12 +1,22 @@
 """Base sets, selection, neighbour pairs and the pool order of the generate stage."""
-import numpy as np
-import pytest
 
 from dataclasses import dataclass
 
+import numpy as np
+import pytest
+
 from graspaug.generation import (
-    Candidate, PoolExhausted, RandomStream, TargetedStream, above_percentile, fill_pool, nested_base_sets, neighbour_pairs, pool_size,
-    ratio_count, targeted_candidates,
+    Candidate,
+    PoolExhausted,
+    RandomStream,
+    TargetedStream,
+    above_percentile,
+    fill_pool,
+    neighbour_pairs,
+    nested_base_sets,
+    pool_size,
+    ratio_count,
+    targeted_candidates,
 )
 
 # Points on a line at 0, 1, 3, 7, 12, 18: no ties, so every point's neighbour ranks are clear:
@@ -18,7 +28,18 @@ def test_neighbour_pairs_are_exactly_the_nth_to_n_plus_kth():
     # (shape, its neighbour); a pair met the other way round before is dropped
     assert neighbour_pairs(LINE, 1, 0) == [(0, 1), (2, 1), (3, 2), (4, 3), (5, 4)]
     # rank 2: 0-2 1-2 (2-0) 3-4 4-5 5-3, then rank 3: 0-3 1-3 2-3 (3-1) 4-2 5-2
-    assert neighbour_pairs(LINE, 2, 1) == [(0, 2), (1, 2), (3, 4), (4, 5), (5, 3), (0, 3), (1, 3), (2, 3), (4, 2), (5, 2)]
+    assert neighbour_pairs(LINE, 2, 1) == [
+        (0, 2),
+        (1, 2),
+        (3, 4),
+        (4, 5),
+        (5, 3),
+        (0, 3),
+        (1, 3),
+        (2, 3),
+        (4, 2),
+        (5, 2),
+    ]
     assert neighbour_pairs(LINE, 5, 3) == [(0, 5), (1, 5), (2, 5), (3, 5), (4, 0)]  # only 5 others: rank 5 is the last
     assert neighbour_pairs(LINE[:1], 1, 2) == []
 
@@ -47,8 +68,14 @@ def test_targeted_candidates_interleave_groups_and_weights():
     cands = targeted_candidates(z, rare, graspable, 50, 1, 0, [0.5, 0.3])
     by = [(c.selected_by, c.a, c.b, c.alpha) for c in cands]
     assert by == [
-        ("rarity", 3, 4, 0.5), ("graspness", 0, 1, 0.5), ("rarity", 5, 4, 0.5), ("graspness", 2, 1, 0.5),
-        ("rarity", 3, 4, 0.3), ("graspness", 0, 1, 0.3), ("rarity", 5, 4, 0.3), ("graspness", 2, 1, 0.3),
+        ("rarity", 3, 4, 0.5),
+        ("graspness", 0, 1, 0.5),
+        ("rarity", 5, 4, 0.5),
+        ("graspness", 2, 1, 0.5),
+        ("rarity", 3, 4, 0.3),
+        ("graspness", 0, 1, 0.3),
+        ("rarity", 5, 4, 0.3),
+        ("graspness", 2, 1, 0.3),
     ]
     # a shape in both groups: its pairs are not generated twice
     both = targeted_candidates(z, rare, rare, 50, 1, 0, [0.5])

@@ -1,4 +1,5 @@
 """Per-shape stages on a real Dask distributed cluster give what the local joblib run gives."""
+
 from __future__ import annotations
 
 import dataclasses
@@ -7,8 +8,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from graspaug.profiles import profile_params
 from graspaug.parallel import Workers, parallel_map
+from graspaug.profiles import profile_params
 
 
 def square(x: int) -> int:
@@ -48,7 +49,12 @@ def run_ingest_and_voxelize(folder, params, monkeypatch) -> tuple[pd.DataFrame, 
 def test_stages_on_a_dask_cluster_equal_the_local_run(repo_root, tmp_path, monkeypatch):
     distributed = pytest.importorskip("distributed")
     tiny = profile_params("tiny", repo_root / "profiles")
-    params = tiny.model_copy(update={"data": dataclasses.replace(tiny.data, limit=6), "ingest": dataclasses.replace(tiny.ingest, min_shapes=2)})
+    params = tiny.model_copy(
+        update={
+            "data": dataclasses.replace(tiny.data, limit=6),
+            "ingest": dataclasses.replace(tiny.ingest, min_shapes=2),
+        }
+    )
     (tmp_path / "local").mkdir()
     (tmp_path / "cluster").mkdir()
     local = run_ingest_and_voxelize(tmp_path / "local", params, monkeypatch)

@@ -1,4 +1,5 @@
 """Real ``dvc repro`` in a temporary copy of the repository, on the tiny profile (``profiles/tiny.yaml``)."""
+
 import os
 import shutil
 import subprocess
@@ -15,9 +16,12 @@ from graspaug.nets.gqcnn import GQCNN, GQCNNEnsemble
 
 pytestmark = pytest.mark.slow
 
+
 def copy_repo(src: Path, dst: Path) -> None:
     """The files a user's clone has (tracked by git), without outputs or caches."""
-    listed = subprocess.run(["git", "ls-files", "-co", "--exclude-standard"], cwd=src, capture_output=True, text=True, check=True)
+    listed = subprocess.run(
+        ["git", "ls-files", "-co", "--exclude-standard"], cwd=src, capture_output=True, text=True, check=True
+    )
     for rel in listed.stdout.splitlines():
         if not (src / rel).is_file():
             continue
@@ -35,9 +39,18 @@ def run(cmd, cwd, env):
 def tiny_repo(repo_root, tmp_path_factory):
     work = tmp_path_factory.mktemp("repo")
     copy_repo(repo_root, work)
-    run([str(Path(sys.executable).parent / "graspaug"), "profile", "tiny"], work, {**os.environ})  # the documented way to apply a profile
-    env = {**os.environ, "DVC_NO_ANALYTICS": "1", "PATH": f"{Path(sys.executable).parent}{os.pathsep}{os.environ['PATH']}",
-           "GIT_AUTHOR_NAME": "test", "GIT_AUTHOR_EMAIL": "test@example.com", "GIT_COMMITTER_NAME": "test", "GIT_COMMITTER_EMAIL": "test@example.com"}
+    run(
+        [str(Path(sys.executable).parent / "graspaug"), "profile", "tiny"], work, {**os.environ}
+    )  # the documented way to apply a profile
+    env = {
+        **os.environ,
+        "DVC_NO_ANALYTICS": "1",
+        "PATH": f"{Path(sys.executable).parent}{os.pathsep}{os.environ['PATH']}",
+        "GIT_AUTHOR_NAME": "test",
+        "GIT_AUTHOR_EMAIL": "test@example.com",
+        "GIT_COMMITTER_NAME": "test",
+        "GIT_COMMITTER_EMAIL": "test@example.com",
+    }
     run(["git", "init", "-q"], work, env)
     run(["git", "add", "-A"], work, env)
     run(["git", "commit", "-q", "-m", "clone"], work, env)  # a user's clone has commits (DVCLive needs one)
@@ -69,8 +82,14 @@ def test_dvc_repro_critic_eval_and_embed(tiny_repo):
 
     work, env = tiny_repo
     run(["dvc", "repro", "critic_eval", "embed"], work, env)
-    for path in ("models/ae.pt", "models/ae_critic.pt", "reports/critic_eval/interpolations.png",
-                 "reports/critic_eval/outliers.png", "reports/embed/tsne.png", "metrics/train_ae/ae/metrics.json"):
+    for path in (
+        "models/ae.pt",
+        "models/ae_critic.pt",
+        "reports/critic_eval/interpolations.png",
+        "reports/critic_eval/outliers.png",
+        "reports/embed/tsne.png",
+        "metrics/train_ae/ae/metrics.json",
+    ):
         assert (work / path).stat().st_size > 0, path
     result = json.loads((work / "metrics/critic_eval.json").read_text())
     assert result["n_pairs"] == 3 and result["n_decoded_per_model"] == 18
@@ -80,7 +99,9 @@ def test_dvc_repro_critic_eval_and_embed(tiny_repo):
     assert result["critic_auc"] is None or 0 <= result["critic_auc"] <= 1
     assert (work / "models/ae_extra.pt").stat().st_size > 0
     summary = json.loads((work / "metrics/train_ae.json").read_text())
-    assert 0 <= summary["ae_iou_test"] <= 1 and "ae_shapes_per_s" not in summary  # results only: timings go to reports/timing
+    assert (
+        0 <= summary["ae_iou_test"] <= 1 and "ae_shapes_per_s" not in summary
+    )  # results only: timings go to reports/timing
     assert json.loads((work / "reports/timing/train_ae.json").read_text())["ae_shapes_per_s"] > 0
     latents = pd.read_parquet(work / "data/latents.parquet")
     assert len(latents) == 20 and len(latents.z[0]) == 16
@@ -181,7 +202,11 @@ def test_dvc_repro_render(tiny_repo):
         else:
             generated = pd.read_parquet(work / f"data/generated/{corpus[4:]}/index.parquet")
             assert set(index.shape_id) <= set(generated.shape_id) and (index.base_size == int(corpus[4:])).all()
-            assert set(index.pool) <= {"targeted", "random"} and index.order.notna().all() and (index.split == "train").all()
+            assert (
+                set(index.pool) <= {"targeted", "random"}
+                and index.order.notna().all()
+                and (index.split == "train").all()
+            )
         assert (work / f"reports/render/{corpus}/examples.png").stat().st_size > 0
     again = run(["dvc", "repro", "render", "render_generated"], work, env)
     assert "Running stage" not in again.stdout
@@ -192,11 +217,19 @@ def test_dvc_repro_gqcnn_matrix_and_report(tiny_repo):
 
     work, env = tiny_repo
     run(["dvc", "repro", "report"], work, env)
-    names = ["targeted/4-0"] + [f"{p}/6-{r:g}" for p in ("targeted", "random", "real") for r in (0.5, 1.0)] + ["targeted/6-0", "ceiling"]
+    names = (
+        ["targeted/4-0"]
+        + [f"{p}/6-{r:g}" for p in ("targeted", "random", "real") for r in (0.5, 1.0)]
+        + ["targeted/6-0", "ceiling"]
+    )
     digests, validation = {}, {}
     for seed in (0, 1):
         metrics = json.loads((work / f"metrics/gqcnn/s{seed}.json").read_text())["networks"]
-        assert set(metrics) == {"targeted", "random", "real", "ceiling"} and set(metrics["targeted"]["6"]) == {"0", "0.5", "1"}
+        assert set(metrics) == {"targeted", "random", "real", "ceiling"} and set(metrics["targeted"]["6"]) == {
+            "0",
+            "0.5",
+            "1",
+        }
         assert set(metrics["targeted"]["4"]) == {"0"} and set(metrics["real"]["6"]) == {"0.5", "1"}
         split = json.loads((work / f"models/gqcnn/s{seed}/split.json").read_text())
         for name in names:
@@ -205,19 +238,32 @@ def test_dvc_repro_gqcnn_matrix_and_report(tiny_repo):
             assert set(summary["test"]) == {"ap", "accuracy", "roc_auc", "positive_share", "datapoints"}
             # the tiny profile's networks are ensembles of 2 members, each with its own kept step
             assert 4 <= summary["train"]["steps"] <= 6 and summary["train"]["members"] == 2
-            assert len(summary["train"]["best_step"]) == 2 and all(1 <= b <= summary["train"]["steps"] for b in summary["train"]["best_step"])
-            test_p, members_p = np.load(folder / "test_predictions.npy"), np.load(folder / "test_predictions_members.npy")
+            assert len(summary["train"]["best_step"]) == 2 and all(
+                1 <= b <= summary["train"]["steps"] for b in summary["train"]["best_step"]
+            )
+            test_p, members_p = (
+                np.load(folder / "test_predictions.npy"),
+                np.load(folder / "test_predictions_members.npy"),
+            )
             assert test_p.shape == (summary["test"]["datapoints"],) and members_p.shape == (2, len(test_p))
             assert np.allclose(test_p, members_p.mean(axis=0)) and not np.allclose(members_p[0], members_p[1])
             assert sorted(pd.read_csv(folder / "history.csv").member) == [0, 0, 1, 1]  # evals: 2 per member
             digests.setdefault(seed, set()).add(summary["init_digest"])
             net, card = read_gqcnn(folder / "model.pt")  # the model and card planning reads
             assert isinstance(net, GQCNNEnsemble) and len(net.members) == 2
-            assert card["crop_size"] == 96 and card["intrinsics"]["fx"] == 525 and card["camera_distance"] == [0.65, 0.75]
+            assert (
+                card["crop_size"] == 96 and card["intrinsics"]["fx"] == 525 and card["camera_distance"] == [0.65, 0.75]
+            )
             assert card["training_set"]["seed"] == seed and card["test_ap"] == summary["test"]["ap"]
-            assert card["training_set"]["precision"] == summary["train"]["precision"] == "bfloat16"  # the tiny profile's
+            assert (
+                card["training_set"]["precision"] == summary["train"]["precision"] == "bfloat16"
+            )  # the tiny profile's
             validation.setdefault(seed, set()).add(summary["validation"]["datapoints"])
-        assert len(split["validation"]) == 2 and not set(split["validation"]) & set(split["base"]["6"]) and not set(split["validation"]) & set(split["real_pool"])
+        assert (
+            len(split["validation"]) == 2
+            and not set(split["validation"]) & set(split["base"]["6"])
+            and not set(split["validation"]) & set(split["real_pool"])
+        )
         assert (work / f"reports/gqcnn/validation/s{seed}.png").stat().st_size > 0
     # paired: every network of a seed starts from the same weights, seeds from different ones; one validation set for all
     assert len(digests[0]) == len(digests[1]) == 1 and digests[0] != digests[1]
@@ -225,17 +271,31 @@ def test_dvc_repro_gqcnn_matrix_and_report(tiny_repo):
     real = json.loads((work / "models/gqcnn/s0/real/6-1/summary.json").read_text())["train"]
     assert real["original_shapes"] == 12 and real["generated_shapes_asked"] == 0
     targeted = json.loads((work / "models/gqcnn/s0/targeted/6-1/summary.json").read_text())["train"]
-    assert targeted["generated_shapes_asked"] == 6 and targeted["original_shapes"] == 6 and 0 < targeted["positive_share"] < 1
+    assert (
+        targeted["generated_shapes_asked"] == 6
+        and targeted["original_shapes"] == 6
+        and 0 < targeted["positive_share"] < 1
+    )
     ap = json.loads((work / "metrics/ap.json").read_text())
     report = (work / "reports/gqcnn/report.md").read_text()
-    assert set(ap["contrasts"]) - {"targeted_vs_none_chosen@6"} == {"real_data", "targeted_vs_none@6", "targeted_vs_random@6", "targeted_vs_real@6"}
+    assert set(ap["contrasts"]) - {"targeted_vs_none_chosen@6"} == {
+        "real_data",
+        "targeted_vs_none@6",
+        "targeted_vs_random@6",
+        "targeted_vs_real@6",
+    }
     assert ("targeted_vs_none_chosen@6" in ap["contrasts"]) == ("6" in ap["chosen_ratio"])
     for c in ap["contrasts"].values():
         assert {"mean", "ci_low", "ci_high", "n_seeds", "boot_low", "boot_high"} <= set(c)
         if c["mean"] is not None:
             assert c["n_seeds"] == 2 and c["ci_low"] <= c["mean"] <= c["ci_high"]
     assert set(ap["networks"]["targeted"]["6"]) == {"0", "0.5", "1"} and ap["seeds"] == [0, 1]
-    assert "| targeted | 4 | 1:0 |" in report and "| real | 6 | 1:0.5 |" in report and "## Contrasts" in report and "## What the numbers say" in report
+    assert (
+        "| targeted | 4 | 1:0 |" in report
+        and "| real | 6 | 1:0.5 |" in report
+        and "## Contrasts" in report
+        and "## What the numbers say" in report
+    )
     for picture in ("ap_vs_ratio", "improvement_by_score", "tsne_graspness"):
         assert (work / f"reports/gqcnn/{picture}.png").stat().st_size > 0
     shown = run(["dvc", "metrics", "show", "--json"], work, env)
@@ -244,23 +304,35 @@ def test_dvc_repro_gqcnn_matrix_and_report(tiny_repo):
     assert "Running stage" not in again.stdout
 
 
-def test_a_one_member_network_is_a_plain_gqcnn(tiny_repo, tmp_path, monkeypatch):
+def test_a_one_member_network_is_a_plain_gqcnn(tiny_repo, tmp_path):
     """gqcnn.members = 1 (the study and paper profiles) writes one GQ-CNN, as before ensembles existed."""
     from graspaug.config import load_params
     from graspaug.experiments.networks import NetworkJob, seed_members, train_network, weights_digest
-    from graspaug.training.gqcnn_data import Variant, load_split
+    from graspaug.experiments.variants import Variant
+    from graspaug.io.tables import read_table
+    from graspaug.training.gqcnn_data import Corpora, load_split
 
     work, env = tiny_repo
     run(["dvc", "repro", "render@original"], work, env)
-    monkeypatch.chdir(work)  # the library reads data/ relative to the project
     params = load_params(work / "params.yaml")
     cfg = params.gqcnn
-    split = load_split(list(params.generate.base_sizes), cfg.val_shapes, params.seed)
+    corpora = Corpora(work / "data/gqcnn/original")
+    shapes = read_table(work / "data/shapes.parquet")
+    split = load_split(corpora.original, shapes, list(params.generate.base_sizes), cfg.val_shapes, params.seed)
     inits, noise_seeds = seed_members(cfg.net, params.seed, 0, 1)
-    assert weights_digest(inits[0]) == weights_digest(seed_members(cfg.net, params.seed, 0, 2)[0][0])  # member 0 whatever K
-    summary = train_network(NetworkJob(Variant("targeted", 6, 0.0), split, cfg.net, cfg.train, inits, noise_seeds, 0, "cpu", tmp_path))
+    assert weights_digest(inits[0]) == weights_digest(
+        seed_members(cfg.net, params.seed, 0, 2)[0][0]
+    )  # member 0 whatever K
+    job = NetworkJob(
+        Variant("targeted", 6, 0.0), split, cfg.net, cfg.train, inits, noise_seeds, 0, "cpu", tmp_path, corpora
+    )
+    summary = train_network(job)
     folder = tmp_path / "targeted" / "6-0"
-    assert isinstance(summary["train"]["best_step"], int) and isinstance(summary["noise_seed"], int) and "members" not in summary["train"]
+    assert (
+        isinstance(summary["train"]["best_step"], int)
+        and isinstance(summary["noise_seed"], int)
+        and "members" not in summary["train"]
+    )
     assert summary["init_digest"] == weights_digest(inits[0]) and not list(folder.glob("*_members.npy"))
     from graspaug.io.checkpoints import finish_gqcnn_card
 
@@ -280,9 +352,13 @@ def test_dvc_repro_sim(tiny_repo, tmp_path):
     run(["dvc", "repro", "sim"], work, env)
     metrics = json.loads((work / "metrics/sim.json").read_text())
     ap = json.loads((work / "metrics/ap.json").read_text())
-    after_ratio = ap["summary"]["6"]["best_ratio"] if "6" in ap["summary"] else 1.0  # no validation AP: the largest ratio
+    after_ratio = (
+        ap["summary"]["6"]["best_ratio"] if "6" in ap["summary"] else 1.0
+    )  # no validation AP: the largest ratio
     assert metrics["arms"]["before"]["ratio"] == 0.0 and metrics["arms"]["after"]["ratio"] == after_ratio
-    assert metrics["setup"]["after_ratio_from_report"] == ("6" in ap["summary"]) and metrics["setup"]["model_seeds"] == [0, 1]
+    assert metrics["setup"]["after_ratio_from_report"] == ("6" in ap["summary"]) and metrics["setup"][
+        "model_seeds"
+    ] == [0, 1]
     assert metrics["per_seed"]["0"]["before"]["attempts"] == metrics["per_seed"]["1"]["before"]["attempts"] == 4
     network_arms = ["before", "after"] + (["real"] if after_ratio > 0 else [])
     assert list(metrics["arms"]) == [*network_arms, "antipodal"]  # the tiny run trains the real pool at B = 6
@@ -294,10 +370,15 @@ def test_dvc_repro_sim(tiny_repo, tmp_path):
     for name in ("after_vs_before", "network_vs_antipodal") + (("after_vs_real",) if after_ratio > 0 else ()):
         c = metrics["contrasts"][name]
         # against the antipodal arm (one run per drop) each of the 4 drops counts once; network arms pair 2 seeds × 4 drops
-        assert c["n_trials"] == (4 if name == "network_vs_antipodal" else 8) and c["ci_low"] <= c["mean"] <= c["ci_high"]
+        assert (
+            c["n_trials"] == (4 if name == "network_vs_antipodal" else 8) and c["ci_low"] <= c["mean"] <= c["ci_high"]
+        )
         assert c["n_seeds"] == 2 and c["t_ci_low"] <= c["mean"] <= c["t_ci_high"]
     trials = pd.read_csv(work / "reports/sim/trials.csv")
-    assert len(trials) == 4 * len(network_arms) * 2 + 4 and set(trials.object) == {"cube", metrics["setup"]["test_shapes"][0]}
+    assert len(trials) == 4 * len(network_arms) * 2 + 4 and set(trials.object) == {
+        "cube",
+        metrics["setup"]["test_shapes"][0],
+    }
     planned = (trials.arm != "antipodal") & (trials.outcome != "no_grasp")
     assert trials.quality[trials.arm == "antipodal"].isna().all() and trials.quality[planned].notna().all()
     trials = trials[trials.arm != "antipodal"]
@@ -314,7 +395,10 @@ def test_dvc_repro_sim(tiny_repo, tmp_path):
     report = (work / "reports/sim/report.md").read_text()
     assert "## Contrasts" in report and "## Calibration" in report and "network_vs_antipodal" in report
     calibration = pd.read_csv(work / "reports/sim/calibration.csv")
-    assert set(calibration.object) == {"cube", metrics["setup"]["test_shapes"][0]} and calibration.graspness.isna().sum() == 1
+    assert (
+        set(calibration.object) == {"cube", metrics["setup"]["test_shapes"][0]}
+        and calibration.graspness.isna().sum() == 1
+    )
     for picture in ("success.png", "trials/before-cube.png", "trials/after-cube.png", "trials/antipodal-cube.png"):
         assert (work / "reports/sim" / picture).stat().st_size > 0
     again = run(["dvc", "repro", "sim"], work, env)
@@ -340,7 +424,9 @@ def test_every_declared_plot_renders(tiny_repo):
             if render["type"] == "image":
                 assert (work / render["url"]).exists() if not render["url"].startswith("data:") else True, name
     generated = {name for name in plots if "reports/generate/" in name}
-    assert "reports/generate/6/pairs.png" in generated and not any("generate/4/" in n for n in generated)  # the tiny profile's augmented base size
+    assert "reports/generate/6/pairs.png" in generated and not any(
+        "generate/4/" in n for n in generated
+    )  # the tiny profile's augmented base size
 
 
 def test_queued_two_point_sweep_lines_up_metrics(tiny_repo):
@@ -354,7 +440,11 @@ def test_queued_two_point_sweep_lines_up_metrics(tiny_repo):
     run(["git", "add", "-A"], work, env)
     run(["git", "commit", "-q", "-m", "baseline"], work, env)
     for force in (10.0, 40.0):
-        run(["dvc", "exp", "run", "--queue", "-S", f"sim.hand.grip_force={force}", "--name", f"grip-{int(force)}"], work, env)
+        run(
+            ["dvc", "exp", "run", "--queue", "-S", f"sim.hand.grip_force={force}", "--name", f"grip-{int(force)}"],
+            work,
+            env,
+        )
     run(["dvc", "queue", "start", "-j", "1"], work, env)
     deadline = time.time() + 600
     while time.time() < deadline:
@@ -379,9 +469,16 @@ def test_queued_two_point_sweep_lines_up_metrics(tiny_repo):
         assert sim["arms"]["before"]["attempts"] == 8 and "contrasts" in ap
     changed = json.loads(run(["dvc", "params", "diff", "grip-10", "grip-40", "--json"], work, env).stdout)
     assert list(changed["params.yaml"]) == ["sim.hand.grip_force"]
-    assert (changed["params.yaml"]["sim.hand.grip_force"]["old"], changed["params.yaml"]["sim.hand.grip_force"]["new"]) == (10.0, 40.0)
+    assert (
+        changed["params.yaml"]["sim.hand.grip_force"]["old"],
+        changed["params.yaml"]["sim.hand.grip_force"]["new"],
+    ) == (10.0, 40.0)
     diff = json.loads(run(["dvc", "metrics", "diff", "grip-10", "grip-40", "--json", "--all"], work, env).stdout)
-    assert diff["metrics/sim.json"]["arms.before.attempts"] == {"old": 8, "new": 8, "diff": 0}  # --all lines up every metric
+    assert diff["metrics/sim.json"]["arms.before.attempts"] == {
+        "old": 8,
+        "new": 8,
+        "diff": 0,
+    }  # --all lines up every metric
     run(["dvc", "queue", "stop"], work, env)
 
 
@@ -393,8 +490,14 @@ def test_killed_stage_leaves_no_output_and_repro_completes(tiny_repo):
 
     work, env = tiny_repo
     before = pd.read_parquet(work / "data/shapes.parquet")
-    process = subprocess.Popen(["dvc", "repro", "-f", "-s", "ingest"], cwd=work, env=env, stdout=subprocess.DEVNULL,
-                               stderr=subprocess.DEVNULL, start_new_session=True)
+    process = subprocess.Popen(
+        ["dvc", "repro", "-f", "-s", "ingest"],
+        cwd=work,
+        env=env,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+        start_new_session=True,
+    )
     partial = []
     deadline = time.time() + 120
     while time.time() < deadline and process.poll() is None:
@@ -405,9 +508,30 @@ def test_killed_stage_leaves_no_output_and_repro_completes(tiny_repo):
         time.sleep(0.01)
     process.wait()
     assert partial, "the stage finished before any mesh was written; nothing was killed"
-    assert not (work / "data/shapes").exists()  # DVC removed the old output; the half-written one is only a .tmp sibling
+    assert not (
+        work / "data/shapes"
+    ).exists()  # DVC removed the old output; the half-written one is only a .tmp sibling
     assert "ingest" in run(["dvc", "status", "ingest"], work, env).stdout  # the stage is not taken as up to date
     run(["dvc", "repro", "sim"], work, env)  # DVC runs ingest again (or restores it from its run cache)
     pd.testing.assert_frame_equal(pd.read_parquet(work / "data/shapes.parquet"), before)
     again = run(["dvc", "repro", "sim"], work, env)
     assert "Running stage" not in again.stdout
+
+
+def test_editing_a_sim_setting_reruns_only_sim(tiny_repo):
+    """Exact code deps: a sim-only module's edit (a settings description) changes the `sim` stage alone."""
+    import json
+
+    work, env = tiny_repo
+    run(["dvc", "repro", "sim"], work, env)  # the pipeline is complete (no-op after the tests above)
+    settings = work / "src/graspaug/sim/settings.py"
+    original = settings.read_text()
+    edited = original.replace('description="', 'description="(edited) ', 1)
+    assert edited != original
+    settings.write_text(edited)
+    try:
+        changed = json.loads(run(["dvc", "status", "--json"], work, env).stdout)
+    finally:
+        settings.write_text(original)
+    assert set(changed) == {"sim"}, f"changed stages: {sorted(changed)}"
+    assert json.loads(run(["dvc", "status", "--json"], work, env).stdout) == {}

@@ -1,4 +1,5 @@
 """Rarity (eq. 3-4) against scikit-learn's LOF, and graspness."""
+
 import numpy as np
 import pytest
 from scipy.stats import spearmanr

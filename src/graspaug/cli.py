@@ -1,4 +1,10 @@
-"""``graspaug``: one command per pipeline stage (``dvc.yaml`` calls these)."""
+"""``graspaug``: one command per pipeline stage (``dvc.yaml`` calls these), and the user's commands.
+
+A stage command imports its stage module, and through it only the params sections that stage
+reads, when it runs (``tests/test_dvc_deps.py`` derives each stage's code deps from that); the
+params tables in ``--help`` are filled in when help is shown.
+"""
+
 from __future__ import annotations
 
 import importlib
@@ -7,13 +13,7 @@ import sys
 from pathlib import Path
 
 import typer
-
-from graspaug.config import (
-    AEParams, CriticEvalParams, EmbedParams, GenerateParams, GQCNNParams, GraspsParams, IngestParams, Params, ParamsError, RenderParams, ScoreParams,
-    SimParams, VoxelizeParams, load_params,
-)
-from graspaug.io.settings import CorpusSettings
-from graspaug.settings import describe
+from typer.core import TyperCommand
 
 app = typer.Typer(
     help="graspaug: augment a grasp planner's training objects with generated shapes.\n\n"
@@ -27,16 +27,39 @@ app = typer.Typer(
 ParamsOption = typer.Option(Path("params.yaml"), "--params", "-p", help="The params file to read.")
 
 
-def _load(path: Path) -> Params:
+def _load(path: Path, stage):
+    """The params ``stage`` (a stage module) reads from the file at ``path``; exit 2 with one line when they are bad."""
+    from graspaug.params.base import ParamsError, load
+
     logging.basicConfig(level=logging.INFO, format="%(asctime)s %(levelname)s %(name)s: %(message)s", stream=sys.stderr)
     try:
-        return load_params(path)
+        return load(path, stage.Params)
     except ParamsError as exc:
         typer.echo(f"error: {exc}", err=True)
         raise typer.Exit(code=2) from None
 
 
-def _run(stage_run, params: Params) -> None:
+def _stage(module: str):
+    return importlib.import_module(f"graspaug.stages.{module}")
+
+
+def _with_params(module: str, *sections: str) -> type[TyperCommand]:
+    """A command class whose help fills ``{params}`` with the keys of ``sections`` of stage ``module``'s params."""
+
+    class StageCommand(TyperCommand):
+        def format_help(self, ctx, formatter) -> None:
+            if "{params}" in (self.help or ""):
+                from graspaug.settings import describe
+
+                fields = _stage(module).Params.model_fields
+                tables = [f"Params `{s}`:\n\n{describe(fields[s].annotation, s + '.')}" for s in sections]
+                self.help = self.help.replace("{params}", "\n\n".join(tables))
+            super().format_help(ctx, formatter)
+
+    return StageCommand
+
+
+def _run(stage_run, params) -> None:
     from graspaug.device import keep_freed_memory
     from graspaug.errors import CheckpointMismatch, DataError, StageError
 
@@ -48,15 +71,16 @@ def _run(stage_run, params: Params) -> None:
         raise typer.Exit(code=1) from None
 
 
-def stage_command(name: str, help: str) -> None:
-    """Register ``graspaug <name>``: load params, run ``graspaug.stages.<module>.run``."""
+def stage_command(name: str, help: str, *sections: str) -> None:
+    """Register ``graspaug <name>``: load params, run ``graspaug.stages.<module>.run``; ``{params}`` in
+    ``help`` becomes the keys of ``sections``."""
     module = name.replace("-", "_")
 
     def command(params: Path = ParamsOption) -> None:
-        stage = importlib.import_module(f"graspaug.stages.{module}")
-        _run(stage.run, _load(params))
+        stage = _stage(module)
+        _run(stage.run, _load(params, stage))
 
-    app.command(name=name, help=help)(command)
+    app.command(name=name, help=help, cls=_with_params(module, *sections))(command)
 
 
 stage_command(
@@ -64,34 +88,39 @@ stage_command(
     "Load the shape corpus, reject broken meshes with a reason, rebuild one closed outer surface "
     "per shape, center and scale it, and split train/test.\n\n"
     "Writes `data/shapes/<shape_id>.ply`, `data/shapes.parquet`, `data/rejects.parquet`.\n\n"
-    f"Params `data`:\n\n{describe(CorpusSettings, 'data.')}\n\nParams `ingest`:\n\n{describe(IngestParams, 'ingest.')}\n\n"
-    "Also `seed` (split) and `n_jobs`.",
+    "{params}\n\nAlso `seed` (split) and `n_jobs`.",
+    "data",
+    "ingest",
 )
 stage_command(
     "voxelize",
     "Voxelize every shape's closed surface into a solid R×R×R occupancy grid (voxel centers "
     "inside the surface), scaled to fit with a margin; pitch and origin are kept to go back to meters.\n\n"
-    f"Writes `data/voxels.npz`.\n\nParams `voxelize`:\n\n{describe(VoxelizeParams, 'voxelize.')}\n\nAlso `n_jobs`.",
+    "Writes `data/voxels.npz`.\n\n{params}\n\nAlso `n_jobs`.",
+    "voxelize",
 )
 stage_command(
     "train-ae",
     "Train the AutoEncoder (phase 1, binary cross-entropy), then from it the AE-Critic (phase 2, eqs. (1)-(2) "
     "of the paper) and its control (phase 2 with λ = 0) on the train split's voxel grids; test shapes stay unseen.\n\n"
     "Writes `models/ae.pt`, `models/ae_extra.pt` (control), `models/ae_critic.pt`, DVCLive logs in `metrics/train_ae/`, "
-    f"and `metrics/train_ae.json` (test/train reconstruction IoU, the critic's AUC on held-out shapes).\n\nParams `ae`:\n\n{describe(AEParams, 'ae.')}\n\n"
+    "and `metrics/train_ae.json` (test/train reconstruction IoU, the critic's AUC on held-out shapes).\n\n{params}\n\n"
     "Also `seed`, `device`.",
+    "ae",
 )
 stage_command(
     "embed",
     "Encode every shape with the AE-Critic: `data/latents.parquet` (shape_id, split, z) and a 2-D t-SNE map "
-    f"(`reports/embed/tsne.csv`, `.png`).\n\nParams `embed`:\n\n{describe(EmbedParams, 'embed.')}",
+    "(`reports/embed/tsne.csv`, `.png`).\n\n{params}",
+    "embed",
 )
 stage_command(
     "critic-eval",
     "The paper's critic study: decode interpolations of random train pairs with the AE, its λ = 0 control and "
     "the AE-Critic, cluster each with DBSCAN, report the mean outlier percentage per α with bootstrap intervals, "
     "the paired difference AE-Critic − control and the critic's AUC (`metrics/critic_eval.json`) with plots "
-    f"in `reports/critic_eval/`.\n\nParams `critic_eval`:\n\n{describe(CriticEvalParams, 'critic_eval.')}",
+    "in `reports/critic_eval/`.\n\n{params}",
+    "critic_eval",
 )
 
 
@@ -102,15 +131,20 @@ stage_command(
     "Writes `data/grasps/<corpus>.parquet` (one row per grasp) and `metrics/grasps/<corpus>.json`; corpus "
     "`original` is the ingested shapes, `gen_<B>` the shapes generated for base size B. "
     "A shape without any grasp gets no rows and a warning with the reason.\n\n"
-    f"Params `grasps`:\n\n{describe(GraspsParams, 'grasps.')}\n\nAlso `seed` and `n_jobs`.",
+    "{params}\n\nAlso `seed` and `n_jobs`.",
+    cls=_with_params("grasps", "grasps"),
 )
 def grasps_command(
-    corpus: str = typer.Option("original", "--corpus", "-c", help="Which shapes: `original` (ingested corpus) or `gen_<B>` (generated for base size B)."),
+    corpus: str = typer.Option(
+        "original",
+        "--corpus",
+        "-c",
+        help="Which shapes: `original` (ingested corpus) or `gen_<B>` (generated for base size B).",
+    ),
     params: Path = ParamsOption,
 ) -> None:
-    from graspaug.stages import grasps
-
-    _run(lambda p: grasps.run(p, corpus), _load(params))
+    stage = _stage("grasps")
+    _run(lambda p: stage.run(p, corpus), _load(params, stage))
 
 
 stage_command(
@@ -118,7 +152,8 @@ stage_command(
     "Score every original shape: rarity (eq. (3)-(4) of the paper on the AE-Critic latents, relative to the "
     "train split) and graspness (share of its grasps with robust ε above the threshold).\n\n"
     "Writes `data/scores.parquet`, `metrics/score.json`, and histograms and a grasp picture in `reports/score/`.\n\n"
-    f"Params `score`:\n\n{describe(ScoreParams, 'score.')}\n\nAlso `grasps.threshold` (for labels).",
+    "{params}\n\nAlso `grasps.threshold` (for labels).",
+    "score",
 )
 
 
@@ -131,15 +166,15 @@ stage_command(
     "the first round(R × B) are the set for ratio R.\n\n"
     "Writes `data/generated/<B>/` (`meshes/*.obj`, `index.parquet`, `rejects.parquet`, `base.parquet`), "
     "`metrics/generate/<B>.json` and `reports/generate/<B>/{pairs,tsne}.png`.\n\n"
-    f"Params `generate`:\n\n{describe(GenerateParams, 'generate.')}\n\nAlso `score.k` (rarity on the base set), `seed`, `device`, `n_jobs`.",
+    "{params}\n\nAlso `score.k` (rarity on the base set), `seed`, `device`, `n_jobs`.",
+    cls=_with_params("generate", "generate"),
 )
 def generate_command(
     base_size: int = typer.Option(..., "--base-size", "-b", help="The base set size B (one of generate.base_sizes)."),
     params: Path = ParamsOption,
 ) -> None:
-    from graspaug.stages import generate
-
-    _run(lambda p: generate.run(p, base_size), _load(params))
+    stage = _stage("generate")
+    _run(lambda p: stage.run(p, base_size), _load(params, stage))
 
 
 @app.command(
@@ -152,15 +187,20 @@ def generate_command(
     "full 640×480 renders (tests/render).\n\n"
     "Writes `data/gqcnn/<corpus>/` (.npy shards of images, z, labels, ε; `index.parquet`; `skipped.parquet`), "
     "`metrics/render/<corpus>.json` and `reports/render/<corpus>/examples.png`.\n\n"
-    f"Params `render`:\n\n{describe(RenderParams, 'render.')}\n\nAlso `grasps.gripper` (the hand), `grasps.threshold` (labels), `seed` and `n_jobs`.",
+    "{params}\n\nAlso `grasps.gripper` (the hand), `grasps.threshold` (labels), `seed` and `n_jobs`.",
+    cls=_with_params("render", "render"),
 )
 def render_command(
-    corpus: str = typer.Option("original", "--corpus", "-c", help="Which shapes: `original` (train and test) or `gen_<B>` (generated for base size B)."),
+    corpus: str = typer.Option(
+        "original",
+        "--corpus",
+        "-c",
+        help="Which shapes: `original` (train and test) or `gen_<B>` (generated for base size B).",
+    ),
     params: Path = ParamsOption,
 ) -> None:
-    from graspaug.stages import render
-
-    _run(lambda p: render.run(p, corpus), _load(params))
+    stage = _stage("render")
+    _run(lambda p: stage.run(p, corpus), _load(params, stage))
 
 
 @app.command(
@@ -201,15 +241,15 @@ def export_dexnet_command(
     "validated, tested and planned with. Test = every test-split grasp of the original corpus.\n\n"
     "Writes `models/gqcnn/s<seed>/<pool>/<B>-<R>/` (model.pt, predictions, history.csv), `metrics/gqcnn/s<seed>.json` "
     "(validation and test AP per network) and `reports/gqcnn/validation/s<seed>.png` (validation AP vs step).\n\n"
-    f"Params `gqcnn`:\n\n{describe(GQCNNParams, 'gqcnn.')}\n\nAlso `seed`, `device`, `n_jobs`.",
+    "{params}\n\nAlso `seed`, `device`, `n_jobs`.",
+    cls=_with_params("train_gqcnn", "gqcnn"),
 )
 def train_gqcnn_command(
     seed: int = typer.Option(0, "--seed", "-s", help="Training seed (one of gqcnn.seeds)."),
     params: Path = ParamsOption,
 ) -> None:
-    from graspaug.stages import train_gqcnn
-
-    _run(lambda p: train_gqcnn.run(p, seed), _load(params))
+    stage = _stage("train_gqcnn")
+    _run(lambda p: stage.run(p, seed), _load(params, stage))
 
 
 stage_command(
@@ -235,7 +275,8 @@ stage_command(
     "Writes `metrics/sim.json` (success per arm and object with 95% Wilson intervals; `contrasts` after_vs_before, "
     "network_vs_antipodal, after_vs_real with bootstrap intervals over objects; calibration) and `reports/sim/` "
     "(`report.md`, `trials.csv`, `success.csv/.png`, `objects.csv`, `calibration.csv`, `timing.json`, `trials/<arm>-<object>.png`).\n\n"
-    f"Params `sim`:\n\n{describe(SimParams, 'sim.')}",
+    "{params}",
+    "sim",
 )
 
 
@@ -251,16 +292,24 @@ stage_command(
 )
 def plan_command(
     depth: Path = typer.Argument(..., help="Depth image: .npy (meters) or 16-bit .png (millimeters)."),
-    model: Path = typer.Option(..., "--model", "-m", help="A trained GQ-CNN, e.g. models/gqcnn/s0/targeted/50-0/model.pt."),
-    intrinsics: Path | None = typer.Option(None, "--intrinsics", "-i", help="JSON file with fx, fy, cx, cy (px); instead of the flags."),
+    model: Path = typer.Option(
+        ..., "--model", "-m", help="A trained GQ-CNN, e.g. models/gqcnn/s0/targeted/50-0/model.pt."
+    ),
+    intrinsics: Path | None = typer.Option(
+        None, "--intrinsics", "-i", help="JSON file with fx, fy, cx, cy (px); instead of the flags."
+    ),
     fx: float | None = typer.Option(None, "--fx", help="Focal length along u (px)."),
     fy: float | None = typer.Option(None, "--fy", help="Focal length along v (px; default: fx)."),
     cx: float | None = typer.Option(None, "--cx", help="Principal point u (px; default: the image center)."),
     cy: float | None = typer.Option(None, "--cy", help="Principal point v (px; default: the image center)."),
     top: int = typer.Option(1, "--top", "-k", min=1, help="List the K best grasps."),
     seed: int = typer.Option(0, "--seed", help="Seed of the sampler."),
-    camera_distance: float | None = typer.Option(None, "--camera-distance", help="Camera to table along the optical axis (m; default: the image's median depth)."),
-    fill_missing: bool = typer.Option(False, "--fill-missing", help="Give missing pixels (0, NaN) the nearest valid depth instead of stopping."),
+    camera_distance: float | None = typer.Option(
+        None, "--camera-distance", help="Camera to table along the optical axis (m; default: the image's median depth)."
+    ),
+    fill_missing: bool = typer.Option(
+        False, "--fill-missing", help="Give missing pixels (0, NaN) the nearest valid depth instead of stopping."
+    ),
     out: Path = typer.Option(Path("."), "--out", "-o", help="Folder for grasp.json and grasp.png."),
 ) -> None:
     import json
@@ -284,18 +333,37 @@ def plan_command(
         raise typer.Exit(code=2) from None
     out.mkdir(parents=True, exist_ok=True)
     with atomic_path(out / "grasp.json") as tmp:
-        tmp.write_text(json.dumps({"depth": str(depth), "model": str(model), "grasps": [g.to_dict() for g in grasps],
-                                   "model_card": planner.card.to_dict()}, indent=1) + "\n")
+        tmp.write_text(
+            json.dumps(
+                {
+                    "depth": str(depth),
+                    "model": str(model),
+                    "grasps": [g.to_dict() for g in grasps],
+                    "model_card": planner.card.to_dict(),
+                },
+                indent=1,
+            )
+            + "\n"
+        )
     labels = [f"#{i + 1} Q = {g.quality:.3f}" for i, g in enumerate(grasps)]
     shown = np.where(np.isfinite(image) & (image > 0), image, np.nan) if image.dtype.kind == "f" else image
-    planned_grasps(np.nan_to_num(shown, nan=float(np.nanmax(shown))), [g.jaw_pixels for g in grasps], labels, out / "grasp.png",
-                   f"{depth.name}: {len(grasps)} grasp(s), model {model.parent.name}/{model.name}")
+    planned_grasps(
+        np.nan_to_num(shown, nan=float(np.nanmax(shown))),
+        [g.jaw_pixels for g in grasps],
+        labels,
+        out / "grasp.png",
+        f"{depth.name}: {len(grasps)} grasp(s), model {model.parent.name}/{model.name}",
+    )
     if not grasps:
-        typer.echo(f"no grasp: no antipodal pair of depth edges in {depth} fits the gripper (wrote {out / 'grasp.json'})")
+        typer.echo(
+            f"no grasp: no antipodal pair of depth edges in {depth} fits the gripper (wrote {out / 'grasp.json'})"
+        )
         raise typer.Exit(code=1)
     for i, g in enumerate(grasps):
-        typer.echo(f"#{i + 1}: center ({g.u:.1f}, {g.v:.1f}) px, angle {np.degrees(g.angle):.1f} deg, depth {g.depth:.3f} m, "
-                   f"width {1000 * g.width:.1f} mm, quality {g.quality:.3f}")
+        typer.echo(
+            f"#{i + 1}: center ({g.u:.1f}, {g.v:.1f}) px, angle {np.degrees(g.angle):.1f} deg, depth {g.depth:.3f} m, "
+            f"width {1000 * g.width:.1f} mm, quality {g.quality:.3f}"
+        )
     typer.echo(f"wrote {out / 'grasp.json'} and {out / 'grasp.png'} ({grasps[0].planning_time:.2f} s)")
 
 
@@ -334,6 +402,7 @@ def profile_command(
     profiles: Path = typer.Option(Path("profiles"), "--profiles", help="Folder of profile overlays."),
 ) -> None:
     from graspaug.io.atomic import atomic_path
+    from graspaug.params.base import ParamsError
     from graspaug.profiles import profile_yaml
 
     try:
@@ -367,7 +436,11 @@ def _version(value: bool) -> None:
 
 
 @app.callback()
-def _root(version: bool = typer.Option(False, "--version", callback=_version, is_eager=True, help="Print the version and exit.")) -> None:
+def _root(
+    version: bool = typer.Option(
+        False, "--version", callback=_version, is_eager=True, help="Print the version and exit."
+    ),
+) -> None:
     """graspaug: augment a grasp planner's training objects with generated shapes."""
 
 

@@ -1,4 +1,5 @@
 """One source file → one row of the shape table (its mesh written), duplicates, and the train/test split."""
+
 from __future__ import annotations
 
 import os
@@ -15,9 +16,13 @@ from graspaug.geometry.voxelize import fit_grid, pack_bits, voxelize_solid
 from graspaug.io.meshes import mesh_path, write_mesh
 from graspaug.io.sources import Source
 
-
-_KINDS = ((stat.S_ISDIR, "a directory"), (stat.S_ISFIFO, "a FIFO (named pipe)"), (stat.S_ISCHR, "a character device"),
-          (stat.S_ISBLK, "a block device"), (stat.S_ISSOCK, "a socket"))
+_KINDS = (
+    (stat.S_ISDIR, "a directory"),
+    (stat.S_ISFIFO, "a FIFO (named pipe)"),
+    (stat.S_ISCHR, "a character device"),
+    (stat.S_ISBLK, "a block device"),
+    (stat.S_ISSOCK, "a socket"),
+)
 
 
 def file_problem(path: Path) -> str | None:
@@ -28,7 +33,11 @@ def file_problem(path: Path) -> str | None:
         link = stat.S_ISLNK(os.lstat(path).st_mode)
         mode = os.stat(path).st_mode
     except FileNotFoundError:
-        return f"broken symlink: its target {os.readlink(path)} does not exist" if os.path.islink(path) else "file vanished"
+        return (
+            f"broken symlink: its target {os.readlink(path)} does not exist"
+            if os.path.islink(path)
+            else "file vanished"
+        )
     except OSError as exc:
         return f"unreadable: {'symlink loop' if exc.errno == 40 else exc.strerror or exc}"
     if stat.S_ISREG(mode):
@@ -71,7 +80,11 @@ def ingest_source(source: Source, max_faces: int, max_file_mb: float, settings: 
         except MeshRejected as exc:
             return {**row, "ok": False, "reason": _with_warnings(str(exc), caught)}
         except OSError as exc:
-            return {**row, "ok": False, "reason": _with_warnings(f"unreadable: {type(exc).__name__}: {exc.strerror or exc}", caught)}
+            return {
+                **row,
+                "ok": False,
+                "reason": _with_warnings(f"unreadable: {type(exc).__name__}: {exc.strerror or exc}", caught),
+            }
     mesh, norm = prepared.mesh, prepared.normalization
     write_mesh(mesh, mesh_path(out_dir, source.shape_id))
     extents = mesh.extents
@@ -125,13 +138,17 @@ def flag_duplicates(shapes: pd.DataFrame, occupancy: list[bytes]) -> pd.DataFram
                 break
         if not duplicate_of[row]:
             originals.append(row)
-        first_by_hash.setdefault(out.at[row, "source_sha256"], row if not duplicate_of[row] else
-                                 int(np.flatnonzero(out["shape_id"] == duplicate_of[row])[0]))
+        first_by_hash.setdefault(
+            out.at[row, "source_sha256"],
+            row if not duplicate_of[row] else int(np.flatnonzero(out["shape_id"] == duplicate_of[row])[0]),
+        )
     out["duplicate_of"], out["duplicate_kind"] = duplicate_of, kind
     return out
 
 
-def assign_split(shape_ids: list[str], test_fraction: float, seed: int, duplicate_of: dict[str, str] | None = None) -> dict[str, str]:
+def assign_split(
+    shape_ids: list[str], test_fraction: float, seed: int, duplicate_of: dict[str, str] | None = None
+) -> dict[str, str]:
     """Seeded shuffle of the sorted ids; the first ``round(test_fraction * n)`` are ``test``.
     A shape in ``duplicate_of`` (id → the id it duplicates) takes its original's split, so a
     duplicate never sits on the other side of the split (n counts originals only)."""

@@ -1,4 +1,5 @@
 """The torch device the ``device`` param names."""
+
 from __future__ import annotations
 
 import torch
@@ -37,7 +38,9 @@ def keep_freed_memory() -> bool:
     except (OSError, AttributeError):
         return False
     m_trim_threshold, m_mmap_threshold = -1, -3  # glibc's malloc.h
-    mmap_set = mallopt(m_mmap_threshold, _HEAP_KEPT) or mallopt(m_mmap_threshold, 32 << 20)  # glibc < 2.35 caps it at 32 MiB
+    mmap_set = mallopt(m_mmap_threshold, _HEAP_KEPT) or mallopt(
+        m_mmap_threshold, 32 << 20
+    )  # glibc < 2.35 caps it at 32 MiB
     return bool(mmap_set) and bool(mallopt(m_trim_threshold, _HEAP_KEPT))
 
 
@@ -47,4 +50,8 @@ def has_native_bfloat16(device: torch.device) -> bool:
     ``torch.autocast`` emulates bfloat16, slower than float32."""
     if device.type == "cuda":
         return torch.cuda.is_bf16_supported()
-    return device.type == "cpu" and torch.backends.mkldnn.is_available() and bool(torch.ops.mkldnn._is_mkldnn_bf16_supported())
+    return (
+        device.type == "cpu"
+        and torch.backends.mkldnn.is_available()
+        and bool(torch.ops.mkldnn._is_mkldnn_bf16_supported())
+    )

@@ -1,4 +1,5 @@
 """2-D maps of latent codes."""
+
 from __future__ import annotations
 
 import numpy as np

@@ -5,6 +5,7 @@ A pool is an append-only stream of ``Candidate`` (parent pair + interpolation we
 kept ones, in stream order, make the pool, whose first ``ratio_count(R, B)`` shapes are the
 augmentation set for ratio ``R``: sets for larger ratios contain those for smaller ones.
 """
+
 from __future__ import annotations
 
 import math
@@ -15,6 +16,8 @@ from typing import Protocol, TypeVar
 import numpy as np
 import pandas as pd
 from sklearn.neighbors import NearestNeighbors
+
+from graspaug.errors import DataError
 
 EXTRA_ALPHAS = (0.4, 0.2, 0.1, 0.05)  # weights a targeted stream adds, in this order, when it runs dry
 
@@ -46,7 +49,7 @@ def nested_base_sets(shape_ids: np.ndarray, sizes: list[int], rng: np.random.Gen
     """Base sets of each size drawn from ``shape_ids`` (e.g. the train split): one seeded
     permutation, so each set is the first ``size`` of it and smaller sets lie inside larger ones."""
     if max(sizes) > len(shape_ids):
-        raise ValueError(f"base size {max(sizes)} is larger than the {len(shape_ids)} shapes to draw from")
+        raise DataError(f"base size {max(sizes)} is larger than the {len(shape_ids)} shapes to draw from")
     order = rng.permutation(len(shape_ids))
     return {size: np.asarray(shape_ids)[order[:size]] for size in sizes}
 
@@ -56,7 +59,7 @@ BASE_SEED = 0xBA5E  # base sets: their own stream of the seed
 
 def draw_base_sets(shapes: pd.DataFrame, sizes, seed: int) -> dict[int, np.ndarray]:
     """The base sets of every size in ``sizes``, drawn from the train split of ``shapes``
-    (``data/shapes.parquet``) with the global ``seed``: what ``generate`` augments and what the
+    (the ingested shape table) with the global ``seed``: what ``generate`` augments and what the
     GQ-CNN experiment's 1:0 networks train on, the same wherever they are drawn."""
     train_ids = shapes.shape_id[shapes.split == "train"].to_numpy()
     return nested_base_sets(train_ids, sorted(sizes), np.random.default_rng([seed, BASE_SEED]))
@@ -89,7 +92,15 @@ def neighbour_pairs(z: np.ndarray, first: int, extra: int) -> list[tuple[int, in
     return pairs
 
 
-def targeted_candidates(z: np.ndarray, rarity: np.ndarray, graspness: np.ndarray, percentile: float, first: int, extra: int, alphas: Sequence[float]) -> list[Candidate]:
+def targeted_candidates(
+    z: np.ndarray,
+    rarity: np.ndarray,
+    graspness: np.ndarray,
+    percentile: float,
+    first: int,
+    extra: int,
+    alphas: Sequence[float],
+) -> list[Candidate]:
     """Candidates from the shapes above the ``percentile`` in rarity (one group) and in
     graspness (another), each paired with its N-th to (N+K)-th nearest neighbours of its group
     in latent space. The two groups' lists (each: every pair at the first α, then every pair at
@@ -140,14 +151,27 @@ class TargetedStream(CandidateStream):
     one step at a time, each noted: first the next weight of EXTRA_ALPHAS (near pairs stay
     near), then K by one while a group has neighbours that far, then the percentile down by 5."""
 
-    def __init__(self, z: np.ndarray, rarity: np.ndarray, graspness: np.ndarray, percentile: float, first: int, extra: int, alphas: Sequence[float]) -> None:
+    def __init__(
+        self,
+        z: np.ndarray,
+        rarity: np.ndarray,
+        graspness: np.ndarray,
+        percentile: float,
+        first: int,
+        extra: int,
+        alphas: Sequence[float],
+    ) -> None:
         super().__init__()
         self.z, self.rarity, self.graspness, self.first = z, rarity, graspness, first
         self.percentile, self.extra, self.alphas = float(percentile), extra, list(alphas)
         self._refill()
 
     def _refill(self) -> None:
-        self._append(targeted_candidates(self.z, self.rarity, self.graspness, self.percentile, self.first, self.extra, self.alphas))
+        self._append(
+            targeted_candidates(
+                self.z, self.rarity, self.graspness, self.percentile, self.first, self.extra, self.alphas
+            )
+        )
 
     def _grow(self, count: int) -> None:
         while len(self.items) < count:
@@ -161,7 +185,9 @@ class TargetedStream(CandidateStream):
                 self.notes.append(f"K widened to {self.extra} ({len(self.items)} candidates, {count} wanted)")
             elif self.percentile > 0:
                 self.percentile = max(0.0, self.percentile - 5.0)
-                self.notes.append(f"percentile lowered to {self.percentile:g} ({len(self.items)} candidates, {count} wanted)")
+                self.notes.append(
+                    f"percentile lowered to {self.percentile:g} ({len(self.items)} candidates, {count} wanted)"
+                )
             else:
                 return
             self._refill()
@@ -177,7 +203,9 @@ class RandomStream(CandidateStream):
         pairs = [(i, j) for i in range(n_shapes) for j in range(i + 1, n_shapes)]
         order = rng.permutation(len(pairs))
         for round_ in range(len(alphas)):
-            self._append([Candidate(*pairs[p], float(alphas[(k + round_) % len(alphas)]), "random") for k, p in enumerate(order)])
+            self._append(
+                [Candidate(*pairs[p], float(alphas[(k + round_) % len(alphas)]), "random") for k, p in enumerate(order)]
+            )
 
 
 class HasReason(Protocol):
@@ -191,7 +219,9 @@ class PoolExhausted(RuntimeError):
     """A pool could not be filled: every candidate the stream allows was tried."""
 
 
-def fill_pool(stream: CandidateStream, needed: int, run_batch: Callable[[list[Candidate]], list[D]]) -> tuple[list[D], list[D]]:
+def fill_pool(
+    stream: CandidateStream, needed: int, run_batch: Callable[[list[Candidate]], list[D]]
+) -> tuple[list[D], list[D]]:
     """Try the stream's candidates in order until ``needed`` are kept (``reason`` None);
     ``run_batch`` decodes a batch. Returns the kept and the rejected, in stream order; raises
     :class:`PoolExhausted` if the stream ends first."""
@@ -201,7 +231,9 @@ def fill_pool(stream: CandidateStream, needed: int, run_batch: Callable[[list[Ca
         tried = len(kept) + len(rejected)
         batch = stream.take(tried, needed - len(kept))
         if not batch:
-            raise PoolExhausted(f"only {len(kept)} of {needed} shapes after {tried} candidates; no more pairs or weights to try")
+            raise PoolExhausted(
+                f"only {len(kept)} of {needed} shapes after {tried} candidates; no more pairs or weights to try"
+            )
         for outcome in run_batch(batch):
             (rejected if outcome.reason else kept).append(outcome)
     return kept, rejected
@@ -218,28 +250,57 @@ class Decoded:
     reason: str | None
 
 
-def pool_tables(base: np.ndarray, z: np.ndarray, pools: dict[str, tuple[list[Decoded], list[Decoded]]], base_size: int) -> tuple[list[dict], list[dict]]:
+def pool_tables(
+    base: np.ndarray, z: np.ndarray, pools: dict[str, tuple[list[Decoded], list[Decoded]]], base_size: int
+) -> tuple[list[dict], list[dict]]:
     """Rows of ``index.parquet`` (one per kept shape, in pool order) and of ``rejects.parquet``
     for the pools (name → (kept, rejected)) of base set ``base`` (shape ids) with latents ``z`` (B, d)."""
     rows, rejects = [], []
     for pool, (kept, rejected) in pools.items():
         for order, d in enumerate(kept):
             c, m = d.candidate, d.mesh
-            rows.append({
-                "shape_id": f"gen_{base_size}_{pool[0]}{order:04d}", "base_size": base_size, "pool": pool, "order": order,
-                "parent_a": base[c.a], "parent_b": base[c.b], "alpha": c.alpha, "selected_by": c.selected_by,
-                "z": ((1 - c.alpha) * z[c.a] + c.alpha * z[c.b]).astype(np.float32), "faces": len(m.faces), "vertices": len(m.vertices),
-                "watertight": bool(m.is_watertight), "one_piece": len(m.split(only_watertight=False)) == 1, "volume": float(m.volume),
-                "extent_x": m.extents[0], "extent_y": m.extents[1], "extent_z": m.extents[2], "split": "train", "origin": "generated",
-            })
+            rows.append(
+                {
+                    "shape_id": f"gen_{base_size}_{pool[0]}{order:04d}",
+                    "base_size": base_size,
+                    "pool": pool,
+                    "order": order,
+                    "parent_a": base[c.a],
+                    "parent_b": base[c.b],
+                    "alpha": c.alpha,
+                    "selected_by": c.selected_by,
+                    "z": ((1 - c.alpha) * z[c.a] + c.alpha * z[c.b]).astype(np.float32),
+                    "faces": len(m.faces),
+                    "vertices": len(m.vertices),
+                    "watertight": bool(m.is_watertight),
+                    "one_piece": len(m.split(only_watertight=False)) == 1,
+                    "volume": float(m.volume),
+                    "extent_x": m.extents[0],
+                    "extent_y": m.extents[1],
+                    "extent_z": m.extents[2],
+                    "split": "train",
+                    "origin": "generated",
+                }
+            )
     for pool, (_, rejected) in pools.items():
-        rejects += [{"pool": pool, "parent_a": base[d.candidate.a], "parent_b": base[d.candidate.b], "alpha": d.candidate.alpha,
-                     "selected_by": d.candidate.selected_by, "reason": d.reason} for d in rejected]
+        rejects += [
+            {
+                "pool": pool,
+                "parent_a": base[d.candidate.a],
+                "parent_b": base[d.candidate.b],
+                "alpha": d.candidate.alpha,
+                "selected_by": d.candidate.selected_by,
+                "reason": d.reason,
+            }
+            for d in rejected
+        ]
     return rows, rejects
 
 
-def pool_summary(base_size: int, needed: int, pools: dict, targeted: TargetedStream, index, reject_rows: list[dict]) -> tuple[dict, dict[str, float]]:
-    """``metrics/generate/<B>.json`` for the pools (name → (kept, rejected) Decoded lists), and
+def pool_summary(
+    base_size: int, needed: int, pools: dict, targeted: TargetedStream, index, reject_rows: list[dict]
+) -> tuple[dict, dict[str, float]]:
+    """The ``generate`` stage's metrics for the pools (name → (kept, rejected) Decoded lists), and
     each pool's share of usable decodes."""
     import pandas as pd
 
@@ -247,12 +308,24 @@ def pool_summary(base_size: int, needed: int, pools: dict, targeted: TargetedStr
     kept_share = {name: len(kept) / (len(kept) + len(rejected)) for name, (kept, rejected) in pools.items()}
     (kept_t, rejected_t), (kept_r, rejected_r) = pools["targeted"], pools["random"]
     summary = {
-        "base_size": base_size, "pool_size": needed,
-        "targeted": {"kept": len(kept_t), "tried": len(kept_t) + len(rejected_t), "kept_share": round(kept_share["targeted"], 4),
-                     "by_rarity": int((index.selected_by == "rarity").sum()), "by_graspness": int((index.selected_by == "graspness").sum()),
-                     "k_used": targeted.extra, "alphas_used": targeted.alphas, "percentile_used": targeted.percentile,
-                     "widening": targeted.notes},
-        "random": {"kept": len(kept_r), "tried": len(kept_r) + len(rejected_r), "kept_share": round(kept_share["random"], 4)},
+        "base_size": base_size,
+        "pool_size": needed,
+        "targeted": {
+            "kept": len(kept_t),
+            "tried": len(kept_t) + len(rejected_t),
+            "kept_share": round(kept_share["targeted"], 4),
+            "by_rarity": int((index.selected_by == "rarity").sum()),
+            "by_graspness": int((index.selected_by == "graspness").sum()),
+            "k_used": targeted.extra,
+            "alphas_used": targeted.alphas,
+            "percentile_used": targeted.percentile,
+            "widening": targeted.notes,
+        },
+        "random": {
+            "kept": len(kept_r),
+            "tried": len(kept_r) + len(rejected_r),
+            "kept_share": round(kept_share["random"], 4),
+        },
         "rejects": {str(k): int(v) for k, v in reasons.value_counts().sort_index().items()},
         "kept_watertight_one_piece_share": round(float((index.watertight & index.one_piece).mean()), 4),
     }
@@ -265,7 +338,12 @@ def base_scores_table(base: np.ndarray, rarity: np.ndarray, graspness: np.ndarra
     import pandas as pd
 
     rare, graspable = set(above_percentile(rarity, percentile)), set(above_percentile(graspness, percentile))
-    return pd.DataFrame({"shape_id": base, "rarity": rarity, "graspness": graspness,
-                         "selected_by_rarity": [i in rare for i in range(len(base))],
-                         "selected_by_graspness": [i in graspable for i in range(len(base))]})
-
+    return pd.DataFrame(
+        {
+            "shape_id": base,
+            "rarity": rarity,
+            "graspness": graspness,
+            "selected_by_rarity": [i in rare for i in range(len(base))],
+            "selected_by_graspness": [i in graspable for i in range(len(base))],
+        }
+    )

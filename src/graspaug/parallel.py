@@ -7,6 +7,7 @@ the project folder at the same path (a shared filesystem), as the functions read
 files of their shape. Results come back in order either way, so outputs do not depend on where
 they were computed.
 """
+
 from __future__ import annotations
 
 import contextlib
@@ -66,7 +67,11 @@ def parallel_map(fn: Callable[..., T], items: Sequence[Any], workers: int | Work
                 bar.update()
             return results
         if workers.executor == "dask":
-            backend, n_jobs, calls = _dask_backend(workers.scheduler), -1, (delayed(_in_folder)(os.getcwd(), fn, item) for item in items)
+            backend, n_jobs, calls = (
+                _dask_backend(workers.scheduler),
+                -1,
+                (delayed(_in_folder)(os.getcwd(), fn, item) for item in items),
+            )
         else:
             backend, n_jobs, calls = contextlib.nullcontext(), workers.n_jobs, (delayed(fn)(item) for item in items)
         with backend:

@@ -3,6 +3,7 @@
 ``dvc.yaml`` declares the same paths as the stages' outs; the README's data contracts
 say what each file holds.
 """
+
 from pathlib import Path
 
 # ingest
@@ -100,18 +101,10 @@ def render_examples(corpus: str) -> Path:
 
 
 # train_gqcnn (every network of one training seed) and report
-def gqcnn_variant_name(pool: str, base_size: int = 0, ratio: float = 0.0) -> str:
-    """``<pool>/<B>-<R>`` (R as ``%g``: ``50-0.5``, ``200-1``), or ``ceiling``."""
-    return "ceiling" if pool == "ceiling" else f"{pool}/{base_size}-{float(ratio):g}"
-
-
 def gqcnn_seed_dir(seed: int) -> Path:
+    """The networks of a training seed, one folder each (``<pool>/<B>-<R>``, named by
+    :attr:`graspaug.experiments.variants.Variant.name`)."""
     return Path(f"models/gqcnn/s{seed}")
-
-
-def gqcnn_model_dir(pool: str, base_size: int, ratio: float, seed: int) -> Path:
-    """One network's folder: ``models/gqcnn/s<seed>/<pool>/<B>-<R>``; ratio 0 of every pool is the targeted network."""
-    return gqcnn_seed_dir(seed) / gqcnn_variant_name("targeted" if pool != "ceiling" and float(ratio) == 0.0 else pool, base_size, ratio)
 
 
 def gqcnn_seed_metrics(seed: int) -> Path:

@@ -1,4 +1,5 @@
 """Figures as PNG files (matplotlib, Agg backend): what the stages show a person."""
+
 from __future__ import annotations
 
 import os
@@ -40,8 +41,15 @@ def scatter_2d(xy: np.ndarray, groups: Sequence[str], path: str | os.PathLike, t
     _save(fig, path)
 
 
-def lines(x: Sequence[float], series: dict[str, Sequence[float]], path: str | os.PathLike, xlabel: str, ylabel: str, title: str,
-          intervals: dict[str, tuple[Sequence[float], Sequence[float]]] | None = None) -> None:
+def lines(
+    x: Sequence[float],
+    series: dict[str, Sequence[float]],
+    path: str | os.PathLike,
+    xlabel: str,
+    ylabel: str,
+    title: str,
+    intervals: dict[str, tuple[Sequence[float], Sequence[float]]] | None = None,
+) -> None:
     """One line per series over shared x values; ``intervals`` (low, high) per series are drawn as bands."""
     plt = _pyplot()
     fig, ax = plt.subplots(figsize=(6, 4))
@@ -57,7 +65,13 @@ def lines(x: Sequence[float], series: dict[str, Sequence[float]], path: str | os
     _save(fig, path)
 
 
-def voxel_rows(rows: list[list[tuple[np.ndarray, np.ndarray]]], row_labels: list[str], col_labels: list[str], path: str | os.PathLike, title: str) -> None:
+def voxel_rows(
+    rows: list[list[tuple[np.ndarray, np.ndarray]]],
+    row_labels: list[str],
+    col_labels: list[str],
+    path: str | os.PathLike,
+    title: str,
+) -> None:
     """A grid of voxel shapes; each cell is (occupancy, main-part mask): main part green, the rest red.
 
     rows : per row, per column, ``(occupancy (R, R, R) bool, main (R, R, R) bool)``
@@ -98,7 +112,15 @@ def histogram(counts: np.ndarray, edges: np.ndarray, path: str | os.PathLike, xl
     _save(fig, path)
 
 
-def grasps_on_shapes(shapes: list[tuple[np.ndarray, np.ndarray]], segments: list[np.ndarray], qualities: list[np.ndarray], titles: list[str], path: str | os.PathLike, vmax: float, threshold: float) -> None:
+def grasps_on_shapes(
+    shapes: list[tuple[np.ndarray, np.ndarray]],
+    segments: list[np.ndarray],
+    qualities: list[np.ndarray],
+    titles: list[str],
+    path: str | os.PathLike,
+    vmax: float,
+    threshold: float,
+) -> None:
     """Shapes side by side with their grasps drawn as contact-to-contact segments.
 
     shapes : per shape ``(vertices (V, 3) m, faces (F, 3))``
@@ -124,7 +146,11 @@ def grasps_on_shapes(shapes: list[tuple[np.ndarray, np.ndarray]], segments: list
         ax.add_collection3d(Line3DCollection(seg, colors=cmap(norm(q)), linewidths=1.6))
         half = 0.5 * np.ptp(vertices, axis=0).max()
         mid = 0.5 * (vertices.max(axis=0) + vertices.min(axis=0))
-        ax.set(xlim=(mid[0] - half, mid[0] + half), ylim=(mid[1] - half, mid[1] + half), zlim=(mid[2] - half, mid[2] + half))
+        ax.set(
+            xlim=(mid[0] - half, mid[0] + half),
+            ylim=(mid[1] - half, mid[1] + half),
+            zlim=(mid[2] - half, mid[2] + half),
+        )
         ax.set_box_aspect((1, 1, 1))
         ax.set_axis_off()
         ax.set_title(title, fontsize=10)
@@ -133,7 +159,14 @@ def grasps_on_shapes(shapes: list[tuple[np.ndarray, np.ndarray]], segments: list
     _save(fig, path)
 
 
-def crop_grid(images: np.ndarray, titles: Sequence[str], jaw_half_widths: Sequence[float], path: str | os.PathLike, title: str, columns: int = 6) -> None:
+def crop_grid(
+    images: np.ndarray,
+    titles: Sequence[str],
+    jaw_half_widths: Sequence[float],
+    path: str | os.PathLike,
+    title: str,
+    columns: int = 6,
+) -> None:
     """Depth crops (n, s, s) (m) in a grid, each in its own gray scale (near = light), with its
     title and the open jaws drawn as two vertical red ticks ``jaw_half_widths`` pixels left and
     right of the center (the jaw axis is the crop's horizontal)."""
@@ -166,7 +199,9 @@ def ap_vs_ratio(table: pd.DataFrame, path: str | os.PathLike, title: str) -> Non
     plt = _pyplot()
     networks = table[table.pool != "ceiling"]
     bases = sorted(networks.base_size.unique())
-    fig, axes = plt.subplots(1, max(len(bases), 1), figsize=(3.6 * max(len(bases), 1) + 0.8, 3.8), sharey=True, squeeze=False)
+    fig, axes = plt.subplots(
+        1, max(len(bases), 1), figsize=(3.6 * max(len(bases), 1) + 0.8, 3.8), sharey=True, squeeze=False
+    )
     styles = {"targeted": ("-", "tab:blue"), "random": ("--", "tab:orange"), "real": (":", "tab:green")}
     ceiling = table[table.pool == "ceiling"]
     for ax, base in zip(axes[0], bases):
@@ -175,11 +210,27 @@ def ap_vs_ratio(table: pd.DataFrame, path: str | os.PathLike, title: str) -> Non
         for pool, (style, color) in styles.items():
             curve = pd.concat([alone, rows[(rows.pool == pool) & (rows.ratio > 0)]]).sort_values("ratio")
             if len(curve) > len(alone):
-                ax.errorbar(curve.ratio, curve.test_ap, yerr=np.nan_to_num(curve.test_ap_ci.to_numpy(dtype=float)), marker="o", markersize=4,
-                            capsize=3, linestyle=style, color=color, label=pool)
+                ax.errorbar(
+                    curve.ratio,
+                    curve.test_ap,
+                    yerr=np.nan_to_num(curve.test_ap_ci.to_numpy(dtype=float)),
+                    marker="o",
+                    markersize=4,
+                    capsize=3,
+                    linestyle=style,
+                    color=color,
+                    label=pool,
+                )
         if len(alone) and len(rows) == len(alone):
-            ax.errorbar(alone.ratio, alone.test_ap, yerr=np.nan_to_num(alone.test_ap_ci.to_numpy(dtype=float)), marker="o", capsize=3, color="tab:blue",
-                        label="base set alone")
+            ax.errorbar(
+                alone.ratio,
+                alone.test_ap,
+                yerr=np.nan_to_num(alone.test_ap_ci.to_numpy(dtype=float)),
+                marker="o",
+                capsize=3,
+                color="tab:blue",
+                label="base set alone",
+            )
         if len(ceiling) and np.isfinite(ceiling.test_ap.iloc[0]):
             top, half = float(ceiling.test_ap.iloc[0]), float(np.nan_to_num(ceiling.test_ap_ci.iloc[0]))
             ax.axhline(top, color="grey", linewidth=1, label="ceiling (all train shapes)")
@@ -226,7 +277,10 @@ def improvement_by_interval(panels: list[dict], path: str | os.PathLike, title: 
     for ax, panel in zip(axes[0], panels):
         edges = np.asarray(panel["edges"])
         centers, width = (edges[:-1] + edges[1:]) / 2, np.diff(edges)
-        for name, values, color in (("selected", panel["selected"], "tab:orange"), ("generated", panel["generated"], "tab:green")):
+        for name, values, color in (
+            ("selected", panel["selected"], "tab:orange"),
+            ("generated", panel["generated"], "tab:green"),
+        ):
             counts, _ = np.histogram(np.clip(values, edges[0], edges[-1]), bins=edges)
             share = counts / max(counts.sum(), 1)
             ax.bar(centers, share, width=width * 0.9, alpha=0.45, color=color, label=f"{name} shapes ({len(values)})")
@@ -237,7 +291,9 @@ def improvement_by_interval(panels: list[dict], path: str | os.PathLike, title: 
         twin.plot(centers, improvement, marker="o", color="tab:blue", label="mean AP improvement of test objects")
         for x, y, n in zip(centers, improvement, panel["objects"]):
             if np.isfinite(y):
-                twin.annotate(str(n), (x, y), textcoords="offset points", xytext=(0, 5), ha="center", fontsize=7, color="tab:blue")
+                twin.annotate(
+                    str(n), (x, y), textcoords="offset points", xytext=(0, 5), ha="center", fontsize=7, color="tab:blue"
+                )
         twin.axhline(0, color="gray", linewidth=0.8)
         twin.set_ylabel("per-object AP improvement")
         lines, labels = ax.get_legend_handles_labels()
@@ -248,7 +304,9 @@ def improvement_by_interval(panels: list[dict], path: str | os.PathLike, title: 
     _save(fig, path)
 
 
-def scatter_colored(xy: np.ndarray, values: np.ndarray, markers: Sequence[str], path: str | os.PathLike, title: str, colorbar: str) -> None:
+def scatter_colored(
+    xy: np.ndarray, values: np.ndarray, markers: Sequence[str], path: str | os.PathLike, title: str, colorbar: str
+) -> None:
     """(N, 2) points colored by ``values``, one marker style per group in ``markers`` (the paper's Fig. 1)."""
     plt = _pyplot()
     fig, ax = plt.subplots(figsize=(6.5, 6))
@@ -257,8 +315,18 @@ def scatter_colored(xy: np.ndarray, values: np.ndarray, markers: Sequence[str], 
     art = None
     for style, name in zip(styles, sorted(set(markers))):
         sel = markers == name
-        art = ax.scatter(xy[sel, 0], xy[sel, 1], c=values[sel], s=10 if style == "o" else 16, marker=style, cmap="viridis",
-                         vmin=float(np.nanmin(values)), vmax=float(np.nanmax(values)), label=f"{name} ({sel.sum()})", edgecolors="none")
+        art = ax.scatter(
+            xy[sel, 0],
+            xy[sel, 1],
+            c=values[sel],
+            s=10 if style == "o" else 16,
+            marker=style,
+            cmap="viridis",
+            vmin=float(np.nanmin(values)),
+            vmax=float(np.nanmax(values)),
+            label=f"{name} ({sel.sum()})",
+            edgecolors="none",
+        )
     if art is not None:
         fig.colorbar(art, ax=ax, label=colorbar)
     ax.set_title(title, fontsize=9)
@@ -268,7 +336,12 @@ def scatter_colored(xy: np.ndarray, values: np.ndarray, markers: Sequence[str], 
     _save(fig, path)
 
 
-def success_bars(names: Sequence[str], arms: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]], path: str | os.PathLike, title: str) -> None:
+def success_bars(
+    names: Sequence[str],
+    arms: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]],
+    path: str | os.PathLike,
+    title: str,
+) -> None:
     """Grouped bars of success rate per object and arm; ``arms[label] = (rate, low, high)``,
     each (len(names),), drawn with the interval as error bars."""
     plt = _pyplot()
@@ -277,7 +350,9 @@ def success_bars(names: Sequence[str], arms: dict[str, tuple[np.ndarray, np.ndar
     width = 0.8 / max(1, len(arms))
     for i, (label, (rate, low, high)) in enumerate(arms.items()):
         rate, low, high = (np.asarray(a, dtype=float) for a in (rate, low, high))
-        ax.bar(x + (i - (len(arms) - 1) / 2) * width, rate, width, yerr=[rate - low, high - rate], capsize=3, label=label)
+        ax.bar(
+            x + (i - (len(arms) - 1) / 2) * width, rate, width, yerr=[rate - low, high - rate], capsize=3, label=label
+        )
     ax.set_xticks(x)
     ax.set_xticklabels(names, rotation=30, ha="right")
     ax.set_ylim(0, 1.25)
@@ -288,8 +363,14 @@ def success_bars(names: Sequence[str], arms: dict[str, tuple[np.ndarray, np.ndar
     _save(fig, path)
 
 
-def pick_story(depth: np.ndarray, jaw: np.ndarray | None, window: tuple[int, int, int, int], frames: Sequence[tuple[str, np.ndarray]],
-               path: str | os.PathLike, title: str) -> None:
+def pick_story(
+    depth: np.ndarray,
+    jaw: np.ndarray | None,
+    window: tuple[int, int, int, int],
+    frames: Sequence[tuple[str, np.ndarray]],
+    path: str | os.PathLike,
+    title: str,
+) -> None:
     """One trial: the depth image (m) inside ``window`` = (u0, v0, u1, v1) px with the chosen
     grasp's jaw segment ``jaw`` (2, 2) as (u, v) rows drawn, then the RGB pick frames."""
     plt = _pyplot()
@@ -332,7 +413,9 @@ def generated_pairs(base: np.ndarray, voxels, decoded: list, path: str | os.Path
     voxel_rows(rows, labels, ["parent a", "generated", "parent b"], path, title)
 
 
-def planned_grasps(depth: np.ndarray, jaws: Sequence[np.ndarray], labels: Sequence[str], path: str | os.PathLike, title: str) -> None:
+def planned_grasps(
+    depth: np.ndarray, jaws: Sequence[np.ndarray], labels: Sequence[str], path: str | os.PathLike, title: str
+) -> None:
     """The depth image (H, W) m with grasps drawn: each ``jaws`` entry (2, 2) holds the two jaw
     positions (u, v) px; the first (the best) in red, the others in orange, each labelled."""
     plt = _pyplot()
@@ -352,7 +435,9 @@ def planned_grasps(depth: np.ndarray, jaws: Sequence[np.ndarray], labels: Sequen
     _save(fig, path)
 
 
-def precision_recall_roc(labels: np.ndarray, predictions: dict[str, np.ndarray], path: str | os.PathLike, title: str) -> None:
+def precision_recall_roc(
+    labels: np.ndarray, predictions: dict[str, np.ndarray], path: str | os.PathLike, title: str
+) -> None:
     """Precision-recall (left) and ROC (right) curves of several networks' test predictions
     P(success) (N,) against the same 0/1 ``labels`` (N,); AP and ROC AUC in the legends. With
     one class in ``labels`` there are no curves: the panels say so."""

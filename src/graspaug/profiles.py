@@ -5,6 +5,7 @@ merges it into the defaults (:class:`graspaug.config.Params`), validates the res
 returns the text of a complete params.yaml, every key commented with its meaning, so that DVC
 sees every value and ``dvc params diff`` lines them up.
 """
+
 from __future__ import annotations
 
 from pathlib import Path
@@ -25,7 +26,11 @@ def merge(base: dict, overlay: dict, prefix: str = "") -> dict:
     for key, value in (overlay or {}).items():
         if key not in base:
             raise ParamsError(f"{prefix}{key}: unknown key; allowed here: {', '.join(base)}")
-        out[key] = merge(base[key], value, f"{prefix}{key}.") if isinstance(base[key], dict) and isinstance(value, dict) else value
+        out[key] = (
+            merge(base[key], value, f"{prefix}{key}.")
+            if isinstance(base[key], dict) and isinstance(value, dict)
+            else value
+        )
     return out
 
 
@@ -78,7 +83,9 @@ def _scalar(value: Any) -> str:
 def params_yaml(params: Params, header: str) -> str:
     """A complete params.yaml for ``params``: every key, each with its meaning as a comment."""
     comments = _comments()
-    lines = ["# yaml-language-server: $schema=params.schema.json"] + [f"# {line}".rstrip() for line in header.splitlines()]
+    lines = ["# yaml-language-server: $schema=params.schema.json"] + [
+        f"# {line}".rstrip() for line in header.splitlines()
+    ]
 
     def emit(data: dict, path: tuple[str, ...], indent: str) -> None:
         for key, value in data.items():
@@ -95,7 +102,10 @@ def params_yaml(params: Params, header: str) -> str:
 
 def profile_yaml(name: str, folder: Path = PROFILES_DIR) -> str:
     """The text of params.yaml for profile ``name``."""
-    header = (f"graspaug params, profile `{name}`: written by `graspaug profile {name}` from the defaults"
-              + (f" and profiles/{name}.yaml" if name != DEFAULT else "") + ".\n"
-              "Edit values here (or sweep them with `dvc exp run -S key=value`); `graspaug <stage> --help` explains each key.")
+    header = (
+        f"graspaug params, profile `{name}`: written by `graspaug profile {name}` from the defaults"
+        + (f" and profiles/{name}.yaml" if name != DEFAULT else "")
+        + ".\n"
+        "Edit values here (or sweep them with `dvc exp run -S key=value`); `graspaug <stage> --help` explains each key."
+    )
     return params_yaml(profile_params(name, folder), header)

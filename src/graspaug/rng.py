@@ -1,4 +1,5 @@
 """Random streams that do not depend on worker count or processing order."""
+
 from __future__ import annotations
 
 import zlib

@@ -1,4 +1,5 @@
 """Per-shape scores that pick the shapes to augment (paper Section III-B)."""
+
 from __future__ import annotations
 
 import numpy as np

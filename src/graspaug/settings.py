@@ -6,6 +6,7 @@ in Python, ``params.yaml`` fills it as a section (pydantic validates types and r
 rejects unknown keys), and ``--help`` and ``params.schema.json`` print its field descriptions.
 A value is defaulted in exactly one place: its field here.
 """
+
 from __future__ import annotations
 
 import dataclasses

@@ -5,6 +5,7 @@ file is meant to describe. OBJ text gets a distinct texture coordinate at every 
 corner, as textured exports have at UV seams, so a loader that keeps texture coordinates
 splits every vertex (the file's faces do not share a single vertex).
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -45,7 +46,9 @@ def seamed_box() -> tuple[str, float]:
     return obj_with_face_uvs(box, sides), float(box.volume)
 
 
-def _without_faces_near(mesh: trimesh.Trimesh, centers: np.ndarray, radius: float = 0.0, count: int = 0) -> trimesh.Trimesh:
+def _without_faces_near(
+    mesh: trimesh.Trimesh, centers: np.ndarray, radius: float = 0.0, count: int = 0
+) -> trimesh.Trimesh:
     """``mesh`` less the faces whose centers lie within ``radius`` of ``centers``, or the ``count`` nearest ones."""
     keep = np.ones(len(mesh.faces), bool)
     for c in centers:

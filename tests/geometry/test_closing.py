@@ -3,6 +3,7 @@
 Every mesh is built here (``scan_meshes``) with its true volume; ingest's volume is
 compared in the source frame (normalized volume / scale³).
 """
+
 import dataclasses
 
 import numpy as np
@@ -96,3 +97,21 @@ def test_an_open_sheet_encloses_nothing():
     filled = fill_open_mesh(cup, resolution=64, face_budget=3000, max_gap=0.05)
     assert filled.enclosed < 0.5  # prepare_shape rejects it
     assert filled.mesh.volume < 0.01 * np.pi * 0.03**2 * 0.05  # at most the fillet of its inner crease
+
+
+def test_open_and_multi_body_meshes_are_rebuilt_closed():
+    ball, volume = scan_meshes.holed_sphere()
+    assert not ball.is_watertight
+    closed = close_surface(ball, resolution=64, face_budget=3000, max_gap=0.05).mesh
+    assert closed.is_watertight and closed.body_count == 1
+    assert closed.volume == pytest.approx(volume, rel=0.03)  # solid, not a shell
+    boxes = trimesh.util.concatenate(  # overlapping closed bodies
+        [trimesh.creation.box(extents=(0.04, 0.02, 0.02)), trimesh.creation.box(extents=(0.02, 0.02, 0.04))]
+    )
+    closed = close_surface(boxes, resolution=64, face_budget=3000, max_gap=0.05).mesh
+    assert closed.is_watertight and closed.body_count == 1
+    assert closed.volume == pytest.approx(0.04 * 0.02 * 0.02 + 2 * 0.01 * 0.02 * 0.02, rel=0.05)
+    cup = trimesh.creation.cylinder(radius=0.03, height=0.05, sections=48)
+    cup.update_faces(cup.face_normals[:, 2] < 0.9)  # no lid: an open sheet bounds (almost) no volume
+    closed = close_surface(cup, resolution=64, face_budget=3000, max_gap=0.05).mesh
+    assert closed.volume < 0.01 * np.pi * 0.03**2 * 0.05  # at most the fillet of its inner crease

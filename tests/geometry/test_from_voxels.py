@@ -1,4 +1,5 @@
 """Decoded grids to meshes: cleaning with reasons, closed meshes in meters."""
+
 import numpy as np
 import pytest
 

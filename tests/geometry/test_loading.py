@@ -1,4 +1,5 @@
 """Loading real and broken mesh files; every broken kind gets its reason."""
+
 import numpy as np
 import pytest
 import trimesh
@@ -19,7 +20,9 @@ def write_broken_corpus(folder):
     (folder / "tilted.obj").write_text("v 0 0 0\nv 0.05 0 0.01\nv 0 0.05 0.02\nv 0.05 0.05 0.03\nf 1 2 3\nf 2 4 3\n")
     (folder / "empty.stl").write_bytes(b"")
     trimesh.creation.icosphere(subdivisions=6, radius=0.03).export(folder / "huge.ply")  # 81,920 faces
-    (folder / "points.ply").write_text("ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nend_header\n0 0 0\n1 0 0\n0 1 0\n")
+    (folder / "points.ply").write_text(
+        "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nend_header\n0 0 0\n1 0 0\n0 1 0\n"
+    )
     return {
         "garbage": "no triangles",
         "truncated": "unreadable",
@@ -85,8 +88,7 @@ def test_folder_ids_are_stable_and_unique(tmp_path):
 
 
 def test_a_convex_body_is_rebuilt_as_one_part_and_sized(tmp_path):
-    from graspaug.geometry.prepare import prepare_shape
-    from graspaug.geometry.prepare import SurfaceSettings
+    from graspaug.geometry.prepare import SurfaceSettings, prepare_shape
 
     path = tmp_path / "box.stl"
     trimesh.creation.box(extents=(0.1, 0.06, 0.03)).export(path)
@@ -98,8 +100,7 @@ def test_a_convex_body_is_rebuilt_as_one_part_and_sized(tmp_path):
 
 
 def test_a_closed_non_convex_body_keeps_its_triangles(tmp_path):
-    from graspaug.geometry.prepare import prepare_shape
-    from graspaug.geometry.prepare import SurfaceSettings
+    from graspaug.geometry.prepare import SurfaceSettings, prepare_shape
 
     torus = trimesh.creation.torus(major_radius=0.04, minor_radius=0.012)
     path = tmp_path / "ring.ply"
@@ -109,4 +110,8 @@ def test_a_closed_non_convex_body_keeps_its_triangles(tmp_path):
     prepared = prepare_shape(loaded, SurfaceSettings())
     assert len(prepared.mesh.faces) == len(torus.faces) < SurfaceSettings().face_budget
     scale = prepared.normalization.scale
-    assert np.allclose(np.sort(prepared.mesh.vertices, axis=0), np.sort(torus.vertices * scale + prepared.normalization.offset, axis=0), atol=1e-9)
+    assert np.allclose(
+        np.sort(prepared.mesh.vertices, axis=0),
+        np.sort(torus.vertices * scale + prepared.normalization.offset, axis=0),
+        atol=1e-9,
+    )

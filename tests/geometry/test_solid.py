@@ -2,9 +2,7 @@ import numpy as np
 import pytest
 import trimesh
 
-from graspaug.geometry.solid import convex_part, outer_surface_of_mesh, outer_surface_of_parts, union_contains
-
-from .scan_meshes import holed_sphere
+from graspaug.geometry.solid import convex_part, outer_surface_of_parts, union_contains
 
 
 def box_part(lo, hi):
@@ -48,25 +46,10 @@ def test_a_hair_gap_is_closed_but_a_real_gap_is_not():
     assert dropped == pytest.approx(0.25, abs=0.02)  # the small box is a separate piece
 
 
-def test_open_and_multi_body_meshes_are_rebuilt_closed():
-    ball, volume = holed_sphere()
-    assert not ball.is_watertight
-    closed, _ = outer_surface_of_mesh(ball, resolution=64, face_budget=3000)
-    assert closed.is_watertight and closed.body_count == 1
-    assert closed.volume == pytest.approx(volume, rel=0.03)  # solid, not a shell
-    boxes = trimesh.util.concatenate([trimesh.creation.box(extents=(0.04, 0.02, 0.02)),
-                                      trimesh.creation.box(extents=(0.02, 0.02, 0.04))])  # overlapping closed bodies
-    closed, _ = outer_surface_of_mesh(boxes, resolution=64, face_budget=3000)
-    assert closed.is_watertight and closed.body_count == 1
-    assert closed.volume == pytest.approx(0.04 * 0.02 * 0.02 + 2 * 0.01 * 0.02 * 0.02, rel=0.05)
-    cup = trimesh.creation.cylinder(radius=0.03, height=0.05, sections=48)
-    cup.update_faces(cup.face_normals[:, 2] < 0.9)  # no lid: an open sheet bounds (almost) no volume
-    closed, _ = outer_surface_of_mesh(cup, resolution=64, face_budget=3000)
-    assert closed.volume < 0.01 * np.pi * 0.03**2 * 0.05  # at most the fillet of its inner crease
-
-
 # 26 unit directions: the axes, face diagonals and body diagonals of a cube
-_DIRS = np.array([(i, j, k) for i in (-1, 0, 1) for j in (-1, 0, 1) for k in (-1, 0, 1) if (i, j, k) != (0, 0, 0)], float)
+_DIRS = np.array(
+    [(i, j, k) for i in (-1, 0, 1) for j in (-1, 0, 1) for k in (-1, 0, 1) if (i, j, k) != (0, 0, 0)], float
+)
 _DIRS /= np.linalg.norm(_DIRS, axis=1, keepdims=True)
 
 

@@ -16,7 +16,10 @@ def occupied_volume(mesh: trimesh.Trimesh, resolution: int) -> float:
     [
         (trimesh.creation.box(extents=(0.04, 0.06, 0.05)), 0.04 * 0.06 * 0.05),
         (trimesh.creation.icosphere(subdivisions=5, radius=0.03), 4 / 3 * np.pi * 0.03**3),
-        (trimesh.creation.torus(major_radius=0.03, minor_radius=0.01, major_sections=96, minor_sections=48), 2 * np.pi**2 * 0.03 * 0.01**2),
+        (
+            trimesh.creation.torus(major_radius=0.03, minor_radius=0.01, major_sections=96, minor_sections=48),
+            2 * np.pi**2 * 0.03 * 0.01**2,
+        ),
     ],
     ids=["box", "sphere", "torus"],
 )
@@ -82,8 +85,7 @@ def test_pack_roundtrip():
 
 def test_iou_on_real_default_shapes_against_half_spaces(default_loaded):
     """The accuracy target (mean IoU >= 0.97 at 64³) on a few real default objects."""
-    from graspaug.geometry.prepare import prepare_shape
-    from graspaug.geometry.prepare import SurfaceSettings
+    from graspaug.geometry.prepare import SurfaceSettings, prepare_shape
 
     scores = []
     for _, loaded in default_loaded:

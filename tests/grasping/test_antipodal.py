@@ -1,18 +1,26 @@
 """The antipodal sampler on real closed meshes: every grasp it returns passes Dex-Net's tests."""
+
 import dataclasses
 
 import numpy as np
 import pytest
 import trimesh
 
-from graspaug.geometry.prepare import prepare_shape
+from graspaug.geometry.prepare import SurfaceSettings, prepare_shape
 from graspaug.grasping.antipodal import AntipodalSettings, force_closure, sample_antipodal_grasps
 from graspaug.grasping.contacts import close_fingers
 from graspaug.grasping.gripper import ParallelJawGripper
-from graspaug.geometry.prepare import SurfaceSettings
 
-SETTINGS = AntipodalSettings(n_grasps=40, friction_coef=0.5, tries_per_point=2, oversample=5, max_rounds=5, max_surface_points=100,
-                             min_contact_dist=0.0025, coverage_dist=0.0025)
+SETTINGS = AntipodalSettings(
+    n_grasps=40,
+    friction_coef=0.5,
+    tries_per_point=2,
+    oversample=5,
+    max_rounds=5,
+    max_surface_points=100,
+    min_contact_dist=0.0025,
+    coverage_dist=0.0025,
+)
 PANDA = ParallelJawGripper()
 
 

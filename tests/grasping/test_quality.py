@@ -1,5 +1,6 @@
 """Ferrari-Canny ε: hand-computed values, invariances, and agreement of the fast facet search
 with qhull and of qhull with independent computations."""
+
 import numpy as np
 import pytest
 import trimesh
@@ -7,7 +8,13 @@ from scipy.optimize import linprog
 from scipy.spatial import ConvexHull
 
 from graspaug.grasping.gripper import ParallelJawGripper
-from graspaug.grasping.quality import TANGENT_SEARCH_STEPS, contact_frames, ferrari_canny, ferrari_canny_qhull, grasp_wrenches
+from graspaug.grasping.quality import (
+    TANGENT_SEARCH_STEPS,
+    contact_frames,
+    ferrari_canny,
+    ferrari_canny_qhull,
+    grasp_wrenches,
+)
 from graspaug.grasping.robust import QualitySettings, grasp_epsilon
 
 QUALITY = QualitySettings(friction_coef=0.5, cone_faces=8, torque_scaling=1000.0)
@@ -50,7 +57,9 @@ def square_cone_grasp(mu, finger_radius, torque_scaling, half_gap):
     """Two contacts on the z axis at ±half_gap, pushing toward each other, 4-sided cones."""
     p1, p2 = np.array([[0, 0, -half_gap]]), np.array([[0, 0, half_gap]])
     n1, n2 = np.array([[0, 0, -1.0]]), np.array([[0, 0, 1.0]])
-    return grasp_wrenches(p1, n1, p2, n2, np.array([[0, 0, 1.0]]), np.zeros(3), mu, torque_scaling, finger_radius, cone_faces=4)[:2]
+    return grasp_wrenches(
+        p1, n1, p2, n2, np.array([[0, 0, 1.0]]), np.zeros(3), mu, torque_scaling, finger_radius, cone_faces=4
+    )[:2]
 
 
 @pytest.mark.parametrize("mu", [0.3, 0.5, 0.8])
@@ -84,7 +93,17 @@ def test_hard_fingers_and_missing_contact_give_zero():
         ferrari_canny(wrenches, np.ones(3, dtype=bool))
     # contact 2 pushed sideways (normal ⟂ push): it contributes nothing
     p1, p2 = np.array([[0, 0, -0.01]]), np.array([[0, 0, 0.01]])
-    wrenches, slips, _ = grasp_wrenches(p1, np.array([[0, 0, -1.0]]), p2, np.array([[1.0, 0, 0]]), np.array([[0, 0, 1.0]]), np.zeros(3), 0.5, 1000.0, 0.005)
+    wrenches, slips, _ = grasp_wrenches(
+        p1,
+        np.array([[0, 0, -1.0]]),
+        p2,
+        np.array([[1.0, 0, 0]]),
+        np.array([[0, 0, 1.0]]),
+        np.zeros(3),
+        0.5,
+        1000.0,
+        0.005,
+    )
     assert slips[0]
     assert ferrari_canny(wrenches)[0] == 0.0 and ferrari_canny_qhull(wrenches[0]) == 0.0
 
@@ -158,7 +177,11 @@ def test_rigid_motion_of_object_and_grasp_keeps_epsilon():
 def perturbed_grasp_wrenches(n, seed, cone_faces=8):
     """Wrench sets of random grasps on an ellipsoid, a box and a sphere, random μ."""
     rng = np.random.default_rng(seed)
-    meshes = [trimesh.creation.icosphere(4, 0.03), trimesh.creation.box((0.05, 0.04, 0.07)), trimesh.creation.icosphere(4, 1.0)]
+    meshes = [
+        trimesh.creation.icosphere(4, 0.03),
+        trimesh.creation.box((0.05, 0.04, 0.07)),
+        trimesh.creation.icosphere(4, 1.0),
+    ]
     meshes[2].apply_scale([0.03, 0.02, 0.04])
     from graspaug.grasping.contacts import close_fingers
 
@@ -170,7 +193,9 @@ def perturbed_grasp_wrenches(n, seed, cone_faces=8):
         c = close_fingers(mesh, centers, axes, 0.08)
         f = c.found
         mu = np.clip(rng.normal(0.5, 0.1, f.sum()), 0, 1)
-        w, _, inside = grasp_wrenches(c.p1[f], c.n1[f], c.p2[f], c.n2[f], axes[f], mesh.center_mass, mu, 1000.0, 0.005, cone_faces)
+        w, _, inside = grasp_wrenches(
+            c.p1[f], c.n1[f], c.p2[f], c.n2[f], axes[f], mesh.center_mass, mu, 1000.0, 0.005, cone_faces
+        )
         out.append((w, inside))
     return np.concatenate([w for w, _ in out]), np.concatenate([i for _, i in out])
 
@@ -189,7 +214,9 @@ def test_fast_epsilon_equals_qhull_on_grasp_wrenches():
     # the geometric force-closure test never vouches for a set whose origin is not inside
     assert inside.sum() > 100 and np.all(plain[inside] > 0)
     np.testing.assert_allclose(ferrari_canny(wrenches), plain, rtol=0, atol=1e-9)  # origin checked for every set
-    np.testing.assert_allclose(ferrari_canny(wrenches, inside), plain, rtol=0, atol=1e-9)  # checked where not vouched for
+    np.testing.assert_allclose(
+        ferrari_canny(wrenches, inside), plain, rtol=0, atol=1e-9
+    )  # checked where not vouched for
 
 
 @pytest.mark.parametrize("cone_faces", [3, 5, 12])
@@ -205,7 +232,13 @@ def boundary_distance_lp(points, direction):
     n = len(points)
     a_eq = np.zeros((7, n + 1))
     a_eq[:6, :n], a_eq[:6, n], a_eq[6, :n] = points.T, -direction, 1.0
-    lp = linprog(c=np.r_[np.zeros(n), -1.0], A_eq=a_eq, b_eq=np.r_[np.zeros(6), 1.0], bounds=[(0, None)] * (n + 1), method="highs")
+    lp = linprog(
+        c=np.r_[np.zeros(n), -1.0],
+        A_eq=a_eq,
+        b_eq=np.r_[np.zeros(6), 1.0],
+        bounds=[(0, None)] * (n + 1),
+        method="highs",
+    )
     assert lp.status == 0
     return -lp.fun
 
@@ -218,7 +251,10 @@ def test_epsilon_of_grasp_wrenches_matches_support_function_and_lp():
 
     c = close_fingers(mesh, np.zeros((2, 3)), np.eye(3)[1:], 0.08)
     sym = grasp_wrenches(c.p1, c.n1, c.p2, c.n2, np.eye(3)[1:], mesh.center_mass, 0.5, 1000.0, 0.005)
-    wrenches, inside = np.concatenate([wrenches[inside][:10], sym.points]), np.concatenate([inside[inside][:10], sym.interior])
+    wrenches, inside = (
+        np.concatenate([wrenches[inside][:10], sym.points]),
+        np.concatenate([inside[inside][:10], sym.interior]),
+    )
     eps = ferrari_canny(wrenches, inside)
     rng = np.random.default_rng(2)
     directions = rng.normal(size=(50_000, 6))

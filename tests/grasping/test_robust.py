@@ -1,13 +1,27 @@
 """Robust Ferrari-Canny: perturbations, determinism, and the plain reference."""
+
 import numpy as np
 import trimesh
 
 from graspaug.grasping.gripper import ParallelJawGripper
 from graspaug.grasping.quality import ferrari_canny_qhull
-from graspaug.grasping.robust import Perturbations, QualitySettings, grasp_epsilon, perturbed_grasps, robust_ferrari_canny
+from graspaug.grasping.robust import (
+    Perturbations,
+    QualitySettings,
+    grasp_epsilon,
+    perturbed_grasps,
+    robust_ferrari_canny,
+)
 
 QUALITY = QualitySettings(friction_coef=0.5, cone_faces=8, torque_scaling=1000.0)
-NOISE = Perturbations(n_samples=25, center_sigma=0.005, axis_sigma=0.001, object_translation_sigma=0.01, object_rotation_sigma=0.01, friction_sigma=0.1)
+NOISE = Perturbations(
+    n_samples=25,
+    center_sigma=0.005,
+    axis_sigma=0.001,
+    object_translation_sigma=0.01,
+    object_rotation_sigma=0.01,
+    friction_sigma=0.1,
+)
 PANDA = ParallelJawGripper()
 
 
@@ -52,8 +66,16 @@ def test_plain_reference_gives_the_same_robust_quality():
     mesh = trimesh.creation.box((0.05, 0.04, 0.06))
     centers, axes = grasps_across(mesh, 8, 3)
     ours = robust_ferrari_canny(mesh, centers, axes, PANDA, QUALITY, NOISE, np.random.default_rng(4))
-    plain = robust_ferrari_canny(mesh, centers, axes, PANDA, QUALITY, NOISE, np.random.default_rng(4),
-                                 epsilon=lambda w, inside: np.array([ferrari_canny_qhull(x) for x in w]))
+    plain = robust_ferrari_canny(
+        mesh,
+        centers,
+        axes,
+        PANDA,
+        QUALITY,
+        NOISE,
+        np.random.default_rng(4),
+        epsilon=lambda w, inside: np.array([ferrari_canny_qhull(x) for x in w]),
+    )
     np.testing.assert_allclose(ours, plain, atol=1e-9)
     assert ours[0].max() > 0.002
 
@@ -77,6 +99,12 @@ def test_object_pose_noise_moves_the_object_rigidly():
     for i in range(6):
         moved = mesh.copy()
         moved.apply_transform(np.vstack([np.c_[rotations[i].as_matrix(), shifts[i]], [0, 0, 0, 1]]))
-        expected.append(grasp_epsilon(moved, centers[i:i + 1], axes[i:i + 1], 0.5, PANDA, QUALITY, x_axis=rotations[i].apply([1.0, 0, 0]))[0])
+        expected.append(
+            grasp_epsilon(
+                moved, centers[i : i + 1], axes[i : i + 1], 0.5, PANDA, QUALITY, x_axis=rotations[i].apply([1.0, 0, 0])
+            )[0]
+        )
     np.testing.assert_allclose(mean, expected, rtol=5e-3, atol=1e-12)
-    assert not np.allclose(mean, grasp_epsilon(mesh, centers, axes, 0.5, PANDA, QUALITY), rtol=1e-3)  # the noise did something
+    assert not np.allclose(
+        mean, grasp_epsilon(mesh, centers, axes, 0.5, PANDA, QUALITY), rtol=1e-3
+    )  # the noise did something

@@ -1,4 +1,5 @@
 """Atomic writes survive a killed writer: nothing under the final name, leftovers cleaned later."""
+
 import os
 import signal
 import subprocess

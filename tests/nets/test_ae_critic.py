@@ -1,7 +1,15 @@
 import pytest
 import torch
 
-from graspaug.nets.ae_critic import AEConfig, AutoEncoder, Critic, autoencoder_loss, critic_loss, folded_alpha, reversed_partners
+from graspaug.nets.ae_critic import (
+    AEConfig,
+    AutoEncoder,
+    Critic,
+    autoencoder_loss,
+    critic_loss,
+    folded_alpha,
+    reversed_partners,
+)
 
 
 @pytest.mark.parametrize(("resolution", "base", "top"), [(16, 8, 32), (32, 8, 32), (64, 4, 32)])
@@ -139,7 +147,11 @@ def test_with_lambda_zero_the_critic_term_sends_no_gradient_to_the_autoencoder()
     def grads(lam: float, with_critic: bool) -> list[torch.Tensor]:
         z = ae.encoder(x)
         recon = ae.decoder(z)
-        c_interp = critic(torch.sigmoid(ae.interpolate(z, z[reversed_partners(4)], torch.full((4,), 0.3)))) if with_critic else None
+        c_interp = (
+            critic(torch.sigmoid(ae.interpolate(z, z[reversed_partners(4)], torch.full((4,), 0.3))))
+            if with_critic
+            else None
+        )
         loss, _, _ = autoencoder_loss(recon, x, c_interp, lam)
         return torch.autograd.grad(loss, list(ae.parameters()), allow_unused=True)
 

@@ -1,4 +1,5 @@
 """The GQ-CNN network: shapes, layer sizes, normalization kept in the model."""
+
 import pytest
 import torch
 
@@ -41,7 +42,9 @@ def test_local_response_norm_equals_torchs(size):
 
     x = torch.randn(3, 7, 5, 6, dtype=torch.float64)
     expected = torch.nn.LocalResponseNorm(size, alpha=0.3, beta=0.75, k=1.0)(x)
-    torch.testing.assert_close(LocalResponseNorm(size, alpha=0.3, beta=0.75, k=1.0)(x), expected, rtol=1e-12, atol=1e-12)
+    torch.testing.assert_close(
+        LocalResponseNorm(size, alpha=0.3, beta=0.75, k=1.0)(x), expected, rtol=1e-12, atol=1e-12
+    )
 
 
 def test_an_ensemble_averages_its_members_and_survives_a_checkpoint(tmp_path):
@@ -56,8 +59,12 @@ def test_an_ensemble_averages_its_members_and_survives_a_checkpoint(tmp_path):
     each = torch.stack([m.success_probability(images, z) for m in members])
     assert not torch.allclose(each[0], each[1])  # the members differ
     torch.testing.assert_close(ensemble.success_probability(images, z), each.mean(0))
-    torch.testing.assert_close(torch.softmax(ensemble(images, z), dim=1)[:, 1], each.mean(0))  # what export_model traces
-    assert ensemble.describe()["members"] == 3 and ensemble.describe()["parameters"] == 3 * sum(p.numel() for p in members[0].parameters())
+    torch.testing.assert_close(
+        torch.softmax(ensemble(images, z), dim=1)[:, 1], each.mean(0)
+    )  # what export_model traces
+    assert ensemble.describe()["members"] == 3 and ensemble.describe()["parameters"] == 3 * sum(
+        p.numel() for p in members[0].parameters()
+    )
     save_gqcnn(tmp_path / "model.pt", ensemble, {"pool": "targeted"}, None)
     loaded, card = read_gqcnn(tmp_path / "model.pt")
     assert isinstance(loaded, GQCNNEnsemble) and len(loaded.members) == 3 and card is None

@@ -1,4 +1,5 @@
 """Meshes for the render tests: primitives and real objects from pybullet_data."""
+
 from __future__ import annotations
 
 import pybullet_data

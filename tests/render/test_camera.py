@@ -1,8 +1,10 @@
 """Pinhole cameras: projection, frames, Dex-Net's random viewpoints."""
+
 import numpy as np
 import pytest
 
-from graspaug.render.camera import Intrinsics, ViewpointRanges, look_at, sample_viewpoint
+from graspaug.render.camera import look_at, sample_viewpoint
+from graspaug.render.settings import Intrinsics, ViewpointRanges
 
 
 def test_a_camera_straight_above_sees_its_target_at_the_principal_point():

@@ -1,4 +1,5 @@
 """Approach collisions of the Panda's fingers and palm with the object and the table."""
+
 import numpy as np
 import pytest
 import trimesh
@@ -19,7 +20,11 @@ def resting(extents):
 
 
 def free(mesh, pose, center, axis=ALONG_X):
-    return bool(CollisionChecker(mesh, HAND).collision_free(np.atleast_2d(center), axis, approach_directions(axis), pose=pose)[0])
+    return bool(
+        CollisionChecker(mesh, HAND).collision_free(np.atleast_2d(center), axis, approach_directions(axis), pose=pose)[
+            0
+        ]
+    )
 
 
 def test_a_small_cube_grasped_at_mid_height_is_reachable():
@@ -55,7 +60,9 @@ def test_placing_by_pose_equals_moving_the_mesh(random_object):
     approaches = approach_directions(axes)
     np.testing.assert_allclose(np.einsum("ij,ij->i", approaches, axes), 0, atol=1e-12)
     np.testing.assert_allclose(np.linalg.norm(approaches, axis=1), 1, atol=1e-12)
-    np.testing.assert_allclose(approaches[:, 2], -np.sqrt(1 - axes[:, 2] ** 2), atol=1e-12)  # as steep as the axis allows
+    np.testing.assert_allclose(
+        approaches[:, 2], -np.sqrt(1 - axes[:, 2] ** 2), atol=1e-12
+    )  # as steep as the axis allows
     pose = trimesh.transformations.random_rotation_matrix(rng.random(3))
     moved = random_object.copy().apply_transform(pose)
     pose[2, 3] = -moved.bounds[0, 2]  # on the table

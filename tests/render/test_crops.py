@@ -1,12 +1,14 @@
 """Grasp crops: the ray-cast fast path against full 640×480 renders put through rotate/crop/resize."""
+
 import numpy as np
 import pytest
 import trimesh
 
-from graspaug.render.camera import Intrinsics, ViewpointRanges, sample_viewpoint
+from graspaug.render.camera import sample_viewpoint
 from graspaug.render.crops import CropGeometry, crops_by_ray_casting, crops_from_depth_image
 from graspaug.render.depth import render_depth
 from graspaug.render.pybullet_depth import PybulletDepthScene
+from graspaug.render.settings import Intrinsics, ViewpointRanges
 from graspaug.render.stable_poses import stable_poses
 
 INTRINSICS = Intrinsics()
@@ -78,7 +80,9 @@ def test_ray_cast_crops_match_pybullet_tiny_renderer(scenes):
             reference = crops_from_depth_image(pybullet_scene.depth(camera, INTRINSICS), centers, angles)
             fast, _ = crops_by_ray_casting(mesh, camera, INTRINSICS, centers, angles, pose=pose)
             table_only = crops_from_depth_image(render_depth(None, camera, INTRINSICS), centers, angles)
-            object_pixels = ndimage.binary_dilation(np.abs(fast - table_only) > 1e-9, structure=np.ones((1, 3, 3), bool))
+            object_pixels = ndimage.binary_dilation(
+                np.abs(fast - table_only) > 1e-9, structure=np.ones((1, 3, 3), bool)
+            )
             diff = np.abs(fast - reference)
             assert diff.mean() <= 1e-3
             assert diff[~object_pixels].max() <= 1e-4

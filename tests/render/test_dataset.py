@@ -1,6 +1,6 @@
 """One shape's datapoints: which grasps appear, their geometry, determinism."""
+
 import numpy as np
-import pytest
 import trimesh
 
 from graspaug.grasping.gripper import ParallelJawGripper
@@ -41,7 +41,9 @@ def test_only_table_parallel_grasps_appear_and_their_geometry_is_consistent():
     assert np.all((cols["camera_tilt"] >= 0.1) & (cols["camera_tilt"] <= 5.0))
     # the object is under the crop center: nearer than the table around it
     center = data.images[:, 15:17, 15:17].mean(axis=(1, 2))
-    corners = np.concatenate([data.images[:, :2, :2], data.images[:, -2:, -2:]], axis=1).reshape(len(data), -1).max(axis=1)
+    corners = (
+        np.concatenate([data.images[:, :2, :2], data.images[:, -2:, -2:]], axis=1).reshape(len(data), -1).max(axis=1)
+    )
     assert np.all(center < corners - 0.01)
     # open jaws: 8 cm at ~0.7 m is ~60 px
     assert np.all((cols["width_px"] > 50) & (cols["width_px"] < 70))
@@ -62,7 +64,9 @@ def test_same_seed_same_datapoints_and_grasp_caps():
         np.testing.assert_array_equal(first.columns[name], again.columns[name])
     other = render_shape(mesh, centers, axes, HAND, RenderSettings(), np.random.default_rng(6))
     assert not np.array_equal(other.columns["camera_height"], first.columns["camera_height"])
-    capped = render_shape(mesh, centers, axes, HAND, RenderSettings(max_grasps_per_image=1, max_poses=2), np.random.default_rng(5))
+    capped = render_shape(
+        mesh, centers, axes, HAND, RenderSettings(max_grasps_per_image=1, max_poses=2), np.random.default_rng(5)
+    )
     assert np.all(np.bincount(capped.columns["image_id"]) <= 1) and capped.n_poses == 2
 
 
@@ -76,15 +80,18 @@ def test_no_grasps_or_no_table_parallel_grasp_gives_no_datapoints():
 
 
 def test_crops_that_would_leave_the_image_are_not_rendered():
-    from graspaug.render.camera import ViewpointRanges
     from graspaug.render.dataset import crop_inside_image, plan_scenes
+    from graspaug.render.settings import ViewpointRanges
 
     mesh, centers, axes = box_grasps()
     settings = RenderSettings(max_poses=6, images_per_pose=40, viewpoints=ViewpointRanges(object_offset=0.3))
     scenes, _ = plan_scenes(mesh, centers, axes, HAND.max_width, settings, np.random.default_rng(0))
     shown = sum(len(s.grasp_index) for s in scenes)
     centered = RenderSettings(max_poses=6, images_per_pose=40, viewpoints=ViewpointRanges(object_offset=0.0))
-    all_shown = sum(len(s.grasp_index) for s in plan_scenes(mesh, centers, axes, HAND.max_width, centered, np.random.default_rng(0))[0])
+    all_shown = sum(
+        len(s.grasp_index)
+        for s in plan_scenes(mesh, centers, axes, HAND.max_width, centered, np.random.default_rng(0))[0]
+    )
     # with the object up to 0.3 m off the image center, many crops would cross the border
     assert 0 < shown < 0.9 * all_shown
     for scene in scenes:

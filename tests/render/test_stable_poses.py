@@ -1,4 +1,5 @@
 """Stable poses: the same poses and probabilities as trimesh's reference implementation."""
+
 import numpy as np
 import pytest
 import trimesh
@@ -19,7 +20,9 @@ def test_same_poses_as_trimesh(name, random_object):
         "cylinder": trimesh.creation.cylinder(0.02, 0.08, sections=24),
         "capsule": trimesh.creation.capsule(0.06, 0.015),
         "random_object": random_object,
-        "wedge": trimesh.convex.convex_hull(np.array([[0, 0, 0], [0.08, 0, 0], [0, 0.03, 0], [0.08, 0.03, 0], [0, 0, 0.05], [0, 0.03, 0.05]], float)),
+        "wedge": trimesh.convex.convex_hull(
+            np.array([[0, 0, 0], [0.08, 0, 0], [0, 0.03, 0], [0.08, 0.03, 0], [0, 0, 0.05], [0, 0.03, 0.05]], float)
+        ),
     }
     mesh = meshes[name]
     expected_t, expected_p = trimesh.poses.compute_stable_poses(mesh)

@@ -1,4 +1,5 @@
 """Objects for the simulation tests, decomposed once per session into a temporary cache."""
+
 from __future__ import annotations
 
 import pytest

@@ -1,4 +1,5 @@
 """The D435-like depth sensor: its measured statistics match its params."""
+
 from __future__ import annotations
 
 import dataclasses

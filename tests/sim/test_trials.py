@@ -1,4 +1,5 @@
 """Real pybullet: the cell, the Panda's scripted picks, and one planned pick end to end."""
+
 from __future__ import annotations
 
 import numpy as np
@@ -7,10 +8,14 @@ import pytest
 import torch
 
 from graspaug.nets.gqcnn import GQCNN, GQCNNConfig
-from graspaug.sim.policy import CEMSettings, CrossEntropyGraspPolicy, SamplerSettings
-from graspaug.sim.scene import CellLayout, PickScene
+from graspaug.planning import Planner
+from graspaug.planning.grasps import ImageGrasps
+from graspaug.planning.settings import CEMSettings, SamplerSettings
+from graspaug.render.camera import look_at
+from graspaug.render.settings import Intrinsics
+from graspaug.sim.scene import CellLayout, PickScene, camera_pose
 from graspaug.sim.settings import HandSettings, TrialSettings
-from graspaug.sim.trials import OUTCOMES, run_trial
+from graspaug.sim.trials import OUTCOMES, grasp_in_table_frame, run_trial
 
 
 def top_down_across(position, quaternion):
@@ -18,6 +23,25 @@ def top_down_across(position, quaternion):
     axes = np.array(pybullet.getMatrixFromQuaternion(quaternion)).reshape(3, 3).T  # rows: body axes in the table frame
     flat = axes[np.argmin(np.abs(axes[:, 2]))]
     return np.asarray(position), float(np.arctan2(flat[1], flat[0]))
+
+
+def test_the_camera_looks_straight_down_from_its_height():
+    camera = camera_pose(CellLayout(camera_height=0.7))
+    assert np.isclose(camera.height, 0.7) and np.isclose(camera.tilt, 0.0)
+    on_axis = camera.to_table(np.array([[0.0, 0.0, 0.7]]))
+    assert np.allclose(on_axis, 0.0, atol=1e-12)  # the optical axis meets the table at the origin
+
+
+def test_image_grasp_to_table_frame():
+    K = Intrinsics()
+    camera = look_at(np.array([0.0, 0.0, 0.65]), np.zeros(3))
+    point = np.array([[0.05, -0.03, 0.02]])
+    uv = K.project(camera.to_camera(point))
+    grasps = ImageGrasps(centers=uv, angles=np.array([0.4]), depths=np.array([0.63]), widths=np.array([30.0]))
+    centers, angles = grasp_in_table_frame(grasps, camera, K)
+    assert np.allclose(centers, point, atol=1e-9)
+    # seen from above the image's u axis is the table's x axis and v is -y: image angle a is table angle -a
+    assert np.isclose(angles[0], -0.4)
 
 
 def test_empty_table_depth_is_camera_height_at_center():
@@ -58,8 +82,8 @@ def test_user_folder_of_meshes_runs_through_the_trials(tmp_path, sim_cache):
     are scaled like the corpus's shapes, get drawn physics, and each runs one trial."""
     import trimesh
 
+    from graspaug.experiments.sim import ObjectJob, prepare_objects, run_object
     from graspaug.geometry.settings import SurfaceSettings
-    from graspaug.sim.experiment import ObjectJob, prepare_objects, run_object
     from graspaug.sim.objects import folder_meshes
     from graspaug.sim.settings import ObjectPhysics
 
@@ -69,18 +93,34 @@ def test_user_folder_of_meshes_runs_through_the_trials(tmp_path, sim_cache):
     (tmp_path / "notes.txt").write_text("not a mesh file")
     surface = SurfaceSettings()
     meshes, skipped = folder_meshes(tmp_path, surface)
-    assert [name for name, _ in meshes] == ["block", "can"] and list(skipped) == ["broken.obj"] and skipped["broken.obj"]
+    assert (
+        [name for name, _ in meshes] == ["block", "can"] and list(skipped) == ["broken.obj"] and skipped["broken.obj"]
+    )
     for _, mesh in meshes:
-        assert sorted(mesh.extents)[1] == pytest.approx(surface.size_m, rel=0.02)  # the middle extent, as ingest sizes shapes
+        assert sorted(mesh.extents)[1] == pytest.approx(
+            surface.size_m, rel=0.02
+        )  # the middle extent, as ingest sizes shapes
     physics = ObjectPhysics()
-    objects = prepare_objects([], [], tmp_path, physics, seed=0, vhacd_resolution=10_000, user_meshes=meshes, cache_dir=sim_cache)
-    again = prepare_objects([], [], tmp_path, physics, seed=0, vhacd_resolution=10_000, user_meshes=meshes, cache_dir=sim_cache)
+    objects = prepare_objects(
+        [], [], tmp_path, physics, seed=0, vhacd_resolution=10_000, user_meshes=meshes, cache_dir=sim_cache
+    )
+    again = prepare_objects(
+        [], [], tmp_path, physics, seed=0, vhacd_resolution=10_000, user_meshes=meshes, cache_dir=sim_cache
+    )
     assert [o.body.mass for o in objects] == [o.body.mass for o in again]  # drawn from the seed
     for obj in objects:
         assert obj.kind == "user" and physics.mass_range[0] <= obj.body.mass <= physics.mass_range[1]
         assert physics.friction_range[0] <= obj.body.lateral_friction <= physics.friction_range[1]
         job = ObjectJob("antipodal", -1, None, obj.name, obj.kind, obj.body, (3,), (4,), False)
-        rows = run_object(job, layout=CellLayout(), hand=HandSettings(), sampler=SamplerSettings(), cem=CEMSettings(), crop_size=96, out_size=32)
+        rows = run_object(
+            job,
+            layout=CellLayout(),
+            hand=HandSettings(),
+            sampler=SamplerSettings(),
+            cem=CEMSettings(),
+            crop_size=96,
+            out_size=32,
+        )
         assert len(rows) == 1 and rows[0]["outcome"] in OUTCOMES and rows[0]["object"] == obj.name
 
 
@@ -110,28 +150,44 @@ def test_drop_is_seeded_and_object_falls_onto_table(cube):
     assert a.drop_position != c.drop_position
 
 
-def planner_with(net: GQCNN, layout: CellLayout, seed: int):
-    from graspaug.planning import check_depth
-
-    policy = CrossEntropyGraspPolicy(net, layout.intrinsics, cem=CEMSettings(num_seed_samples=100))
+def planner_with(net: GQCNN, seed: int):
+    """A grasp source as the sim stage builds one: the public planner, Dex-Net's policy (no image check)."""
+    planner = Planner(net, cem=CEMSettings(num_seed_samples=100), check_image=False)
     rng = np.random.default_rng(seed)
-    return lambda depth, camera, intrinsics: policy.plan(check_depth(depth, fill_missing=True), rng)
+
+    def plan(depth, camera, intrinsics):
+        return next(iter(planner.plan(depth, intrinsics, rng, camera_distance=camera.height, fill_missing=True)), None)
+
+    return plan
 
 
 def test_planned_pick_same_seed_same_outcome(duck):
     torch.manual_seed(0)
     net = GQCNN(GQCNNConfig(filters=4, fc=16, pose_fc=4)).eval()
     layout = CellLayout()
-    first = run_trial(duck, drop_seed=11, planner=planner_with(net, layout, 7), layout=layout, record=True)
-    second = run_trial(duck, drop_seed=11, planner=planner_with(net, layout, 7), layout=layout, record=True)
+    first = run_trial(duck, drop_seed=11, planner=planner_with(net, 7), layout=layout, record=True)
+    second = run_trial(duck, drop_seed=11, planner=planner_with(net, 7), layout=layout, record=True)
     assert first.image_grasp is not None and first.quality is not None
-    assert first.drop_position == second.drop_position and np.array_equal(first.depth, second.depth)  # the same noisy image
+    assert first.drop_position == second.drop_position and np.array_equal(
+        first.depth, second.depth
+    )  # the same noisy image
     assert (first.depth == 0).any()  # the sensor lost pixels (at the duck's edges)
-    assert first.outcome == second.outcome and first.image_grasp == second.image_grasp and first.grasp_center == second.grasp_center
+    assert (
+        first.outcome == second.outcome
+        and first.image_grasp == second.image_grasp
+        and first.grasp_center == second.grasp_center
+    )
     # the planned grasp lies on the duck: its center pixel sees something above the table
     u, v = round(first.image_grasp["u"]), round(first.image_grasp["v"])
     assert first.depth[v, u] < layout.camera_height - 0.005
-    assert [label for label, _ in first.frames] == ["object dropped", "pre-grasp", "closed", "lifted", "over the bin", "released"][: len(first.frames)]
+    assert [label for label, _ in first.frames] == [
+        "object dropped",
+        "pre-grasp",
+        "closed",
+        "lifted",
+        "over the bin",
+        "released",
+    ][: len(first.frames)]
     assert all(frame.shape == (240, 320, 3) for _, frame in first.frames)
 
 
@@ -142,17 +198,21 @@ def test_jaw_angle_convention_on_a_long_bar(sim_cache):
 
     from graspaug.sim.objects import prepare_object
 
-    bar = prepare_object("bar", trimesh.creation.box(extents=[0.03, 0.12, 0.03]), sim_cache, mass=0.1, lateral_friction=0.5)
+    bar = prepare_object(
+        "bar", trimesh.creation.box(extents=[0.03, 0.12, 0.03]), sim_cache, mass=0.1, lateral_friction=0.5
+    )
 
     def jaws(axis_index):
         def scripted(position, quaternion):
-            axes = np.array(pybullet.getMatrixFromQuaternion(quaternion)).reshape(3, 3).T  # rows: body axes in the table frame
+            axes = (
+                np.array(pybullet.getMatrixFromQuaternion(quaternion)).reshape(3, 3).T
+            )  # rows: body axes in the table frame
             long_axis = axes[1]  # the bar's 12 cm axis lies flat whatever face it rests on
             across = np.array([-long_axis[1], long_axis[0], 0.0])
             axis = across if axis_index == "across" else long_axis
             return np.asarray(position), float(np.arctan2(axis[1], axis[0]))
+
         return scripted
 
     assert run_trial(bar, drop_seed=2, scripted=jaws("across")).outcome == "success"
     assert run_trial(bar, drop_seed=2, scripted=jaws("along")).outcome == "collision"  # a finger lands on the bar's end
-

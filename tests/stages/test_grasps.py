@@ -1,4 +1,5 @@
 """The grasps stage through the real CLI on a small folder corpus."""
+
 import json
 import logging
 
@@ -30,7 +31,10 @@ def test_grasps_stage_writes_labelled_grasps_and_explains_empty_shapes(tmp_path,
     assert result.exit_code == 0, result.output
     table = pd.read_parquet(tmp_path / "data/grasps/original.parquet")
     assert set(table.shape_id) == {"f_plate"}  # the cube gets no rows ...
-    assert "f_cube has no grasp: its oriented bounding box's smallest side, 0.060 m, is wider than the 0.03 m opening" in caplog.text
+    assert (
+        "f_cube has no grasp: its oriented bounding box's smallest side, 0.060 m, is wider than the 0.03 m opening"
+        in caplog.text
+    )
     assert len(table) == 12 and list(table.grasp_id) == list(range(12))
     for column in ("center_x", "axis_z", "p1_y", "n2_x", "width", "eps", "eps_mean", "eps_std", "success"):
         assert column in table

@@ -1,4 +1,5 @@
 """The ingest and voxelize stages through the real CLI, on a folder corpus with broken files."""
+
 import logging
 import os
 
@@ -25,8 +26,12 @@ def make_corpus(folder):
     trimesh.creation.cylinder(radius=0.02, height=0.08).export(good / "can.obj")
     torus = trimesh.creation.torus(major_radius=0.04, minor_radius=0.012)
     torus.export(good / "ring.off")
-    two = trimesh.util.concatenate([trimesh.creation.box(extents=(0.04, 0.04, 0.04)),
-                                    trimesh.creation.box(extents=(0.04, 0.04, 0.04)).apply_translation((0.04, 0, 0))])
+    two = trimesh.util.concatenate(
+        [
+            trimesh.creation.box(extents=(0.04, 0.04, 0.04)),
+            trimesh.creation.box(extents=(0.04, 0.04, 0.04)).apply_translation((0.04, 0, 0)),
+        ]
+    )
     two.export(good / "two_boxes.glb")
     (good / "seamed_can.obj").write_text(scan_meshes.seamed_cylinder()[0])  # closed once merged by position
     scan_meshes.holed_sphere()[0].export(good / "holed_ball.ply")  # open: filled
@@ -46,9 +51,14 @@ def run_stage(tmp_path, stage, params):
 @pytest.fixture
 def corpus_params(tmp_path):
     expected = make_corpus(tmp_path / "meshes")
-    params = {"seed": 3, "n_jobs": 2, "data": {"source": "folder", "path": "meshes"},
-              "ingest": {"max_faces": 50000, "min_shapes": 3, "test_fraction": 0.4},
-              "voxelize": {"resolution": 16}, "ae": {"net": {"resolution": 16}}}
+    params = {
+        "seed": 3,
+        "n_jobs": 2,
+        "data": {"source": "folder", "path": "meshes"},
+        "ingest": {"max_faces": 50000, "min_shapes": 3, "test_fraction": 0.4},
+        "voxelize": {"resolution": 16},
+        "ae": {"net": {"resolution": 16}},
+    }
     return params, expected
 
 
@@ -59,8 +69,15 @@ def test_ingest_keeps_good_shapes_and_records_every_reject(tmp_path, corpus_para
     assert result.exit_code == 0, result.output
     shapes = pd.read_parquet(tmp_path / "data/shapes.parquet")
     rejects = pd.read_parquet(tmp_path / "data/rejects.parquet")
-    assert sorted(shapes.shape_id) == ["f_good_ball", "f_good_box", "f_good_can", "f_good_holed_ball", "f_good_ring",
-                                       "f_good_seamed_can", "f_good_two_boxes"]
+    assert sorted(shapes.shape_id) == [
+        "f_good_ball",
+        "f_good_box",
+        "f_good_can",
+        "f_good_holed_ball",
+        "f_good_ring",
+        "f_good_seamed_can",
+        "f_good_two_boxes",
+    ]
     assert len(rejects) == len(expected)
     for _, row in rejects.iterrows():
         stem = row.source.rsplit("/", 1)[1].rsplit(".", 1)[0]
@@ -68,11 +85,23 @@ def test_ingest_keeps_good_shapes_and_records_every_reject(tmp_path, corpus_para
     assert shapes.watertight.all()
     # the holed ball, once filled, is the ball again: flagged, and in the ball's split (2 of 6 originals are test)
     duplicates = shapes[shapes.duplicate_of != ""]
-    assert list(zip(duplicates.shape_id, duplicates.duplicate_of, duplicates.duplicate_kind)) == [("f_good_holed_ball", "f_good_ball", "geometry")]
+    assert list(zip(duplicates.shape_id, duplicates.duplicate_of, duplicates.duplicate_kind)) == [
+        ("f_good_holed_ball", "f_good_ball", "geometry")
+    ]
     assert set(shapes.split[shapes.shape_id.isin(["f_good_ball", "f_good_holed_ball"])]) in ({"train"}, {"test"})
     assert set(shapes.split) == {"train", "test"} and (shapes.split[shapes.duplicate_of == ""] == "test").sum() == 2
     assert (shapes.origin == "original").all()
-    for col in ("source", "source_sha256", "faces", "vertices", "volume", "extent_x", "scale", "closed_by", "hull_fill"):
+    for col in (
+        "source",
+        "source_sha256",
+        "faces",
+        "vertices",
+        "volume",
+        "extent_x",
+        "scale",
+        "closed_by",
+        "hull_fill",
+    ):
         assert col in shapes
     closed_by = dict(zip(shapes.shape_id, shapes.closed_by))
     assert closed_by.pop("f_good_seamed_can") == "merged" and closed_by.pop("f_good_holed_ball") == "filled"
@@ -153,8 +182,12 @@ def test_links_special_files_and_duplicates(tmp_path, capfd):
     os.mkfifo(folder / "pipe.ply")
     os.symlink(folder / "missing.stl", folder / "gone.stl")
     os.symlink(folder / "loop.obj", folder / "loop.obj")
-    params = {"seed": 3, "n_jobs": 2, "data": {"source": "folder", "path": "meshes"},
-              "ingest": {"max_faces": 50000, "min_shapes": 3, "test_fraction": 0.5}}
+    params = {
+        "seed": 3,
+        "n_jobs": 2,
+        "data": {"source": "folder", "path": "meshes"},
+        "ingest": {"max_faces": 50000, "min_shapes": 3, "test_fraction": 0.5},
+    }
     result = run_stage(tmp_path, "ingest", params)
     assert result.exit_code == 0, result.output
     shapes = pd.read_parquet(tmp_path / "data/shapes.parquet").set_index("shape_id")
@@ -167,9 +200,16 @@ def test_links_special_files_and_duplicates(tmp_path, capfd):
     }
     duplicates = shapes[shapes.duplicate_of != ""]
     assert dict(zip(duplicates.index, zip(duplicates.duplicate_of, duplicates.duplicate_kind))) == {
-        "f_ball_again": ("f_ball", "geometry"), "f_box_copy": ("f_box", "exact"), "f_box_link": ("f_box", "exact")}
-    assert (shapes.loc[duplicates.index, "split"].to_numpy() == shapes.loc[duplicates.duplicate_of, "split"].to_numpy()).all()
-    assert (shapes.split[shapes.duplicate_of == ""] == "test").sum() == 4 and len(shapes) == 10  # round(0.5 × 7 originals)
+        "f_ball_again": ("f_ball", "geometry"),
+        "f_box_copy": ("f_box", "exact"),
+        "f_box_link": ("f_box", "exact"),
+    }
+    assert (
+        shapes.loc[duplicates.index, "split"].to_numpy() == shapes.loc[duplicates.duplicate_of, "split"].to_numpy()
+    ).all()
+    assert (shapes.split[shapes.duplicate_of == ""] == "test").sum() == 4 and len(
+        shapes
+    ) == 10  # round(0.5 × 7 originals)
     assert "Warning" not in capfd.readouterr().err
 
 
@@ -179,7 +219,9 @@ def test_split_keeps_duplicates_with_their_original():
     ids = [f"s{i:02d}" for i in range(40)]
     plain = assign_split(ids, 0.25, seed=0)
     assert plain == assign_split(ids, 0.25, seed=0, duplicate_of={i: "" for i in ids})  # no duplicates: the same split
-    with_copies = assign_split(ids + ["s00_copy", "s07_copy"], 0.25, seed=0, duplicate_of={"s00_copy": "s00", "s07_copy": "s07"})
+    with_copies = assign_split(
+        ids + ["s00_copy", "s07_copy"], 0.25, seed=0, duplicate_of={"s00_copy": "s00", "s07_copy": "s07"}
+    )
     assert with_copies["s00_copy"] == plain["s00"] and with_copies["s07_copy"] == plain["s07"]
     assert {k: v for k, v in with_copies.items() if k in plain} == plain
 

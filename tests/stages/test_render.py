@@ -1,4 +1,5 @@
 """The render stage and the Dex-Net export through the real CLI on a small folder corpus."""
+
 import json
 
 import numpy as np
@@ -83,7 +84,9 @@ def test_render_writes_shards_index_metrics_and_a_dexnet_export(tmp_path, monkey
     assert np.load(out / "tensors/hand_poses_00000.npz")["arr_0"].shape == (5, 7)
     np.testing.assert_array_equal(read_tensor_field(out, "depth_ims_tf_table")[..., 0], images)
     hand_poses = read_tensor_field(out, "hand_poses")
-    np.testing.assert_allclose(hand_poses[:, [0, 1, 2, 3, 6]], index[["center_v", "center_u", "z", "angle", "width_px"]], rtol=1e-6)
+    np.testing.assert_allclose(
+        hand_poses[:, [0, 1, 2, 3, 6]], index[["center_v", "center_u", "z", "angle", "width_px"]], rtol=1e-6
+    )
     np.testing.assert_allclose(hand_poses[:, 4], index.center_v - 239.5, atol=1e-4)
     # Dex-Net's convention: the metric is 0 for colliding grasps, so `metric > threshold` is our label
     metric = read_tensor_field(out, "robust_ferrari_canny")
@@ -96,7 +99,9 @@ def test_render_writes_shards_index_metrics_and_a_dexnet_export(tmp_path, monkey
     obj_ids = np.array(config["obj_ids"])
     np.testing.assert_array_equal(obj_ids[read_tensor_field(out, "obj_labels")], index.shape_id)
     pose_ids = np.array(config["pose_ids"])
-    np.testing.assert_array_equal(pose_ids[read_tensor_field(out, "pose_labels")], index.shape_id + ":" + index.pose_id.astype(str))
+    np.testing.assert_array_equal(
+        pose_ids[read_tensor_field(out, "pose_labels")], index.shape_id + ":" + index.pose_id.astype(str)
+    )
 
     again = CliRunner().invoke(app, ["export-dexnet", "original", str(out)])
     assert again.exit_code == 1 and "is not empty" in again.output
@@ -107,13 +112,21 @@ def test_render_writes_shards_index_metrics_and_a_dexnet_export(tmp_path, monkey
 def test_render_params_are_checked(tmp_path):
     (tmp_path / "params.yaml").write_text("render:\n  viewpoints:\n    tilt_deg: [5.0, 1.0]\n")
     result = CliRunner().invoke(app, ["render", "--params", str(tmp_path / "params.yaml")])
-    assert result.exit_code == 2 and "render.viewpoints: camera tilt range must lie in [0, 90) degrees and be ordered" in result.output
+    assert (
+        result.exit_code == 2
+        and "render.viewpoints: camera tilt range must lie in [0, 90) degrees and be ordered" in result.output
+    )
     (tmp_path / "params.yaml").write_text("render:\n  crop:\n    out_size: 40\n")
     result = CliRunner().invoke(app, ["render", "--params", str(tmp_path / "params.yaml")])
-    assert result.exit_code == 2 and "render.crop: crop_size (96) must be a positive multiple of out_size (40)" in result.output
+    assert (
+        result.exit_code == 2
+        and "render.crop: crop_size (96) must be a positive multiple of out_size (40)" in result.output
+    )
     (tmp_path / "params.yaml").write_text("render:\n  crop:\n    out_size: 16\n")
-    result = CliRunner().invoke(app, ["render", "--params", str(tmp_path / "params.yaml")])
-    assert result.exit_code == 2 and "gqcnn.net.image_size: must equal render.crop.out_size (16); got 32" in result.output
+    result = CliRunner().invoke(app, ["train-gqcnn", "--params", str(tmp_path / "params.yaml")])  # reads both sections
+    assert (
+        result.exit_code == 2 and "gqcnn.net.image_size: must equal render.crop.out_size (16); got 32" in result.output
+    )
 
 
 def test_a_mesh_that_cannot_be_rendered_is_skipped_with_its_reason(tmp_path):
@@ -123,7 +136,23 @@ def test_a_mesh_that_cannot_be_rendered_is_skipped_with_its_reason(tmp_path):
 
     flat = trimesh.Trimesh(vertices=[[0, 0, 0], [0.05, 0, 0], [0, 0.05, 0]], faces=[[0, 1, 2]])  # no volume, no hull
     flat.export(tmp_path / "flat.ply")
-    data, reason = render_one(tmp_path / "flat.ply", "flat", np.zeros((1, 3)), np.array([[1.0, 0, 0]]), RenderSettings(), ParallelJawGripper(), 0)
+    data, reason = render_one(
+        tmp_path / "flat.ply",
+        "flat",
+        np.zeros((1, 3)),
+        np.array([[1.0, 0, 0]]),
+        RenderSettings(),
+        ParallelJawGripper(),
+        0,
+    )
     assert data is None and reason.startswith("rendering failed: ")
-    data, reason = render_one(tmp_path / "missing.ply", "missing", np.zeros((1, 3)), np.array([[1.0, 0, 0]]), RenderSettings(), ParallelJawGripper(), 0)
+    data, reason = render_one(
+        tmp_path / "missing.ply",
+        "missing",
+        np.zeros((1, 3)),
+        np.array([[1.0, 0, 0]]),
+        RenderSettings(),
+        ParallelJawGripper(),
+        0,
+    )
     assert data is None and reason.startswith("mesh could not be read")

@@ -1,5 +1,6 @@
 """The report's words and table on hand-made numbers: an interval above zero is a gain, one
 that includes zero is not, one seed claims nothing; the ratio is chosen on validation."""
+
 import numpy as np
 import pandas as pd
 import pytest
@@ -11,7 +12,13 @@ def contrast(values, boot=(0.01, 0.03)):
     from graspaug.experiments.stats import t_interval
 
     t = t_interval(values)
-    return {**t, "sd": float(np.std(values, ddof=1)) if len(values) > 1 else None, "boot_low": boot[0], "boot_high": boot[1], "meaning": "m"}
+    return {
+        **t,
+        "sd": float(np.std(values, ddof=1)) if len(values) > 1 else None,
+        "boot_low": boot[0],
+        "boot_high": boot[1],
+        "meaning": "m",
+    }
 
 
 def test_a_consistent_gain_is_claimed_and_a_noisy_one_is_not():
@@ -23,8 +30,14 @@ def test_a_consistent_gain_is_claimed_and_a_noisy_one_is_not():
 
 
 def test_the_ratio_is_chosen_on_validation_not_test():
-    runs = pd.DataFrame([("targeted", 50, r, s, v, t, 0.8) for s in (0, 1) for r, v, t in ((0.0, 0.30, 0.30), (0.5, 0.33, 0.28), (1.0, 0.31, 0.40))],
-                        columns=["pool", "base_size", "ratio", "seed", "val_ap", "test_ap", "test_roc_auc"])
+    runs = pd.DataFrame(
+        [
+            ("targeted", 50, r, s, v, t, 0.8)
+            for s in (0, 1)
+            for r, v, t in ((0.0, 0.30, 0.30), (0.5, 0.33, 0.28), (1.0, 0.31, 0.40))
+        ],
+        columns=["pool", "base_size", "ratio", "seed", "val_ap", "test_ap", "test_roc_auc"],
+    )
     assert choose_ratios(runs, [50]) == {50: 0.5}  # best validation AP, although 1:1 has the best test AP
     per_object = runs[["pool", "base_size", "ratio", "seed"]].assign(per_object_ap=0.5)
     table = network_table(runs, per_object)

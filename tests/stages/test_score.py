@@ -1,4 +1,5 @@
 """The score stage's table logic and its handling of corpora without grasps."""
+
 import numpy as np
 import pandas as pd
 import pytest

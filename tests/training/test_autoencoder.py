@@ -6,7 +6,14 @@ import trimesh
 from graspaug.geometry.voxelize import fit_grid, voxelize_solid
 from graspaug.io.checkpoints import CheckpointMismatch, load_autoencoder, save_autoencoder
 from graspaug.nets.ae_critic import AEConfig, AutoEncoder, Critic
-from graspaug.training.autoencoder import AETrainConfig, critic_separation, encode, reconstruction_iou, train_ae_critic, train_autoencoder
+from graspaug.training.autoencoder import (
+    AETrainConfig,
+    critic_separation,
+    encode,
+    reconstruction_iou,
+    train_ae_critic,
+    train_autoencoder,
+)
 
 CPU = torch.device("cpu")
 
@@ -24,9 +31,14 @@ def primitive_grids(resolution: int) -> torch.Tensor:
     """Eight real solid shapes voxelized with the project's voxelizer: (8, 1, R, R, R) uint8."""
     c = trimesh.creation
     meshes = [
-        c.box(extents=(0.1, 0.06, 0.03)), c.icosphere(radius=0.05), c.cylinder(radius=0.03, height=0.1),
-        c.capsule(height=0.06, radius=0.02), c.torus(major_radius=0.04, minor_radius=0.015), c.cone(radius=0.04, height=0.09),
-        c.box(extents=(0.05, 0.05, 0.05)), c.annulus(r_min=0.02, r_max=0.045, height=0.03),
+        c.box(extents=(0.1, 0.06, 0.03)),
+        c.icosphere(radius=0.05),
+        c.cylinder(radius=0.03, height=0.1),
+        c.capsule(height=0.06, radius=0.02),
+        c.torus(major_radius=0.04, minor_radius=0.015),
+        c.cone(radius=0.04, height=0.09),
+        c.box(extents=(0.05, 0.05, 0.05)),
+        c.annulus(r_min=0.02, r_max=0.045, height=0.03),
     ]
     grids = [voxelize_solid(m.vertices, m.faces, fit_grid(m.bounds, resolution)) for m in meshes]
     return torch.from_numpy(np.stack(grids)[:, None].astype(np.uint8))
@@ -61,7 +73,10 @@ def _train_twice_state(seed: int) -> dict[str, torch.Tensor]:
     gen = torch.Generator().manual_seed(seed)
     train_autoencoder(ae, x, tcfg, CPU, gen)
     train_ae_critic(ae, critic, x, tcfg, CPU, gen)
-    return {**{f"ae.{k}": v for k, v in ae.state_dict().items()}, **{f"c.{k}": v for k, v in critic.state_dict().items()}}
+    return {
+        **{f"ae.{k}": v for k, v in ae.state_dict().items()},
+        **{f"c.{k}": v for k, v in critic.state_dict().items()},
+    }
 
 
 def test_same_seed_gives_identical_weights():
@@ -104,7 +119,14 @@ def test_phase_2_leaves_the_decoders_normalization_statistics_unchanged():
     weights_before = ae.decoder.fc.weight.clone()
     encoder_stats_before = _normalization_buffers(ae.encoder)
     assert stats_before and encoder_stats_before
-    train_ae_critic(ae, critic, x, train_settings(batch_size=4, epochs_critic=2, critic_warmup=0), CPU, torch.Generator().manual_seed(0))
+    train_ae_critic(
+        ae,
+        critic,
+        x,
+        train_settings(batch_size=4, epochs_critic=2, critic_warmup=0),
+        CPU,
+        torch.Generator().manual_seed(0),
+    )
     stats_after = _normalization_buffers(ae.decoder)
     assert all(torch.equal(stats_before[k], stats_after[k]) for k in stats_before)
     assert not torch.equal(weights_before, ae.decoder.fc.weight)
@@ -119,7 +141,14 @@ def _phase_2_weights(critic: Critic | None, lam: float) -> dict[str, torch.Tenso
     ae = AutoEncoder(cfg)
     if critic is not None:
         critic = Critic(cfg)
-    train_ae_critic(ae, critic, x, train_settings(batch_size=4, epochs_critic=2, critic_warmup=1, lam=lam), CPU, torch.Generator().manual_seed(3))
+    train_ae_critic(
+        ae,
+        critic,
+        x,
+        train_settings(batch_size=4, epochs_critic=2, critic_warmup=1, lam=lam),
+        CPU,
+        torch.Generator().manual_seed(3),
+    )
     return ae.state_dict()
 
 

@@ -1,10 +1,20 @@
 """Training a GQ-CNN: metrics, noise, and learning a separable toy set."""
+
 import numpy as np
 import pytest
 import torch
 
 from graspaug.nets.gqcnn import GQCNN, GQCNNConfig
-from graspaug.training.gqcnn import GraspArrays, NoiseSettings, TrainSettings, augment, classification_metrics, cosine_lr, predict, train_gqcnn
+from graspaug.training.gqcnn import (
+    GraspArrays,
+    NoiseSettings,
+    TrainSettings,
+    augment,
+    classification_metrics,
+    cosine_lr,
+    predict,
+    train_gqcnn,
+)
 
 
 def test_average_precision_matches_a_hand_computed_case():
@@ -29,11 +39,23 @@ def test_augmentation_noise_and_symmetries():
     # a 180° turn is both flips, so the 8 equally likely combinations give 4 distinct images: 3/4 change
     changed = float((sym != images).flatten(1).any(1).float().mean())
     assert 0.72 < changed < 0.78
-    scaled, scaled_z = augment(torch.ones(4000, 1, 4, 4), torch.full((4000,), 2.0), NoiseSettings(gamma_shape=1000, gp_prob=0, symmetrize=False), gen)
+    scaled, scaled_z = augment(
+        torch.ones(4000, 1, 4, 4),
+        torch.full((4000,), 2.0),
+        NoiseSettings(gamma_shape=1000, gp_prob=0, symmetrize=False),
+        gen,
+    )
     scaled = scaled[:, 0, 0, 0]
-    assert float(scaled.mean()) == pytest.approx(1.0, abs=0.003) and float(scaled.std()) == pytest.approx(1000**-0.5, rel=0.1)
+    assert float(scaled.mean()) == pytest.approx(1.0, abs=0.003) and float(scaled.std()) == pytest.approx(
+        1000**-0.5, rel=0.1
+    )
     torch.testing.assert_close(scaled_z, 2 * scaled)  # image and gripper depth scaled together
-    field, _ = augment(torch.zeros(2000, 1, 32, 32), torch.zeros(2000), NoiseSettings(gamma_shape=0, gp_prob=0.5, gp_sigma=0.005, symmetrize=False), gen)
+    field, _ = augment(
+        torch.zeros(2000, 1, 32, 32),
+        torch.zeros(2000),
+        NoiseSettings(gamma_shape=0, gp_prob=0.5, gp_sigma=0.005, symmetrize=False),
+        gen,
+    )
     noisy = field.flatten(1).abs().amax(1) > 0
     assert 0.45 < float(noisy.float().mean()) < 0.55
     assert 0.003 < float(field[noisy].std()) < 0.006  # the grid's sigma, smoothed by the upsampling
@@ -62,7 +84,15 @@ def test_a_tiny_gqcnn_learns_a_separable_toy_set():
     net = GQCNN(GQCNNConfig(filters=8, fc=32, pose_fc=4))
     logged = []
     settings = TrainSettings(epochs=1.0, min_steps=150, max_steps=150, batch_size=32, lr=0.01, evals=3)
-    speed = train_gqcnn(net, train, test, settings, torch.device("cpu"), torch.Generator().manual_seed(0), lambda step, m: logged.append((step, m)))
+    speed = train_gqcnn(
+        net,
+        train,
+        test,
+        settings,
+        torch.device("cpu"),
+        torch.Generator().manual_seed(0),
+        lambda step, m: logged.append((step, m)),
+    )
     assert [step for step, _ in logged] == [50, 100, 150] and speed["steps"] == 150
     assert set(logged[0][1]) == {"loss", "train_accuracy", "lr", "val_accuracy", "val_ap"}
     assert logged[-1][1]["loss"] < logged[0][1]["loss"]
@@ -78,7 +108,11 @@ def test_a_tiny_gqcnn_learns_a_separable_toy_set():
 def test_the_step_budget_follows_the_training_set():
     settings = TrainSettings(epochs=4.0, min_steps=100, max_steps=1000, batch_size=100)
     assert settings.steps_for(1000) == 100 and settings.steps_for(5000) == 200 and settings.steps_for(50_000) == 1000
-    assert cosine_lr(0, 11, 0.01) == 1.0 and cosine_lr(10, 11, 0.01) == pytest.approx(0.01) and cosine_lr(5, 11, 0.01) == pytest.approx(0.505)
+    assert (
+        cosine_lr(0, 11, 0.01) == 1.0
+        and cosine_lr(10, 11, 0.01) == pytest.approx(0.01)
+        and cosine_lr(5, 11, 0.01) == pytest.approx(0.505)
+    )
     with pytest.raises(ValueError, match="min_steps"):
         TrainSettings(min_steps=10, max_steps=5)
 
@@ -87,7 +121,9 @@ def test_depth_minus_gripper_input_sees_heights_relative_to_the_gripper():
     images, z = torch.full((3, 1, 32, 32), 0.7), torch.tensor([0.6, 0.65, 0.7])
     net = GQCNN(GQCNNConfig(filters=4, fc=8, pose_fc=4, image_input="depth_minus_gripper"))
     assert torch.allclose(net.image_input(images, z)[:, 0, 0, 0], torch.tensor([0.1, 0.05, 0.0]))
-    assert torch.equal(GQCNN(GQCNNConfig(filters=4, fc=8, pose_fc=4, image_input="depth")).image_input(images, z), images)
+    assert torch.equal(
+        GQCNN(GQCNNConfig(filters=4, fc=8, pose_fc=4, image_input="depth")).image_input(images, z), images
+    )
 
 
 def test_averaged_weights_are_the_exponential_moving_average_of_the_trained_ones():
@@ -108,7 +144,9 @@ def test_averaged_weights_are_the_exponential_moving_average_of_the_trained_ones
     w1, w2, averaged = weights(1, 0.0), weights(2, 0.0), weights(2, 0.9)
     for name in w2:
         torch.testing.assert_close(averaged[name], 0.9 * w1[name] + 0.1 * w2[name])
-    assert any(not torch.equal(averaged[name], w2[name]) for name in w2)  # the kept weights are the average, not the last
+    assert any(
+        not torch.equal(averaged[name], w2[name]) for name in w2
+    )  # the kept weights are the average, not the last
 
 
 def test_bfloat16_mixed_precision_learns_and_keeps_float32_weights():
@@ -126,7 +164,11 @@ def test_bfloat16_mixed_precision_learns_and_keeps_float32_weights():
 
     half, again, full = trained("bfloat16"), trained("bfloat16"), trained("float32")
     assert all(p.dtype == torch.float32 for p in half.parameters())
-    assert all(torch.equal(a, b) for a, b in zip(half.state_dict().values(), again.state_dict().values()))  # same seed, same weights
-    assert any(not torch.equal(a, b) for a, b in zip(half.state_dict().values(), full.state_dict().values()))  # the setting acts
+    assert all(
+        torch.equal(a, b) for a, b in zip(half.state_dict().values(), again.state_dict().values())
+    )  # same seed, same weights
+    assert any(
+        not torch.equal(a, b) for a, b in zip(half.state_dict().values(), full.state_dict().values())
+    )  # the setting acts
     probability = predict(half, test, torch.device("cpu"))
     assert probability.dtype == np.float32 and classification_metrics(test.labels, probability)["ap"] > 0.95

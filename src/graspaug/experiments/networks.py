@@ -2,14 +2,16 @@
 stream and the same validation shapes for every variant, so differences between variants
 of a seed are paired (common random numbers); seeds are the replicates.
 
-A seed's networks live in ``models/gqcnn/s<seed>/<pool>/<B>-<R>/`` (``ceiling/`` for the
-ceiling): ``model.pt`` (config, weights, summary), ``summary.json``, ``history.csv``
-(validation AP per evaluation), ``test_predictions.npy`` and ``val_predictions.npy``
+A seed's folder holds one folder per network, ``<pool>/<B>-<R>/`` (``ceiling/`` for the
+ceiling; :attr:`~graspaug.experiments.variants.Variant.name`): ``model.pt`` (config, weights,
+summary), ``summary.json``, ``history.csv`` (validation AP per evaluation),
+``test_predictions.npy`` and ``val_predictions.npy``
 (P(success) per datapoint, rows in ``test_rows.npy`` / ``val_rows.npy`` of the seed folder).
 With ``gqcnn.members`` = K > 1 every network is an ensemble of K members (member m of every
 variant starts from the same weights and noise stream) whose mean P(success) is validated and
 tested; ``*_predictions_members.npy`` (K, N) keep each member's.
 """
+
 from __future__ import annotations
 
 import hashlib
@@ -21,11 +23,12 @@ import numpy as np
 import pandas as pd
 import torch
 
+from graspaug.experiments.variants import Variant
 from graspaug.io.checkpoints import finish_gqcnn_card, save_gqcnn
 from graspaug.nets.gqcnn import GQCNN, GQCNNEnsemble
 from graspaug.nets.settings import GQCNNConfig
 from graspaug.training.gqcnn import GraspArrays, classification_metrics, predict, train_gqcnn
-from graspaug.training.gqcnn_data import ExperimentSplit, Variant, shapes_datapoints, test_set, training_set
+from graspaug.training.gqcnn_data import Corpora, ExperimentSplit, shapes_datapoints, test_set, training_set
 from graspaug.training.settings import TrainSettings
 
 
@@ -33,7 +36,13 @@ def seed_variants(base_sizes, ratios, augment_base_sizes, ceiling: bool) -> list
     """Every network of a seed: 1:0 at every base size; targeted, random and real at every
     nonzero ratio of ``augment_base_sizes``; the ceiling."""
     out = [Variant("targeted", b, 0.0) for b in base_sizes]
-    out += [Variant(p, b, float(r)) for p in ("targeted", "random", "real") for b in augment_base_sizes for r in ratios if r > 0]
+    out += [
+        Variant(p, b, float(r))
+        for p in ("targeted", "random", "real")
+        for b in augment_base_sizes
+        for r in ratios
+        if r > 0
+    ]
     return out + ([Variant("ceiling")] if ceiling else [])
 
 
@@ -50,7 +59,9 @@ def initial_weights(config: GQCNNConfig, weight_seed: int) -> dict[str, torch.Te
     return GQCNN(config).state_dict()
 
 
-def seed_members(config: GQCNNConfig, global_seed: int, seed: int, members: int) -> tuple[tuple[dict, ...], tuple[int, ...]]:
+def seed_members(
+    config: GQCNNConfig, global_seed: int, seed: int, members: int
+) -> tuple[tuple[dict, ...], tuple[int, ...]]:
     """Initial weights and noise seeds of the ``members`` members of every network of a seed:
     member m starts from the same weights and noise stream in every variant (paired)."""
     streams = [stream_seeds(global_seed, seed, m) for m in range(members)]
@@ -77,7 +88,8 @@ def members_digest(inits: tuple[dict, ...]) -> str:
 @dataclass(frozen=True)
 class NetworkJob:
     """One network of a seed (a worker's unit of work): one member per initial weights and
-    noise seed (:func:`seed_members`), their P(success) averaged."""
+    noise seed (:func:`seed_members`), their P(success) averaged; trained on datapoints of
+    ``corpora``, written into its folder in the seed's folder ``out_dir``."""
 
     variant: Variant
     split: ExperimentSplit
@@ -88,6 +100,7 @@ class NetworkJob:
     seed: int
     device: str
     out_dir: Path
+    corpora: Corpora
     card: dict | None = None  # the model card's data part (graspaug.io.checkpoints.gqcnn_card)
 
 
@@ -102,18 +115,30 @@ def train_network(job: NetworkJob, val: GraspArrays | None = None, test: GraspAr
     :class:`~graspaug.nets.gqcnn.GQCNNEnsemble` and every member's predictions are kept too
     (``*_predictions_members.npy``, (K, N))."""
     device = torch.device(job.device)
-    train, info = training_set(job.variant, job.split)
-    val = val if val is not None else shapes_datapoints(job.split.validation)[0]
-    test = test if test is not None else test_set()[0]
+    train, info = training_set(job.variant, job.split, job.corpora)
+    val = val if val is not None else shapes_datapoints(job.corpora.original, job.split.validation)[0]
+    test = test if test is not None else test_set(job.corpora.original)[0]
     members, fits, val_ps, test_ps, history = [], [], [], [], []
     for m, (init, noise_seed) in enumerate(zip(job.inits, job.noise_seeds, strict=True)):
         net = GQCNN(job.net)
         net.load_state_dict(init)
         gen = torch.Generator().manual_seed(noise_seed)
         member = {"member": m} if len(job.inits) > 1 else {}  # history.csv names members only in an ensemble
-        fit = train_gqcnn(net, train, val, job.train, device, gen, on_log=lambda step, metrics, member=member: history.append({**member, "step": step, **metrics}),
-                          progress=False)
-        val_ps.append(fit["val_predictions"] if fit["val_predictions"] is not None else predict(net, val, device, job.train.eval_batch))  # the kept weights
+        fit = train_gqcnn(
+            net,
+            train,
+            val,
+            job.train,
+            device,
+            gen,
+            on_log=lambda step, metrics, member=member: history.append({**member, "step": step, **metrics}),
+            progress=False,
+        )
+        val_ps.append(
+            fit["val_predictions"]
+            if fit["val_predictions"] is not None
+            else predict(net, val, device, job.train.eval_batch)
+        )  # the kept weights
         test_ps.append(predict(net, test, device, job.train.eval_batch))
         members.append(net)
         fits.append(fit)
@@ -122,11 +147,25 @@ def train_network(job: NetworkJob, val: GraspArrays | None = None, test: GraspAr
     val_p, test_p = np.mean(val_ps, axis=0, dtype=np.float32), np.mean(test_ps, axis=0, dtype=np.float32)
     init_digest = members_digest(job.inits)
     rounded = lambda d: {k: (round(v, 5) if isinstance(v, float) else v) for k, v in d.items()}  # noqa: E731
-    summary = {"pool": job.variant.pool, "base_size": job.variant.base_size, "ratio": job.variant.ratio, "seed": job.seed,
-               "validation": rounded(classification_metrics(val.labels, val_p)), "test": rounded(classification_metrics(test.labels, test_p)),
-               "train": {**info, "steps": fits[0]["steps"], "best_step": fits[0]["best_step"] if single else [f["best_step"] for f in fits],
-                         "batch_size": job.train.batch_size, "precision": job.train.precision, **({} if single else {"members": len(members)})},
-               "parameters": net.describe()["parameters"], "init_digest": init_digest, "noise_seed": job.noise_seeds[0] if single else list(job.noise_seeds)}
+    summary = {
+        "pool": job.variant.pool,
+        "base_size": job.variant.base_size,
+        "ratio": job.variant.ratio,
+        "seed": job.seed,
+        "validation": rounded(classification_metrics(val.labels, val_p)),
+        "test": rounded(classification_metrics(test.labels, test_p)),
+        "train": {
+            **info,
+            "steps": fits[0]["steps"],
+            "best_step": fits[0]["best_step"] if single else [f["best_step"] for f in fits],
+            "batch_size": job.train.batch_size,
+            "precision": job.train.precision,
+            **({} if single else {"members": len(members)}),
+        },
+        "parameters": net.describe()["parameters"],
+        "init_digest": init_digest,
+        "noise_seed": job.noise_seeds[0] if single else list(job.noise_seeds),
+    }
     folder = network_dir(job.out_dir, job.variant)
     folder.mkdir(parents=True, exist_ok=True)
     save_gqcnn(folder / "model.pt", net, summary, finish_gqcnn_card(job.card, summary))
@@ -138,7 +177,11 @@ def train_network(job: NetworkJob, val: GraspArrays | None = None, test: GraspAr
     pd.DataFrame(history).to_csv(folder / "history.csv", index=False)
     (folder / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
     seconds = sum(f["train_seconds"] for f in fits)
-    return {**summary, "train_seconds": seconds, "samples_per_second": len(fits) * fits[0]["steps"] * min(job.train.batch_size, len(train)) / seconds}
+    return {
+        **summary,
+        "train_seconds": seconds,
+        "samples_per_second": len(fits) * fits[0]["steps"] * min(job.train.batch_size, len(train)) / seconds,
+    }
 
 
 def _by_member(value):
@@ -153,17 +196,25 @@ def seed_table(summaries: list[dict]) -> dict:
     for s in summaries:
         key = ("ceiling", "all", "-") if s["pool"] == "ceiling" else (s["pool"], str(s["base_size"]), f"{s['ratio']:g}")
         out.setdefault(key[0], {}).setdefault(key[1], {})[key[2]] = {
-            "val_ap": s["validation"]["ap"], "test_ap": s["test"]["ap"], "test_roc_auc": s["test"]["roc_auc"],
-            "datapoints": s["train"]["datapoints"], "steps": s["train"]["steps"], "best_step": _by_member(s["train"]["best_step"])}
+            "val_ap": s["validation"]["ap"],
+            "test_ap": s["test"]["ap"],
+            "test_roc_auc": s["test"]["roc_auc"],
+            "datapoints": s["train"]["datapoints"],
+            "steps": s["train"]["steps"],
+            "best_step": _by_member(s["train"]["best_step"]),
+        }
     return out
 
 
 def read_history(seed_dir: Path, variants: list[Variant]) -> pd.DataFrame:
     """Validation AP per evaluation of every network of a seed: network (``<name> #<m>`` for
     member m > 0 of an ensemble), step, val_ap, loss, lr."""
+
     def named(frame: pd.DataFrame, name: str) -> pd.DataFrame:
         member = frame["member"] if "member" in frame else pd.Series(0, index=frame.index)
         return frame.assign(network=[name if m == 0 else f"{name} #{m}" for m in member])
 
     frames = [named(pd.read_csv(network_dir(seed_dir, v) / "history.csv"), v.name) for v in variants]
-    return pd.concat(frames, ignore_index=True)[["network", "step", "val_ap", "loss", "lr"]] if frames else pd.DataFrame()
+    return (
+        pd.concat(frames, ignore_index=True)[["network", "step", "val_ap", "loss", "lr"]] if frames else pd.DataFrame()
+    )

@@ -1,13 +1,23 @@
-"""Interval estimates for paired experiments: t-intervals over seeds and bootstrap intervals
-that resample test *objects* (every datapoint of a drawn object comes along).
+"""The statistics of the three experiments (GQ-CNN AP, critic study, simulated trials).
 
-Average Precision here is sklearn's (step-wise, no interpolation): the mean over positives of
-the precision at their rank, with datapoint weights for the bootstrap.
+* :func:`t_interval`: mean and t-interval over training seeds (the replicates);
+* :class:`ObjectBootstrap`: the cluster bootstrap. Each resample draws the clusters (test
+  objects; the critic study's interpolation pairs: :class:`PairBootstrap`) with replacement, as
+  many as there are, and every datapoint of a drawn cluster comes along;
+* :func:`percentile_interval`, :func:`mean_interval`, :func:`paired_contrast`: the mean of values
+  (of paired differences) with its percentile bootstrap interval;
+* :func:`weighted_average_precision`: Average Precision as sklearn's (step-wise, no
+  interpolation): the mean over positives of the precision at their rank, with datapoint
+  weights for the bootstrap;
+* :func:`wilson_interval` (a success rate) and :func:`mcnemar_test` (two planners on the same
+  attempts).
 """
+
 from __future__ import annotations
 
 import numpy as np
 from scipy import stats
+from scipy.stats import binomtest
 
 
 def t_interval(values, level: float = 0.95) -> dict:
@@ -25,25 +35,67 @@ def t_interval(values, level: float = 0.95) -> dict:
 
 
 class ObjectBootstrap:
-    """Resamples of the test objects: ``weights`` (n_resamples, n_datapoints), each row the
-    number of times each datapoint's object was drawn (objects with replacement, as many as
-    there are)."""
+    """Resamples of the objects (the clusters of the datapoints).
 
-    def __init__(self, object_ids: np.ndarray, n_resamples: int, seed: int) -> None:
+    Parameters
+    ----------
+    object_ids : (N,) — the object of each datapoint (any sortable labels).
+    n_resamples : int — bootstrap resamples.
+    seed : int or numpy.random.Generator — seeds a fresh generator; a generator is drawn from as it is.
+
+    Attributes
+    ----------
+    draws : (n_resamples, n_objects) int — the objects drawn with replacement, one resample per
+        row, as indices into the sorted unique ``object_ids``.
+    object_counts : (n_resamples, n_objects) float32 — how often each object was drawn.
+    object_index : (N,) int — each datapoint's object, as an index into the sorted unique ids.
+    """
+
+    def __init__(self, object_ids: np.ndarray, n_resamples: int, seed: int | np.random.Generator) -> None:
         objects, self.object_index = np.unique(np.asarray(object_ids), return_inverse=True)
         rng = np.random.default_rng(seed)
-        draws = rng.integers(0, len(objects), size=(n_resamples, len(objects)))
+        self.draws = rng.integers(0, len(objects), size=(n_resamples, len(objects)))
         counts = np.zeros((n_resamples, len(objects)), dtype=np.float32)
-        np.add.at(counts, (np.arange(n_resamples)[:, None], draws), 1.0)
+        np.add.at(counts, (np.arange(n_resamples)[:, None], self.draws), 1.0)
         self.object_counts = counts
         self.n_objects = len(objects)
 
     def average_precision(self, labels: np.ndarray, scores: np.ndarray) -> np.ndarray:
-        """AP of ``scores`` under every resample (n_resamples,)."""
+        """(n_resamples,) AP of ``scores`` (N,) for ``labels`` (N,) under every resample."""
         order = np.argsort(-np.asarray(scores), kind="stable")
         y = np.asarray(labels, dtype=np.float32)[order]
         w = self.object_counts[:, self.object_index[order]]
         return weighted_average_precision(y, w)
+
+    def means(self, values: np.ndarray) -> np.ndarray:
+        """(n_resamples,) mean of ``values`` (N,), one per datapoint, under every resample: each
+        drawn object brings all its datapoints, once per draw."""
+        sums = np.bincount(self.object_index, weights=values, minlength=self.n_objects)
+        counts = np.bincount(self.object_index, minlength=self.n_objects)
+        return (self.object_counts @ sums) / (self.object_counts @ counts)
+
+
+class PairBootstrap(ObjectBootstrap):
+    """The critic study's resamples: every interpolation pair is an object with one value, and
+    a value that is NaN (an empty decoded grid) is left out of its resamples.
+
+    Parameters
+    ----------
+    n_pairs : int — pairs (objects ``0 .. n_pairs − 1``).
+    n_resamples : int — bootstrap resamples.
+    rng : numpy.random.Generator — the study's generator, drawn from as it is.
+    """
+
+    def __init__(self, n_pairs: int, n_resamples: int, rng: np.random.Generator) -> None:
+        super().__init__(np.arange(n_pairs), n_resamples, rng)
+
+    def means(self, values: np.ndarray) -> np.ndarray:
+        """(n_resamples,) mean of the finite ``values`` (n_pairs,) of every resample's drawn pairs;
+        NaN for a resample without a finite value."""
+        drawn = values[self.draws]  # (n_resamples, P)
+        counts = np.isfinite(drawn).sum(axis=1)
+        sums = np.where(np.isfinite(drawn), drawn, 0.0).sum(axis=1)
+        return np.divide(sums, counts, out=np.full(len(drawn), np.nan), where=counts > 0)
 
 
 def weighted_average_precision(labels_sorted: np.ndarray, weights: np.ndarray) -> np.ndarray:
@@ -53,7 +105,12 @@ def weighted_average_precision(labels_sorted: np.ndarray, weights: np.ndarray) -
     seen = np.cumsum(weights, axis=-1)
     precision = np.divide(tp, seen, out=np.zeros_like(tp), where=seen > 0)
     positives = tp[..., -1]
-    return np.divide((precision * weights * labels_sorted).sum(axis=-1), positives, out=np.full_like(positives, np.nan), where=positives > 0)
+    return np.divide(
+        (precision * weights * labels_sorted).sum(axis=-1),
+        positives,
+        out=np.full_like(positives, np.nan),
+        where=positives > 0,
+    )
 
 
 def percentile_interval(samples: np.ndarray, level: float = 0.95) -> tuple[float | None, float | None]:
@@ -64,3 +121,43 @@ def percentile_interval(samples: np.ndarray, level: float = 0.95) -> tuple[float
         return None, None
     low, high = np.quantile(x, [0.5 - level / 2, 0.5 + level / 2])
     return float(low), float(high)
+
+
+def mean_interval(values: np.ndarray, boot: ObjectBootstrap, level: float = 0.95) -> dict[str, float | None]:
+    """Mean of the finite ``values`` (N,) and the two-sided ``level`` percentile interval of
+    their mean over the resamples of ``boot`` (:meth:`ObjectBootstrap.means`); all None when
+    no value is finite."""
+    finite = np.isfinite(values)
+    if not finite.any():
+        return {"mean": None, "ci_low": None, "ci_high": None}
+    low, high = percentile_interval(boot.means(values), level)
+    return {"mean": float(np.mean(values[finite])), "ci_low": low, "ci_high": high}
+
+
+def paired_contrast(
+    a: np.ndarray, b: np.ndarray, boot: ObjectBootstrap, level: float = 0.95
+) -> dict[str, float | None]:
+    """``a − b`` on paired datapoints (both (N,), the same datapoints of the same objects): the
+    mean difference and its bootstrap interval (:func:`mean_interval`). A datapoint whose
+    difference is NaN (either value NaN) is left out."""
+    return mean_interval(a - b, boot, level)
+
+
+def wilson_interval(successes: int, attempts: int, confidence: float = 0.95) -> tuple[float, float]:
+    """Wilson score interval of a success rate (scipy); (0, 1) when there were no attempts."""
+    if attempts == 0:
+        return 0.0, 1.0
+    ci = binomtest(int(successes), int(attempts)).proportion_ci(confidence_level=confidence, method="wilson")
+    return float(ci.low), float(ci.high)
+
+
+def mcnemar_test(before: np.ndarray, after: np.ndarray) -> dict[str, float | int]:
+    """Exact McNemar test of two planners on the same attempts: ``before``, ``after`` (N,) bool
+    outcomes of the same drops. Counts the discordant attempts and gives the two-sided p-value
+    of "neither planner wins the discordant attempts more often"."""
+    before, after = np.asarray(before, dtype=bool), np.asarray(after, dtype=bool)
+    only_before = int(np.sum(before & ~after))
+    only_after = int(np.sum(after & ~before))
+    n = only_before + only_after
+    p = 1.0 if n == 0 else float(binomtest(only_after, n, 0.5).pvalue)
+    return {"only_before": only_before, "only_after": only_after, "p_value": p}

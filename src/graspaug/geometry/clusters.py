@@ -1,4 +1,5 @@
 """Connected pieces of voxel grids, by DBSCAN as in the paper's critic study (Section IV-B)."""
+
 from __future__ import annotations
 
 import numpy as np

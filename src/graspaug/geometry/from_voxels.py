@@ -3,6 +3,7 @@
 Threshold, fill holes, binary opening, keep the largest face-connected piece, marching cubes
 (Lewiner), Humphrey smoothing (Vollmer et al. 1999).
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -11,6 +12,7 @@ import numpy as np
 import trimesh
 from scipy import ndimage
 from skimage.measure import marching_cubes
+
 from graspaug.geometry.settings import DecodeSettings
 
 
@@ -25,7 +27,9 @@ class CleanGrid:
     reason: str | None
 
 
-def clean_occupancy(probability: np.ndarray, threshold: float, opening: int, min_voxels: int, min_main_share: float) -> CleanGrid:
+def clean_occupancy(
+    probability: np.ndarray, threshold: float, opening: int, min_voxels: int, min_main_share: float
+) -> CleanGrid:
     """Binary solid from decoded probabilities (R, R, R): ``> threshold``, holes filled, opened
     ``opening`` times (removes one-voxel spurs), reduced to its largest face-connected piece
     (voxels touching only along an edge or corner would make separate surfaces).
@@ -65,10 +69,14 @@ def mesh_from_occupancy(occupancy: np.ndarray, pitch: float, smoothing_iteration
     return mesh
 
 
-def mesh_decoded(probability: np.ndarray, pitch: float, settings: DecodeSettings) -> tuple[CleanGrid, trimesh.Trimesh | None, str | None]:
+def mesh_decoded(
+    probability: np.ndarray, pitch: float, settings: DecodeSettings
+) -> tuple[CleanGrid, trimesh.Trimesh | None, str | None]:
     """Clean a decoded grid (R, R, R) of probabilities and mesh it at ``pitch`` (m per voxel);
     a reason instead of a mesh when it is degenerate."""
-    grid = clean_occupancy(probability, settings.threshold, settings.opening, settings.min_voxels, settings.min_main_share)
+    grid = clean_occupancy(
+        probability, settings.threshold, settings.opening, settings.min_voxels, settings.min_main_share
+    )
     if grid.reason:
         return grid, None, grid.reason
     mesh = mesh_from_occupancy(grid.occupancy, pitch, settings.smoothing_iterations)

@@ -11,6 +11,7 @@ pieces), vertices are merged by position alone (UVs and normals ignored), degene
 and duplicate faces dropped and holes of three or four edges filled; ``closed_by``
 says which of these closed it (see :class:`LoadedShape`).
 """
+
 from __future__ import annotations
 
 import hashlib
@@ -75,7 +76,9 @@ def _first_line(exc: BaseException) -> str:
     return f"{type(exc).__name__}: {text[0][:120]}" if text else type(exc).__name__
 
 
-def load_shape(path: str | os.PathLike, unit_scale: float = 1.0, max_faces: int = 1_000_000, max_file_mb: float = 100.0) -> LoadedShape:
+def load_shape(
+    path: str | os.PathLike, unit_scale: float = 1.0, max_faces: int = 1_000_000, max_file_mb: float = 100.0
+) -> LoadedShape:
     """Load and check one mesh file.
 
     Parameters

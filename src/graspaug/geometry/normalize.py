@@ -1,4 +1,5 @@
 """Placing a shape in its normalized frame: center of mass at the origin, graspable size."""
+
 from __future__ import annotations
 
 from dataclasses import dataclass

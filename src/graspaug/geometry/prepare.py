@@ -1,4 +1,5 @@
 """From a loaded source file to the normalized closed outer surface every stage uses."""
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -6,11 +7,11 @@ from dataclasses import dataclass
 import numpy as np
 import trimesh
 
+from graspaug.geometry.closing import MIN_ENCLOSED, close_surface
 from graspaug.geometry.loading import LoadedShape, MeshRejected
 from graspaug.geometry.normalize import Normalization, normalization
-from graspaug.geometry.closing import MIN_ENCLOSED, close_surface
-from graspaug.geometry.solid import outer_surface_of_parts, resolution_for_parts
 from graspaug.geometry.settings import SurfaceSettings
+from graspaug.geometry.solid import outer_surface_of_parts, resolution_for_parts
 
 
 @dataclass
@@ -39,11 +40,15 @@ def prepare_shape(loaded: LoadedShape, settings: SurfaceSettings) -> PreparedSha
     """
     closed_by = loaded.closed_by
     if loaded.parts:
-        resolution = resolution_for_parts(loaded.parts, settings.resolution, settings.finest_resolution, settings.cells_per_thickness)
+        resolution = resolution_for_parts(
+            loaded.parts, settings.resolution, settings.finest_resolution, settings.cells_per_thickness
+        )
         surface, dropped = outer_surface_of_parts(loaded.parts, resolution, settings.face_budget)
     else:
         resolution = settings.resolution
-        closed = close_surface(loaded.mesh, resolution, settings.face_budget, settings.max_gap, settings.finest_resolution)
+        closed = close_surface(
+            loaded.mesh, resolution, settings.face_budget, settings.max_gap, settings.finest_resolution
+        )
         surface, dropped, resolution = closed.mesh, closed.dropped, closed.resolution
         if closed.filled:
             closed_by = "filled"
@@ -63,5 +68,12 @@ def prepare_shape(loaded: LoadedShape, settings: SurfaceSettings) -> PreparedSha
     if not np.isfinite(mesh.vertices).all():
         raise MeshRejected("degenerate: normalization produced non-finite coordinates")
     hull_fill = float(mesh.volume / mesh.convex_hull.volume)
-    return PreparedShape(mesh=mesh, normalization=norm, n_parts=len(loaded.parts), resolution=resolution, dropped_volume=dropped,
-                         closed_by=closed_by, hull_fill=hull_fill)
+    return PreparedShape(
+        mesh=mesh,
+        normalization=norm,
+        n_parts=len(loaded.parts),
+        resolution=resolution,
+        dropped_volume=dropped,
+        closed_by=closed_by,
+        hull_fill=hull_fill,
+    )

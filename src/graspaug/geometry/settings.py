@@ -1,4 +1,5 @@
 """Settings of the geometry library: rebuilding surfaces at ingest, meshing decoded grids."""
+
 from __future__ import annotations
 
 from typing import Literal
@@ -10,14 +11,59 @@ from graspaug.settings import Field, settings
 class SurfaceSettings:
     """How the outer surface is rebuilt and sized (params section ``ingest.surface``)."""
 
-    resolution: int = Field(96, ge=16, le=512, description="Marching-cubes samples along a shape's largest extent when its closed outer surface is rebuilt (cell = extent / resolution).")
-    finest_resolution: int = Field(160, ge=16, le=512, description="Upper limit of that resolution for shapes made of thin convex parts (lattices), which get a finer grid.")
-    cells_per_thickness: float = Field(6.0, ge=0, description="Field cells across a typical (median) convex part; sets the finer grid for thin-part shapes (0: always resolution).")
+    resolution: int = Field(
+        96,
+        ge=16,
+        le=512,
+        description=(
+            "Marching-cubes samples along a shape's largest extent when its closed outer surface is rebuilt (cell = "
+            "extent / resolution)."
+        ),
+    )
+    finest_resolution: int = Field(
+        160,
+        ge=16,
+        le=512,
+        description=(
+            "Upper limit of that resolution for shapes made of thin convex parts (lattices), which get a finer grid."
+        ),
+    )
+    cells_per_thickness: float = Field(
+        6.0,
+        ge=0,
+        description=(
+            "Field cells across a typical (median) convex part; sets the finer grid for thin-part shapes (0: always "
+            "resolution)."
+        ),
+    )
     face_budget: int = Field(5000, ge=100, description="Triangles per outer surface after quadric decimation.")
-    size_rule: Literal["min", "mid", "max"] = Field("mid", description="Which extent the size rule fixes: `min`, `mid` (the middle one) or `max`.")
-    size_m: float = Field(0.06, gt=0, description="That extent after scaling, meters. Default: middle extent 0.06 m, so a Franka Panda (0.08 m opening) closes across the two smaller extents of most objects.")
-    max_dropped: float = Field(0.1, ge=0, le=1, description="Reject a shape whose largest connected piece misses more than this share of its volume.")
-    max_gap: float = Field(0.05, ge=0, le=0.5, description="Widest hole or crack bridged when an open mesh (a scan, a file split at UV seams) is rebuilt as a solid, as a share of the shape's largest extent (0.05: 5 mm on a 10 cm object); a mesh that needs a wider one bridged is rejected. Openings wider than this (a mug's top) stay open.")
+    size_rule: Literal["min", "mid", "max"] = Field(
+        "mid", description="Which extent the size rule fixes: `min`, `mid` (the middle one) or `max`."
+    )
+    size_m: float = Field(
+        0.06,
+        gt=0,
+        description=(
+            "That extent after scaling, meters. Default: middle extent 0.06 m, so a Franka Panda (0.08 m opening) "
+            "closes across the two smaller extents of most objects."
+        ),
+    )
+    max_dropped: float = Field(
+        0.1,
+        ge=0,
+        le=1,
+        description="Reject a shape whose largest connected piece misses more than this share of its volume.",
+    )
+    max_gap: float = Field(
+        0.05,
+        ge=0,
+        le=0.5,
+        description=(
+            "Widest hole or crack bridged when an open mesh (a scan, a file split at UV seams) is rebuilt as a solid, "
+            "as a share of the shape's largest extent (0.05: 5 mm on a 10 cm object); a mesh that needs a wider one "
+            "bridged is rejected. Openings wider than this (a mug's top) stay open."
+        ),
+    )
 
 
 @settings
@@ -25,7 +71,16 @@ class DecodeSettings:
     """Decoded occupancy probabilities → a cleaned solid and its mesh (params section ``generate.decode``)."""
 
     threshold: float = Field(0.5, gt=0, le=1, description="Occupancy threshold of decoded grids.")
-    opening: int = Field(1, ge=0, le=3, description="Binary opening iterations on the decoded solid (removes one-voxel spurs).")
-    min_voxels: int = Field(100, ge=1, description="A decode with a largest piece smaller than this is rejected (tiny).")
-    min_main_share: float = Field(0.9, gt=0, le=1, description="A decode whose largest piece holds less than this share of its voxels is rejected (in pieces).")
+    opening: int = Field(
+        1, ge=0, le=3, description="Binary opening iterations on the decoded solid (removes one-voxel spurs)."
+    )
+    min_voxels: int = Field(
+        100, ge=1, description="A decode with a largest piece smaller than this is rejected (tiny)."
+    )
+    min_main_share: float = Field(
+        0.9,
+        gt=0,
+        le=1,
+        description="A decode whose largest piece holds less than this share of its voxels is rejected (in pieces).",
+    )
     smoothing_iterations: int = Field(10, ge=0, description="Humphrey smoothing iterations on the marching-cubes mesh.")

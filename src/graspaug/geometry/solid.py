@@ -16,6 +16,7 @@ on one closed outer surface rebuilt here:
    fine cell,
 4. the largest connected piece is kept and decimated to a face budget.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -23,6 +24,8 @@ from dataclasses import dataclass
 import numpy as np
 import trimesh
 from scipy.spatial import ConvexHull, QhullError
+
+from graspaug.geometry.fields import decimate, grid_around, largest_piece, surface_from_field
 
 
 @dataclass(frozen=True)
@@ -92,16 +95,9 @@ def resolution_for_parts(parts: list[ConvexPart], base: int, finest: int, cells_
     return int(np.clip(np.ceil(cells_per_thickness * size / thickness), base, max(base, finest)))
 
 
-def _field_grid(bounds: np.ndarray, resolution: int) -> tuple[np.ndarray, float, tuple[int, int, int]]:
-    """Sample points around ``bounds``: cubic cells, ``resolution`` along the largest extent."""
-    extent = bounds[1] - bounds[0]
-    pitch = float(extent.max()) / resolution
-    origin = bounds[0] - 2 * pitch
-    shape = tuple(int(n) for n in np.ceil(extent / pitch).astype(int) + 5)
-    return origin, pitch, shape
-
-
-def union_field_grid(parts: list[ConvexPart], origin: np.ndarray, pitch: float, shape: tuple[int, int, int]) -> np.ndarray:
+def union_field_grid(
+    parts: list[ConvexPart], origin: np.ndarray, pitch: float, shape: tuple[int, int, int]
+) -> np.ndarray:
     """The union's field sampled on a regular grid, ``min_part max_plane (n·x + d)``.
 
     Exact within ``2 * pitch`` of some part's bounding box; samples farther away get
@@ -134,60 +130,6 @@ def union_field_grid(parts: list[ConvexPart], origin: np.ndarray, pitch: float, 
     return field
 
 
-def surface_from_field(field: np.ndarray, origin: np.ndarray, pitch: float, level: float = 0.0) -> trimesh.Trimesh:
-    """Closed surface of ``{field < level}`` by marching cubes (Lewiner).
-
-    Parameters
-    ----------
-    field : (a, b, c) float — samples, negative inside; must be positive on the border
-    origin : (3,) float — position of sample (0, 0, 0), meters
-    pitch : float — sample spacing, meters
-    """
-    from skimage.measure import marching_cubes
-
-    # samples exactly on the level (plateaus after morphology, vertices on the grid)
-    # make marching cubes emit non-manifold pieces; a level a hair inside avoids them
-    level = level - 1e-6 * pitch
-    verts, faces, _, _ = marching_cubes(field, level=level, spacing=(pitch,) * 3, method="lewiner", allow_degenerate=False)
-    mesh = trimesh.Trimesh(verts + origin, faces, process=True)
-    trimesh.repair.fix_normals(mesh)
-    return mesh
-
-
-def largest_piece(mesh: trimesh.Trimesh) -> tuple[trimesh.Trimesh, float]:
-    """The connected piece with the largest volume, and the share of volume dropped."""
-    pieces = mesh.split(only_watertight=False)
-    if len(pieces) <= 1:
-        return mesh, 0.0
-    with np.errstate(divide="ignore", invalid="ignore"):  # slivers of zero volume warn in trimesh
-        volumes = np.array([abs(p.volume) for p in pieces])
-    best = int(np.argmax(volumes))
-    return pieces[best], float(1.0 - volumes[best] / volumes.sum())
-
-
-def decimate(mesh: trimesh.Trimesh, face_budget: int) -> trimesh.Trimesh:
-    """Quadric decimation to at most ``face_budget`` faces, kept only if still closed and in one piece.
-
-    fast-simplification sometimes pinches a few edges into non-manifold ones, at
-    some aggression settings and not others; settings are tried in turn (3, 7, 1,
-    0; the gentlest may stop above the budget) and the first result that is
-    closed and in one piece is kept. If none is, the undecimated mesh is returned.
-    """
-    if len(mesh.faces) <= face_budget:
-        return mesh
-    for aggression in (3, 7, 1, 0):
-        try:
-            small = mesh.simplify_quadric_decimation(face_count=face_budget, aggression=aggression)
-        except Exception:  # noqa: BLE001 — the decimator is optional, the undecimated mesh is valid
-            return mesh
-        small.merge_vertices()
-        small.remove_unreferenced_vertices()
-        if small.is_watertight and small.body_count == 1 and small.volume > 0:
-            trimesh.repair.fix_normals(small)
-            return small
-    return mesh
-
-
 def outer_surface_of_parts(parts: list[ConvexPart], resolution: int, face_budget: int) -> tuple[trimesh.Trimesh, float]:
     """One closed outer surface of the union of convex ``parts``.
 
@@ -211,57 +153,10 @@ def outer_surface_of_parts(parts: list[ConvexPart], resolution: int, face_budget
     from scipy import ndimage
 
     bounds = np.array([np.min([p.bounds[0] for p in parts], axis=0), np.max([p.bounds[1] for p in parts], axis=0)])
-    origin, pitch, shape = _field_grid(bounds, resolution)
+    origin, pitch, shape = grid_around(bounds, resolution, pad_cells=2)
     field = union_field_grid(parts, origin, pitch, shape)
     mesh, dropped = largest_piece(surface_from_field(field, origin, pitch))
     if dropped > 0:
         closed = ndimage.grey_opening(field, size=(3, 3, 3))  # min then max filter: closes the solid
         mesh, dropped = largest_piece(surface_from_field(closed, origin, pitch))
     return decimate(mesh, face_budget), dropped
-
-
-def outer_surface_of_mesh(
-    mesh: trimesh.Trimesh, resolution: int, face_budget: int, max_gap: float = 0.05
-) -> tuple[trimesh.Trimesh, float]:
-    """One closed outer surface for an arbitrary mesh (several bodies, holes, inner faces).
-
-    See :func:`graspaug.geometry.closing.close_surface`: a closed body is kept, several
-    become their union, an open mesh is filled bridging gaps up to ``max_gap`` (share of
-    the largest extent). An open sheet that encloses nothing comes out empty or as slivers
-    (``close_surface`` says how much of the area encloses the solid).
-
-    Returns
-    -------
-    mesh : closed, outward-oriented surface, meters
-    dropped : float — share of the volume in pieces that were dropped
-    """
-    from graspaug.geometry.closing import close_surface
-
-    closed = close_surface(mesh, resolution, face_budget, max_gap)
-    return closed.mesh, closed.dropped
-
-
-def union_of_closed_bodies(mesh: trimesh.Trimesh, resolution: int, face_budget: int) -> tuple[trimesh.Trimesh, float]:
-    """The union of several closed bodies: winding-count occupancy on a fine grid, lightly
-    smoothed, then marching cubes; the largest piece, decimated.
-
-    Returns
-    -------
-    mesh : closed, outward-oriented surface of the largest piece, meters
-    dropped : float — share of the volume in pieces that were dropped
-    """
-    from scipy import ndimage
-
-    from graspaug.geometry.voxelize import VoxelGrid, voxelize_solid
-
-    bounds = mesh.bounds
-    origin, pitch, shape = _field_grid(bounds, resolution)
-    n = max(shape)
-    grid = VoxelGrid(n, pitch, origin - 0.5 * pitch)  # voxel centers on the sample points
-    occupied = np.zeros((n, n, n), dtype=bool)
-    for body in mesh.split(only_watertight=False):
-        occupied |= voxelize_solid(body.vertices, body.faces, grid)
-    smooth = ndimage.gaussian_filter(occupied.astype(np.float32), sigma=0.7)
-    out = surface_from_field(0.5 - smooth, origin, pitch)
-    out, dropped = largest_piece(out)
-    return decimate(out, face_budget), dropped

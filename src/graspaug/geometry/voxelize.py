@@ -13,6 +13,7 @@ many contain the point, so ``!= 0`` is their union. Only the column/triangle
 pairs whose 2-D bounding boxes overlap are visited, so the cost scales with the
 surface, not the volume.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass

@@ -12,6 +12,7 @@ Unlike Dex-Net, surface points come from the exact mesh surface rather than SDF 
 SDF gradients, and axes are not flipped at random: Dex-Net flips because SDF gradients can
 point the wrong way, while the normals of our closed, outward-oriented meshes cannot.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -67,7 +68,13 @@ def force_closure(p1: np.ndarray, n1: np.ndarray, p2: np.ndarray, n2: np.ndarray
     return ok
 
 
-def _candidates(mesh: trimesh.Trimesh, gripper: ParallelJawGripper, settings: AntipodalSettings, n_points: int, rng: np.random.Generator) -> Grasps:
+def _candidates(
+    mesh: trimesh.Trimesh,
+    gripper: ParallelJawGripper,
+    settings: AntipodalSettings,
+    n_points: int,
+    rng: np.random.Generator,
+) -> Grasps:
     """One sampling round: up to ``n_points · tries_per_point`` grasps that pass every test."""
     points, faces = trimesh.sample.sample_surface(mesh, n_points, seed=rng)
     points = np.repeat(points, settings.tries_per_point, axis=0)
@@ -104,7 +111,9 @@ def _spread(grasps: Grasps, kept_centers: np.ndarray, min_dist: float) -> np.nda
     return np.array(chosen, dtype=np.int64)
 
 
-def sample_antipodal_grasps(mesh: trimesh.Trimesh, gripper: ParallelJawGripper, settings: AntipodalSettings, rng: np.random.Generator) -> Grasps:
+def sample_antipodal_grasps(
+    mesh: trimesh.Trimesh, gripper: ParallelJawGripper, settings: AntipodalSettings, rng: np.random.Generator
+) -> Grasps:
     """Up to ``settings.n_grasps`` antipodal grasps on the closed ``mesh`` (fewer, maybe none,
     if the rounds run out: e.g. an object wider than the gripper everywhere)."""
     kept: list[Grasps] = []

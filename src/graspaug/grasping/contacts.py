@@ -1,4 +1,5 @@
 """Where a closing parallel-jaw gripper touches a closed mesh: one ray per jaw (embree via trimesh)."""
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -20,7 +21,9 @@ class Contacts:
     found: np.ndarray
 
 
-def first_entries(mesh: trimesh.Trimesh, origins: np.ndarray, directions: np.ndarray, max_distance: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def first_entries(
+    mesh: trimesh.Trimesh, origins: np.ndarray, directions: np.ndarray, max_distance: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """First surface crossing of each ray (N, 3) origins / unit directions, if it enters the solid.
 
     Returns hit points (N, 3), outward face normals (N, 3) and ``ok`` (N,): False where the ray

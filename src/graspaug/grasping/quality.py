@@ -16,6 +16,7 @@ the origin is not strictly inside or the hull is flat): the smallest facet-plane
 1 ms each in 6-D); :func:`ferrari_canny` gets the same value (to 1e-9) 16-21x faster by trying
 only the hyperplanes that can be facets of this particular point set (:func:`_epsilon_inside`).
 """
+
 from __future__ import annotations
 
 from typing import NamedTuple
@@ -132,7 +133,11 @@ def grasp_wrenches(
         with np.errstate(divide="ignore", invalid="ignore"):
             x, y = np.einsum("ij,ij->i", toward, t1) / height, np.einsum("ij,ij->i", toward, t2) / height
             reach = x[:, None] * np.cos(edge_normals) + y[:, None] * np.sin(edge_normals)
-            interior &= (c > 0) & (height > 0) & np.all(reach < (1 - INTERIOR_MARGIN) * mu[:, None] * np.cos(np.pi / cone_faces), axis=1)
+            interior &= (
+                (c > 0)
+                & (height > 0)
+                & np.all(reach < (1 - INTERIOR_MARGIN) * mu[:, None] * np.cos(np.pi / cone_faces), axis=1)
+            )
         tangent = t1[:, None, :] * np.cos(phi)[None, :, None] + t2[:, None, :] * np.sin(phi)[None, :, None]
         cone = in_normal[:, None, :] + mu[:, None, None] * tangent  # (N, m, 3)
         torques = np.cross((np.asarray(p, dtype=float) - com)[:, None, :], cone)
@@ -253,7 +258,9 @@ def _supporting_offset(x: np.ndarray, points: np.ndarray, n_points: int, side_to
 
 
 @njit(cache=True)
-def _origin_not_inside(points: np.ndarray, poly: np.ndarray, poly_n: np.ndarray, rank_tol: float, side_tol: float) -> bool:
+def _origin_not_inside(
+    points: np.ndarray, poly: np.ndarray, poly_n: np.ndarray, rank_tol: float, side_tol: float
+) -> bool:
     """Whether some hyperplane through the origin has every wrench point (2m+4, 6) on one side.
 
     Such a plane contains ``±τ1, ±τ2``, so it passes through the origin, ``τ1``, ``τ2`` and
@@ -285,7 +292,9 @@ def _origin_not_inside(points: np.ndarray, poly: np.ndarray, poly_n: np.ndarray,
 
 
 @njit(cache=True)
-def _epsilon_inside(points: np.ndarray, poly: np.ndarray, poly_n: np.ndarray, rank_tol: float, side_tol: float) -> float:
+def _epsilon_inside(
+    points: np.ndarray, poly: np.ndarray, poly_n: np.ndarray, rank_tol: float, side_tol: float
+) -> float:
     """ε of one wrench set (2m+4, 6) whose hull has the origin strictly inside.
 
     A facet's plane then meets each cone polygon in a face of it (:func:`_polygon_faces`) and
@@ -335,7 +344,9 @@ def _epsilon_inside(points: np.ndarray, poly: np.ndarray, poly_n: np.ndarray, ra
                     c0 = g[u, 1] * g[w, 2] - g[u, 2] * g[w, 1]
                     c1 = g[u, 2] * g[w, 0] - g[u, 0] * g[w, 2]
                     c2 = g[u, 0] * g[w, 1] - g[u, 1] * g[w, 0]
-                    size = np.sqrt((g[u, 0] ** 2 + g[u, 1] ** 2 + g[u, 2] ** 2) * (g[w, 0] ** 2 + g[w, 1] ** 2 + g[w, 2] ** 2))
+                    size = np.sqrt(
+                        (g[u, 0] ** 2 + g[u, 1] ** 2 + g[u, 2] ** 2) * (g[w, 0] ** 2 + g[w, 1] ** 2 + g[w, 2] ** 2)
+                    )
                     if np.sqrt(c0 * c0 + c1 * c1 + c2 * c2) <= PIN_TOL * size:
                         continue  # the two points pin down no single plane
                 for j in range(7):
@@ -354,7 +365,9 @@ def _epsilon_inside(points: np.ndarray, poly: np.ndarray, poly_n: np.ndarray, ra
 
 
 @njit(cache=True)
-def _epsilon_batch(wrenches: np.ndarray, inside: np.ndarray, poly: np.ndarray, poly_n: np.ndarray, out: np.ndarray) -> None:
+def _epsilon_batch(
+    wrenches: np.ndarray, inside: np.ndarray, poly: np.ndarray, poly_n: np.ndarray, out: np.ndarray
+) -> None:
     for i in range(wrenches.shape[0]):
         points = wrenches[i]
         scale = max(1.0, np.abs(points).max())

@@ -1,5 +1,6 @@
 """Robust Ferrari-Canny: the mean (and spread) of ε over perturbed grasp poses, object poses
 and friction coefficients (Dex-Net's ``RobustPointGraspMetrics3D``), in SI units."""
+
 from __future__ import annotations
 
 from collections.abc import Callable
@@ -12,9 +13,7 @@ from scipy.stats import truncnorm
 from graspaug.grasping.contacts import close_fingers
 from graspaug.grasping.gripper import ParallelJawGripper
 from graspaug.grasping.quality import X_AXIS, ferrari_canny, grasp_wrenches
-from graspaug.grasping.settings import QualitySettings
-from graspaug.grasping.settings import Perturbations
-
+from graspaug.grasping.settings import Perturbations, QualitySettings
 
 Epsilon = Callable[[np.ndarray, np.ndarray], np.ndarray]  # (wrench sets, origin known inside) -> ε
 
@@ -41,8 +40,17 @@ def grasp_epsilon(
         return out
     mu = np.broadcast_to(np.asarray(friction_coef, dtype=float), (len(centers),))[ok]
     wrenches, slips, inside = grasp_wrenches(
-        contacts.p1[ok], contacts.n1[ok], contacts.p2[ok], contacts.n2[ok], np.asarray(axes, dtype=float)[ok],
-        np.asarray(mesh.center_mass), mu, quality.torque_scaling, gripper.finger_radius, quality.cone_faces, x_axis,
+        contacts.p1[ok],
+        contacts.n1[ok],
+        contacts.p2[ok],
+        contacts.n2[ok],
+        np.asarray(axes, dtype=float)[ok],
+        np.asarray(mesh.center_mass),
+        mu,
+        quality.torque_scaling,
+        gripper.finger_radius,
+        quality.cone_faces,
+        x_axis,
     )
     eps = np.zeros(len(wrenches))
     eps[~slips] = epsilon(wrenches[~slips], inside[~slips])
@@ -50,7 +58,9 @@ def grasp_epsilon(
     return out
 
 
-def perturbed_grasps(centers: np.ndarray, axes: np.ndarray, friction_coef: float, noise: Perturbations, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def perturbed_grasps(
+    centers: np.ndarray, axes: np.ndarray, friction_coef: float, noise: Perturbations, rng: np.random.Generator
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``n_samples`` perturbed copies of each grasp, expressed in the object's frame.
 
     Returns centers (N, S, 3), unit axes (N, S, 3) and friction coefficients (N, S). The grasp
@@ -88,7 +98,9 @@ def robust_ferrari_canny(
     grasp (``centers``, ``axes`` (N, 3)); ``epsilon`` computes ε of wrench sets."""
     if len(centers) == 0:
         return np.zeros(0), np.zeros(0)
-    center, axis, mu = perturbed_grasps(np.asarray(centers, float), np.asarray(axes, float), quality.friction_coef, noise, rng)
+    center, axis, mu = perturbed_grasps(
+        np.asarray(centers, float), np.asarray(axes, float), quality.friction_coef, noise, rng
+    )
     eps = grasp_epsilon(mesh, center.reshape(-1, 3), axis.reshape(-1, 3), mu.reshape(-1), gripper, quality, epsilon)
     eps = eps.reshape(len(centers), noise.n_samples)
     return eps.mean(axis=1), eps.std(axis=1)

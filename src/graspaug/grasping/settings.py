@@ -1,4 +1,5 @@
 """Settings of the grasping library: antipodal sampling, the wrench model, the robust metric's perturbations."""
+
 from __future__ import annotations
 
 from graspaug.settings import Field, settings
@@ -9,22 +10,46 @@ class AntipodalSettings:
     """How grasps are sampled; see the module docstring."""
 
     n_grasps: int = Field(100, ge=1, description="Grasps sampled per shape (Dex-Net 2.0: up to 100; EGAD: 100).")
-    friction_coef: float = Field(0.5, gt=0, le=1, description="Friction coefficient of the antipodality test (Dex-Net: 0.5).")
+    friction_coef: float = Field(
+        0.5, gt=0, le=1, description="Friction coefficient of the antipodality test (Dex-Net: 0.5)."
+    )
     tries_per_point: int = Field(2, ge=1, description="Grasp axes drawn per sampled surface point (Dex-Net: 2).")
-    oversample: int = Field(5, ge=1, description="Candidates per missing grasp in the first round; doubles each round (Dex-Net: 5).")
+    oversample: int = Field(
+        5, ge=1, description="Candidates per missing grasp in the first round; doubles each round (Dex-Net: 5)."
+    )
     max_rounds: int = Field(5, ge=1, le=10, description="Sampling rounds before giving up on a shape (Dex-Net: 5-10).")
     max_surface_points: int = Field(100, ge=1, description="Surface points sampled per round at most (Dex-Net: 100).")
-    min_contact_dist: float = Field(0.0025, ge=0, description="Contacts closer than this (m) are rejected (Dex-Net: 2.5 mm).")
-    coverage_dist: float = Field(0.0025, ge=0, description="Grasp centers closer than this (m) to a kept one are dropped (EGAD: 2.5 mm; 0 disables).")
+    min_contact_dist: float = Field(
+        0.0025, ge=0, description="Contacts closer than this (m) are rejected (Dex-Net: 2.5 mm)."
+    )
+    coverage_dist: float = Field(
+        0.0025,
+        ge=0,
+        description="Grasp centers closer than this (m) to a kept one are dropped (EGAD: 2.5 mm; 0 disables).",
+    )
 
 
 @settings
 class QualitySettings:
     """The wrench-space model: friction coefficient μ, cone faces, torque scaling s (1/m)."""
 
-    friction_coef: float = Field(0.5, gt=0, le=1, description="Friction coefficient μ of the grasp wrench model (Dex-Net: 0.5); also the mean of the perturbed μ.")
+    friction_coef: float = Field(
+        0.5,
+        gt=0,
+        le=1,
+        description=(
+            "Friction coefficient μ of the grasp wrench model (Dex-Net: 0.5); also the mean of the perturbed μ."
+        ),
+    )
     cone_faces: int = Field(8, ge=3, le=32, description="Faces of the polyhedral friction cone (Dex-Net: 8).")
-    torque_scaling: float = Field(1000.0, gt=0, description="s in the wrench [f; s·τ] (1/m). With s = 1000, soft fingers bound ε by π r² μ s = 0.039 and 0.002 splits grasps as in Dex-Net 2.0.")
+    torque_scaling: float = Field(
+        1000.0,
+        gt=0,
+        description=(
+            "s in the wrench [f; s·τ] (1/m). With s = 1000, soft fingers bound ε by π r² μ s = 0.039 and 0.002 splits "
+            "grasps as in Dex-Net 2.0."
+        ),
+    )
 
 
 @settings
@@ -38,4 +63,6 @@ class Perturbations:
     axis_sigma: float = Field(0.001, ge=0, description="Std of the grasp axis rotation in rad.")
     object_translation_sigma: float = Field(0.01, ge=0, description="Std of the object translation in m.")
     object_rotation_sigma: float = Field(0.01, ge=0, description="Std of the object rotation in rad.")
-    friction_sigma: float = Field(0.1, ge=0, description="Std of the perturbed friction coefficient (truncated to [0, 1]).")
+    friction_sigma: float = Field(
+        0.1, ge=0, description="Std of the perturbed friction coefficient (truncated to [0, 1])."
+    )

@@ -1,4 +1,5 @@
 """Atomic writes: a file or folder appears under its final name complete, or not at all."""
+
 from __future__ import annotations
 
 import contextlib

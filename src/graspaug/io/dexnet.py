@@ -4,6 +4,7 @@
 one shorter) for every field, plus ``<dir>/config.json`` in autolab_core's TensorDataset form
 (``datapoints_per_file`` and per field ``dtype`` / ``height`` / ``width`` / ``channels``).
 """
+
 from __future__ import annotations
 
 import json
@@ -13,7 +14,9 @@ from pathlib import Path
 import numpy as np
 
 
-def write_tensor_dataset(folder: str | os.PathLike, fields: dict[str, np.ndarray], rows_per_file: int = 1000, extra: dict | None = None) -> int:
+def write_tensor_dataset(
+    folder: str | os.PathLike, fields: dict[str, np.ndarray], rows_per_file: int = 1000, extra: dict | None = None
+) -> int:
     """Write ``fields`` (name → array with N rows each) as a TensorDataset into ``folder`` (made
     if missing); returns the number of files per field. ``extra`` goes into config.json too."""
     sizes = {name: len(values) for name, values in fields.items()}
@@ -56,7 +59,9 @@ def export_dexnet(source: str | os.PathLike, out: str | os.PathLike, rows_per_fi
 
     source = Path(source)
     if not (source / "index.parquet").exists():
-        raise FileNotFoundError(f"{source}: no rendered dataset (run `dvc repro` or `graspaug render --corpus {source.name}` first)")
+        raise FileNotFoundError(
+            f"{source}: no rendered dataset (run `dvc repro` or `graspaug render --corpus {source.name}` first)"
+        )
     out = Path(out)
     if out.exists() and any(out.iterdir()):
         raise FileExistsError(f"{out} exists and is not empty; choose a new folder")
@@ -68,7 +73,18 @@ def export_dexnet(source: str | os.PathLike, out: str | os.PathLike, rows_per_fi
     pose_ids, pose_labels = np.unique(pose_keys.to_numpy(), return_inverse=True)
     _, image_labels = np.unique((pose_keys + ":" + index.image_id.astype(str)).to_numpy(), return_inverse=True)
     cx, cy = info["intrinsics"]["cx"], info["intrinsics"]["cy"]
-    hand_poses = np.stack([index.center_v, index.center_u, index.z, index.angle, index.center_v - cy, index.center_u - cx, index.width_px], axis=1)
+    hand_poses = np.stack(
+        [
+            index.center_v,
+            index.center_u,
+            index.z,
+            index.angle,
+            index.center_v - cy,
+            index.center_u - cx,
+            index.width_px,
+        ],
+        axis=1,
+    )
     fields = {
         "depth_ims_tf_table": data.images()[..., None],
         "hand_poses": hand_poses.astype(np.float32),
@@ -80,10 +96,23 @@ def export_dexnet(source: str | os.PathLike, out: str | os.PathLike, rows_per_fi
         "pose_labels": pose_labels.astype(np.uint32),
         "image_labels": image_labels.astype(np.uint32),
     }
-    extra = {"source": f"graspaug render ({source.name})", "dataset": info, "obj_ids": obj_ids.tolist(), "pose_ids": pose_ids.tolist(),
-             "hand_poses_columns": ["center_row", "center_col", "depth", "angle", "center_row_minus_cy", "center_col_minus_cx", "width_px"],
-             "label_rule": f"robust_ferrari_canny > {info['grasps_threshold']} (robust_ferrari_canny is 0 for colliding grasps, as in Dex-Net; "
-                           "robust_ferrari_canny_raw keeps the robust epsilon before that)"}
+    extra = {
+        "source": f"graspaug render ({source.name})",
+        "dataset": info,
+        "obj_ids": obj_ids.tolist(),
+        "pose_ids": pose_ids.tolist(),
+        "hand_poses_columns": [
+            "center_row",
+            "center_col",
+            "depth",
+            "angle",
+            "center_row_minus_cy",
+            "center_col_minus_cx",
+            "width_px",
+        ],
+        "label_rule": f"robust_ferrari_canny > {info['grasps_threshold']} (robust_ferrari_canny is 0 for colliding grasps, as in Dex-Net; "
+        "robust_ferrari_canny_raw keeps the robust epsilon before that)",
+    }
     with atomic_path(out, directory=True) as folder:
         write_tensor_dataset(folder, fields, rows_per_file, extra)
     return len(index)

@@ -11,6 +11,7 @@ Layout of ``data/gqcnn/<corpus>/``:
 
 Shards open memory-mapped (:meth:`GraspImages.images`), so a trainer reads only what it uses.
 """
+
 from __future__ import annotations
 
 import os
@@ -37,10 +38,18 @@ def write_grasp_images(folder: str | os.PathLike, images: np.ndarray, index: pd.
     position = np.arange(len(index))
     index.insert(0, "row", position % shard_rows)
     index.insert(0, "shard", position // shard_rows)
-    columns = {"images": images, "z": index["z"].to_numpy(), "labels": index["label"].to_numpy(), "eps": index["eps"].to_numpy()}
+    columns = {
+        "images": images,
+        "z": index["z"].to_numpy(),
+        "labels": index["label"].to_numpy(),
+        "eps": index["eps"].to_numpy(),
+    }
     for shard, start in enumerate(range(0, len(index), shard_rows)):
         for field, dtype in ARRAYS.items():
-            np.save(folder / shard_name(field, shard), np.ascontiguousarray(columns[field][start : start + shard_rows], dtype=dtype))
+            np.save(
+                folder / shard_name(field, shard),
+                np.ascontiguousarray(columns[field][start : start + shard_rows], dtype=dtype),
+            )
     index.to_parquet(folder / "index.parquet", index=False)
 
 

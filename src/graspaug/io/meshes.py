@@ -1,5 +1,6 @@
 """Meshes on disk, one file per shape, openable in MeshLab, Blender, trimesh: binary PLY for
 ingested shapes, Wavefront OBJ for generated ones."""
+
 from __future__ import annotations
 
 import os
@@ -22,7 +23,11 @@ def write_mesh(mesh: trimesh.Trimesh, path: str | os.PathLike) -> None:
 
 def write_obj(mesh: trimesh.Trimesh, path: str | os.PathLike) -> None:
     """Write ``mesh`` as a Wavefront OBJ with vertices and faces only (caller makes the folder write atomic)."""
-    Path(path).write_text(trimesh.exchange.obj.export_obj(mesh, include_normals=False, include_color=False, include_texture=False, digits=10, header=None))
+    Path(path).write_text(
+        trimesh.exchange.obj.export_obj(
+            mesh, include_normals=False, include_color=False, include_texture=False, digits=10, header=None
+        )
+    )
 
 
 def read_mesh(path: str | os.PathLike) -> trimesh.Trimesh:

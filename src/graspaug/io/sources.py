@@ -4,6 +4,7 @@ A source is named portably: ``pybullet_data:random_urdfs/000/000.obj`` for files
 that ship in pybullet's data package, ``folder:<path relative to the folder>``
 for a user's mesh folder, so tables do not depend on where a venv lives.
 """
+
 from __future__ import annotations
 
 import os
@@ -77,8 +78,12 @@ def folder_sources(folder: str | Path, unit_scale: float = 1.0, limit: int | Non
         raise FileNotFoundError(f"mesh folder not found: {folder}")
     # every entry with a mesh suffix, links and special files too (ingest reads or rejects each
     # with a reason); linked folders are not entered
-    files = sorted(Path(root, name) for root, dirs, names in os.walk(folder) for name in [*names, *dirs]
-                   if Path(name).suffix.lower() in MESH_SUFFIXES and (name in names or os.path.islink(os.path.join(root, name))))
+    files = sorted(
+        Path(root, name)
+        for root, dirs, names in os.walk(folder)
+        for name in [*names, *dirs]
+        if Path(name).suffix.lower() in MESH_SUFFIXES and (name in names or os.path.islink(os.path.join(root, name)))
+    )
     out, seen = [], set()
     for path in files:
         rel = path.relative_to(folder).as_posix()

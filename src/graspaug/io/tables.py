@@ -1,4 +1,5 @@
 """Parquet tables (pandas + pyarrow), written atomically."""
+
 from __future__ import annotations
 
 import os

@@ -9,6 +9,7 @@ pitch : (N,) float — voxel edge, meters
 origin : (N, 3) float — grid corner in the shape's normalized frame, meters;
     voxel (i, j, k) has its center at ``origin + pitch * (ijk + 0.5)``
 """
+
 from __future__ import annotations
 
 import os
@@ -71,4 +72,6 @@ def read_voxels(path: str | os.PathLike) -> VoxelSet:
     """Read a file written by :func:`write_voxels`."""
     with np.load(path, allow_pickle=False) as z:
         r = int(z["resolution"])
-        return VoxelSet(shape_id=z["shape_id"], occupancy=unpack_bits(z["occupancy"], r), pitch=z["pitch"], origin=z["origin"])
+        return VoxelSet(
+            shape_id=z["shape_id"], occupancy=unpack_bits(z["occupancy"], r), pitch=z["pitch"], origin=z["origin"]
+        )

@@ -18,25 +18,34 @@ Widths: layer i of the down path has ``min(base_width * 2**i, top_width)``
 channels and the stride-1 layer ``top_width``. Paper profile (R = 64): base 64 →
 64, 128, 256, 512, then 512. The CPU default (R = 32) is narrower.
 """
-from __future__ import annotations
 
+from __future__ import annotations
 
 import torch
 import torch.nn.functional as F
 from torch import nn
+
 from graspaug.nets.settings import AEConfig
 
 
 def _down(c_in: int, c_out: int, normalize: bool = True) -> list[nn.Module]:
     if not normalize:
         return [nn.Conv3d(c_in, c_out, kernel_size=4, stride=2, padding=1), nn.LeakyReLU(0.2, inplace=True)]
-    return [nn.Conv3d(c_in, c_out, kernel_size=4, stride=2, padding=1, bias=False), nn.BatchNorm3d(c_out), nn.ReLU(inplace=True)]
+    return [
+        nn.Conv3d(c_in, c_out, kernel_size=4, stride=2, padding=1, bias=False),
+        nn.BatchNorm3d(c_out),
+        nn.ReLU(inplace=True),
+    ]
 
 
 def _same(c_in: int, c_out: int, normalize: bool = True) -> list[nn.Module]:
     if not normalize:
         return [nn.Conv3d(c_in, c_out, kernel_size=4, stride=1, padding="same"), nn.LeakyReLU(0.2, inplace=True)]
-    return [nn.Conv3d(c_in, c_out, kernel_size=4, stride=1, padding="same", bias=False), nn.BatchNorm3d(c_out), nn.ReLU(inplace=True)]
+    return [
+        nn.Conv3d(c_in, c_out, kernel_size=4, stride=1, padding="same", bias=False),
+        nn.BatchNorm3d(c_out),
+        nn.ReLU(inplace=True),
+    ]
 
 
 class Encoder(nn.Module):
@@ -144,7 +153,9 @@ def folded_alpha(batch_size: int, gen: torch.Generator) -> torch.Tensor:
     return 0.5 - (u - 0.5).abs()
 
 
-def critic_loss(critic: Critic, x: torch.Tensor, x_hat: torch.Tensor, x_alpha: torch.Tensor, alpha: torch.Tensor, gamma: float) -> torch.Tensor:
+def critic_loss(
+    critic: Critic, x: torch.Tensor, x_hat: torch.Tensor, x_alpha: torch.Tensor, alpha: torch.Tensor, gamma: float
+) -> torch.Tensor:
     """Eq. (1): ‖C(x̂_α) − α‖² + ‖C(γx + (1 − γ)x̂)‖², batch means.
 
     x : (B, 1, R, R, R) real grids; x_hat : their reconstructions (probabilities);
@@ -157,7 +168,9 @@ def critic_loss(critic: Critic, x: torch.Tensor, x_hat: torch.Tensor, x_alpha: t
     return (c_interp - alpha).pow(2).mean() + c_real.pow(2).mean()  # eq. (1)
 
 
-def autoencoder_loss(recon_logits: torch.Tensor, x: torch.Tensor, critic_on_interp: torch.Tensor | None, lam: float) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+def autoencoder_loss(
+    recon_logits: torch.Tensor, x: torch.Tensor, critic_on_interp: torch.Tensor | None, lam: float
+) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
     """Eq. (2): L_B(x̂, x) + λ‖C(x̂_α)‖². Returns (total, reconstruction BCE, regularizer).
 
     With λ = 0 (or no critic output) the total is the BCE alone: the critic term sends no

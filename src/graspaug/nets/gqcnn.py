@@ -13,6 +13,7 @@ GQ-CNNs of one config (``gqcnn.members``). Inputs are normalized by the training
 the model (``image_mean``, ``image_std``, ``z_mean``, ``z_std``) so a saved model takes raw
 depths in meters.
 """
+
 from __future__ import annotations
 
 from dataclasses import asdict
@@ -20,6 +21,7 @@ from dataclasses import asdict
 import torch
 import torch.nn.functional as F
 from torch import nn
+
 from graspaug.nets.settings import GQCNNConfig
 
 
@@ -127,4 +129,8 @@ class GQCNNEnsemble(nn.Module):
         return torch.stack([torch.log1p(-p), torch.log(p)], dim=1)
 
     def describe(self) -> dict:
-        return {**asdict(self.config), "members": len(self.members), "parameters": sum(p.numel() for p in self.parameters())}
+        return {
+            **asdict(self.config),
+            "members": len(self.members),
+            "parameters": sum(p.numel() for p in self.parameters()),
+        }

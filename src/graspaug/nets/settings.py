@@ -1,4 +1,5 @@
 """Layer sizes of the two networks (the nets themselves: ``ae_critic.py``, ``gqcnn.py``)."""
+
 from __future__ import annotations
 
 import math
@@ -13,7 +14,13 @@ class AEConfig:
 
     resolution: int = Field(32, description="R: voxels per side, a power of two >= 8; must equal voxelize.resolution.")
     z_dim: int = Field(128, ge=2, description="Latent size (paper: 128).")
-    base_width: int = Field(16, ge=1, description="Channels of the first conv layer; doubles per down-sampling layer up to top_width (paper profile: 64).")
+    base_width: int = Field(
+        16,
+        ge=1,
+        description=(
+            "Channels of the first conv layer; doubles per down-sampling layer up to top_width (paper profile: 64)."
+        ),
+    )
     top_width: int = Field(128, ge=1, description="Channels of the 4×4×4 map before the FC layer (paper: 512).")
 
     @property
@@ -38,11 +45,19 @@ class GQCNNConfig:
     """Layer sizes (params section ``gqcnn.net``)."""
 
     image_size: int = Field(32, ge=4, description="Crop side the network takes (px); must equal render.crop.out_size.")
-    filters: int = Field(8, ge=1, description="Channels of each conv layer (Dex-Net 2.0 / paper profile: 64; 8 fits the CPU budget).")
+    filters: int = Field(
+        8, ge=1, description="Channels of each conv layer (Dex-Net 2.0 / paper profile: 64; 8 fits the CPU budget)."
+    )
     fc: int = Field(64, ge=1, description="Width of fc3 and fc4 (Dex-Net: 1024).")
     pose_fc: int = Field(16, ge=1, description="Width of the gripper-depth layer pc1 (Dex-Net: 16).")
     pool_after_conv2: bool = Field(True, description="Max pool after conv2_2 (Dex-Net's 2018 config; 2017: none).")
-    image_input: Literal["depth", "depth_minus_gripper"] = Field("depth_minus_gripper", description="What the conv layers see: the crop minus the gripper depth (gqcnn's `im_depth_sub`: each pixel's height relative to the fingertips; the default, 0.52 vs 0.39 validation AP at B = 200 in studies/gqcnn_options.py), or the depth crop itself (Dex-Net 2.0).")
+    image_input: Literal["depth", "depth_minus_gripper"] = Field(
+        "depth_minus_gripper",
+        description=(
+            "What the conv layers see: the crop minus the gripper depth (gqcnn's `im_depth_sub`: each pixel's height "
+            "relative to the fingertips; the default), or the depth crop itself (Dex-Net 2.0)."
+        ),
+    )
 
     def __post_init__(self) -> None:
         if self.image_size % (4 if self.pool_after_conv2 else 2):

@@ -6,6 +6,7 @@ z: approach direction, y = z × x, origin at the grasp center). A straight appro
 length, so the approach is collision free when none of the three stretched boxes overlaps the
 object (FCL, exact box-against-triangle-mesh tests) or reaches below the table plane z = 0.
 """
+
 from __future__ import annotations
 
 import fcl
@@ -52,7 +53,9 @@ class CollisionChecker:
         self.box_centers, self.box_extents = swept_gripper_boxes(gripper, approach_distance)
         self.boxes = [fcl.Box(*extents) for extents in self.box_extents]
 
-    def collision_free(self, centers: np.ndarray, axes: np.ndarray, approaches: np.ndarray, pose: np.ndarray | None = None) -> np.ndarray:
+    def collision_free(
+        self, centers: np.ndarray, axes: np.ndarray, approaches: np.ndarray, pose: np.ndarray | None = None
+    ) -> np.ndarray:
         """(G,) bool: True where the gripper reaches the grasp (centers (G, 3), unit axes and
         approach directions (G, 3), table frame) without touching object or table, for the
         object placed in the table frame by ``pose`` (4, 4; default identity)."""
@@ -70,7 +73,12 @@ class CollisionChecker:
                 continue
             box_rotation = to_object @ rotation
             for box, box_center in zip(self.boxes, (box_centers - shift) @ to_object.T):
-                if fcl.collide(fcl.CollisionObject(box, fcl.Transform(box_rotation, box_center)), self.object, request, fcl.CollisionResult()):
+                if fcl.collide(
+                    fcl.CollisionObject(box, fcl.Transform(box_rotation, box_center)),
+                    self.object,
+                    request,
+                    fcl.CollisionResult(),
+                ):
                     free[g] = False
                     break
         return free

@@ -15,20 +15,22 @@ reference, and what a robot's camera gives), and :func:`crops_by_ray_casting`, w
 only for the image pixels the crops read and only where the object can be (the table is
 analytic), then runs the same bilinear + block-average sampling in compiled code.
 """
-from __future__ import annotations
 
+from __future__ import annotations
 
 import numba
 import numpy as np
 import trimesh
 from scipy import ndimage
 
-from graspaug.render.camera import CameraPose, Intrinsics
+from graspaug.render.camera import CameraPose
 from graspaug.render.depth import object_depth, table_depth
-from graspaug.render.settings import CropGeometry
+from graspaug.render.settings import CropGeometry, Intrinsics
 
 
-def crop_sample_points(centers: np.ndarray, angles: np.ndarray, geometry: CropGeometry) -> tuple[np.ndarray, np.ndarray]:
+def crop_sample_points(
+    centers: np.ndarray, angles: np.ndarray, geometry: CropGeometry
+) -> tuple[np.ndarray, np.ndarray]:
     """Image coordinates u, v (G, S, S) read by the crops of grasps at ``centers`` (G, 2) as
     (u, v) with jaw directions ``angles`` (G,) (radians)."""
     offsets = np.arange(geometry.crop_size) - (geometry.crop_size - 1) / 2
@@ -45,7 +47,9 @@ def block_mean(crops: np.ndarray, geometry: CropGeometry) -> np.ndarray:
     return crops.reshape(g, n, f, n, f).mean(axis=(2, 4))
 
 
-def crops_from_depth_image(image: np.ndarray, centers: np.ndarray, angles: np.ndarray, geometry: CropGeometry = CropGeometry()) -> np.ndarray:
+def crops_from_depth_image(
+    image: np.ndarray, centers: np.ndarray, angles: np.ndarray, geometry: CropGeometry = CropGeometry()
+) -> np.ndarray:
     """Crops (G, out, out) float32 of a depth image (H, W) (m) for grasps at ``centers`` (G, 2)
     as (u, v) pixels with jaw directions ``angles`` (G,) (radians). Pixels outside the image
     repeat its border."""
@@ -72,8 +76,16 @@ def _sample_crops(patch, u0, v0, table, centers, angles, crop_size, out_size, ou
         for i in range(out_size):
             for j in range(out_size):
                 # block center; its samples and their bilinear taps lie within `margin` pixels
-                bu = centers[g, 0] + cos * (j * factor + (factor - 1) / 2.0 - half) - sin * (i * factor + (factor - 1) / 2.0 - half)
-                bv = centers[g, 1] + sin * (j * factor + (factor - 1) / 2.0 - half) + cos * (i * factor + (factor - 1) / 2.0 - half)
+                bu = (
+                    centers[g, 0]
+                    + cos * (j * factor + (factor - 1) / 2.0 - half)
+                    - sin * (i * factor + (factor - 1) / 2.0 - half)
+                )
+                bv = (
+                    centers[g, 1]
+                    + sin * (j * factor + (factor - 1) / 2.0 - half)
+                    + cos * (i * factor + (factor - 1) / 2.0 - half)
+                )
                 if bv + margin < v0 or bv - margin > v0 + rows - 1 or bu + margin < u0 or bu - margin > u0 + cols - 1:
                     # only table under the block: the mean of the smooth table depth over the
                     # block equals its value at the block center to < 1e-8 m
@@ -109,8 +121,15 @@ def _sample_crops(patch, u0, v0, table, centers, angles, crop_size, out_size, ou
                 out[g, i, j] = total * scale
 
 
-def crops_by_ray_casting(mesh: trimesh.Trimesh, camera: CameraPose, intrinsics: Intrinsics, centers: np.ndarray, angles: np.ndarray,
-                         geometry: CropGeometry = CropGeometry(), pose: np.ndarray | None = None) -> tuple[np.ndarray, int]:
+def crops_by_ray_casting(
+    mesh: trimesh.Trimesh,
+    camera: CameraPose,
+    intrinsics: Intrinsics,
+    centers: np.ndarray,
+    angles: np.ndarray,
+    geometry: CropGeometry = CropGeometry(),
+    pose: np.ndarray | None = None,
+) -> tuple[np.ndarray, int]:
     """The crops (G, out, out) float32 that :func:`crops_from_depth_image` would cut from the
     full ray-cast depth image of ``mesh`` (m) on the table, and the number of rays cast.
 
@@ -125,7 +144,9 @@ def crops_by_ray_casting(mesh: trimesh.Trimesh, camera: CameraPose, intrinsics: 
         return out.astype(np.float32), 0
     if camera.position[2] <= 0:
         raise ValueError(f"the camera must be above the table, got height {camera.position[2]}")
-    reach = (geometry.crop_size - 1) / 2 * (np.abs(np.cos(angles)) + np.abs(np.sin(angles)))  # half-size of each crop's bounding box
+    reach = (
+        (geometry.crop_size - 1) / 2 * (np.abs(np.cos(angles)) + np.abs(np.sin(angles)))
+    )  # half-size of each crop's bounding box
     u0, v0 = np.floor(np.min(centers - reach[:, None], axis=0)).astype(int)
     u1, v1 = np.floor(np.max(centers + reach[:, None], axis=0)).astype(int) + 1
     object_camera = camera if pose is None else camera.in_frame(pose)
@@ -134,8 +155,10 @@ def crops_by_ray_casting(mesh: trimesh.Trimesh, camera: CameraPose, intrinsics: 
     fu1, fv1 = np.minimum(np.ceil(footprint.max(axis=0)).astype(int), (u1, v1))
     if fu0 <= fu1 and fv0 <= fv1:
         vv, uu = np.mgrid[fv0 : fv1 + 1, fu0 : fu1 + 1]
-        patch = np.minimum(object_depth(mesh, object_camera, intrinsics, uu.ravel(), vv.ravel()),
-                           table_depth(camera, intrinsics, uu.ravel(), vv.ravel())).reshape(uu.shape)
+        patch = np.minimum(
+            object_depth(mesh, object_camera, intrinsics, uu.ravel(), vv.ravel()),
+            table_depth(camera, intrinsics, uu.ravel(), vv.ravel()),
+        ).reshape(uu.shape)
     else:
         fu0, fv0, patch = 0, 0, np.full((0, 0), np.inf)
     # table depth at pixel (u, v) = -height / (ray_z(u, v)), ray_z linear in u and v

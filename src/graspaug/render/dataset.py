@@ -1,4 +1,5 @@
 """One shape's Dex-Net 2.0 datapoints: stable poses × camera views × table-parallel grasps."""
+
 from __future__ import annotations
 
 import logging
@@ -11,17 +12,29 @@ import trimesh
 
 from graspaug.grasping.gripper import ParallelJawGripper
 from graspaug.io.meshes import read_mesh
-from graspaug.render.camera import CameraPose, Intrinsics, sample_viewpoint
+from graspaug.render.camera import CameraPose, sample_viewpoint
 from graspaug.render.collision import CollisionChecker, approach_directions
 from graspaug.render.crops import CropGeometry, crops_by_ray_casting
+from graspaug.render.settings import Intrinsics, RenderSettings
 from graspaug.render.stable_poses import stable_poses
 from graspaug.rng import shape_rng
-from graspaug.render.settings import RenderSettings
 
 log = logging.getLogger(__name__)
 
-COLUMNS = ("grasp_index", "pose_id", "pose_probability", "image_id", "camera_height", "camera_tilt", "center_u", "center_v", "angle", "z",
-           "width_px", "collision_free")
+COLUMNS = (
+    "grasp_index",
+    "pose_id",
+    "pose_probability",
+    "image_id",
+    "camera_height",
+    "camera_tilt",
+    "center_u",
+    "center_v",
+    "angle",
+    "z",
+    "width_px",
+    "collision_free",
+)
 
 
 @dataclass(frozen=True)
@@ -40,15 +53,22 @@ class ShapeDatapoints:
         return len(self.images)
 
 
-def grasp_image_geometry(camera: CameraPose, intrinsics: Intrinsics, centers: np.ndarray, axes: np.ndarray, opening: float) -> dict[str, np.ndarray]:
+def grasp_image_geometry(
+    camera: CameraPose, intrinsics: Intrinsics, centers: np.ndarray, axes: np.ndarray, opening: float
+) -> dict[str, np.ndarray]:
     """Image center (u, v), jaw direction angle (rad), depth z (m) and jaw opening in pixels of
     grasps with table-frame ``centers`` and unit ``axes`` (G, 3)."""
     center_cam = camera.to_camera(centers)
     uv = intrinsics.project(center_cam)
     ends = [intrinsics.project(camera.to_camera(centers + sign * axes * opening / 2)) for sign in (-1.0, 1.0)]
     jaw = ends[1] - ends[0]
-    return {"center_u": uv[:, 0], "center_v": uv[:, 1], "angle": np.arctan2(jaw[:, 1], jaw[:, 0]), "z": center_cam[:, 2],
-            "width_px": np.linalg.norm(jaw, axis=1)}
+    return {
+        "center_u": uv[:, 0],
+        "center_v": uv[:, 1],
+        "angle": np.arctan2(jaw[:, 1], jaw[:, 0]),
+        "z": center_cam[:, 2],
+        "width_px": np.linalg.norm(jaw, axis=1),
+    }
 
 
 @dataclass(frozen=True)
@@ -70,15 +90,25 @@ class Scene:
     image: dict[str, np.ndarray]
 
 
-def crop_inside_image(u: np.ndarray, v: np.ndarray, angle: np.ndarray, crop: CropGeometry, intrinsics: Intrinsics) -> np.ndarray:
+def crop_inside_image(
+    u: np.ndarray, v: np.ndarray, angle: np.ndarray, crop: CropGeometry, intrinsics: Intrinsics
+) -> np.ndarray:
     """(G,) bool: the crop around each grasp center (u, v) turned by ``angle`` reads only pixels
     of the image (so it is the crop a real camera image gives, without border padding)."""
     reach = (crop.crop_size - 1) / 2 * (np.abs(np.cos(angle)) + np.abs(np.sin(angle))) + 1
-    return (u - reach >= 0) & (u + reach <= intrinsics.width - 1) & (v - reach >= 0) & (v + reach <= intrinsics.height - 1)
+    return (
+        (u - reach >= 0) & (u + reach <= intrinsics.width - 1) & (v - reach >= 0) & (v + reach <= intrinsics.height - 1)
+    )
 
 
-def plan_scenes(mesh: trimesh.Trimesh, centers: np.ndarray, axes: np.ndarray, opening: float, settings: RenderSettings,
-                rng: np.random.Generator) -> tuple[list[Scene], int]:
+def plan_scenes(
+    mesh: trimesh.Trimesh,
+    centers: np.ndarray,
+    axes: np.ndarray,
+    opening: float,
+    settings: RenderSettings,
+    rng: np.random.Generator,
+) -> tuple[list[Scene], int]:
     """The scenes of one object (``mesh`` in meters, its own frame) for grasps with ``centers``
     and unit jaw ``axes`` (N, 3) in that frame, and the number of stable poses used. A grasp
     appears in a pose's views if its jaw axis is within the tolerance of parallel to the table
@@ -102,19 +132,37 @@ def plan_scenes(mesh: trimesh.Trimesh, centers: np.ndarray, axes: np.ndarray, op
         for image_id in range(settings.images_per_pose):
             camera = sample_viewpoint(settings.viewpoints, rng)
             image = grasp_image_geometry(camera, intrinsics, pose_centers, pose_axes, opening)
-            chosen = np.flatnonzero(crop_inside_image(image["center_u"], image["center_v"], image["angle"], settings.crop, intrinsics))
+            chosen = np.flatnonzero(
+                crop_inside_image(image["center_u"], image["center_v"], image["angle"], settings.crop, intrinsics)
+            )
             if 0 < settings.max_grasps_per_image < len(chosen):
                 chosen = np.sort(rng.choice(chosen, settings.max_grasps_per_image, replace=False))
             if len(chosen) == 0:
                 continue
-            scenes.append(Scene(pose_id=int(pose_id), pose=pose, probability=float(poses.probabilities[pose_id]),
-                                image_id=int(pose_id) * settings.images_per_pose + image_id, camera=camera, grasp_index=aligned[chosen],
-                                centers=pose_centers[chosen], axes=pose_axes[chosen], image={k: v[chosen] for k, v in image.items()}))
+            scenes.append(
+                Scene(
+                    pose_id=int(pose_id),
+                    pose=pose,
+                    probability=float(poses.probabilities[pose_id]),
+                    image_id=int(pose_id) * settings.images_per_pose + image_id,
+                    camera=camera,
+                    grasp_index=aligned[chosen],
+                    centers=pose_centers[chosen],
+                    axes=pose_axes[chosen],
+                    image={k: v[chosen] for k, v in image.items()},
+                )
+            )
     return scenes, len(keep)
 
 
-def render_shape(mesh: trimesh.Trimesh, centers: np.ndarray, axes: np.ndarray, gripper: ParallelJawGripper, settings: RenderSettings,
-                 rng: np.random.Generator) -> ShapeDatapoints:
+def render_shape(
+    mesh: trimesh.Trimesh,
+    centers: np.ndarray,
+    axes: np.ndarray,
+    gripper: ParallelJawGripper,
+    settings: RenderSettings,
+    rng: np.random.Generator,
+) -> ShapeDatapoints:
     """Datapoints of one object (``mesh`` in meters, its own frame) for grasps with ``centers``
     and unit jaw ``axes`` (N, 3) in that frame: a crop, image geometry and approach collision
     check for every grasp of every scene of :func:`plan_scenes`."""
@@ -122,8 +170,15 @@ def render_shape(mesh: trimesh.Trimesh, centers: np.ndarray, axes: np.ndarray, g
     checker = CollisionChecker(mesh, gripper, settings.approach_distance) if scenes else None
     images, rows, n_rays = [], {name: [] for name in COLUMNS}, 0
     for scene in scenes:
-        crops, rays = crops_by_ray_casting(mesh, scene.camera, settings.intrinsics, np.stack([scene.image["center_u"], scene.image["center_v"]], axis=1),
-                                           scene.image["angle"], settings.crop, pose=scene.pose)
+        crops, rays = crops_by_ray_casting(
+            mesh,
+            scene.camera,
+            settings.intrinsics,
+            np.stack([scene.image["center_u"], scene.image["center_v"]], axis=1),
+            scene.image["angle"],
+            settings.crop,
+            pose=scene.pose,
+        )
         n_rays += rays
         images.append(crops)
         count = len(scene.grasp_index)
@@ -135,13 +190,26 @@ def render_shape(mesh: trimesh.Trimesh, centers: np.ndarray, axes: np.ndarray, g
         rows["camera_tilt"].append(np.full(count, np.degrees(scene.camera.tilt)))
         for name, values in scene.image.items():
             rows[name].append(values)
-        rows["collision_free"].append(checker.collision_free(scene.centers, scene.axes, approach_directions(scene.axes), pose=scene.pose))
+        rows["collision_free"].append(
+            checker.collision_free(scene.centers, scene.axes, approach_directions(scene.axes), pose=scene.pose)
+        )
     if not images:
         out = settings.crop.out_size
-        empty = {name: np.zeros(0, dtype=bool if name == "collision_free" else int if name in ("grasp_index", "pose_id", "image_id") else float)
-                 for name in COLUMNS}
+        empty = {
+            name: np.zeros(
+                0,
+                dtype=bool
+                if name == "collision_free"
+                else int
+                if name in ("grasp_index", "pose_id", "image_id")
+                else float,
+            )
+            for name in COLUMNS
+        }
         return ShapeDatapoints(np.zeros((0, out, out), np.float32), empty, n_poses, n_rays)
-    return ShapeDatapoints(np.concatenate(images), {name: np.concatenate(parts) for name, parts in rows.items()}, n_poses, n_rays)
+    return ShapeDatapoints(
+        np.concatenate(images), {name: np.concatenate(parts) for name, parts in rows.items()}, n_poses, n_rays
+    )
 
 
 SHAPE_COLUMNS = ("shape_id", "origin", "split", "base_size", "pool", "order")
@@ -174,7 +242,9 @@ def datapoints_index(shapes, by_shape: dict, results: list, threshold: float) ->
     return images, parts, skipped, n_rays, n_poses
 
 
-def render_file(path: Path, shape_id: str, centers: np.ndarray, axes: np.ndarray, settings: RenderSettings, hand, seed: int) -> tuple[ShapeDatapoints | None, str | None]:
+def render_file(
+    path: Path, shape_id: str, centers: np.ndarray, axes: np.ndarray, settings: RenderSettings, hand, seed: int
+) -> tuple[ShapeDatapoints | None, str | None]:
     """One shape's datapoints, or None and why there are none."""
     if len(centers) == 0:
         return None, "the shape has no grasps"
@@ -187,6 +257,8 @@ def render_file(path: Path, shape_id: str, centers: np.ndarray, axes: np.ndarray
     except Exception as exc:  # a degenerate mesh (no hull, no volume) is skipped with its reason
         return None, f"rendering failed: {type(exc).__name__}: {exc}"
     if len(data) == 0:
-        return None, (f"none of its {len(centers)} grasps has its jaw axis within {settings.axis_tolerance_deg} deg of the table "
-                      f"in its {data.n_poses} stable poses")
+        return None, (
+            f"none of its {len(centers)} grasps has its jaw axis within {settings.axis_tolerance_deg} deg of the table "
+            f"in its {data.n_poses} stable poses"
+        )
     return data, None

@@ -1,13 +1,17 @@
 """Depth by ray casting: an object mesh (embree through trimesh) above an analytic table plane."""
+
 from __future__ import annotations
 
 import numpy as np
 import trimesh
 
-from graspaug.render.camera import CameraPose, Intrinsics
+from graspaug.render.camera import CameraPose
+from graspaug.render.settings import Intrinsics
 
 
-def table_depth(camera: CameraPose, intrinsics: Intrinsics, u: np.ndarray, v: np.ndarray, table_height: float = 0.0) -> np.ndarray:
+def table_depth(
+    camera: CameraPose, intrinsics: Intrinsics, u: np.ndarray, v: np.ndarray, table_height: float = 0.0
+) -> np.ndarray:
     """Depth (N,) of the table plane z = ``table_height`` seen through pixels (u, v); inf where
     the ray does not go down to it."""
     directions = intrinsics.rays(u, v) @ camera.rotation.T  # table frame, unit camera-z
@@ -17,7 +21,9 @@ def table_depth(camera: CameraPose, intrinsics: Intrinsics, u: np.ndarray, v: np
     return np.where(down < 0, depth, np.inf)
 
 
-def object_depth(mesh: trimesh.Trimesh, camera: CameraPose, intrinsics: Intrinsics, u: np.ndarray, v: np.ndarray) -> np.ndarray:
+def object_depth(
+    mesh: trimesh.Trimesh, camera: CameraPose, intrinsics: Intrinsics, u: np.ndarray, v: np.ndarray
+) -> np.ndarray:
     """Depth (N,) of ``mesh`` (table frame, m) through pixels (u, v); inf where a ray misses.
 
     Embree finds the first triangle each ray hits (in float32); the depth is then recomputed in
@@ -32,11 +38,15 @@ def object_depth(mesh: trimesh.Trimesh, camera: CameraPose, intrinsics: Intrinsi
     faces = hit[rays]
     normals = mesh.face_normals[faces]
     corner = mesh.triangles[faces, 0]
-    depth[rays] = np.einsum("ij,ij->i", normals, corner - camera.position) / np.einsum("ij,ij->i", normals, directions[rays])
+    depth[rays] = np.einsum("ij,ij->i", normals, corner - camera.position) / np.einsum(
+        "ij,ij->i", normals, directions[rays]
+    )
     return depth
 
 
-def scene_depth(mesh: trimesh.Trimesh | None, camera: CameraPose, intrinsics: Intrinsics, u: np.ndarray, v: np.ndarray) -> np.ndarray:
+def scene_depth(
+    mesh: trimesh.Trimesh | None, camera: CameraPose, intrinsics: Intrinsics, u: np.ndarray, v: np.ndarray
+) -> np.ndarray:
     """Depth (N,) of the object on the table (the nearer of the two) through pixels (u, v)."""
     depth = table_depth(camera, intrinsics, u, v)
     if mesh is not None:

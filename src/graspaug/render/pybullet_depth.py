@@ -5,13 +5,15 @@ OpenGL view and projection matrices; the z-buffer is turned back into metric dep
 ``depth = far * near / (far - (far - near) * zbuffer)``. Used by the render benchmark and the
 tests as an independent check of the ray-cast crops, and by simulated robot trials.
 """
+
 from __future__ import annotations
 
 import numpy as np
 import pybullet
 import trimesh
 
-from graspaug.render.camera import CameraPose, Intrinsics
+from graspaug.render.camera import CameraPose
+from graspaug.render.settings import Intrinsics
 
 
 def view_matrix(camera: CameraPose) -> list[float]:
@@ -48,8 +50,14 @@ def render_depth(client: int, camera: CameraPose, intrinsics: Intrinsics, near: 
     """The depth image (height, width) float64 (m) that ``camera`` sees in pybullet ``client``
     (TinyRenderer, clipping planes ``near`` and ``far`` m)."""
     _, _, _, zbuffer, _ = pybullet.getCameraImage(
-        intrinsics.width, intrinsics.height, view_matrix(camera), projection_matrix(intrinsics, near, far),
-        renderer=pybullet.ER_TINY_RENDERER, flags=pybullet.ER_NO_SEGMENTATION_MASK, physicsClientId=client)
+        intrinsics.width,
+        intrinsics.height,
+        view_matrix(camera),
+        projection_matrix(intrinsics, near, far),
+        renderer=pybullet.ER_TINY_RENDERER,
+        flags=pybullet.ER_NO_SEGMENTATION_MASK,
+        physicsClientId=client,
+    )
     return depth_from_zbuffer(np.reshape(zbuffer, (intrinsics.height, intrinsics.width)), near, far)
 
 
@@ -71,11 +79,19 @@ class PybulletDepthScene:
         if self.body is not None:
             pybullet.removeBody(self.body, physicsClientId=self.client)
         pose = np.eye(4) if pose is None else np.asarray(pose, dtype=float)
-        shape = pybullet.createVisualShape(pybullet.GEOM_MESH, vertices=mesh.vertices.tolist(), indices=mesh.faces.ravel().tolist(),
-                                           physicsClientId=self.client)
+        shape = pybullet.createVisualShape(
+            pybullet.GEOM_MESH,
+            vertices=mesh.vertices.tolist(),
+            indices=mesh.faces.ravel().tolist(),
+            physicsClientId=self.client,
+        )
         quaternion = trimesh.transformations.quaternion_from_matrix(pose)  # w, x, y, z
-        self.body = pybullet.createMultiBody(baseVisualShapeIndex=shape, basePosition=pose[:3, 3].tolist(),
-                                             baseOrientation=[*quaternion[1:], quaternion[0]], physicsClientId=self.client)
+        self.body = pybullet.createMultiBody(
+            baseVisualShapeIndex=shape,
+            basePosition=pose[:3, 3].tolist(),
+            baseOrientation=[*quaternion[1:], quaternion[0]],
+            physicsClientId=self.client,
+        )
 
     def depth(self, camera: CameraPose, intrinsics: Intrinsics) -> np.ndarray:
         """The depth image (height, width) float64 (m) that ``camera`` sees."""

@@ -9,6 +9,7 @@ lies beyond; probability flows along topples to resting triangles; coplanar rest
 time (~0.15 s for a 900-triangle hull); this takes a few milliseconds and gives the same poses
 (tests/render/test_stable_poses.py).
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass

@@ -6,6 +6,7 @@ Every object is a visual mesh (what the camera sees) plus its convex decompositi
 V-HACD (what collides); the decomposition is cached per mesh under the cache folder, keyed by the
 SHA-256 of the mesh file and the V-HACD resolution, so it runs once per machine.
 """
+
 from __future__ import annotations
 
 import contextlib
@@ -94,7 +95,9 @@ def convex_decomposition(mesh_file: Path, cache_dir: Path, resolution: int = 100
 def default_cache_dir() -> Path:
     """Where decompositions are cached: ``$GRASPAUG_CACHE`` or ``$XDG_CACHE_HOME/graspaug``
     (``~/.cache/graspaug``), subfolder ``sim``."""
-    root = os.environ.get("GRASPAUG_CACHE") or Path(os.environ.get("XDG_CACHE_HOME", Path.home() / ".cache")) / "graspaug"
+    root = (
+        os.environ.get("GRASPAUG_CACHE") or Path(os.environ.get("XDG_CACHE_HOME", Path.home() / ".cache")) / "graspaug"
+    )
     return Path(root) / "sim"
 
 
@@ -110,11 +113,18 @@ def draw_physics(volume: float, settings: ObjectPhysics, rng: np.random.Generato
     density = float(rng.uniform(*settings.density_range))
     friction = float(rng.uniform(*settings.friction_range))
     mass = float(np.clip(density * volume, *settings.mass_range))
-    return {"density": density, "mass": mass, "lateral_friction": friction, "spinning_friction": settings.spinning_friction,
-            "rolling_friction": settings.rolling_friction}
+    return {
+        "density": density,
+        "mass": mass,
+        "lateral_friction": friction,
+        "spinning_friction": settings.spinning_friction,
+        "rolling_friction": settings.rolling_friction,
+    }
 
 
-def folder_meshes(folder: Path, surface, max_faces: int = 1_000_000, max_file_mb: float = 100.0) -> tuple[list[tuple[str, trimesh.Trimesh]], dict[str, str]]:
+def folder_meshes(
+    folder: Path, surface, max_faces: int = 1_000_000, max_file_mb: float = 100.0
+) -> tuple[list[tuple[str, trimesh.Trimesh]], dict[str, str]]:
     """The meshes (.obj, .stl, .ply) of ``folder``, named by file stem, each loaded, closed and
     scaled as the corpus's shapes are (:func:`graspaug.geometry.prepare.prepare_shape` with
     ``surface``, the ``ingest.surface`` settings), and {file name: reason} for those skipped.
@@ -137,12 +147,22 @@ def folder_meshes(folder: Path, surface, max_faces: int = 1_000_000, max_file_mb
             skipped[path.name] = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
             log.warning("sim: skipping %s: %s", path, skipped[path.name])
     if not meshes:
-        raise ValueError(f"sim.objects_path: no usable mesh in {folder} ({len(skipped)} skipped: {'; '.join(f'{k}: {v}' for k, v in skipped.items())})")
+        raise ValueError(
+            f"sim.objects_path: no usable mesh in {folder} ({len(skipped)} skipped: {'; '.join(f'{k}: {v}' for k, v in skipped.items())})"
+        )
     return meshes, skipped
 
 
-def prepare_object(name: str, mesh: trimesh.Trimesh, cache_dir: Path, mass: float, lateral_friction: float,
-                   resolution: int = 100_000, spinning_friction: float = 0.0, rolling_friction: float = 0.0) -> SimObject:
+def prepare_object(
+    name: str,
+    mesh: trimesh.Trimesh,
+    cache_dir: Path,
+    mass: float,
+    lateral_friction: float,
+    resolution: int = 100_000,
+    spinning_friction: float = 0.0,
+    rolling_friction: float = 0.0,
+) -> SimObject:
     """Write ``mesh`` (m) to the cache as ``<name>-<sha256>.obj``, decompose it, and return the
     :class:`SimObject` for the trials. The mesh is centered on its center of mass when it is a
     closed volume, else on its bounding-box center (several pybullet_data meshes are open); the
@@ -158,5 +178,12 @@ def prepare_object(name: str, mesh: trimesh.Trimesh, cache_dir: Path, mass: floa
         with os.fdopen(fd, "w") as f:
             f.write(data)
         os.replace(tmp, visual)
-    return SimObject(name=name, visual=visual, collision=convex_decomposition(visual, cache_dir, resolution),
-                     mass=mass, lateral_friction=lateral_friction, spinning_friction=spinning_friction, rolling_friction=rolling_friction)
+    return SimObject(
+        name=name,
+        visual=visual,
+        collision=convex_decomposition(visual, cache_dir, resolution),
+        mass=mass,
+        lateral_friction=lateral_friction,
+        spinning_friction=spinning_friction,
+        rolling_friction=rolling_friction,
+    )

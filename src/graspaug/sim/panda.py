@@ -6,13 +6,14 @@ gear constraint), link 11 ``panda_grasptarget`` is the grasp center between the 
 toward inverse-kinematics targets along straight Cartesian lines, stepped at the simulation's
 rate; nothing is teleported once an object is in contact.
 """
+
 from __future__ import annotations
 
 import numpy as np
 import pybullet
 import pybullet_data
-from graspaug.sim.settings import HandSettings
 
+from graspaug.sim.settings import HandSettings
 
 ARM_JOINTS = tuple(range(7))
 FINGER_JOINTS = (9, 10)
@@ -27,15 +28,37 @@ FINGER_OPEN = 0.04  # each finger's travel at full opening (m): 0.08 m between t
 class Panda:
     """A Panda fixed at ``base_position`` (m) in pybullet client ``client``."""
 
-    def __init__(self, client: int, base_position, hand: HandSettings = HandSettings(), time_step: float = 1 / 240) -> None:
+    def __init__(
+        self, client: int, base_position, hand: HandSettings = HandSettings(), time_step: float = 1 / 240
+    ) -> None:
         self.client, self.hand, self.time_step = client, hand, time_step
-        self.body = pybullet.loadURDF(f"{pybullet_data.getDataPath()}/franka_panda/panda.urdf", basePosition=list(base_position),
-                                      useFixedBase=True, flags=pybullet.URDF_USE_SELF_COLLISION_EXCLUDE_PARENT, physicsClientId=client)
-        gear = pybullet.createConstraint(self.body, FINGER_JOINTS[0], self.body, FINGER_JOINTS[1], pybullet.JOINT_GEAR, [1, 0, 0],
-                                         [0, 0, 0], [0, 0, 0], physicsClientId=client)
+        self.body = pybullet.loadURDF(
+            f"{pybullet_data.getDataPath()}/franka_panda/panda.urdf",
+            basePosition=list(base_position),
+            useFixedBase=True,
+            flags=pybullet.URDF_USE_SELF_COLLISION_EXCLUDE_PARENT,
+            physicsClientId=client,
+        )
+        gear = pybullet.createConstraint(
+            self.body,
+            FINGER_JOINTS[0],
+            self.body,
+            FINGER_JOINTS[1],
+            pybullet.JOINT_GEAR,
+            [1, 0, 0],
+            [0, 0, 0],
+            [0, 0, 0],
+            physicsClientId=client,
+        )
         pybullet.changeConstraint(gear, gearRatio=-1, erp=0.1, maxForce=50, physicsClientId=client)
         for link in FINGER_JOINTS:
-            pybullet.changeDynamics(self.body, link, lateralFriction=hand.finger_friction, spinningFriction=hand.finger_spinning_friction, physicsClientId=client)
+            pybullet.changeDynamics(
+                self.body,
+                link,
+                lateralFriction=hand.finger_friction,
+                spinningFriction=hand.finger_spinning_friction,
+                physicsClientId=client,
+            )
         self.finger_target = FINGER_OPEN
         self.reset(REST_POSE)
 
@@ -55,7 +78,9 @@ class Panda:
 
     def grasp_pose(self) -> tuple[np.ndarray, np.ndarray]:
         """Position (3,) m and quaternion (x, y, z, w) of the grasp center link."""
-        state = pybullet.getLinkState(self.body, GRASP_TARGET_LINK, computeForwardKinematics=True, physicsClientId=self.client)
+        state = pybullet.getLinkState(
+            self.body, GRASP_TARGET_LINK, computeForwardKinematics=True, physicsClientId=self.client
+        )
         return np.array(state[4]), np.array(state[5])
 
     # --- kinematics --------------------------------------------------------------------------
@@ -69,18 +94,38 @@ class Panda:
         """Arm angles (7,) that put the grasp center at ``position`` (3,) m with ``orientation``
         (pybullet's damped least squares from the current angles, null space toward the rest pose)."""
         angles = pybullet.calculateInverseKinematics(
-            self.body, GRASP_TARGET_LINK, list(position), orientation, lowerLimits=LOWER_LIMITS.tolist(),
-            upperLimits=UPPER_LIMITS.tolist(), jointRanges=(UPPER_LIMITS - LOWER_LIMITS).tolist(), restPoses=REST_POSE.tolist(),
-            maxNumIterations=100, residualThreshold=1e-5, physicsClientId=self.client)
+            self.body,
+            GRASP_TARGET_LINK,
+            list(position),
+            orientation,
+            lowerLimits=LOWER_LIMITS.tolist(),
+            upperLimits=UPPER_LIMITS.tolist(),
+            jointRanges=(UPPER_LIMITS - LOWER_LIMITS).tolist(),
+            restPoses=REST_POSE.tolist(),
+            maxNumIterations=100,
+            residualThreshold=1e-5,
+            physicsClientId=self.client,
+        )
         return np.array(angles[:7])
 
     # --- motion ------------------------------------------------------------------------------
     def _command(self, arm: np.ndarray) -> None:
-        pybullet.setJointMotorControlArray(self.body, ARM_JOINTS, pybullet.POSITION_CONTROL, targetPositions=arm.tolist(),
-                                           forces=ARM_EFFORT.tolist(), physicsClientId=self.client)
-        pybullet.setJointMotorControlArray(self.body, FINGER_JOINTS, pybullet.POSITION_CONTROL,
-                                           targetPositions=[self.finger_target] * 2, forces=[self.hand.grip_force] * 2,
-                                           physicsClientId=self.client)
+        pybullet.setJointMotorControlArray(
+            self.body,
+            ARM_JOINTS,
+            pybullet.POSITION_CONTROL,
+            targetPositions=arm.tolist(),
+            forces=ARM_EFFORT.tolist(),
+            physicsClientId=self.client,
+        )
+        pybullet.setJointMotorControlArray(
+            self.body,
+            FINGER_JOINTS,
+            pybullet.POSITION_CONTROL,
+            targetPositions=[self.finger_target] * 2,
+            forces=[self.hand.grip_force] * 2,
+            physicsClientId=self.client,
+        )
 
     def step(self, n: int, arm: np.ndarray | None = None) -> None:
         arm = self.arm_angles() if arm is None else arm
@@ -90,9 +135,17 @@ class Panda:
 
     def contact_force(self) -> float:
         """Total normal force (N) of the robot's contacts with other bodies now."""
-        return float(sum(c[9] for c in pybullet.getContactPoints(bodyA=self.body, physicsClientId=self.client) if c[2] != self.body))
+        return float(
+            sum(
+                c[9]
+                for c in pybullet.getContactPoints(bodyA=self.body, physicsClientId=self.client)
+                if c[2] != self.body
+            )
+        )
 
-    def move_line(self, target, jaw_angle: float, speed: float | None = None, settle: float = 0.1, max_force: float | None = None) -> float:
+    def move_line(
+        self, target, jaw_angle: float, speed: float | None = None, settle: float = 0.1, max_force: float | None = None
+    ) -> float:
         """Move the grasp center in a straight line to ``target`` (3,) m at ``speed`` m/s, the hand
         pointing down at ``jaw_angle``, then hold the last target for ``settle`` s. With
         ``max_force`` (N) the robot's contacts with other bodies are watched and the motion stops

@@ -6,16 +6,23 @@ and the bin (pybullet_data's ``tray/traybox.urdf``, scaled) at ``bin_position``,
 the camera's view. One :class:`PickScene` is one pybullet DIRECT client; a trial builds a fresh
 one so that the same seed always gives the same physics.
 """
+
 from __future__ import annotations
 
 import numpy as np
 import pybullet
 import pybullet_data
 
+from graspaug.render.camera import CameraPose, look_at
 from graspaug.render.pybullet_depth import render_depth
 from graspaug.sim.objects import SimObject
 from graspaug.sim.panda import HandSettings, Panda
 from graspaug.sim.settings import CellLayout
+
+
+def camera_pose(layout: CellLayout) -> CameraPose:
+    """The overhead depth camera of ``layout``: ``camera_height`` m above the table origin, looking straight down."""
+    return look_at(np.array([0.0, 0.0, layout.camera_height]), np.zeros(3))
 
 
 class PickScene:
@@ -31,11 +38,18 @@ class PickScene:
         pybullet.setTimeStep(layout.time_step, physicsClientId=c)
         half = [layout.table_size[0] / 2, layout.table_size[1] / 2, 0.025]
         table = pybullet.createCollisionShape(pybullet.GEOM_BOX, halfExtents=half, physicsClientId=c)
-        table_visual = pybullet.createVisualShape(pybullet.GEOM_BOX, halfExtents=half, rgbaColor=[0.8, 0.7, 0.55, 1], physicsClientId=c)
+        table_visual = pybullet.createVisualShape(
+            pybullet.GEOM_BOX, halfExtents=half, rgbaColor=[0.8, 0.7, 0.55, 1], physicsClientId=c
+        )
         self.table = pybullet.createMultiBody(0, table, table_visual, basePosition=[0, 0, -0.025], physicsClientId=c)
         pybullet.changeDynamics(self.table, -1, lateralFriction=layout.table_friction, physicsClientId=c)
-        self.bin = pybullet.loadURDF(f"{pybullet_data.getDataPath()}/tray/traybox.urdf", basePosition=list(layout.bin_position),
-                                     globalScaling=layout.bin_scale, useFixedBase=True, physicsClientId=c)
+        self.bin = pybullet.loadURDF(
+            f"{pybullet_data.getDataPath()}/tray/traybox.urdf",
+            basePosition=list(layout.bin_position),
+            globalScaling=layout.bin_scale,
+            useFixedBase=True,
+            physicsClientId=c,
+        )
         self.robot = Panda(c, layout.robot_base, hand, layout.time_step)
         self.object: int | None = None
 
@@ -44,24 +58,41 @@ class PickScene:
         """Put ``obj`` at ``position`` (3,) m with quaternion ``orientation`` (x, y, z, w)."""
         c = self.client
         collision = pybullet.createCollisionShape(pybullet.GEOM_MESH, fileName=str(obj.collision), physicsClientId=c)
-        visual = pybullet.createVisualShape(pybullet.GEOM_MESH, fileName=str(obj.visual), rgbaColor=[0.3, 0.5, 0.8, 1],
-                                            physicsClientId=c)
-        self.object = pybullet.createMultiBody(obj.mass, collision, visual, basePosition=list(position),
-                                               baseOrientation=list(orientation), physicsClientId=c)
-        pybullet.changeDynamics(self.object, -1, lateralFriction=obj.lateral_friction, spinningFriction=obj.spinning_friction,
-                                rollingFriction=obj.rolling_friction, physicsClientId=c)
+        visual = pybullet.createVisualShape(
+            pybullet.GEOM_MESH, fileName=str(obj.visual), rgbaColor=[0.3, 0.5, 0.8, 1], physicsClientId=c
+        )
+        self.object = pybullet.createMultiBody(
+            obj.mass,
+            collision,
+            visual,
+            basePosition=list(position),
+            baseOrientation=list(orientation),
+            physicsClientId=c,
+        )
+        pybullet.changeDynamics(
+            self.object,
+            -1,
+            lateralFriction=obj.lateral_friction,
+            spinningFriction=obj.spinning_friction,
+            rollingFriction=obj.rolling_friction,
+            physicsClientId=c,
+        )
         return self.object
 
     def add_box(self, half_extents, position) -> int:
         """A static box with ``half_extents`` (3,) m centered at ``position`` (3,) m."""
         c = self.client
         shape = pybullet.createCollisionShape(pybullet.GEOM_BOX, halfExtents=list(half_extents), physicsClientId=c)
-        visual = pybullet.createVisualShape(pybullet.GEOM_BOX, halfExtents=list(half_extents), rgbaColor=[0.6, 0.2, 0.2, 1], physicsClientId=c)
+        visual = pybullet.createVisualShape(
+            pybullet.GEOM_BOX, halfExtents=list(half_extents), rgbaColor=[0.6, 0.2, 0.2, 1], physicsClientId=c
+        )
         return pybullet.createMultiBody(0, shape, visual, basePosition=list(position), physicsClientId=c)
 
     def move_object(self, position, orientation) -> None:
         """Put the object at ``position`` (3,) m with quaternion (x, y, z, w) at once, at rest."""
-        pybullet.resetBasePositionAndOrientation(self.object, list(position), list(orientation), physicsClientId=self.client)
+        pybullet.resetBasePositionAndOrientation(
+            self.object, list(position), list(orientation), physicsClientId=self.client
+        )
 
     def object_pose(self) -> tuple[np.ndarray, np.ndarray]:
         position, orientation = pybullet.getBasePositionAndOrientation(self.object, physicsClientId=self.client)
@@ -89,7 +120,10 @@ class PickScene:
         """Whether the object's center lies inside the bin's walls, below its rim."""
         position, _ = self.object_pose()
         offset = position[:2] - np.asarray(self.layout.bin_position[:2])
-        return bool(np.all(np.abs(offset) < self.layout.bin_half_extent) and position[2] < self.layout.bin_position[2] + self.layout.bin_height)
+        return bool(
+            np.all(np.abs(offset) < self.layout.bin_half_extent)
+            and position[2] < self.layout.bin_position[2] + self.layout.bin_height
+        )
 
     def object_touches_robot(self) -> bool:
         return len(pybullet.getContactPoints(self.object, self.robot.body, physicsClientId=self.client)) > 0
@@ -97,14 +131,21 @@ class PickScene:
     # --- sensing -----------------------------------------------------------------------------
     def depth_image(self) -> np.ndarray:
         """The overhead camera's depth image (H, W) float64 m (TinyRenderer z-buffer → metric)."""
-        return render_depth(self.client, self.layout.camera, self.layout.intrinsics, self.near, self.far)
+        return render_depth(self.client, camera_pose(self.layout), self.layout.intrinsics, self.near, self.far)
 
     def color_frame(self, width: int = 320, height: int = 240) -> np.ndarray:
         """An RGB picture (height, width, 3) uint8 of the cell from the front-left, for the reports."""
         view = pybullet.computeViewMatrix([0.35, -0.55, 0.45], [-0.15, 0.2, 0.08], [0, 0, 1])
         projection = pybullet.computeProjectionMatrixFOV(45, width / height, 0.05, 5.0)
-        _, _, rgba, _, _ = pybullet.getCameraImage(width, height, view, projection, renderer=pybullet.ER_TINY_RENDERER,
-                                                   flags=pybullet.ER_NO_SEGMENTATION_MASK, physicsClientId=self.client)
+        _, _, rgba, _, _ = pybullet.getCameraImage(
+            width,
+            height,
+            view,
+            projection,
+            renderer=pybullet.ER_TINY_RENDERER,
+            flags=pybullet.ER_NO_SEGMENTATION_MASK,
+            physicsClientId=self.client,
+        )
         return np.reshape(np.asarray(rgba, dtype=np.uint8), (height, width, 4))[..., :3]
 
     def close(self) -> None:

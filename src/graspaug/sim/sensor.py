@@ -5,12 +5,13 @@ and depths rounded to the camera's depth unit (the model and its numbers: :class
 Missing pixels read 0, as the camera reports them; the planner fills them from the nearest
 valid pixel (:func:`graspaug.planning.check_depth` with ``fill_missing``).
 """
+
 from __future__ import annotations
 
 import numpy as np
 from scipy import ndimage
 
-from graspaug.render.camera import Intrinsics
+from graspaug.render.settings import Intrinsics
 from graspaug.sim.settings import DepthNoise
 
 
@@ -43,7 +44,9 @@ def noise_sd(depth: np.ndarray, settings: DepthNoise) -> np.ndarray:
     return settings.sd_coefficient * np.square(depth)
 
 
-def sense_depth(depth: np.ndarray, intrinsics: Intrinsics, settings: DepthNoise, rng: np.random.Generator) -> np.ndarray:
+def sense_depth(
+    depth: np.ndarray, intrinsics: Intrinsics, settings: DepthNoise, rng: np.random.Generator
+) -> np.ndarray:
     """What the sensor reads for the exact depth image ``depth`` (H, W) m: a new (H, W) float64
     array in m, 0 where the pixel is lost. ``depth`` is left unchanged; with
     ``settings.enabled`` false it is returned as a copy."""

@@ -1,9 +1,12 @@
-"""Settings of the simulated cell: layout, hand, motion script, grasp planner."""
+"""Settings of the simulated cell: layout, hand, motion script, depth sensor, object physics (plain data).
+
+The grasp planner's settings (``sim.sampler``, ``sim.cem``) are in :mod:`graspaug.planning.settings`;
+the camera pose of a layout is :func:`graspaug.sim.scene.camera_pose`.
+"""
+
 from __future__ import annotations
 
-import numpy as np
-
-from graspaug.render.camera import CameraPose, Intrinsics, look_at
+from graspaug.render.settings import Intrinsics
 from graspaug.settings import Field, settings
 
 
@@ -11,12 +14,22 @@ from graspaug.settings import Field, settings
 class CellLayout:
     """Where things stand (m) and how the world steps (params section ``sim.cell``)."""
 
-    camera_height: float = Field(0.65, gt=0.1, description="Depth camera height above the table, looking straight down (m; paper: 0.65).")
-    intrinsics: Intrinsics = Field(default_factory=Intrinsics, description="The overhead depth camera.")
-    table_size: tuple[float, float] = Field((1.2, 1.2), description="Table top (m).")
-    table_friction: float = Field(0.8, gt=0, description="Lateral friction of the table.")
-    robot_base: tuple[float, float, float] = Field((-0.6, 0.0, 0.0), description="Where the Panda's base stands (m, table frame).")
-    bin_position: tuple[float, float, float] = Field((-0.25, 0.5, 0.0), description="Where the bin stands (m, table frame).")
+    camera_height: float = Field(
+        0.65, gt=0.1, description="Depth camera height above the table, looking straight down (m; paper: 0.65)."
+    )
+    intrinsics: Intrinsics = Field(
+        default_factory=Intrinsics, description="The overhead depth camera: image size and intrinsics (px)."
+    )
+    table_size: tuple[float, float] = Field((1.2, 1.2), description="Table top size along x and y (m).")
+    table_friction: float = Field(
+        0.8, gt=0, description="Lateral friction coefficient of the table (pybullet multiplies it by the object's)."
+    )
+    robot_base: tuple[float, float, float] = Field(
+        (-0.6, 0.0, 0.0), description="Where the Panda's base stands (m, table frame)."
+    )
+    bin_position: tuple[float, float, float] = Field(
+        (-0.25, 0.5, 0.0), description="Where the bin stands (m, table frame)."
+    )
     bin_scale: float = Field(0.5, gt=0, description="Scale of pybullet_data's traybox (0.6 × 0.6 × 0.15 m at scale 1).")
     time_step: float = Field(1 / 240, gt=0, description="Simulation time step (s).")
     gravity: float = Field(9.81, gt=0, description="Gravity (m/s²).")
@@ -28,22 +41,39 @@ class CellLayout:
 
     @property
     def bin_height(self) -> float:
+        """Height of the bin's walls (m)."""
         return 0.15 * self.bin_scale
-
-    @property
-    def camera(self) -> CameraPose:
-        return look_at(np.array([0.0, 0.0, self.camera_height]), np.zeros(3))
 
 
 @settings
 class HandSettings:
     """How the hand moves and holds (SI units; params section ``sim.hand``)."""
 
-    grip_force: float = Field(70.0, gt=0, description="Closing force limit per finger motor (N). With both fingers on the object each presses with this force, so it is the grasp's clamping force: the Franka Hand's spec sheet gives 70 N continuous (140 N peak).")
-    finger_friction: float = Field(1.0, gt=0, description="Lateral friction of the finger pads (pybullet multiplies it by the object's: the pad-object coefficient is the object's friction).")
-    finger_spinning_friction: float = Field(0.0033, ge=0, description="Torsional (spinning) friction of the finger pads (m): the friction torque a pad can resist is this × the object's lateral friction × the normal force (Bullet's combination). 0.0033 = (2/3)·5 mm, a uniformly pressed contact disc of 5 mm radius (a rubber pad on a rigid object).")
+    grip_force: float = Field(
+        70.0,
+        gt=0,
+        description="Closing force limit per finger motor (N). With both fingers on the object each presses with "
+        "this force, so it is the grasp's clamping force (the Franka Hand is rated 70 N continuous, "
+        "140 N peak).",
+    )
+    finger_friction: float = Field(
+        1.0,
+        gt=0,
+        description="Lateral friction of the finger pads (pybullet multiplies it by the object's: the pad-object "
+        "coefficient is the object's friction).",
+    )
+    finger_spinning_friction: float = Field(
+        0.0033,
+        ge=0,
+        description="Torsional (spinning) friction of the finger pads (m): the friction torque a pad can resist is "
+        "this × the object's lateral friction × the normal force (Bullet's combination). "
+        "0.0033 = (2/3)·5 mm, a uniformly pressed contact disc of 5 mm radius (a rubber pad on a rigid "
+        "object).",
+    )
     speed: float = Field(0.25, gt=0, description="Cartesian speed of the grasp center on the way down and up (m/s).")
-    transit_speed: float = Field(0.5, gt=0, description="Cartesian speed from the rest pose to the pre-grasp pose (m/s).")
+    transit_speed: float = Field(
+        0.5, gt=0, description="Cartesian speed from the rest pose to the pre-grasp pose (m/s)."
+    )
     close_time: float = Field(0.5, gt=0, description="Time given to close the fingers (s).")
 
 
@@ -51,15 +81,27 @@ class HandSettings:
 class TrialSettings:
     """The motion script (m, s; params section ``sim.trial``)."""
 
-    drop_offset: float = Field(0.05, ge=0, le=0.15, description="Objects are dropped up to this far from the table center in x and y, in a random orientation (m).")
-    drop_clearance: float = Field(0.02, ge=0, description="Gap between the table and the object's lowest point at release (m).")
+    drop_offset: float = Field(
+        0.05,
+        ge=0,
+        le=0.15,
+        description="Objects are dropped up to this far from the table center in x and y, in a random orientation (m).",
+    )
+    drop_clearance: float = Field(
+        0.02, ge=0, description="Gap between the table and the object's lowest point at release (m)."
+    )
     settle_time: float = Field(2.0, gt=0, description="At most this long for the object to come to rest (s).")
     pregrasp_height: float = Field(0.15, gt=0, description="Pre-grasp pose above the grasp center (m).")
     lift_height: float = Field(0.2, gt=0, description="Lift after closing (m).")
     carry_height: float = Field(0.25, gt=0, description="Grasp center above the bin floor when released (m).")
     carry_speed: float = Field(0.5, gt=0, description="Carrying speed (m/s).")
     release_time: float = Field(1.0, gt=0, description="Wait after opening, before the bin check (s).")
-    collision_force: float = Field(10.0, gt=0, description="A contact of the robot with anything (object, table, obstacle) pressing harder than this (N) on the way to the grasp, before the fingers close, ends the trial as `collision` (a fingertip brushing the object's side on the way down measured up to 3 N).")
+    collision_force: float = Field(
+        10.0,
+        gt=0,
+        description="A contact of the robot with anything (object, table, obstacle) pressing harder than this (N) "
+        "on the way to the grasp, before the fingers close, ends the trial as `collision`.",
+    )
 
 
 @settings
@@ -67,24 +109,38 @@ class DepthNoise:
     """The overhead depth sensor, modelled on an Intel RealSense D435 at 0.65 m (params section ``sim.sensor``).
 
     Axial noise: SD = ``sd_coefficient`` × z² (stereo depth error grows with the square of the
-    distance: RMS ≈ z² · subpixel / (focal length · baseline); the D435 with 0.08 px subpixel,
-    a 50 mm baseline and 424 px focal length at 848 × 480 gives 0.0038 / m, i.e. 1.6 mm at
-    0.65 m), spatially correlated over ``correlation_px`` (stereo matching windows). Missing
-    pixels (read as 0, as the camera reports them): within ``edge_band_px`` of a depth jump
-    above ``edge_jump`` each pixel is lost with probability ``edge_dropout`` (occlusion and
-    matching failure at object borders), and pixels of surfaces steeper than ``steep_angle``
-    to the view ray with probability ``steep_dropout``. Depths are rounded to ``quantization``
-    (the D435's default depth unit: 1 mm).
+    distance: RMS ≈ z² · subpixel / (focal length · baseline); the D435's 0.08 px subpixel,
+    50 mm baseline and 424 px focal length at 848 × 480 give 0.0038 / m), spatially correlated
+    over ``correlation_px`` (stereo matching windows). Missing pixels (read as 0, as the camera
+    reports them): within ``edge_band_px`` of a depth jump above ``edge_jump`` each pixel is lost
+    with probability ``edge_dropout`` (occlusion and matching failure at object borders), and
+    pixels of surfaces steeper than ``steep_angle`` to the view ray with probability
+    ``steep_dropout``. Depths are rounded to ``quantization`` (the D435's default depth unit: 1 mm).
     """
 
-    enabled: bool = Field(True, description="Add the noise (false: the renderer's exact depth, as before).")
-    sd_coefficient: float = Field(0.0038, ge=0, description="Noise SD per squared depth (1/m): SD(z) = this × z² (0.0038: 1.6 mm at 0.65 m, the D435's RMS error).")
-    correlation_px: float = Field(2.0, ge=0, description="Gaussian smoothing (px) of the noise field: stereo matching windows correlate neighbouring pixels (0: independent pixels).")
-    edge_jump: float = Field(0.005, gt=0, description="A depth difference to a 4-neighbour above this (m) marks a depth edge.")
-    edge_band_px: int = Field(2, ge=0, description="Pixels this close to a depth edge (both sides) form the edge band.")
-    edge_dropout: float = Field(0.3, ge=0, le=1, description="Share of edge-band pixels lost (read 0).")
-    steep_angle: float = Field(70.0, gt=0, lt=90, description="Surfaces tilted more than this from facing the camera (degrees) are steep.")
-    steep_dropout: float = Field(0.5, ge=0, le=1, description="Share of steep-surface pixels (outside the edge band) lost (read 0).")
+    enabled: bool = Field(True, description="Add the noise (false: the renderer's exact depth).")
+    sd_coefficient: float = Field(
+        0.0038, ge=0, description="Noise SD per squared depth (1/m): SD(z) = this × z², with z in m."
+    )
+    correlation_px: float = Field(
+        2.0,
+        ge=0,
+        description="SD of the Gaussian smoothing of the noise field (px): stereo matching windows correlate "
+        "neighbouring pixels (0: independent pixels).",
+    )
+    edge_jump: float = Field(
+        0.005, gt=0, description="A depth difference to a 4-neighbour above this (m) marks a depth edge."
+    )
+    edge_band_px: int = Field(
+        2, ge=0, description="Pixels within this distance of a depth edge (px, both sides) form the edge band."
+    )
+    edge_dropout: float = Field(0.3, ge=0, le=1, description="Probability that an edge-band pixel is lost (reads 0).")
+    steep_angle: float = Field(
+        70.0, gt=0, lt=90, description="Surfaces tilted more than this from facing the camera (degrees) are steep."
+    )
+    steep_dropout: float = Field(
+        0.5, ge=0, le=1, description="Probability that a steep-surface pixel (outside the edge band) is lost (reads 0)."
+    )
     quantization: float = Field(0.001, ge=0, description="Depth step (m; D435 depth unit 1 mm; 0: none).")
 
 
@@ -98,39 +154,28 @@ class ObjectPhysics:
     to solid plastic and fruit (~900).
     """
 
-    density_range: tuple[float, float] = Field((150.0, 900.0), description="Density drawn uniformly per object (kg/m³).")
-    mass_range: tuple[float, float] = Field((0.03, 1.0), description="The mass is clipped to this range (kg; the Panda hand and arm carry 3 kg).")
-    friction_range: tuple[float, float] = Field((0.3, 0.7), description="Lateral friction drawn uniformly per object (pybullet multiplies it by the partner's: 1.0 for the pads, the table's 0.8).")
-    spinning_friction: float = Field(0.0, ge=0, description="The object's own torsional friction (m); the pads' is sim.hand.finger_spinning_friction.")
-    rolling_friction: float = Field(0.0001, ge=0, description="Rolling friction of the object (m): small, so round objects still roll.")
+    density_range: tuple[float, float] = Field(
+        (150.0, 900.0), description="Density drawn uniformly per object (kg/m³)."
+    )
+    mass_range: tuple[float, float] = Field(
+        (0.03, 1.0), description="The mass is clipped to this range (kg; the Panda hand and arm carry 3 kg)."
+    )
+    friction_range: tuple[float, float] = Field(
+        (0.3, 0.7),
+        description="Lateral friction drawn uniformly per object (pybullet multiplies it by the partner's: 1.0 for "
+        "the pads, the table's 0.8).",
+    )
+    spinning_friction: float = Field(
+        0.0,
+        ge=0,
+        description="The object's own torsional friction (m); the pads' is sim.hand.finger_spinning_friction.",
+    )
+    rolling_friction: float = Field(
+        0.0001, ge=0, description="Rolling friction of the object (m): small, so round objects still roll."
+    )
 
     def __post_init__(self) -> None:
         for name in ("density_range", "mass_range", "friction_range"):
             low, high = getattr(self, name)
             if not 0 < low <= high:
                 raise ValueError(f"sim.physics.{name}: must be (low, high) with 0 < low <= high; got {[low, high]}")
-
-
-@settings
-class SamplerSettings:
-    """Dex-Net 2.0's antipodal depth-image sampler (params section ``sim.sampler``)."""
-
-    friction_coef: float = Field(0.8, gt=0, description="Friction coefficient of the antipodality test on depth edges (Dex-Net: 0.8).")
-    depth_grad_thresh: float = Field(0.0025, gt=0, description="Depth gradient (m per px) that marks an edge pixel (Dex-Net: 0.0025).")
-    min_dist_from_boundary: int = Field(45, ge=0, description="Edge pixels this close to the image border are ignored (px; Dex-Net: 45).")
-    min_depth_offset: float = Field(0.005, ge=0, description="Grasp depth below the surface between the jaws, lowest (m; Dex-Net: 0.005).")
-    max_depth_offset: float = Field(0.04, ge=0, description="... and highest (m; Dex-Net: 0.04).")
-    max_width: float = Field(0.08, gt=0, description="Jaw opening (m); must equal grasps.gripper.max_width.")
-    max_edge_pixels: int = Field(3000, ge=2, description="Edge pixels kept at random to pair up.")
-
-
-@settings
-class CEMSettings:
-    """Cross-entropy refinement, Dex-Net 2.0's (params section ``sim.cem``)."""
-
-    num_seed_samples: int = Field(250, ge=1, description="Antipodal seed grasps per image (Dex-Net: 100-250).")
-    num_iters: int = Field(3, ge=0, description="Cross-entropy iterations (Dex-Net: 3).")
-    elite_fraction: float = Field(0.25, gt=0, le=1, description="Share of the best grasps refit each iteration (Dex-Net: 0.25).")
-    gmm_components: int = Field(3, ge=1, description="Gaussian mixture components at most ...")
-    gmm_component_fraction: float = Field(0.4, gt=0, le=1, description="... or ceil(this × elites) when fewer (Dex-Net: 0.4).")
-    num_gmm_samples: int = Field(50, ge=1, description="Grasps drawn from the mixture per iteration (Dex-Net: 50).")

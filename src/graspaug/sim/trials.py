@@ -5,9 +5,10 @@ on the object, the drop seed and the grasp: the same seed gives the same drop (a
 noisy depth image: the sensor noise is drawn from the drop seed too) to every planner. The hand
 travels from its rest pose to the pre-grasp pose and down to the grasp along straight lines;
 a contact pressing harder than ``collision_force`` on the way, before the fingers close, ends
-the trial as ``collision``. The grasp comes from a planner callable (depth image → image
-grasp) or, for scripted tests, directly as a table-frame pose.
+the trial as ``collision``. The grasp comes from a grasp source (depth image → planned grasp,
+:class:`graspaug.planning.PlannedGrasp`) or, for scripted tests, directly as a table-frame pose.
 """
+
 from __future__ import annotations
 
 from collections.abc import Callable
@@ -15,11 +16,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from graspaug.render.camera import CameraPose, Intrinsics
+from graspaug.planning.grasps import ImageGrasps
+from graspaug.planning.planner import PlannedGrasp
+from graspaug.render.camera import CameraPose
+from graspaug.render.settings import Intrinsics
 from graspaug.sim.objects import SimObject
 from graspaug.sim.panda import FINGER_OPEN, HandSettings
-from graspaug.sim.policy import ImageGrasps, PlannedGrasp, grasp_in_table_frame
-from graspaug.sim.scene import CellLayout, PickScene
+from graspaug.sim.scene import CellLayout, PickScene, camera_pose
 from graspaug.sim.sensor import sense_depth
 from graspaug.sim.settings import DepthNoise, TrialSettings
 
@@ -53,15 +56,44 @@ def random_orientation(rng: np.random.Generator) -> np.ndarray:
     return q / np.linalg.norm(q)
 
 
-Planner = Callable[[np.ndarray, CameraPose, Intrinsics], "PlannedGrasp | None"]
+#: What plans the grasp: the sensed depth image (H, W) m (0 where a pixel is lost), the camera's pose and
+#: intrinsics → the planned grasp, or None when there is none.
+GraspSource = Callable[[np.ndarray, CameraPose, Intrinsics], "PlannedGrasp | None"]
 
 
 ScriptedGrasp = Callable[[np.ndarray, np.ndarray], "tuple[np.ndarray, float]"]
 
 
-def run_trial(obj: SimObject, drop_seed: int, planner: Planner | None = None, scripted: ScriptedGrasp | None = None,
-              layout: CellLayout = CellLayout(), hand: HandSettings = HandSettings(), settings: TrialSettings = TrialSettings(),
-              sensor: DepthNoise = DepthNoise(), record: bool = False, obstacles: tuple[Obstacle, ...] = ()) -> TrialResult:
+def grasp_in_table_frame(
+    grasps: ImageGrasps, camera: CameraPose, intrinsics: Intrinsics
+) -> tuple[np.ndarray, np.ndarray]:
+    """Table-frame grasps of image grasps seen by ``camera`` with ``intrinsics``.
+
+    Returns
+    -------
+    centers : (N, 3) float — grasp centers, m (the center pixel deprojected at the grasp depth)
+    angles : (N,) float — jaw angles in the table plane from the table's x axis, rad (the image
+        jaw direction carried to the table and flattened onto it)
+    """
+    rays = intrinsics.rays(grasps.centers[:, 0], grasps.centers[:, 1])
+    centers = camera.to_table(rays * grasps.depths[:, None])
+    direction_cam = np.stack([np.cos(grasps.angles), np.sin(grasps.angles), np.zeros(len(grasps))], axis=1)
+    direction = direction_cam @ camera.rotation.T
+    return centers, np.arctan2(direction[:, 1], direction[:, 0])
+
+
+def run_trial(
+    obj: SimObject,
+    drop_seed: int,
+    planner: GraspSource | None = None,
+    scripted: ScriptedGrasp | None = None,
+    layout: CellLayout = CellLayout(),
+    hand: HandSettings = HandSettings(),
+    settings: TrialSettings = TrialSettings(),
+    sensor: DepthNoise = DepthNoise(),
+    record: bool = False,
+    obstacles: tuple[Obstacle, ...] = (),
+) -> TrialResult:
     """Drop ``obj`` at the pose drawn from ``drop_seed``, then pick it with ``planner``'s grasp
     on the ``sensor``'s depth image (or the ``scripted`` one: the object's resting position (3,) m
     and quaternion (x, y, z, w) → table-frame grasp center (3,) m and jaw angle rad) and carry
@@ -85,15 +117,25 @@ def run_trial(obj: SimObject, drop_seed: int, planner: Planner | None = None, sc
             depth = sense_depth(scene.depth_image(), layout.intrinsics, sensor, np.random.default_rng([drop_seed, 1]))
             if record:
                 result.depth = depth
-            planned = planner(depth, layout.camera, layout.intrinsics) if planner is not None else None
+            camera = camera_pose(layout)
+            planned = planner(depth, camera, layout.intrinsics) if planner is not None else None
             if planned is None:
                 return result
             g: ImageGrasps = planned.grasp
-            centers, angles = grasp_in_table_frame(g, layout.camera, layout.intrinsics)
+            centers, angles = grasp_in_table_frame(g, camera, layout.intrinsics)
             center, jaw_angle = centers[0], float(angles[0])
-            result.image_grasp = {"u": float(g.centers[0, 0]), "v": float(g.centers[0, 1]), "angle": float(g.angles[0]),
-                                  "depth": float(g.depths[0]), "width_px": float(g.widths[0])}
-            result.quality, result.planning_time, result.candidates = planned.quality, planned.planning_time, planned.candidates
+            result.image_grasp = {
+                "u": float(g.centers[0, 0]),
+                "v": float(g.centers[0, 1]),
+                "angle": float(g.angles[0]),
+                "depth": float(g.depths[0]),
+                "width_px": float(g.widths[0]),
+            }
+            result.quality, result.planning_time, result.candidates = (
+                planned.quality,
+                planned.planning_time,
+                planned.candidates,
+            )
         else:
             center, jaw_angle = scripted(*scene.object_pose())
             center, jaw_angle = np.asarray(center, dtype=float), float(jaw_angle)
@@ -102,7 +144,9 @@ def run_trial(obj: SimObject, drop_seed: int, planner: Planner | None = None, sc
 
         robot = scene.robot
         limit = settings.collision_force
-        result.contact_force = robot.move_line(center + [0, 0, settings.pregrasp_height], jaw_angle, speed=hand.transit_speed, max_force=limit)
+        result.contact_force = robot.move_line(
+            center + [0, 0, settings.pregrasp_height], jaw_angle, speed=hand.transit_speed, max_force=limit
+        )
         if record and result.contact_force <= limit:  # a collision on the way is drawn once, below
             frames.append(("pre-grasp", scene.color_frame()))
         if result.contact_force <= limit:
@@ -122,7 +166,9 @@ def run_trial(obj: SimObject, drop_seed: int, planner: Planner | None = None, sc
         if not lifted:
             result.outcome = "not_lifted"
             return result
-        above_bin = np.array([layout.bin_position[0], layout.bin_position[1], layout.bin_position[2] + settings.carry_height])
+        above_bin = np.array(
+            [layout.bin_position[0], layout.bin_position[1], layout.bin_position[2] + settings.carry_height]
+        )
         robot.move_line(above_bin, jaw_angle, speed=settings.carry_speed)
         held = scene.object_touches_robot()
         if record:

@@ -1,4 +1,5 @@
 """One thin module per DVC stage: read its params, call library functions, write outputs."""
+
 from graspaug.errors import StageError
 
 __all__ = ["StageError", "corpus_paths"]

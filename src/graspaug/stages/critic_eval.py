@@ -8,6 +8,7 @@ over pairs; paired contrasts; the critic's AUC on held-out shapes),
 ``reports/critic_eval/outliers.{csv,png}`` and ``reports/critic_eval/interpolations.png``
 (the paper's Fig. 5: AE / control / AE-Critic rows per pair, main part green, outliers red).
 """
+
 from __future__ import annotations
 
 import logging
@@ -15,21 +16,51 @@ import logging
 import numpy as np
 import pandas as pd
 
-from graspaug.config import Params
-from graspaug.critic_study import decoded_interpolations, outlier_table, paired_contrast, pair_resamples, random_pairs, summarize
 from graspaug.device import resolve_device
-from graspaug.geometry.clusters import largest_cluster
+from graspaug.experiments.critic import (
+    decoded_interpolations,
+    interpolation_rows,
+    outlier_columns,
+    outlier_contrast,
+    outlier_table,
+    random_pairs,
+    summarize,
+)
+from graspaug.experiments.stats import PairBootstrap
 from graspaug.io.checkpoints import load_autoencoder
 from graspaug.io.tables import write_csv, write_json
+from graspaug.params.ae import AEParams
+from graspaug.params.base import params_model
+from graspaug.params.critic_eval import CriticEvalParams
+from graspaug.paths import (
+    AE_CRITIC_MODEL,
+    AE_EXTRA_MODEL,
+    AE_MODEL,
+    CRITIC_EVAL_METRICS,
+    INTERPOLATIONS_PNG,
+    OUTLIERS_CSV,
+    OUTLIERS_PNG,
+    SHAPES_TABLE,
+    VOXELS,
+)
 from graspaug.plots import lines, voxel_rows
 from graspaug.stages import StageError
-from graspaug.paths import AE_CRITIC_MODEL, AE_EXTRA_MODEL, AE_MODEL, CRITIC_EVAL_METRICS, INTERPOLATIONS_PNG, OUTLIERS_CSV, OUTLIERS_PNG, SHAPES_TABLE, VOXELS
 from graspaug.training.autoencoder import critic_separation, encode, grids_by_split
 
 log = logging.getLogger(__name__)
 
-MODELS = {"ae": (AE_MODEL, "AE"), "ae_extra": (AE_EXTRA_MODEL, "AE + extra epochs (λ = 0)"), "ae_critic": (AE_CRITIC_MODEL, "AE-Critic")}
-CONTRASTS = {"critic_vs_control": ("ae_critic", "ae_extra"), "critic_vs_ae": ("ae_critic", "ae"), "control_vs_ae": ("ae_extra", "ae")}
+Params = params_model("The params the `critic_eval` stage reads.", ae=AEParams, critic_eval=CriticEvalParams)
+
+MODELS = {
+    "ae": (AE_MODEL, "AE"),
+    "ae_extra": (AE_EXTRA_MODEL, "AE + extra epochs (λ = 0)"),
+    "ae_critic": (AE_CRITIC_MODEL, "AE-Critic"),
+}
+CONTRASTS = {
+    "critic_vs_control": ("ae_critic", "ae_extra"),
+    "critic_vs_ae": ("ae_critic", "ae"),
+    "control_vs_ae": ("ae_extra", "ae"),
+}
 
 
 def run(params: Params) -> None:
@@ -40,7 +71,7 @@ def run(params: Params) -> None:
     pairs = random_pairs(len(grids["train"]), cfg.n_shapes, cfg.n_pairs, rng)
     if len(pairs) == 0:
         raise StageError(f"critic_eval needs at least 2 train shapes, the split has {len(grids['train'])}")
-    resamples = pair_resamples(len(pairs), cfg.n_bootstrap, rng)
+    boot = PairBootstrap(len(pairs), cfg.n_bootstrap, rng)
     alphas = np.asarray(cfg.alphas, dtype=np.float32)
     keys = [f"{a:.2f}" for a in cfg.alphas]
     seq_alphas = np.linspace(0, 1, 7, dtype=np.float32)
@@ -55,34 +86,58 @@ def run(params: Params) -> None:
         if name == "ae_critic":
             if model_critic is None:
                 raise StageError(f"{path} holds no critic; retrain it with `dvc repro train_ae`")
-            critic = {k: v if np.isfinite(v) else None for k, v in critic_separation(ae, model_critic, grids["test"], device).items()}
+            separation = critic_separation(ae, model_critic, grids["test"], device)
+            critic = {k: v if np.isfinite(v) else None for k, v in separation.items()}
 
-    summary = {name: dict(zip(keys, summarize(pct[name], resamples))) for name in MODELS}
-    contrast = {c: dict(zip(keys, paired_contrast(pct[a], pct[b], resamples))) for c, (a, b) in CONTRASTS.items()}
-    write_json({
-        "n_pairs": int(len(pairs)), "n_decoded_per_model": int(pct["ae"].size), "n_bootstrap": cfg.n_bootstrap,
-        "critic_auc": critic["auc"], "critic": critic,
-        "outlier_pct": {name: {k: v["mean"] for k, v in summary[name].items()} for name in MODELS},
-        "outlier_pct_ci": summary, "contrast": contrast,
-        "empty_grids": {name: int(np.isnan(pct[name]).sum()) for name in MODELS},
-    }, CRITIC_EVAL_METRICS)
+    summary = {name: dict(zip(keys, summarize(pct[name], boot))) for name in MODELS}
+    contrast = {c: dict(zip(keys, outlier_contrast(pct[a], pct[b], boot))) for c, (a, b) in CONTRASTS.items()}
+    write_json(
+        {
+            "n_pairs": int(len(pairs)),
+            "n_decoded_per_model": int(pct["ae"].size),
+            "n_bootstrap": cfg.n_bootstrap,
+            "critic_auc": critic["auc"],
+            "critic": critic,
+            "outlier_pct": {name: {k: v["mean"] for k, v in summary[name].items()} for name in MODELS},
+            "outlier_pct_ci": summary,
+            "contrast": contrast,
+            "empty_grids": {name: int(np.isnan(pct[name]).sum()) for name in MODELS},
+        },
+        CRITIC_EVAL_METRICS,
+    )
 
     # one row per α, one column per model (and its interval), so `dvc plots` draws one line per model
-    columns = {m: [summary[m][k]["mean"] for k in keys] for m in MODELS}
-    bounds = {f"{m}_{end}": [summary[m][k][f"ci_{end}"] for k in keys] for m in MODELS for end in ("low", "high")}
-    wide = pd.DataFrame({"alpha": list(cfg.alphas), **columns, **bounds})
+    wide = pd.DataFrame(outlier_columns(summary, cfg.alphas, keys))
     write_csv(wide, OUTLIERS_CSV)
-    lines(list(cfg.alphas), {label: wide[m].to_numpy(dtype=float) for m, (_, label) in MODELS.items()}, OUTLIERS_PNG,
-          "interpolation weight α", "mean outlier voxels (%)", f"Outliers of decoded interpolations ({len(pairs)} pairs, 95% bootstrap intervals)",
-          intervals={label: (wide[f"{m}_low"].to_numpy(dtype=float), wide[f"{m}_high"].to_numpy(dtype=float)) for m, (_, label) in MODELS.items()})
-
-    rows, row_labels = [], []
-    for p in range(len(examples)):
-        for name, (_, label) in MODELS.items():
-            rows.append([(g, largest_cluster(g)) for g in sequences[name][p]])
-            row_labels.append(f"pair {p + 1} {label.split(' (')[0]}")
-    voxel_rows(rows, row_labels, [f"α={a:.2f}" for a in seq_alphas], INTERPOLATIONS_PNG, "Interpolations per pair: AE, AE + extra epochs (λ = 0), AE-Critic; main part green, outliers red")
+    labels = {m: label for m, (_, label) in MODELS.items()}
+    lines(
+        list(cfg.alphas),
+        {label: wide[m].to_numpy(dtype=float) for m, label in labels.items()},
+        OUTLIERS_PNG,
+        "interpolation weight α",
+        "mean outlier voxels (%)",
+        f"Outliers of decoded interpolations ({len(pairs)} pairs, 95% bootstrap intervals)",
+        intervals={
+            label: (wide[f"{m}_low"].to_numpy(dtype=float), wide[f"{m}_high"].to_numpy(dtype=float))
+            for m, label in labels.items()
+        },
+    )
+    rows, row_labels = interpolation_rows(sequences, {m: label.split(" (")[0] for m, label in labels.items()})
+    voxel_rows(
+        rows,
+        row_labels,
+        [f"α={a:.2f}" for a in seq_alphas],
+        INTERPOLATIONS_PNG,
+        "Interpolations per pair: AE, AE + extra epochs (λ = 0), AE-Critic; main part green, outliers red",
+    )
 
     diff = contrast["critic_vs_control"]
-    log.info("critic_eval: critic AUC %s; AE-Critic − control outlier %% at α %s: %s", critic["auc"], keys,
-             [None if diff[k]["mean"] is None else f"{diff[k]['mean']:+.2f} [{diff[k]['ci_low']:+.2f}, {diff[k]['ci_high']:+.2f}]" for k in keys])
+    log.info(
+        "critic_eval: critic AUC %s; AE-Critic − control outlier %% at α %s: %s",
+        critic["auc"],
+        keys,
+        [
+            None if d["mean"] is None else f"{d['mean']:+.2f} [{d['ci_low']:+.2f}, {d['ci_high']:+.2f}]"
+            for d in (diff[k] for k in keys)
+        ],
+    )

@@ -3,6 +3,7 @@
 Outputs: ``data/latents.parquet`` (``shape_id``, ``split``, ``z``: 128 float32),
 ``reports/embed/tsne.csv`` (for ``dvc plots``) and ``reports/embed/tsne.png``.
 """
+
 from __future__ import annotations
 
 import logging
@@ -10,16 +11,20 @@ import logging
 import numpy as np
 import pandas as pd
 
-from graspaug.config import Params
-from graspaug.io.checkpoints import load_autoencoder
-from graspaug.io.tables import write_csv, write_table
-from graspaug.plots import scatter_2d
-from graspaug.paths import AE_CRITIC_MODEL, LATENTS, SHAPES_TABLE, TSNE_CSV, TSNE_PNG, VOXELS
 from graspaug.device import resolve_device
 from graspaug.embedding import tsne_2d
+from graspaug.io.checkpoints import load_autoencoder
+from graspaug.io.tables import write_csv, write_table
+from graspaug.params.ae import AEParams
+from graspaug.params.base import params_model
+from graspaug.params.embed import EmbedParams
+from graspaug.paths import AE_CRITIC_MODEL, LATENTS, SHAPES_TABLE, TSNE_CSV, TSNE_PNG, VOXELS
+from graspaug.plots import scatter_2d
 from graspaug.training.autoencoder import encode, voxel_grids
 
 log = logging.getLogger(__name__)
+
+Params = params_model("The params the `embed` stage reads.", ae=AEParams, embed=EmbedParams)
 
 
 def run(params: Params) -> None:

@@ -12,6 +12,7 @@ Outputs, in ``data/generated/<B>/``: ``meshes/<shape_id>.obj``, ``index.parquet`
 per kept shape), ``rejects.parquet``, ``base.parquet`` (the base set with its scores); plus
 ``metrics/generate/<B>.json`` and ``reports/generate/<B>/{pairs,tsne}.png``.
 """
+
 from __future__ import annotations
 
 import logging
@@ -20,11 +21,21 @@ import time
 import numpy as np
 import pandas as pd
 
-from graspaug.config import Params
 from graspaug.device import resolve_device
 from graspaug.embedding import tsne_2d
 from graspaug.generation import (
-    BASE_SEED, Candidate, Decoded, PoolExhausted, RandomStream, TargetedStream, base_scores_table, draw_base_sets, fill_pool, pool_size, pool_summary, pool_tables,
+    BASE_SEED,
+    Candidate,
+    Decoded,
+    PoolExhausted,
+    RandomStream,
+    TargetedStream,
+    base_scores_table,
+    draw_base_sets,
+    fill_pool,
+    pool_size,
+    pool_summary,
+    pool_tables,
 )
 from graspaug.geometry.from_voxels import mesh_decoded
 from graspaug.io.atomic import atomic_path
@@ -32,8 +43,22 @@ from graspaug.io.checkpoints import load_autoencoder
 from graspaug.io.meshes import mesh_path, write_obj
 from graspaug.io.tables import read_table, write_json, write_table
 from graspaug.io.voxels import read_voxels
+from graspaug.params.ae import AEParams
+from graspaug.params.base import params_model
+from graspaug.params.embed import EmbedParams
+from graspaug.params.generate import GenerateParams
+from graspaug.params.score import ScoreParams
 from graspaug.paths import (
-    AE_CRITIC_MODEL, GENERATED_SUFFIX, LATENTS, SCORES, SHAPES_TABLE, VOXELS, generate_metrics, generate_reports, generated_dir, timing_file,
+    AE_CRITIC_MODEL,
+    GENERATED_SUFFIX,
+    LATENTS,
+    SCORES,
+    SHAPES_TABLE,
+    VOXELS,
+    generate_metrics,
+    generate_reports,
+    generated_dir,
+    timing_file,
 )
 from graspaug.plots import generated_pairs, scatter_2d
 from graspaug.scores import rarity
@@ -41,6 +66,10 @@ from graspaug.stages import StageError
 from graspaug.training.autoencoder import decode
 
 log = logging.getLogger(__name__)
+
+Params = params_model(
+    "The params the `generate` stage reads.", ae=AEParams, embed=EmbedParams, score=ScoreParams, generate=GenerateParams
+)
 
 
 def run(params: Params, base_size: int) -> None:
@@ -72,12 +101,23 @@ def run(params: Params, base_size: int) -> None:
         b = np.array([c.b for c in candidates])
         alpha = np.array([c.alpha for c in candidates], dtype=np.float32)[:, None]
         probability = decode(ae, (1 - alpha) * z[a] + alpha * z[b], device)
-        child_pitch = (1 - alpha[:, 0]) * pitch[a] + alpha[:, 0] * pitch[b]  # metric size: the parents' scales interpolated
-        out = parallel_map(lambda job: mesh_decoded(job[0], job[1], cfg.decode), list(zip(probability, child_pitch)), params.workers, f"generate {base_size}")
-        return [Decoded(c, np.packbits(grid.occupancy), mesh, reason) for c, (grid, mesh, reason) in zip(candidates, out)]
+        child_pitch = (1 - alpha[:, 0]) * pitch[a] + alpha[:, 0] * pitch[
+            b
+        ]  # metric size: the parents' scales interpolated
+        out = parallel_map(
+            lambda job: mesh_decoded(job[0], job[1], cfg.decode),
+            list(zip(probability, child_pitch)),
+            params.workers,
+            f"generate {base_size}",
+        )
+        return [
+            Decoded(c, np.packbits(grid.occupancy), mesh, reason) for c, (grid, mesh, reason) in zip(candidates, out)
+        ]
 
     needed = pool_size(cfg.ratios, base_size)
-    targeted_stream = TargetedStream(z, base_rarity, graspness, cfg.percentile, cfg.first_neighbour, cfg.extra_neighbours, cfg.alphas)
+    targeted_stream = TargetedStream(
+        z, base_rarity, graspness, cfg.percentile, cfg.first_neighbour, cfg.extra_neighbours, cfg.alphas
+    )
     random_stream = RandomStream(base_size, cfg.alphas, np.random.default_rng([params.seed, BASE_SEED, base_size]))
     pools = {}
     for name, stream in (("targeted", targeted_stream), ("random", random_stream)):
@@ -98,21 +138,41 @@ def run(params: Params, base_size: int) -> None:
         for row, d in zip(rows, targeted + randoms):
             write_obj(d.mesh, mesh_path(folder / "meshes", row["shape_id"], GENERATED_SUFFIX))
         write_table(index, folder / "index.parquet")
-        write_table(pd.DataFrame(reject_rows, columns=["pool", "parent_a", "parent_b", "alpha", "selected_by", "reason"]), folder / "rejects.parquet")
+        write_table(
+            pd.DataFrame(reject_rows, columns=["pool", "parent_a", "parent_b", "alpha", "selected_by", "reason"]),
+            folder / "rejects.parquet",
+        )
         write_table(base_table, folder / "base.parquet")
 
-    generated_pairs(base, voxels, targeted[:cfg.n_examples] + randoms[:2], generate_reports(base_size) / "pairs.png",
-                    f"Generated shapes of base set {base_size}")
+    generated_pairs(
+        base,
+        voxels,
+        targeted[: cfg.n_examples] + randoms[:2],
+        generate_reports(base_size) / "pairs.png",
+        f"Generated shapes of base set {base_size}",
+    )
     xy = tsne_2d(np.concatenate([z, np.stack(index.z.to_numpy())]), params.embed.perplexity, params.seed)
     groups = ["base"] * base_size + [f"generated ({s})" for s in index.selected_by]
-    scatter_2d(xy, groups, generate_reports(base_size) / "tsne.png", f"t-SNE of base set {base_size} and its generated shapes")
+    scatter_2d(
+        xy, groups, generate_reports(base_size) / "tsne.png", f"t-SNE of base set {base_size} and its generated shapes"
+    )
 
     summary, kept_share = pool_summary(base_size, needed, pools, targeted_stream, index, reject_rows)
     for name, share in kept_share.items():
         if share < 0.95:
-            log.warning("generate %d: only %.1f%% of the %s pool's decodes were usable meshes", base_size, 100 * share, name)
+            log.warning(
+                "generate %d: only %.1f%% of the %s pool's decodes were usable meshes", base_size, 100 * share, name
+            )
     write_json(summary, generate_metrics(base_size))
     seconds = round(time.perf_counter() - start, 1)
     write_json({"seconds": seconds}, timing_file("generate", str(base_size)))
-    log.info("generate %d: %d targeted (%d tried) + %d random (%d tried) shapes, %d rejected, in %.1f s", base_size, len(targeted),
-             summary["targeted"]["tried"], len(randoms), summary["random"]["tried"], len(reject_rows), seconds)
+    log.info(
+        "generate %d: %d targeted (%d tried) + %d random (%d tried) shapes, %d rejected, in %.1f s",
+        base_size,
+        len(targeted),
+        summary["targeted"]["tried"],
+        len(randoms),
+        summary["random"]["tried"],
+        len(reject_rows),
+        seconds,
+    )

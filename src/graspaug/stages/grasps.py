@@ -7,6 +7,7 @@ outward normals ``n1_*``, ``n2_*`` (m, in the shape's normalized frame), ``width
 ``eps`` (ε of the grasp as sampled), ``eps_mean`` / ``eps_std`` (robust ε over perturbations),
 ``success`` (``eps_mean > threshold``); and ``metrics/grasps/<corpus>.json``.
 """
+
 from __future__ import annotations
 
 import logging
@@ -16,16 +17,19 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from graspaug.config import GraspsParams, Params
 from graspaug.grasping.antipodal import sample_antipodal_grasps
 from graspaug.grasping.robust import grasp_epsilon, robust_ferrari_canny
 from graspaug.io.meshes import mesh_path, read_mesh
 from graspaug.io.tables import read_table, write_json, write_table
+from graspaug.params.base import params_model
+from graspaug.params.grasps import GraspsParams
 from graspaug.paths import grasps_metrics, grasps_table, timing_file
 from graspaug.rng import shape_rng
 from graspaug.stages import corpus_paths
 
 log = logging.getLogger(__name__)
+
+Params = params_model("The params the `grasps` stage reads.", grasps=GraspsParams)
 
 VECTORS = ("center", "axis", "p1", "n1", "p2", "n2")
 
@@ -38,7 +42,10 @@ def grasps_of_shape(path: Path, shape_id: str, cfg: GraspsParams, seed: int) -> 
     grasps = sample_antipodal_grasps(mesh, hand, cfg.sampler, rng)
     eps = grasp_epsilon(mesh, grasps.center, grasps.axis, quality.friction_coef, hand, quality)
     eps_mean, eps_std = robust_ferrari_canny(mesh, grasps.center, grasps.axis, hand, quality, cfg.perturbations, rng)
-    columns: dict[str, object] = {"shape_id": np.full(len(grasps), shape_id, dtype=object), "grasp_id": np.arange(len(grasps))}
+    columns: dict[str, object] = {
+        "shape_id": np.full(len(grasps), shape_id, dtype=object),
+        "grasp_id": np.arange(len(grasps)),
+    }
     for name in VECTORS:
         values = getattr(grasps, name)
         for i, axis in enumerate("xyz"):
@@ -47,8 +54,11 @@ def grasps_of_shape(path: Path, shape_id: str, cfg: GraspsParams, seed: int) -> 
     reason = None
     if len(grasps) == 0:
         smallest = float(np.min(mesh.bounding_box_oriented.extents))
-        reason = (f"its oriented bounding box's smallest side, {smallest:.3f} m, is wider than the {hand.max_width} m opening" if smallest >= hand.max_width
-                  else f"no antipodal grasp passed the width and force-closure tests in {cfg.sampler.max_rounds} rounds")
+        reason = (
+            f"its oriented bounding box's smallest side, {smallest:.3f} m, is wider than the {hand.max_width} m opening"
+            if smallest >= hand.max_width
+            else f"no antipodal grasp passed the width and force-closure tests in {cfg.sampler.max_rounds} rounds"
+        )
     return pd.DataFrame(columns), reason
 
 
@@ -61,7 +71,9 @@ def run(params: Params, corpus: str = "original") -> None:
     table_path, mesh_dir, suffix = files
     shape_ids = list(read_table(table_path)["shape_id"])
     jobs = [(mesh_path(mesh_dir.resolve(), s, suffix), s) for s in shape_ids]  # workers may have another cwd
-    results = parallel_map(lambda job: grasps_of_shape(job[0], job[1], cfg, params.seed), jobs, params.workers, f"grasps ({corpus})")
+    results = parallel_map(
+        lambda job: grasps_of_shape(job[0], job[1], cfg, params.seed), jobs, params.workers, f"grasps ({corpus})"
+    )
     for shape_id, (_, reason) in zip(shape_ids, results):
         if reason:
             log.warning("grasps: %s has no grasp: %s", shape_id, reason)
@@ -81,5 +93,12 @@ def run(params: Params, corpus: str = "original") -> None:
     }
     write_json(summary, grasps_metrics(corpus))
     write_json({"seconds": round(seconds, 1)}, timing_file("grasps", corpus))
-    log.info("grasps (%s): %d grasps on %d shapes (%d without), %.1f%% successful, in %.1f s", corpus, len(table), len(shape_ids),
-             summary["shapes_without_grasps"], 100 * (summary["success_share"] or 0), seconds)
+    log.info(
+        "grasps (%s): %d grasps on %d shapes (%d without), %.1f%% successful, in %.1f s",
+        corpus,
+        len(table),
+        len(shape_ids),
+        summary["shapes_without_grasps"],
+        100 * (summary["success_share"] or 0),
+        seconds,
+    )

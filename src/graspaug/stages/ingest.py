@@ -2,6 +2,7 @@
 
 Outputs: ``data/shapes/<shape_id>.ply``, ``data/shapes.parquet``, ``data/rejects.parquet``.
 """
+
 from __future__ import annotations
 
 import logging
@@ -10,15 +11,19 @@ from collections import Counter
 
 import pandas as pd
 
-from graspaug.config import Params
 from graspaug.corpus import assign_split, closing_summary, flag_duplicates, ingest_source
 from graspaug.io.atomic import atomic_path
+from graspaug.io.settings import CorpusSettings
 from graspaug.io.sources import folder_sources, pybullet_sources
 from graspaug.io.tables import write_table
+from graspaug.params.base import params_model
+from graspaug.params.ingest import IngestParams
 from graspaug.paths import REJECTS_TABLE, SHAPES_DIR, SHAPES_TABLE
 from graspaug.stages import StageError
 
 log = logging.getLogger(__name__)
+
+Params = params_model("The params the `ingest` stage reads.", data=CorpusSettings, ingest=IngestParams)
 
 
 def run(params: Params) -> None:
@@ -36,14 +41,27 @@ def run(params: Params) -> None:
 
     with atomic_path(SHAPES_DIR, directory=True) as tmp_dir:
         tmp_dir = tmp_dir.resolve()  # worker processes may have another working directory
-        rows = parallel_map(lambda s: ingest_source(s, cfg.max_faces, cfg.max_file_mb, cfg.surface, tmp_dir), sources, params.workers, "ingest")
+        rows = parallel_map(
+            lambda s: ingest_source(s, cfg.max_faces, cfg.max_file_mb, cfg.surface, tmp_dir),
+            sources,
+            params.workers,
+            "ingest",
+        )
         kept = [r for r in rows if r.pop("ok")]
-        shapes = flag_duplicates(pd.DataFrame(kept).drop(columns="_occupancy", errors="ignore"), [r["_occupancy"] for r in kept])
-        rejects = pd.DataFrame([r for r in rows if "reason" in r], columns=["shape_id", "source", "source_sha256", "reason"])
+        shapes = flag_duplicates(
+            pd.DataFrame(kept).drop(columns="_occupancy", errors="ignore"), [r["_occupancy"] for r in kept]
+        )
+        rejects = pd.DataFrame(
+            [r for r in rows if "reason" in r], columns=["shape_id", "source", "source_sha256", "reason"]
+        )
         if len(shapes) < cfg.min_shapes:
             reasons = "; ".join(f"{n}× {r}" for r, n in Counter(rejects["reason"]).most_common(3))
-            raise StageError(f"only {len(shapes)} of {len(sources)} shapes are usable, ingest.min_shapes={cfg.min_shapes} ({reasons})")
-        split = assign_split(list(shapes["shape_id"]), cfg.test_fraction, params.seed, dict(zip(shapes.shape_id, shapes.duplicate_of)))
+            raise StageError(
+                f"only {len(shapes)} of {len(sources)} shapes are usable, ingest.min_shapes={cfg.min_shapes} ({reasons})"
+            )
+        split = assign_split(
+            list(shapes["shape_id"]), cfg.test_fraction, params.seed, dict(zip(shapes.shape_id, shapes.duplicate_of))
+        )
         shapes["split"] = shapes["shape_id"].map(split)
         shapes["origin"] = "original"
         write_table(shapes, SHAPES_TABLE)
@@ -53,11 +71,21 @@ def run(params: Params) -> None:
         log.info("rejected %d: %s", n, reason)
     log.info("ingest: %s", closing_summary(shapes))
     kinds = shapes["duplicate_kind"].value_counts()
-    log.info("ingest: %d duplicates kept and flagged (%d exact, %d same geometry), each in its original's split",
-             int((shapes["duplicate_of"] != "").sum()), kinds.get("exact", 0), kinds.get("geometry", 0))
+    log.info(
+        "ingest: %d duplicates kept and flagged (%d exact, %d same geometry), each in its original's split",
+        int((shapes["duplicate_of"] != "").sum()),
+        kinds.get("exact", 0),
+        kinds.get("geometry", 0),
+    )
     counts = shapes["split"].value_counts()
     log.info(
         "ingest: %d shapes (%d train, %d test), %d rejected, %d/%d watertight, median %d faces, in %.1f s",
-        len(shapes), counts.get("train", 0), counts.get("test", 0), len(rejects),
-        int(shapes["watertight"].sum()), len(shapes), int(shapes["faces"].median()), time.perf_counter() - start,
+        len(shapes),
+        counts.get("train", 0),
+        counts.get("test", 0),
+        len(rejects),
+        int(shapes["watertight"].sum()),
+        len(shapes),
+        int(shapes["faces"].median()),
+        time.perf_counter() - start,
     )

@@ -16,6 +16,7 @@ axis in the image), ``z`` (m, gripper depth), ``width_px`` (open jaws in image p
 ``label`` (= collision_free and success); ``metrics/render/<corpus>.json``;
 ``reports/render/<corpus>/examples.png``.
 """
+
 from __future__ import annotations
 
 import json
@@ -25,16 +26,21 @@ import time
 import numpy as np
 import pandas as pd
 
-from graspaug.config import Params
 from graspaug.io.atomic import atomic_path
 from graspaug.io.gqcnn import write_grasp_images
 from graspaug.io.meshes import mesh_path
 from graspaug.io.tables import read_table, write_json
+from graspaug.params.base import params_model
+from graspaug.params.grasps import GraspsParams
+from graspaug.params.render import RenderParams
 from graspaug.paths import gqcnn_dir, grasps_table, render_examples, render_metrics, timing_file
 from graspaug.render.dataset import datapoints_index, render_file
 from graspaug.stages import StageError, corpus_paths
 
 log = logging.getLogger(__name__)
+
+Params = params_model("The params the `render` stage reads.", render=RenderParams, grasps=GraspsParams)
+
 
 def run(params: Params, corpus: str = "original") -> None:
     from graspaug.parallel import parallel_map
@@ -58,13 +64,23 @@ def run(params: Params, corpus: str = "original") -> None:
     jobs = []
     for shape_id in shapes.shape_id:
         rows = by_shape.get(shape_id, empty)
-        jobs.append((mesh_path(mesh_dir.resolve(), shape_id, suffix), shape_id, rows[["center_x", "center_y", "center_z"]].to_numpy(),
-                     rows[["axis_x", "axis_y", "axis_z"]].to_numpy()))
-    results = parallel_map(lambda job: render_file(*job, settings, hand, params.seed), jobs, params.workers, f"render ({corpus})")
+        jobs.append(
+            (
+                mesh_path(mesh_dir.resolve(), shape_id, suffix),
+                shape_id,
+                rows[["center_x", "center_y", "center_z"]].to_numpy(),
+                rows[["axis_x", "axis_y", "axis_z"]].to_numpy(),
+            )
+        )
+    results = parallel_map(
+        lambda job: render_file(*job, settings, hand, params.seed), jobs, params.workers, f"render ({corpus})"
+    )
 
     images, parts, skipped, n_rays, n_poses = datapoints_index(shapes, by_shape, results, params.grasps.threshold)
     if not parts:
-        raise StageError(f"render ({corpus}): no shape gave a datapoint; reasons: {sorted({s['reason'] for s in skipped})[:3]}")
+        raise StageError(
+            f"render ({corpus}): no shape gave a datapoint; reasons: {sorted({s['reason'] for s in skipped})[:3]}"
+        )
     index = pd.concat(parts, ignore_index=True)
     for column in ("base_size", "order"):
         index[column] = index[column].astype("Int64")
@@ -72,9 +88,20 @@ def run(params: Params, corpus: str = "original") -> None:
     images = np.concatenate(images)
     camera = settings.intrinsics
     dataset_info = {
-        "corpus": corpus, "intrinsics": {"width": camera.width, "height": camera.height, "fx": camera.fx, "fy": camera.fy, "cx": camera.cx, "cy": camera.cy},
-        "crop_size": settings.crop.crop_size, "out_size": settings.crop.out_size, "gripper_max_width": hand.max_width,
-        "label": f"collision_free and robust Ferrari-Canny eps_mean > {params.grasps.threshold}", "grasps_threshold": params.grasps.threshold,
+        "corpus": corpus,
+        "intrinsics": {
+            "width": camera.width,
+            "height": camera.height,
+            "fx": camera.fx,
+            "fy": camera.fy,
+            "cx": camera.cx,
+            "cy": camera.cy,
+        },
+        "crop_size": settings.crop.crop_size,
+        "out_size": settings.crop.out_size,
+        "gripper_max_width": hand.max_width,
+        "label": f"collision_free and robust Ferrari-Canny eps_mean > {params.grasps.threshold}",
+        "grasps_threshold": params.grasps.threshold,
     }
     with atomic_path(gqcnn_dir(corpus), directory=True) as folder:
         write_grasp_images(folder, images, index, cfg.shard_rows)
@@ -92,12 +119,21 @@ def run(params: Params, corpus: str = "original") -> None:
         "positive_share": round(float(index.label.mean()), 4),
         "collision_free_share": round(float(index.collision_free.mean()), 4),
         "success_share": round(float(index.success.mean()), 4),
-        "by_split": {split: {"datapoints": int(len(rows)), "positives": int(rows.label.sum()), "shapes": int(rows.shape_id.nunique())}
-                     for split, rows in index.groupby("split")},
+        "by_split": {
+            split: {
+                "datapoints": int(len(rows)),
+                "positives": int(rows.label.sum()),
+                "shapes": int(rows.shape_id.nunique()),
+            }
+            for split, rows in index.groupby("split")
+        },
         "rays_per_datapoint": round(n_rays / len(index), 1),
     }
     write_json(summary, render_metrics(corpus))
-    write_json({"seconds": round(seconds, 1), "datapoints_per_second": round(len(index) / seconds, 1)}, timing_file("render", corpus))
+    write_json(
+        {"seconds": round(seconds, 1), "datapoints_per_second": round(len(index) / seconds, 1)},
+        timing_file("render", corpus),
+    )
 
     rng = np.random.default_rng([params.seed, len(index)])
     half = cfg.n_examples // 2
@@ -106,8 +142,24 @@ def run(params: Params, corpus: str = "original") -> None:
     take_neg = rng.choice(negatives, min(len(negatives), cfg.n_examples - len(take_pos)), replace=False)
     chosen = np.concatenate([np.sort(take_pos), np.sort(take_neg)])
     picked = index.iloc[chosen]
-    titles = [f"{'+' if r.label else '-'} {r.shape_id}\nε={r.eps:.4f} z={r.z:.3f}" + ("" if r.collision_free else " hit") for r in picked.itertuples()]
-    crop_grid(images[chosen], titles, picked.width_px.to_numpy() / 2 / settings.crop.factor, render_examples(corpus),
-              f"render ({corpus}): positives (+) then negatives (-); red ticks: open jaws; 'hit': approach collides")
-    log.info("render (%s): %d datapoints from %d shapes (%d skipped), %.1f%% positive (%.1f%% collision free), %.1f s", corpus, len(index),
-             len(parts), len(skipped), 100 * summary["positive_share"], 100 * summary["collision_free_share"], seconds)
+    titles = [
+        f"{'+' if r.label else '-'} {r.shape_id}\nε={r.eps:.4f} z={r.z:.3f}" + ("" if r.collision_free else " hit")
+        for r in picked.itertuples()
+    ]
+    crop_grid(
+        images[chosen],
+        titles,
+        picked.width_px.to_numpy() / 2 / settings.crop.factor,
+        render_examples(corpus),
+        f"render ({corpus}): positives (+) then negatives (-); red ticks: open jaws; 'hit': approach collides",
+    )
+    log.info(
+        "render (%s): %d datapoints from %d shapes (%d skipped), %.1f%% positive (%.1f%% collision free), %.1f s",
+        corpus,
+        len(index),
+        len(parts),
+        len(skipped),
+        100 * summary["positive_share"],
+        100 * summary["collision_free_share"],
+        seconds,
+    )

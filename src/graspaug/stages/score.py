@@ -10,6 +10,7 @@ Outputs: ``data/scores.parquet`` (``shape_id``, ``split``, ``rarity``, ``graspne
 rarity histograms of the train split (CSV + PNG; the graspness one is the paper's Fig. 4) and
 ``grasp_examples.png`` (low / middle / high graspness shapes with their grasps).
 """
+
 from __future__ import annotations
 
 import logging
@@ -17,18 +18,31 @@ import logging
 import numpy as np
 import pandas as pd
 
-from graspaug.config import Params
 from graspaug.io.meshes import mesh_path, read_mesh
 from graspaug.io.tables import read_table, write_csv, write_json, write_table
+from graspaug.params.base import params_model
+from graspaug.params.grasps import GraspsParams
+from graspaug.params.score import ScoreParams
 from graspaug.paths import (
-    GRASP_EXAMPLES_PNG, GRASPNESS_HIST_CSV, GRASPNESS_HIST_PNG, LATENTS, RARITY_HIST_CSV, RARITY_HIST_PNG, SCORE_METRICS,
-    SCORES, SHAPES_DIR, SHAPES_TABLE, grasps_table,
+    GRASP_EXAMPLES_PNG,
+    GRASPNESS_HIST_CSV,
+    GRASPNESS_HIST_PNG,
+    LATENTS,
+    RARITY_HIST_CSV,
+    RARITY_HIST_PNG,
+    SCORE_METRICS,
+    SCORES,
+    SHAPES_DIR,
+    SHAPES_TABLE,
+    grasps_table,
 )
 from graspaug.plots import grasps_on_shapes, histogram
 from graspaug.scores import graspness, rarity
 from graspaug.stages import StageError
 
 log = logging.getLogger(__name__)
+
+Params = params_model("The params the `score` stage reads.", score=ScoreParams, grasps=GraspsParams)
 
 
 def shape_scores(shapes: pd.DataFrame, latents: pd.DataFrame, grasps: pd.DataFrame, k: int) -> pd.DataFrame:
@@ -49,13 +63,25 @@ def shape_scores(shapes: pd.DataFrame, latents: pd.DataFrame, grasps: pd.DataFra
     known = grasps.shape_id.isin(index).to_numpy()
     share, counts = graspness(grasps.success.to_numpy()[known], index.get_indexer(grasps.shape_id[known]), len(shapes))
     wins = np.rint(share * counts).astype(np.int64)
-    return pd.DataFrame({"shape_id": shapes.shape_id.to_numpy(), "split": shapes.split.to_numpy(), "rarity": scores,
-                         "graspness": share, "n_grasps": counts, "n_success": wins})
+    return pd.DataFrame(
+        {
+            "shape_id": shapes.shape_id.to_numpy(),
+            "split": shapes.split.to_numpy(),
+            "rarity": scores,
+            "graspness": share,
+            "n_grasps": counts,
+            "n_success": wins,
+        }
+    )
 
 
 def histogram_table(values: np.ndarray, bins: int, lo: float | None = None, hi: float | None = None) -> pd.DataFrame:
-    counts, edges = np.histogram(values, bins=bins, range=(lo if lo is not None else values.min(), hi if hi is not None else values.max()))
-    return pd.DataFrame({"bin_left": edges[:-1], "bin_right": edges[1:], "bin_center": 0.5 * (edges[:-1] + edges[1:]), "shapes": counts})
+    counts, edges = np.histogram(
+        values, bins=bins, range=(lo if lo is not None else values.min(), hi if hi is not None else values.max())
+    )
+    return pd.DataFrame(
+        {"bin_left": edges[:-1], "bin_right": edges[1:], "bin_center": 0.5 * (edges[:-1] + edges[1:]), "shapes": counts}
+    )
 
 
 def example_shapes(scores: pd.DataFrame) -> list[str]:
@@ -82,12 +108,22 @@ def run(params: Params) -> None:
     train = scores[scores.split == "train"]
     g_hist = histogram_table(train.graspness.to_numpy(), cfg.bins, 0.0, 1.0)
     write_csv(g_hist, GRASPNESS_HIST_CSV)
-    histogram(g_hist.shapes.to_numpy(), np.r_[g_hist.bin_left, g_hist.bin_right.iloc[-1]], GRASPNESS_HIST_PNG,
-              f"graspness (share of grasps with robust ε > {params.grasps.threshold})", f"Graspness of the {len(train)} train shapes")
+    histogram(
+        g_hist.shapes.to_numpy(),
+        np.r_[g_hist.bin_left, g_hist.bin_right.iloc[-1]],
+        GRASPNESS_HIST_PNG,
+        f"graspness (share of grasps with robust ε > {params.grasps.threshold})",
+        f"Graspness of the {len(train)} train shapes",
+    )
     r_hist = histogram_table(train.rarity.to_numpy(), cfg.bins)
     write_csv(r_hist, RARITY_HIST_CSV)
-    histogram(r_hist.shapes.to_numpy(), np.r_[r_hist.bin_left, r_hist.bin_right.iloc[-1]], RARITY_HIST_PNG,
-              f"rarity R, eq. (4), k = {cfg.k}", f"Rarity of the {len(train)} train shapes")
+    histogram(
+        r_hist.shapes.to_numpy(),
+        np.r_[r_hist.bin_left, r_hist.bin_right.iloc[-1]],
+        RARITY_HIST_PNG,
+        f"rarity R, eq. (4), k = {cfg.k}",
+        f"Rarity of the {len(train)} train shapes",
+    )
 
     picks = example_shapes(scores)
     if not picks:
@@ -95,10 +131,15 @@ def run(params: Params) -> None:
     drawn = [(read_mesh(mesh_path(SHAPES_DIR, s)), grasps[grasps.shape_id == s]) for s in picks]
     grasps_on_shapes(
         [(m.vertices, m.faces) for m, _ in drawn],
-        [np.stack([g[["p1_x", "p1_y", "p1_z"]].to_numpy(), g[["p2_x", "p2_y", "p2_z"]].to_numpy()], axis=1) for _, g in drawn],
+        [
+            np.stack([g[["p1_x", "p1_y", "p1_z"]].to_numpy(), g[["p2_x", "p2_y", "p2_z"]].to_numpy()], axis=1)
+            for _, g in drawn
+        ],
         [g.eps_mean.to_numpy() for _, g in drawn],
         [f"{s}: graspness {scores.set_index('shape_id').graspness[s]:.2f}" for s in picks],
-        GRASP_EXAMPLES_PNG, vmax=2 * params.grasps.threshold, threshold=params.grasps.threshold,
+        GRASP_EXAMPLES_PNG,
+        vmax=2 * params.grasps.threshold,
+        threshold=params.grasps.threshold,
     )
     summary = {
         "n_train": int(len(train)),
@@ -110,4 +151,9 @@ def run(params: Params) -> None:
         "rarity_graspness_spearman": _rounded(train[["rarity", "graspness"]].corr(method="spearman").iloc[0, 1]),
     }
     write_json(summary, SCORE_METRICS)
-    log.info("score: %d shapes; train graspness mean %.3f, rarity median %.3f", len(scores), summary["graspness_train_mean"], summary["rarity_train_median"])
+    log.info(
+        "score: %d shapes; train graspness mean %.3f, rarity median %.3f",
+        len(scores),
+        summary["graspness_train_mean"],
+        summary["rarity_train_median"],
+    )

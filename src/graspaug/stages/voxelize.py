@@ -1,4 +1,5 @@
 """Stage ``voxelize``: every shape's outer surface → a solid R³ occupancy grid in ``data/voxels.npz``."""
+
 from __future__ import annotations
 
 import logging
@@ -7,14 +8,17 @@ from pathlib import Path
 
 import numpy as np
 
-from graspaug.config import Params
 from graspaug.geometry.voxelize import fit_grid, voxelize_solid
 from graspaug.io.meshes import mesh_path, read_mesh
 from graspaug.io.tables import read_table
 from graspaug.io.voxels import VoxelSet, write_voxels
+from graspaug.params.base import params_model
+from graspaug.params.voxelize import VoxelizeParams
 from graspaug.paths import SHAPES_DIR, SHAPES_TABLE, VOXELS
 
 log = logging.getLogger(__name__)
+
+Params = params_model("The params the `voxelize` stage reads.", voxelize=VoxelizeParams)
 
 
 def voxelize_file(path: Path, resolution: int, margin: int) -> tuple[np.ndarray, float, np.ndarray]:
@@ -41,4 +45,10 @@ def run(params: Params) -> None:
     )
     write_voxels(voxels, VOXELS)
     fill = voxels.occupancy.mean(axis=(1, 2, 3))
-    log.info("voxelize: %d shapes at %d³, mean fill %.3f, in %.1f s", len(shape_ids), cfg.resolution, fill.mean(), time.perf_counter() - start)
+    log.info(
+        "voxelize: %d shapes at %d³, mean fill %.3f, in %.1f s",
+        len(shape_ids),
+        cfg.resolution,
+        fill.mean(),
+        time.perf_counter() - start,
+    )

@@ -4,6 +4,7 @@ Voxel grids travel as ``(N, 1, R, R, R)`` uint8 tensors (0/1) and are turned int
 float batches on the device. Every random choice (batch order, flips, α) comes from one
 ``torch.Generator``.
 """
+
 from __future__ import annotations
 
 import time
@@ -15,7 +16,6 @@ from tqdm import tqdm
 
 from graspaug.nets.ae_critic import AutoEncoder, Critic, autoencoder_loss, critic_loss, folded_alpha, reversed_partners
 from graspaug.training.settings import AETrainConfig
-
 
 EpochCallback = Callable[[int, dict[str, float]], None]
 
@@ -35,7 +35,14 @@ def _as_float(x: torch.Tensor, device: torch.device) -> torch.Tensor:
     return x.to(device=device, dtype=torch.float32, non_blocking=True)
 
 
-def train_autoencoder(ae: AutoEncoder, voxels: torch.Tensor, cfg: AETrainConfig, device: torch.device, gen: torch.Generator, on_epoch: EpochCallback | None = None) -> float:
+def train_autoencoder(
+    ae: AutoEncoder,
+    voxels: torch.Tensor,
+    cfg: AETrainConfig,
+    device: torch.device,
+    gen: torch.Generator,
+    on_epoch: EpochCallback | None = None,
+) -> float:
     """Phase 1: minimize the reconstruction BCE with Adam(lr_ae). Returns shapes/s."""
     ae.to(device)
     opt = torch.optim.Adam(ae.parameters(), lr=cfg.lr_ae)
@@ -60,7 +67,15 @@ def train_autoencoder(ae: AutoEncoder, voxels: torch.Tensor, cfg: AETrainConfig,
     return seen / max(elapsed, 1e-9)
 
 
-def train_ae_critic(ae: AutoEncoder, critic: Critic | None, voxels: torch.Tensor, cfg: AETrainConfig, device: torch.device, gen: torch.Generator, on_epoch: EpochCallback | None = None) -> float:
+def train_ae_critic(
+    ae: AutoEncoder,
+    critic: Critic | None,
+    voxels: torch.Tensor,
+    cfg: AETrainConfig,
+    device: torch.device,
+    gen: torch.Generator,
+    on_epoch: EpochCallback | None = None,
+) -> float:
     """Phase 2: critic on eq. (1) with Adam(lr_critic), AE on eq. (2) with Adam(lr_ae_critic).
 
     ``critic=None`` is the control arm: the same epochs, learning rate, batches, flips and
@@ -81,7 +96,9 @@ def train_ae_critic(ae: AutoEncoder, critic: Critic | None, voxels: torch.Tensor
         opt_c = torch.optim.Adam(critic.parameters(), lr=cfg.lr_critic)
     lam = cfg.lam if critic is not None else 0.0
     seen, elapsed = 0, 0.0
-    for epoch in tqdm(range(cfg.epochs_critic), desc="train AE-Critic" if critic is not None else "train AE, λ = 0", unit="epoch"):
+    for epoch in tqdm(
+        range(cfg.epochs_critic), desc="train AE-Critic" if critic is not None else "train AE, λ = 0", unit="epoch"
+    ):
         train_ae = epoch >= cfg.critic_warmup
         ae.train(train_ae)  # in the warm-up the AE does not learn, its statistics included
         ae.decoder.eval()  # frozen normalization statistics (weights still learn)
@@ -129,7 +146,14 @@ def train_ae_critic(ae: AutoEncoder, critic: Critic | None, voxels: torch.Tensor
 
 
 @torch.no_grad()
-def critic_separation(ae: AutoEncoder, critic: Critic, voxels: torch.Tensor, device: torch.device, n_shapes: int = 200, batch_size: int = 64) -> dict[str, float]:
+def critic_separation(
+    ae: AutoEncoder,
+    critic: Critic,
+    voxels: torch.Tensor,
+    device: torch.device,
+    n_shapes: int = 200,
+    batch_size: int = 64,
+) -> dict[str, float]:
     """How well the critic tells held-out real grids from decoded interpolants.
 
     The first ``n_shapes`` of ``voxels`` (N, 1, R, R, R) (held-out shapes: the test split) are
@@ -144,14 +168,22 @@ def critic_separation(ae: AutoEncoder, critic: Critic, voxels: torch.Tensor, dev
     grids = voxels[:n_shapes]
     n = len(grids)
     if n < 2:
-        return {"auc": float("nan"), "auc_vs_reconstructions": float("nan"), "real_mean": float("nan"), "reconstruction_mean": float("nan"), "interp_mean": float("nan")}
+        return {
+            "auc": float("nan"),
+            "auc_vs_reconstructions": float("nan"),
+            "real_mean": float("nan"),
+            "reconstruction_mean": float("nan"),
+            "interp_mean": float("nan"),
+        }
     alpha = torch.linspace(0.1, 0.5, n)
     z = torch.as_tensor(encode(ae, grids, device))
     z_mix = (1 - alpha[:, None]) * z + alpha[:, None] * z.flip(0)
     critic.eval().to(device)
 
     def scores(batch_of: Callable[[slice], torch.Tensor]) -> np.ndarray:
-        return torch.cat([critic(batch_of(slice(i, i + batch_size)).to(device)).cpu() for i in range(0, n, batch_size)]).numpy()
+        return torch.cat(
+            [critic(batch_of(slice(i, i + batch_size)).to(device)).cpu() for i in range(0, n, batch_size)]
+        ).numpy()
 
     real = scores(lambda s: _as_float(grids[s], device))
     recon = scores(lambda s: torch.from_numpy(decode(ae, z[s].numpy(), device))[:, None])
@@ -204,7 +236,11 @@ def voxel_grids(voxels_path, shapes_path) -> tuple[np.ndarray, np.ndarray, torch
 
     voxels = read_voxels(voxels_path)
     split = read_table(shapes_path).set_index("shape_id")["split"]
-    return voxels.shape_id, split.reindex(voxels.shape_id).to_numpy(), torch.from_numpy(voxels.occupancy[:, None].astype(np.uint8))
+    return (
+        voxels.shape_id,
+        split.reindex(voxels.shape_id).to_numpy(),
+        torch.from_numpy(voxels.occupancy[:, None].astype(np.uint8)),
+    )
 
 
 def grids_by_split(voxels_path, shapes_path) -> dict[str, torch.Tensor]:

@@ -6,6 +6,7 @@ one ``torch.Generator``. The budget rule is a number of passes over each network
 training set (with a step cap), the learning rate annealed along a cosine, and the weights
 with the best validation AP kept: every variant is trained to about the same convergence.
 """
+
 from __future__ import annotations
 
 import copy
@@ -17,8 +18,8 @@ from dataclasses import dataclass
 import numpy as np
 import torch
 import torch.nn.functional as F
-from torch.optim.swa_utils import AveragedModel, get_ema_multi_avg_fn
 from sklearn.metrics import accuracy_score, average_precision_score, roc_auc_score
+from torch.optim.swa_utils import AveragedModel, get_ema_multi_avg_fn
 from tqdm import tqdm
 
 from graspaug.nets.gqcnn import GQCNN
@@ -36,26 +37,29 @@ class GraspArrays:
     def __len__(self) -> int:
         return len(self.labels)
 
-    def subset(self, rows: np.ndarray) -> GraspArrays:
-        return GraspArrays(self.images[rows], self.z[rows], self.labels[rows])
-
 
 LogCallback = Callable[[int, dict[str, float]], None]
 
 
 def normalization(net: GQCNN, train: GraspArrays) -> tuple[float, float, float, float]:
     """One scalar mean / std of what the conv layers see and of z over the training data (Dex-Net)."""
-    images = net.image_input(torch.from_numpy(np.ascontiguousarray(train.images)).unsqueeze(1), torch.from_numpy(train.z.astype(np.float32)))
+    images = net.image_input(
+        torch.from_numpy(np.ascontiguousarray(train.images)).unsqueeze(1), torch.from_numpy(train.z.astype(np.float32))
+    )
     return (float(images.mean()), float(images.std()) or 1.0, float(train.z.mean()), float(train.z.std()) or 1.0)
 
 
-def augment(images: torch.Tensor, z: torch.Tensor, noise: NoiseSettings, gen: torch.Generator) -> tuple[torch.Tensor, torch.Tensor]:
+def augment(
+    images: torch.Tensor, z: torch.Tensor, noise: NoiseSettings, gen: torch.Generator
+) -> tuple[torch.Tensor, torch.Tensor]:
     """Noisy, symmetrized copies of a batch of depth crops (N, 1, S, S) and gripper depths (N,)
     (m). The multiplicative noise scales a crop and its gripper depth together (the scene seen
     nearer or farther), so the object's height relative to the gripper keeps its meaning."""
     n, _, size, _ = images.shape
     if noise.gamma_shape > 0:
-        draws = np.random.default_rng(int(torch.randint(2**31, (1,), generator=gen))).gamma(noise.gamma_shape, 1 / noise.gamma_shape, n)
+        draws = np.random.default_rng(int(torch.randint(2**31, (1,), generator=gen))).gamma(
+            noise.gamma_shape, 1 / noise.gamma_shape, n
+        )
         scale = torch.from_numpy(draws.astype(np.float32))
         images, z = images * scale.view(n, 1, 1, 1), z * scale
     if noise.gp_prob > 0 and noise.gp_sigma > 0:
@@ -77,7 +81,11 @@ def predict(net: GQCNN, data: GraspArrays, device: torch.device, batch: int = 12
     out = np.empty(len(data), dtype=np.float32)
     with torch.inference_mode():
         for start in range(0, len(data), batch):
-            images = torch.from_numpy(np.ascontiguousarray(data.images[start : start + batch])).unsqueeze(1).to(device, memory_format=torch.channels_last)
+            images = (
+                torch.from_numpy(np.ascontiguousarray(data.images[start : start + batch]))
+                .unsqueeze(1)
+                .to(device, memory_format=torch.channels_last)
+            )
             z = torch.from_numpy(np.ascontiguousarray(data.z[start : start + batch], dtype=np.float32)).to(device)
             out[start : start + batch] = net.success_probability(images, z).cpu().numpy()
     return out
@@ -102,8 +110,16 @@ def cosine_lr(step: int, steps: int, final: float) -> float:
     return final + (1 - final) * 0.5 * (1 + math.cos(math.pi * step / max(steps - 1, 1)))
 
 
-def train_gqcnn(net: GQCNN, train: GraspArrays, val: GraspArrays | None, settings: TrainSettings, device: torch.device, gen: torch.Generator,
-                on_log: LogCallback | None = None, progress: bool = True) -> dict:
+def train_gqcnn(
+    net: GQCNN,
+    train: GraspArrays,
+    val: GraspArrays | None,
+    settings: TrainSettings,
+    device: torch.device,
+    gen: torch.Generator,
+    on_log: LogCallback | None = None,
+    progress: bool = True,
+) -> dict:
     """Train ``net`` for ``settings.steps_for(len(train))`` SGD steps on batches drawn epoch by
     epoch from ``train`` (softmax cross-entropy), evaluating validation AP ``settings.evals``
     times; ``net`` ends with the weights of the best evaluation (the last ones without ``val``).
@@ -120,10 +136,16 @@ def train_gqcnn(net: GQCNN, train: GraspArrays, val: GraspArrays | None, setting
     net.set_normalization(*normalization(net, train))
     net.to(device, memory_format=torch.channels_last)  # measured ~1.3× faster on the CPU at these widths
     # the weights that are evaluated and kept: an exponential moving average of the trained ones, or those themselves
-    averaged = AveragedModel(net, multi_avg_fn=get_ema_multi_avg_fn(settings.ema_decay), use_buffers=True) if settings.ema_decay > 0 else None
+    averaged = (
+        AveragedModel(net, multi_avg_fn=get_ema_multi_avg_fn(settings.ema_decay), use_buffers=True)
+        if settings.ema_decay > 0
+        else None
+    )
     evaluated = averaged.module if averaged is not None else net
     steps = settings.steps_for(len(train))
-    opt = torch.optim.SGD(net.parameters(), lr=settings.lr, momentum=settings.momentum, weight_decay=settings.weight_decay)
+    opt = torch.optim.SGD(
+        net.parameters(), lr=settings.lr, momentum=settings.momentum, weight_decay=settings.weight_decay
+    )
     schedule = torch.optim.lr_scheduler.LambdaLR(opt, lambda step: cosine_lr(step, steps, settings.final_lr))
     eval_at = {int(round(steps * (i + 1) / settings.evals)) for i in range(settings.evals)}
     images = torch.from_numpy(np.ascontiguousarray(train.images)).unsqueeze(1)
@@ -161,8 +183,15 @@ def train_gqcnn(net: GQCNN, train: GraspArrays, val: GraspArrays | None, setting
                 scores = classification_metrics(val.labels, probability)
                 ap = scores["ap"] if scores["ap"] is not None else float("nan")
                 metrics.update(val_accuracy=scores["accuracy"], val_ap=ap)
-                if best["state"] is None or (math.isfinite(ap) and not ap <= best["val_ap"]):  # ties keep the earlier; a NaN is replaced
-                    best = {"step": step, "val_ap": ap, "state": copy.deepcopy(evaluated.state_dict()), "val_predictions": probability}
+                if best["state"] is None or (
+                    math.isfinite(ap) and not ap <= best["val_ap"]
+                ):  # ties keep the earlier; a NaN is replaced
+                    best = {
+                        "step": step,
+                        "val_ap": ap,
+                        "state": copy.deepcopy(evaluated.state_dict()),
+                        "val_predictions": probability,
+                    }
             if on_log is not None:
                 on_log(step, metrics)
             loss_sum, correct, seen = 0.0, 0, 0
@@ -171,5 +200,11 @@ def train_gqcnn(net: GQCNN, train: GraspArrays, val: GraspArrays | None, setting
         net.load_state_dict(best["state"])
     elif averaged is not None:
         net.load_state_dict(evaluated.state_dict())
-    return {"steps": steps, "best_step": best["step"], "best_val_ap": best["val_ap"], "val_predictions": best.get("val_predictions"), "train_seconds": seconds,
-            "samples_per_second": steps * batch_size / seconds}
+    return {
+        "steps": steps,
+        "best_step": best["step"],
+        "best_val_ap": best["val_ap"],
+        "val_predictions": best.get("val_predictions"),
+        "train_seconds": seconds,
+        "samples_per_second": steps * batch_size / seconds,
+    }

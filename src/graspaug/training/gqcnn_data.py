@@ -1,12 +1,13 @@
 """The GQ-CNN experiment's datasets, object-wise: which train-split shapes validate, which form
 the `real` pool and the ceiling, and the datapoints of every training set, the validation set
-and the test set, read from the rendered corpora.
+and the test set, read from the rendered corpora (GQ-CNN dataset folders, :mod:`graspaug.io.gqcnn`).
 
-Datapoints are :class:`~graspaug.training.gqcnn.GraspArrays`. A network is a :class:`Variant`:
+Datapoints are :class:`~graspaug.training.gqcnn.GraspArrays`. A network is a
+:class:`~graspaug.experiments.variants.Variant`:
 
 * ``targeted`` / ``random`` at base size B and ratio R: the datapoints of the B base shapes
-  (drawn from ``data/shapes.parquet`` as ``generate`` draws them) in ``data/gqcnn/original`` plus those of the first
-  round(R × B) shapes of that pool in ``data/gqcnn/gen_B``;
+  (drawn from the shape table as ``generate`` draws them) in the original corpus plus those of
+  the first round(R × B) shapes of that pool in the corpus of base size B's generated shapes;
 * ``real`` at B and R: the base shapes plus the first round(R × B) shapes of the real pool
   (more train-split shapes, in a seeded order);
 * ``ceiling``: every train-split shape outside validation.
@@ -15,34 +16,32 @@ Validation is a fixed, seeded set of train-split shapes that lie in no base set 
 pool: the same for every variant, pool and training seed, never trained on. Ratio 0 of any
 pool is the base set alone (the ``targeted`` network).
 """
+
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
+from graspaug.errors import DataError
+from graspaug.experiments.variants import Variant
 from graspaug.generation import draw_base_sets, ratio_count
 from graspaug.io.gqcnn import GraspImages
 from graspaug.io.tables import read_table
-from graspaug.paths import SHAPES_TABLE, gqcnn_dir, gqcnn_variant_name
 from graspaug.rng import shape_rng
 from graspaug.training.gqcnn import GraspArrays
 
-POOLS = ("targeted", "random", "real")
 
+@dataclass(frozen=True)
+class Corpora:
+    """The rendered GQ-CNN dataset folders the networks read: ``original`` (the ingested shapes)
+    and ``generated``, base size → the folder of that base set's generated shapes (both pools)."""
 
-@dataclass(frozen=True, order=True)
-class Variant:
-    """One network of a seed: ``pool`` (targeted, random, real or ceiling), base size, ratio."""
-
-    pool: str
-    base_size: int = 0
-    ratio: float = 0.0
-
-    @property
-    def name(self) -> str:
-        return gqcnn_variant_name(self.pool, self.base_size, self.ratio)
+    original: Path
+    generated: Mapping[int, Path] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -62,20 +61,28 @@ def experiment_split(train_ids: list[str], base: dict[int, list[str]], n_validat
     in_base = set().union(*map(set, base.values())) if base else set()
     free = sorted(set(train_ids) - in_base)
     if n_validation > len(free):
-        raise ValueError(f"gqcnn.val_shapes = {n_validation}, but only {len(free)} train shapes lie outside the base sets")
+        raise DataError(
+            f"gqcnn.val_shapes = {n_validation}, but only {len(free)} train shapes lie outside the base sets"
+        )
     order = [free[i] for i in shape_rng(seed, "gqcnn", "validation-and-real-pool").permutation(len(free))]
     validation = tuple(sorted(order[:n_validation]))
     ceiling = tuple(sorted(set(train_ids) - set(validation)))
-    return ExperimentSplit({b: tuple(sorted(ids)) for b, ids in base.items()}, validation, tuple(order[n_validation:]), ceiling)
+    return ExperimentSplit(
+        {b: tuple(sorted(ids)) for b, ids in base.items()}, validation, tuple(order[n_validation:]), ceiling
+    )
 
 
-def load_split(base_sizes: list[int], n_validation: int, seed: int) -> ExperimentSplit:
-    """The split of the rendered original corpus and the base sets (drawn as ``generate``
-    draws them, so base sizes that are not augmented need no ``generate`` run)."""
-    index = read_table(gqcnn_dir("original") / "index.parquet")
+def load_split(
+    original: Path, shapes: pd.DataFrame, base_sizes: list[int], n_validation: int, seed: int
+) -> ExperimentSplit:
+    """The split of the rendered original corpus (dataset folder ``original``) and the base sets
+    drawn from the shape table ``shapes`` (as ``generate`` draws them, so base sizes that are not
+    augmented need no ``generate`` run)."""
+    index = read_table(Path(original) / "index.parquet")
     train_ids = sorted(index.shape_id[index.split == "train"].unique())
     rendered = set(train_ids)
-    base = {b: [s for s in ids if s in rendered] for b, ids in draw_base_sets(read_table(SHAPES_TABLE), base_sizes, seed).items()}
+    drawn = draw_base_sets(shapes, base_sizes, seed)
+    base = {b: [s for s in ids if s in rendered] for b, ids in drawn.items()}
     return experiment_split(train_ids, base, n_validation, seed)
 
 
@@ -87,11 +94,12 @@ def _concat(parts: list[GraspArrays]) -> GraspArrays:
     return GraspArrays(*(np.concatenate([getattr(p, f) for p in parts]) for f in ("images", "z", "labels")))
 
 
-def shapes_datapoints(shape_ids: tuple[str, ...] | list[str]) -> tuple[GraspArrays, np.ndarray]:
-    """The original corpus's datapoints of ``shape_ids`` and their rows in its index."""
-    original = GraspImages.open(gqcnn_dir("original"))
-    rows = np.flatnonzero(original.index.shape_id.isin(set(shape_ids)).to_numpy())
-    return _arrays(original, rows), rows
+def shapes_datapoints(original: Path, shape_ids: tuple[str, ...] | list[str]) -> tuple[GraspArrays, np.ndarray]:
+    """The datapoints of ``shape_ids`` in the original corpus (dataset folder ``original``) and
+    their rows in its index."""
+    data = GraspImages.open(original)
+    rows = np.flatnonzero(data.index.shape_id.isin(set(shape_ids)).to_numpy())
+    return _arrays(data, rows), rows
 
 
 def training_shapes(variant: Variant, split: ExperimentSplit) -> tuple[list[str], int]:
@@ -101,37 +109,44 @@ def training_shapes(variant: Variant, split: ExperimentSplit) -> tuple[list[str]
     shapes, extra = list(split.base[variant.base_size]), ratio_count(variant.ratio, variant.base_size)
     if variant.pool == "real":
         if extra > len(split.real_pool):
-            raise ValueError(f"real pool at B = {variant.base_size}, 1:{variant.ratio:g} needs {extra} more train shapes; "
-                             f"{len(split.real_pool)} lie outside the base sets and validation (lower gqcnn.val_shapes or the ratio)")
+            raise DataError(
+                f"real pool at B = {variant.base_size}, 1:{variant.ratio:g} needs {extra} more train shapes; "
+                f"{len(split.real_pool)} lie outside the base sets and validation (lower gqcnn.val_shapes "
+                "or the ratio)"
+            )
         return shapes + list(split.real_pool[:extra]), 0
     return shapes, extra
 
 
-def training_set(variant: Variant, split: ExperimentSplit) -> tuple[GraspArrays, dict]:
-    """A variant's training datapoints and their counts."""
+def training_set(variant: Variant, split: ExperimentSplit, corpora: Corpora) -> tuple[GraspArrays, dict]:
+    """A variant's training datapoints, read from ``corpora``, and their counts."""
     shapes, n_generated = training_shapes(variant, split)
-    data, rows = shapes_datapoints(shapes)
+    data, rows = shapes_datapoints(corpora.original, shapes)
     parts, generated_shapes = [data], 0
     if n_generated:
-        generated = GraspImages.open(gqcnn_dir(f"gen_{variant.base_size}"))
+        if variant.base_size not in corpora.generated:
+            raise DataError(
+                f"{variant.name} needs the rendered generated shapes of base size {variant.base_size}; none were given"
+            )
+        generated = GraspImages.open(corpora.generated[variant.base_size])
         index = generated.index
         gen_rows = np.flatnonzero(((index.pool == variant.pool) & (index.order < n_generated)).to_numpy())
         parts.append(_arrays(generated, gen_rows))
         generated_shapes = int(index.shape_id.iloc[gen_rows].nunique())
     data = _concat(parts)
-    info = {"original_shapes": len(shapes), "generated_shapes_asked": n_generated, "generated_shapes": generated_shapes,
-            "datapoints": len(data), "positive_share": round(float(data.labels.mean()), 4) if len(data) else None}
+    info = {
+        "original_shapes": len(shapes),
+        "generated_shapes_asked": n_generated,
+        "generated_shapes": generated_shapes,
+        "datapoints": len(data),
+        "positive_share": round(float(data.labels.mean()), 4) if len(data) else None,
+    }
     return data, info
 
 
-def test_set() -> tuple[GraspArrays, np.ndarray]:
-    """Every test-split datapoint of the original corpus and its row in the index."""
-    original = GraspImages.open(gqcnn_dir("original"))
-    rows = np.flatnonzero((original.index.split == "test").to_numpy())
-    return _arrays(original, rows), rows
-
-
-def index_of_rows(rows: np.ndarray) -> pd.DataFrame:
-    """``shape_id`` and ``label`` of rows of the original corpus's index."""
-    index = read_table(gqcnn_dir("original") / "index.parquet")[["shape_id", "label"]]
-    return index.iloc[rows].reset_index(drop=True)
+def test_set(original: Path) -> tuple[GraspArrays, np.ndarray]:
+    """Every test-split datapoint of the original corpus (dataset folder ``original``) and its row
+    in the index."""
+    data = GraspImages.open(original)
+    rows = np.flatnonzero((data.index.split == "test").to_numpy())
+    return _arrays(data, rows), rows

@@ -1,4 +1,5 @@
 """Training settings of the AutoEncoder-Critic and the GQ-CNN."""
+
 from __future__ import annotations
 
 from typing import Literal
@@ -10,15 +11,31 @@ from graspaug.settings import Field, settings
 class AETrainConfig:
     """The two training phases (params section ``ae.train``)."""
 
-    batch_size: int = Field(16, ge=2, description="Shapes per batch (16 reached a higher test IoU than 32 in the same CPU time).")
-    epochs_ae: int = Field(30, ge=0, description="Phase 1 epochs: plain AutoEncoder, binary cross-entropy (30 keeps `train_ae` within 8 minutes on 2 CPU cores).")
-    epochs_critic: int = Field(6, ge=0, description="Phase 2 epochs: AE-Critic initialised from phase 1, warm-up included.")
-    critic_warmup: int = Field(2, ge=0, description="First phase-2 epochs in which only the critic learns (the AE's eq. (2) term then starts from a trained critic).")
+    batch_size: int = Field(16, ge=2, description="Shapes per batch.")
+    epochs_ae: int = Field(30, ge=0, description="Phase 1 epochs: plain AutoEncoder, binary cross-entropy.")
+    epochs_critic: int = Field(
+        6, ge=0, description="Phase 2 epochs: AE-Critic initialised from phase 1, warm-up included."
+    )
+    critic_warmup: int = Field(
+        2,
+        ge=0,
+        description=(
+            "First phase-2 epochs in which only the critic learns "
+            "(the AE's eq. (2) term then starts from a trained critic)."
+        ),
+    )
     lr_ae: float = Field(1e-3, gt=0, description="Phase 1 Adam learning rate (paper: 1e-3).")
     lr_ae_critic: float = Field(1e-4, gt=0, description="Phase 2 Adam learning rate of the AutoEncoder (paper: 1e-4).")
     lr_critic: float = Field(1e-3, gt=0, description="Phase 2 Adam learning rate of the Critic (paper: 1e-3).")
-    gamma: float = Field(0.2, ge=0, le=1, description="γ of eq. (1): the critic sees γx + (1−γ)x̂ as non-interpolated (ACAI: 0.2).")
-    lam: float = Field(0.5, ge=0, alias="lambda", description="λ of eq. (2): weight of the critic term in the AE loss (ACAI: 0.5).")
+    gamma: float = Field(
+        0.2,
+        ge=0,
+        le=1,
+        description="γ of eq. (1): the critic sees γx + (1−γ)x̂ as non-interpolated (ACAI: 0.2).",
+    )
+    lam: float = Field(
+        0.5, ge=0, alias="lambda", description="λ of eq. (2): weight of the critic term in the AE loss (ACAI: 0.5)."
+    )
     flips: bool = Field(True, description="Flip training grids along random axes (the AE learns shape, not pose).")
 
 
@@ -26,15 +43,24 @@ class AETrainConfig:
 class NoiseSettings:
     """Dex-Net 2.0's train-time image noise.
 
-    Each image and its gripper depth are multiplied by a Gamma(``gamma_shape``, 1 / ``gamma_shape``) draw (mean 1);
-    with probability ``gp_prob`` it also gets a smooth Gaussian-process field: N(0,
+    Each image and its gripper depth are multiplied by a Gamma(``gamma_shape``, 1 / ``gamma_shape``) draw
+    (mean 1); with probability ``gp_prob`` it also gets a smooth Gaussian-process field: N(0,
     ``gp_sigma``) m on a ``gp_grid`` × ``gp_grid`` grid, upsampled (bicubic) to the image.
     With ``symmetrize``, each image is turned 180° and flipped about either axis with
     probability 0.5 each (a parallel-jaw grasp looks the same).
     """
 
-    gamma_shape: float = Field(1000.0, ge=0, description="Multiplicative noise ~ Gamma(k, 1/k) per image (Dex-Net: k = 1000; 0: off); unlike Dex-Net it scales the gripper depth too, so the object's height relative to the gripper keeps its meaning.")
-    gp_prob: float = Field(0.5, ge=0, le=1, description="Chance of adding smooth Gaussian-process noise to an image (Dex-Net: 0.5).")
+    gamma_shape: float = Field(
+        1000.0,
+        ge=0,
+        description=(
+            "Multiplicative noise ~ Gamma(k, 1/k) per image (Dex-Net: k = 1000; 0: off); unlike Dex-Net it scales "
+            "the gripper depth too, so the object's height relative to the gripper keeps its meaning."
+        ),
+    )
+    gp_prob: float = Field(
+        0.5, ge=0, le=1, description="Chance of adding smooth Gaussian-process noise to an image (Dex-Net: 0.5)."
+    )
     gp_sigma: float = Field(0.005, ge=0, description="Its standard deviation (m) (Dex-Net: 0.005).")
     gp_grid: int = Field(8, ge=1, description="Its grid side before upsampling to the image (Dex-Net: 8 for 32 px).")
     symmetrize: bool = Field(True, description="Turn images 180° and flip them about either axis at random (Dex-Net).")
@@ -47,18 +73,51 @@ class TrainSettings:
     (at least ``min_steps``, at most ``max_steps`` steps); the checkpoint with the best
     validation AP of ``evals`` evenly spaced evaluations is kept (params section ``gqcnn.train``)."""
 
-    epochs: float = Field(8.0, gt=0, description="Passes over the network's own training set (the budget rule: every variant sees each of its datapoints about as often, so a larger set gets more steps).")
-    min_steps: int = Field(500, ge=1, description="Fewest SGD steps, for the smallest training sets (500 raised the B = 50 network's validation AP in 4 of 4 paired seeds over 200-220 and halved its spread: studies/gqcnn_options.py).")
-    max_steps: int = Field(1000, ge=1, description="Most SGD steps, a cap for the largest training sets (the CPU budget).")
+    epochs: float = Field(
+        8.0,
+        gt=0,
+        description=(
+            "Passes over the network's own training set (the budget rule: every variant sees each of its "
+            "datapoints about as often, so a larger set gets more steps)."
+        ),
+    )
+    min_steps: int = Field(500, ge=1, description="Fewest SGD steps, for the smallest training sets.")
+    max_steps: int = Field(
+        1000, ge=1, description="Most SGD steps, a cap for the largest training sets (the CPU budget)."
+    )
     batch_size: int = Field(128, ge=2, description="Datapoints per step (Dex-Net: 64-128).")
     lr: float = Field(0.02, gt=0, description="SGD learning rate at the start (Dex-Net: 0.01 at batch 64).")
-    final_lr: float = Field(0.01, gt=0, le=1, description="Learning rate at the last step, as a share of lr (cosine annealing).")
+    final_lr: float = Field(
+        0.01, gt=0, le=1, description="Learning rate at the last step, as a share of lr (cosine annealing)."
+    )
     momentum: float = Field(0.9, ge=0, le=1, description="SGD momentum (Dex-Net: 0.9).")
     weight_decay: float = Field(5e-4, ge=0, description="L2 weight decay (Dex-Net: 5e-4).")
-    ema_decay: float = Field(0.0, ge=0, lt=1, description="Decay of an exponential moving average of the weights (Polyak averaging), updated after every step; validation, the kept checkpoint and the test use the averaged weights (0: off, the raw weights).")
-    precision: Literal["float32", "bfloat16"] = Field("float32", description="Arithmetic of the training steps' convolutions and matrix products: float32 (the default), or bfloat16 mixed precision (torch.autocast; weights, optimizer, loss, validation and test stay float32): 1.3x the samples/s of float32 in the stage on a CPU with AVX512-BF16 (emulated and slower on CPUs without), validation AP -0.001 [-0.009, +0.007] against float32 over 8 paired seeds (studies/gqcnn_options.py), but a larger seed-to-seed SD of the contrasts with 3 members over 8 seeds (0.008-0.014 against float32's 0.006-0.008), so the default keeps float32.")
-    evals: int = Field(5, ge=1, description="Validation evaluations per network, evenly spaced over its steps (the last at the last step); the weights with the best validation AP are kept.")
-    eval_batch: int = Field(256, ge=1, description="Datapoints per inference batch (on the CPU 128-256 run ~2× faster than 1024).")
+    ema_decay: float = Field(
+        0.0,
+        ge=0,
+        lt=1,
+        description=(
+            "Decay of an exponential moving average of the weights (Polyak averaging), updated after every step; "
+            "validation, the kept checkpoint and the test use the averaged weights (0: off, the raw weights)."
+        ),
+    )
+    precision: Literal["float32", "bfloat16"] = Field(
+        "float32",
+        description=(
+            "Arithmetic of the training steps' convolutions and matrix products: float32 (the default), or bfloat16 "
+            "mixed precision (torch.autocast; weights, optimizer, loss, validation and test stay float32). "
+            "bfloat16 needs a CPU with AVX512-BF16 (elsewhere it is emulated)."
+        ),
+    )
+    evals: int = Field(
+        5,
+        ge=1,
+        description=(
+            "Validation evaluations per network, evenly spaced over its steps (the last at the last step); "
+            "the weights with the best validation AP are kept."
+        ),
+    )
+    eval_batch: int = Field(256, ge=1, description="Datapoints per inference batch.")
     noise: NoiseSettings = Field(default_factory=NoiseSettings, description="Dex-Net 2.0's train-time image noise.")
 
     def __post_init__(self) -> None:

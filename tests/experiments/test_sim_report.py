@@ -1,22 +1,35 @@
 """The sim experiment's statistics and words, on hand-made trial tables."""
+
 import numpy as np
 import pandas as pd
 import pytest
 
-from graspaug.sim.analysis import bootstrap_over_objects, calibration, compare, paired_contrast, report_text, rate_summary
+from graspaug.experiments.sim_report import calibration, compare, rate_summary, report_text, trial_contrast
 
 
 def trials_table(outcomes: dict[tuple[str, int, str], list[bool]]) -> pd.DataFrame:
     """(arm, seed, object) → success per attempt."""
-    rows = [{"arm": arm, "seed": seed, "object": obj, "kind": "test_shape", "attempt": i, "success": ok,
-             "outcome": "success" if ok else "not_lifted"}
-            for (arm, seed, obj), oks in outcomes.items() for i, ok in enumerate(oks)]
+    rows = [
+        {
+            "arm": arm,
+            "seed": seed,
+            "object": obj,
+            "kind": "test_shape",
+            "attempt": i,
+            "success": ok,
+            "outcome": "success" if ok else "not_lifted",
+        }
+        for (arm, seed, obj), oks in outcomes.items()
+        for i, ok in enumerate(oks)
+    ]
     return pd.DataFrame(rows)
 
 
 def test_antipodal_pairs_with_every_training_seed():
-    trials = trials_table({("before", 0, "a"): [True, True], ("before", 1, "a"): [True, False], ("antipodal", -1, "a"): [False, False]})
-    c = paired_contrast(trials, "before", "antipodal", n_boot=200)
+    trials = trials_table(
+        {("before", 0, "a"): [True, True], ("before", 1, "a"): [True, False], ("antipodal", -1, "a"): [False, False]}
+    )
+    c = trial_contrast(trials, "before", "antipodal", n_boot=200)
     # each antipodal drop counts once, against the network's outcomes averaged over the seeds (1 and 0.5)
     assert c["n_trials"] == 2 and c["n_objects"] == 1 and c["mean"] == 0.75
     assert c["mcnemar_p"] is None and c["only_before"] is None  # McNemar needs 0/1 pairs
@@ -30,21 +43,13 @@ def test_contrast_between_network_arms_keeps_mcnemar_and_gives_a_t_interval_over
         for k in range(5):
             outcomes[("before", seed, f"o{k}")] = [False] * gain + [True] * (4 - gain)
             outcomes[("after", seed, f"o{k}")] = [True] * 4
-    c = paired_contrast(trials_table(outcomes), "after", "before", n_boot=200)
+    c = trial_contrast(trials_table(outcomes), "after", "before", n_boot=200)
     assert c["n_trials"] == 60 and c["only_after"] == 20 and c["only_before"] == 0 and c["mcnemar_p"] < 1e-5
     assert c["per_seed"] == {"0": 0.25, "1": 0.5, "2": 0.25} and c["mean"] == pytest.approx(1 / 3, abs=1e-4)
     half = 4.302653 * np.std([0.25, 0.5, 0.25], ddof=1) / np.sqrt(3)
-    assert c["t_ci_low"] == pytest.approx(1 / 3 - half, abs=1e-4) and c["t_ci_high"] == pytest.approx(1 / 3 + half, abs=1e-4)
-
-
-def test_bootstrap_over_objects_covers_the_mean_and_sees_object_spread():
-    objects = np.repeat(np.arange(30), 6)
-    same = np.tile([1.0, 0.0, 0.0, 0.0, 0.0, 0.0], 30)  # every object +1/6
-    low, high = bootstrap_over_objects(same, objects, 1000, 0)
-    assert low == pytest.approx(1 / 6) and high == pytest.approx(1 / 6)  # no spread between objects: no width
-    mixed = np.where(objects % 2 == 0, 1.0, -0.5)  # half the objects gain, half lose
-    low, high = bootstrap_over_objects(mixed, objects, 2000, 1)
-    assert low < 0.25 < high and 0.35 < high - low < 0.7  # 2 × 1.96 × 0.75 / √30 = 0.54
+    assert c["t_ci_low"] == pytest.approx(1 / 3 - half, abs=1e-4) and c["t_ci_high"] == pytest.approx(
+        1 / 3 + half, abs=1e-4
+    )
 
 
 def test_contrast_interval_excludes_zero_for_a_clear_effect_and_report_says_so():
@@ -55,20 +60,43 @@ def test_contrast_interval_excludes_zero_for_a_clear_effect_and_report_says_so()
         outcomes[("after", 0, obj)] = [True, k % 2 == 0, False]
         outcomes[("antipodal", -1, obj)] = [False, k % 4 == 0, False]
     trials = trials_table(outcomes)
-    c = paired_contrast(trials, "before", "antipodal", n_boot=1000)
+    c = trial_contrast(trials, "before", "antipodal", n_boot=1000)
     assert c["ci_low"] > 0 and c["mean"] == pytest.approx(np.mean([1, 1, 2 / 3]) - 1 / 12, abs=1e-4)
     chosen = {"before": ("targeted", 0.0), "after": ("targeted", 1.0), "antipodal": (None, None)}
     metrics = {
-        "setup": {"camera_height": 0.65, "sensor_noise": True, "objects": 12, "attempts": 3, "model_seeds": [0], "base_size": 50},
-        "arms": {arm: {"pool": pool, "ratio": ratio, **rate_summary(trials.success[trials.arm == arm])} for arm, (pool, ratio) in chosen.items()},
-        "contrasts": {"after_vs_before": paired_contrast(trials, "after", "before", n_boot=1000), "network_vs_antipodal": c},
-        "same_network": False, "per_seed": {"0": compare(trials)},
-        "per_object": {f"o{k}": {"kind": "test_shape", "mass": 0.2, "friction": 0.5,
-                                 **{arm: rate_summary(trials.success[(trials.object == f"o{k}") & (trials.arm == arm)]) for arm in chosen}}
-                       for k in range(12)},
+        "setup": {
+            "camera_height": 0.65,
+            "sensor_noise": True,
+            "objects": 12,
+            "attempts": 3,
+            "model_seeds": [0],
+            "base_size": 50,
+        },
+        "arms": {
+            arm: {"pool": pool, "ratio": ratio, **rate_summary(trials.success[trials.arm == arm])}
+            for arm, (pool, ratio) in chosen.items()
+        },
+        "contrasts": {
+            "after_vs_before": trial_contrast(trials, "after", "before", n_boot=1000),
+            "network_vs_antipodal": c,
+        },
+        "same_network": False,
+        "per_seed": {"0": compare(trials)},
+        "per_object": {
+            f"o{k}": {
+                "kind": "test_shape",
+                "mass": 0.2,
+                "friction": 0.5,
+                **{
+                    arm: rate_summary(trials.success[(trials.object == f"o{k}") & (trials.arm == arm)])
+                    for arm in chosen
+                },
+            }
+            for k in range(12)
+        },
     }
     table, metrics["calibration"] = calibration(trials, pd.Series({f"o{k}": k / 12 for k in range(10)}))
-    text = report_text(metrics, trials, table)
+    text = report_text(metrics, trials, table, "scores.parquet")
     assert "`network_vs_antipodal` excludes zero: before succeeds more often than antipodal" in text
     assert "`after_vs_before` excludes zero: after succeeds less often than before" in text
     assert "| o11 | test_shape | 3 | 0.00 | n/a |" in text  # no labels for o10, o11

@@ -1,7 +1,8 @@
 import numpy as np
 import pytest
 
-from graspaug.critic_study import interpolate, outlier_table, paired_contrast, pair_resamples, random_pairs, summarize
+from graspaug.experiments.critic import interpolate, outlier_contrast, outlier_table, random_pairs, summarize
+from graspaug.experiments.stats import PairBootstrap
 
 
 def test_random_pairs_are_distinct_shapes():
@@ -28,8 +29,8 @@ def test_outlier_table_counts_voxels_outside_the_largest_piece():
 def test_intervals_bracket_the_mean_and_shrink_with_more_pairs():
     rng = np.random.default_rng(0)
     few, many = rng.exponential(2.0, (20, 1)), rng.exponential(2.0, (400, 1))
-    narrow = summarize(many, pair_resamples(400, 2000, rng))[0]
-    wide = summarize(few, pair_resamples(20, 2000, rng))[0]
+    narrow = summarize(many, PairBootstrap(400, 2000, rng))[0]
+    wide = summarize(few, PairBootstrap(20, 2000, rng))[0]
     for s in (narrow, wide):
         assert s["ci_low"] < s["mean"] < s["ci_high"]
     assert narrow["ci_high"] - narrow["ci_low"] < wide["ci_high"] - wide["ci_low"]
@@ -43,12 +44,18 @@ def test_paired_contrast_is_exact_for_a_constant_shift_and_skips_empty_pairs():
     b = rng.exponential(3.0, (30, 2))
     a = b + 1.0
     a[0, 1] = np.nan
-    diff = paired_contrast(a, b, pair_resamples(30, 500, rng))
+    diff = outlier_contrast(a, b, PairBootstrap(30, 500, rng))
     for d in diff:
-        assert d["mean"] == pytest.approx(1.0) and d["ci_low"] == pytest.approx(1.0) and d["ci_high"] == pytest.approx(1.0)
-    unpaired = summarize(a, pair_resamples(30, 500, rng))[0]
+        assert (
+            d["mean"] == pytest.approx(1.0) and d["ci_low"] == pytest.approx(1.0) and d["ci_high"] == pytest.approx(1.0)
+        )
+    unpaired = summarize(a, PairBootstrap(30, 500, rng))[0]
     assert unpaired["ci_high"] - unpaired["ci_low"] > 0.5  # the per-model interval carries the pair-to-pair spread
 
 
 def test_all_empty_column_gives_nulls():
-    assert summarize(np.full((5, 1), np.nan), pair_resamples(5, 100, np.random.default_rng(0)))[0] == {"mean": None, "ci_low": None, "ci_high": None}
+    assert summarize(np.full((5, 1), np.nan), PairBootstrap(5, 100, np.random.default_rng(0)))[0] == {
+        "mean": None,
+        "ci_low": None,
+        "ci_high": None,
+    }

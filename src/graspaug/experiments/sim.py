@@ -1,0 +1,311 @@
+"""The simulated robot experiment (paper Section IV-E): arms (which network plans), the objects
+and their physics, one object's attempts in one arm, and the trials table.
+
+Every arm sees the same seeded drops, sensor noise and planner seeds (paired). Arms: ``before``
+= the targeted network of base size B at ratio 0, ``after`` = the same B at the ratio chosen on
+validation AP (by the GQ-CNN experiment's report), ``real`` = the ``real`` pool's network at that
+B and ratio (when it was trained), each once per training seed, and ``antipodal`` = a random
+antipodal seed grasp without a network (once: it has no training seed). The numbers and the
+report's text are :mod:`graspaug.experiments.sim_report`.
+"""
+
+from __future__ import annotations
+
+import functools
+import logging
+import os
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from graspaug.errors import DataError
+from graspaug.experiments.variants import network_variant
+from graspaug.rng import shape_rng
+
+log = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True)
+class ObjectJob:
+    """One object's attempts in one arm (a worker's unit of work)."""
+
+    arm: str
+    seed: int  # the network's training seed; -1 for the antipodal arm
+    model: str | None  # path of model.pt; None: the antipodal reference arm (no network)
+    name: str
+    kind: str  # everyday | test_shape | user
+    sim_object: object  # graspaug.sim.objects.SimObject
+    drop_seeds: tuple[int, ...]
+    plan_seeds: tuple[int, ...]
+    record: bool
+
+
+@dataclass(frozen=True)
+class PreparedObject:
+    """An object of the trials: its name, kind, physics body, extents (3,) m and drawn density (kg/m³)."""
+
+    name: str
+    kind: str
+    body: object  # graspaug.sim.objects.SimObject
+    extents: tuple[float, float, float]
+    density: float
+
+
+def model_path(seed_dir: Path, base_size: int, ratio: float, pool: str = "targeted") -> Path:
+    """The network (``model.pt``) of ``pool`` at base size B and ratio R in its training seed's
+    folder ``seed_dir``."""
+    return Path(seed_dir) / network_variant(pool, base_size, ratio).name / "model.pt"
+
+
+def arms(
+    best_ratio: float, base_size: int, seed_dirs: Mapping[int, Path]
+) -> dict[str, tuple[str | None, float | None]]:
+    """Arm → (pool, ratio): ``before`` (targeted, 0), ``after`` (targeted, ``best_ratio``: the
+    ratio chosen on validation AP for ``base_size``), ``real`` (real, that ratio) when its network
+    exists for every training seed, ``antipodal`` (None, None). ``seed_dirs``: training seed →
+    the folder of its networks; a missing ``before`` or ``after`` network is a :class:`DataError`."""
+    best = float(best_ratio)
+    chosen: dict[str, tuple[str | None, float | None]] = {"before": ("targeted", 0.0), "after": ("targeted", best)}
+    for seed_dir in seed_dirs.values():
+        for pool, ratio in chosen.values():
+            if not model_path(seed_dir, base_size, ratio, pool).exists():
+                raise DataError(
+                    f"{model_path(seed_dir, base_size, ratio, pool)} is missing: run `dvc repro train_gqcnn` first"
+                )
+    if best > 0 and all(model_path(seed_dir, base_size, best, "real").exists() for seed_dir in seed_dirs.values()):
+        chosen["real"] = ("real", best)
+    else:
+        log.info("sim: no `real` network at B = %d, ratio %g for every training seed: no real arm", base_size, best)
+    chosen["antipodal"] = (None, None)
+    return chosen
+
+
+def test_shape_ids(shapes: pd.DataFrame, n: int, seed: int) -> list[str]:
+    """The held-out shapes picked in the trials: a seeded choice of ``n`` from the test split of ``shapes``."""
+    if n == 0:
+        return []
+    test = sorted(shapes.shape_id[shapes.split == "test"])
+    if len(test) < n:
+        raise DataError(f"sim.n_test_objects = {n} but the test split has {len(test)} shapes")
+    chosen = shape_rng(seed, "sim", "test-objects").choice(len(test), size=n, replace=False)
+    return [test[i] for i in sorted(chosen)]
+
+
+def _prepare_one(item: tuple, physics, seed: int, vhacd_resolution: int, cache: Path) -> PreparedObject:
+    from graspaug.sim.objects import draw_physics, mesh_volume, prepare_object
+
+    name, kind, mesh = item
+    drawn = draw_physics(mesh_volume(mesh), physics, shape_rng(seed, name, "sim-physics"))
+    body = prepare_object(
+        name,
+        mesh,
+        cache,
+        drawn["mass"],
+        drawn["lateral_friction"],
+        vhacd_resolution,
+        drawn["spinning_friction"],
+        drawn["rolling_friction"],
+    )
+    return PreparedObject(name, kind, body, tuple(float(x) for x in mesh.extents), drawn["density"])
+
+
+def prepare_objects(
+    everyday: Sequence[str],
+    test_shapes: Sequence[str],
+    shapes_dir: Path,
+    physics,
+    seed: int,
+    vhacd_resolution: int,
+    user_meshes: Sequence[tuple[str, object]] = (),
+    cache_dir: Path | None = None,
+    workers=1,
+) -> list[PreparedObject]:
+    """Every object of the trials (everyday, test shapes read from the mesh folder ``shapes_dir``,
+    the user's meshes), decompositions cached (computed on ``workers``, a process count or
+    :class:`graspaug.parallel.Workers`), with mass and friction drawn per object from ``physics``
+    (``sim.physics``) and the global ``seed`` (the same for every arm)."""
+    from graspaug.io.meshes import mesh_path, read_mesh
+    from graspaug.parallel import parallel_map
+    from graspaug.sim.objects import default_cache_dir, everyday_mesh
+
+    cache = default_cache_dir() if cache_dir is None else Path(cache_dir)
+    meshes = [(name, "everyday", everyday_mesh(name)) for name in everyday]
+    meshes += [(shape_id, "test_shape", read_mesh(mesh_path(shapes_dir, shape_id))) for shape_id in test_shapes]
+    meshes += [(name, "user", mesh) for name, mesh in user_meshes]
+    names = [name for name, _, _ in meshes]
+    if len(set(names)) != len(names):
+        raise DataError(
+            f"sim: two objects share a name: {sorted({n for n in names if names.count(n) > 1})} "
+            "(rename the user's mesh files)"
+        )
+    work = functools.partial(_prepare_one, physics=physics, seed=seed, vhacd_resolution=vhacd_resolution, cache=cache)
+    return parallel_map(work, meshes, workers, "sim objects")
+
+
+def object_jobs(
+    objects: Sequence[PreparedObject],
+    chosen: dict,
+    base_size: int,
+    seed_dirs: Mapping[int, Path],
+    attempts: int,
+    seed: int,
+    n_pictures: int,
+) -> list[ObjectJob]:
+    """A job per object, arm and training seed (``seed_dirs``: training seed → the folder of its
+    networks; the antipodal arm once per object); the drops and planner seeds of an object are
+    drawn from the global ``seed`` and its name, the same in every arm."""
+    model_seeds = list(seed_dirs)
+    jobs = []
+    for index, obj in enumerate(objects):
+        drops = tuple(int(shape_rng(seed, obj.name, f"sim-drop-{a}").integers(2**31 - 1)) for a in range(attempts))
+        plans = tuple(int(shape_rng(seed, obj.name, f"sim-plan-{a}").integers(2**31 - 1)) for a in range(attempts))
+        record = index < n_pictures
+        for arm, (pool, ratio) in chosen.items():
+            if pool is None:
+                jobs.append(ObjectJob(arm, -1, None, obj.name, obj.kind, obj.body, drops, plans, record))
+                continue
+            for s in model_seeds:
+                jobs.append(
+                    ObjectJob(
+                        arm,
+                        s,
+                        str(model_path(seed_dirs[s], base_size, ratio, pool)),
+                        obj.name,
+                        obj.kind,
+                        obj.body,
+                        drops,
+                        plans,
+                        record and s == model_seeds[0],
+                    )
+                )
+    return jobs
+
+
+def _policy(model: str | None, layout, sampler, cem, crop_size: int, out_size: int):
+    """The planner for ``model``, loaded once per worker process and file version."""
+    if model is None:
+        return _cached_policy(None, None, layout, sampler, cem, crop_size, out_size)
+    path = os.path.abspath(model)
+    stat = os.stat(path)
+    return _cached_policy(path, (stat.st_mtime_ns, stat.st_size), layout, sampler, cem, crop_size, out_size)
+
+
+@functools.lru_cache(maxsize=4)
+def _cached_policy(model: str | None, version, layout, sampler, cem, crop_size: int, out_size: int):
+    """A :class:`graspaug.planning.Planner`: the public planner is the one the robot uses. A
+    checkpoint without a model card gets the render params' crop sizes."""
+    import dataclasses
+
+    from graspaug.planning import Planner, load_planner
+
+    if model is None:
+        return Planner(None, sampler=sampler, cem=cem, check_image=False)  # Dex-Net's policy, as it was
+    import torch
+
+    torch.set_num_threads(1)
+    planner = load_planner(model, sampler, cem, check_image=False)
+    if planner.card.assumed:
+        planner.card = dataclasses.replace(planner.card, crop_size=crop_size, out_size=out_size)
+    return planner
+
+
+def run_object(
+    job: ObjectJob, layout, hand, sampler, cem, crop_size: int, out_size: int, trial_settings=None, sensor=None
+) -> list[dict]:
+    """Every attempt of one object in one arm: a row per attempt (plus depth and frames for the
+    first attempt when ``job.record``). The planner fills the sensor's missing pixels from the
+    nearest valid one."""
+    from graspaug.sim.settings import DepthNoise
+    from graspaug.sim.trials import TrialSettings, run_trial
+
+    trial_settings, sensor = trial_settings or TrialSettings(), sensor or DepthNoise()
+    policy = _policy(job.model, layout, sampler, cem, crop_size, out_size)
+    rows = []
+    for attempt, (drop_seed, plan_seed) in enumerate(zip(job.drop_seeds, job.plan_seeds)):
+        rng = np.random.default_rng(plan_seed)
+        record = job.record and attempt == 0
+
+        def plan(depth, camera, k, rng=rng):
+            return next(iter(policy.plan(depth, k, rng, camera_distance=camera.height, fill_missing=True)), None)
+
+        result = run_trial(
+            job.sim_object,
+            drop_seed,
+            planner=plan,
+            layout=layout,
+            hand=hand,
+            settings=trial_settings,
+            sensor=sensor,
+            record=record,
+        )
+        g = result.image_grasp or {}
+        center = result.grasp_center
+        rows.append(
+            {
+                "arm": job.arm,
+                "seed": job.seed,
+                "object": job.name,
+                "kind": job.kind,
+                "attempt": attempt,
+                "drop_seed": drop_seed,
+                "outcome": result.outcome,
+                "success": result.success,
+                "quality": result.quality,
+                "candidates": result.candidates,
+                "u": g.get("u"),
+                "v": g.get("v"),
+                "angle": g.get("angle"),
+                "depth": g.get("depth"),
+                "width_px": g.get("width_px"),
+                "grasp_x": None if center is None else center[0],
+                "grasp_y": None if center is None else center[1],
+                "grasp_z": None if center is None else center[2],
+                "jaw_angle": result.jaw_angle,
+                "contact_force": round(result.contact_force, 3),
+                "planning_time": result.planning_time,
+                "_depth": result.depth,
+                "_frames": result.frames,
+            }
+        )
+    return rows
+
+
+def trials_table(rows: list[dict], chosen: dict[str, tuple[str | None, float | None]]) -> pd.DataFrame:
+    """The trials table: a row per attempt (:func:`run_object`'s rows without the pictures) and
+    the ``ratio`` of its arm (``chosen``: arm → (pool, ratio))."""
+    trials = pd.DataFrame([{k: v for k, v in row.items() if not k.startswith("_")} for row in rows])
+    trials["ratio"] = trials.arm.map({arm: ratio for arm, (_, ratio) in chosen.items()})
+    return trials
+
+
+def trial_picture(row: dict, ratio: float | None) -> dict:
+    """What :func:`graspaug.plots.pick_story` draws of a recorded attempt (a :func:`run_object`
+    row): ``depth`` (H, W) m, missing pixels NaN; ``jaw`` (2, 2) the jaw endpoints (u, v) px or
+    None; ``window`` (u0, v0, u1, v1) px around the grasp; ``frames``; ``title``. ``ratio``: the
+    arm's (None: no network)."""
+    from graspaug.planning.grasps import jaw_endpoints
+
+    depth = np.where(row["_depth"] > 0, row["_depth"], np.nan)  # missing pixels (0) left blank
+    h, w = depth.shape
+    jaw = None
+    if row["u"] is not None:
+        jaw = jaw_endpoints(np.array([[row["u"], row["v"]]]), np.array([row["angle"]]), np.array([row["width_px"]]))[0]
+        cu, cv = int(round(row["u"])), int(round(row["v"]))
+    else:
+        cu, cv = w // 2, h // 2
+    r = min(80, h // 2, w // 2)
+    u0, v0 = int(np.clip(cu - r, 0, w - 2 * r)), int(np.clip(cv - r, 0, h - 2 * r))
+    q = row["quality"]
+    quality = "no grasp found" if q is None else ("random" if np.isnan(q) else f"Q = {q:.3f}")
+    network = "random antipodal grasp, no network" if ratio is None else f"ratio {ratio:g}, training seed {row['seed']}"
+    title = f"{row['object']}, arm {row['arm']} ({network}), attempt 0: {quality} → {row['outcome']}"
+    return {
+        "depth": depth,
+        "jaw": jaw,
+        "window": (u0, v0, u0 + 2 * r, v0 + 2 * r),
+        "frames": row["_frames"],
+        "title": title,
+    }

@@ -1,0 +1,377 @@
+"""What the simulated trials show (:mod:`graspaug.experiments.sim`): success rates with Wilson
+intervals, paired contrasts between arms with a bootstrap interval over objects, the calibration
+of the cell against the labels' graspness, the metrics, the tables and the report's text.
+
+A trials table has a row per attempt: ``arm``, ``seed`` (the network's training seed; −1 for the
+``antipodal`` arm, which has no network and runs once), ``object``, ``kind``, ``attempt``,
+``outcome``, ``success``. Attempts pair up by (seed, object, attempt): every arm sees the same
+drops and planner seeds; the antipodal arm's attempt pairs with that attempt of every seed.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+import pandas as pd
+
+from graspaug.errors import DataError
+from graspaug.experiments.stats import ObjectBootstrap, mcnemar_test, paired_contrast, t_interval, wilson_interval
+
+#: The contrasts of the sim metrics: name → (arm, reference arm); success(arm) − success(reference).
+CONTRASTS = {
+    "after_vs_before": ("after", "before"),
+    "network_vs_antipodal": ("before", "antipodal"),
+    "after_vs_real": ("after", "real"),
+}
+
+
+def rate_summary(outcomes: pd.Series) -> dict:
+    """Successes, attempts, the rate and its 95 % Wilson interval of boolean ``outcomes``."""
+    k, n = int(outcomes.sum()), int(len(outcomes))
+    low, high = wilson_interval(k, n)
+    return {
+        "successes": k,
+        "attempts": n,
+        "success_rate": round(k / n, 5) if n else None,
+        "wilson_low": round(low, 5),
+        "wilson_high": round(high, 5),
+    }
+
+
+def paired_outcomes(trials: pd.DataFrame, arm: str, reference: str) -> pd.DataFrame:
+    """One row per paired attempt: ``seed``, ``object``, ``attempt``, ``a`` and ``b`` (success of
+    ``arm`` and ``reference``); an arm run once (seed −1) pairs with every seed of the other."""
+    columns = ["seed", "object", "attempt", "success"]
+    a = trials.loc[trials.arm == arm, columns].rename(columns={"success": "a"})
+    b = trials.loc[trials.arm == reference, columns].rename(columns={"success": "b"})
+    keys = ["seed", "object", "attempt"]
+    if set(b.seed) == {-1}:
+        b, keys = b.drop(columns="seed"), ["object", "attempt"]
+    elif set(a.seed) == {-1}:
+        a, keys = a.drop(columns="seed"), ["object", "attempt"]
+    if a.empty or b.empty:
+        raise DataError(f"sim: arm {arm if a.empty else reference!r} has no attempts; the arms cannot be paired")
+    paired = a.merge(b, on=keys, how="outer")
+    lonely = paired[paired[["a", "b"]].isna().any(axis=1)]
+    if len(lonely):
+        first = ", ".join(f"{k} {lonely.iloc[0][k]}" for k in keys)
+        raise DataError(
+            f"sim: {len(lonely)} attempts of {arm!r} or {reference!r} have no partner (first: {first}); "
+            "the arms cannot be paired"
+        )
+    return paired.assign(a=paired.a.astype(bool), b=paired.b.astype(bool))
+
+
+def trial_contrast(trials: pd.DataFrame, arm: str, reference: str, n_boot: int = 2000, seed: int = 0) -> dict:
+    """success(arm) − success(reference) on the paired attempts: ``mean``; the 95 % bootstrap
+    interval over objects (``ci_low``, ``ci_high``; each resampled object brings all its
+    attempts); ``n_trials`` (paired drops), ``n_objects``; the 95 % t-interval over training
+    seeds of the per-seed differences (``t_ci_low``, ``t_ci_high``, ``n_seeds``, ``per_seed``);
+    and, when both arms ran once per training seed, the exact McNemar counts and p-value.
+
+    An arm without a network (seed −1) ran each drop once: the other arm's outcomes of that
+    drop are averaged over the training seeds first, so a drop counts once (its differences
+    are then not 0/1, and McNemar does not apply: ``mcnemar_p`` is None)."""
+    paired = paired_outcomes(trials, arm, reference)
+    per_seed = paired.groupby("seed").apply(lambda d: float(d.a.mean() - d.b.mean()), include_groups=False)
+    over_seeds = t_interval(per_seed.to_numpy())
+    once = -1 in set(trials.seed[trials.arm.isin([arm, reference])])
+    if once:
+        drops = paired.groupby(["object", "attempt"], sort=False).agg(a=("a", "mean"), b=("b", "mean")).reset_index()
+        a, b, objects = drops.a.to_numpy(float), drops.b.to_numpy(float), drops.object.to_numpy()
+        counts = {f"only_{arm}": None, f"only_{reference}": None, "mcnemar_p": None}
+    else:
+        a, b, objects = paired.a.to_numpy(float), paired.b.to_numpy(float), paired.object.to_numpy()
+        test = mcnemar_test(paired.b.to_numpy(), paired.a.to_numpy())
+        counts = {
+            f"only_{arm}": test["only_after"],
+            f"only_{reference}": test["only_before"],
+            "mcnemar_p": test["p_value"],
+        }
+    contrast = paired_contrast(a, b, ObjectBootstrap(objects, n_boot, seed))
+    rounded = lambda x: None if x is None else round(float(x), 5)  # noqa: E731
+    return {
+        "mean": rounded(contrast["mean"]),
+        "ci_low": rounded(contrast["ci_low"]),
+        "ci_high": rounded(contrast["ci_high"]),
+        "n_trials": int(len(a)),
+        "n_objects": int(len(set(objects))),
+        "t_ci_low": rounded(over_seeds["ci_low"]),
+        "t_ci_high": rounded(over_seeds["ci_high"]),
+        "n_seeds": over_seeds["n_seeds"],
+        "per_seed": {str(k): round(v, 5) for k, v in per_seed.items()},
+        **counts,
+    }
+
+
+def compare(trials: pd.DataFrame) -> dict:
+    """Before vs after on the attempts of ``trials``: both rates, the difference, and the exact
+    McNemar test on the attempts paired by seed, object and drop."""
+    out = {arm: rate_summary(trials.success[trials.arm == arm]) for arm in ("before", "after")}
+    paired = paired_outcomes(trials, "after", "before")
+    out["difference"] = round(out["after"]["success_rate"] - out["before"]["success_rate"], 5)
+    out["paired"] = mcnemar_test(paired.b.to_numpy(), paired.a.to_numpy())
+    return out
+
+
+def calibration(trials: pd.DataFrame, graspness: pd.Series) -> tuple[pd.DataFrame, dict]:
+    """Per object: the antipodal arm's success rate beside its labels' ``graspness`` (a Series by
+    object name; objects without labels get NaN), and their Spearman correlation over the
+    objects with labels (None with fewer than 3)."""
+    from scipy.stats import spearmanr
+
+    antipodal = trials[trials.arm == "antipodal"]
+    table = antipodal.groupby("object", sort=False).agg(
+        kind=("kind", "first"), attempts=("success", "size"), sim_success=("success", "mean")
+    )
+    table["graspness"] = graspness.reindex(table.index).to_numpy(float)
+    labelled = table.dropna(subset=["graspness"])
+    summary = {"n_objects": int(len(labelled)), "spearman": None, "p_value": None}
+    if len(labelled) >= 3 and labelled.sim_success.nunique() > 1 and labelled.graspness.nunique() > 1:
+        result = spearmanr(labelled.sim_success, labelled.graspness)
+        summary["spearman"], summary["p_value"] = round(float(result.statistic), 4), round(float(result.pvalue), 5)
+    return table.reset_index(), summary
+
+
+def trial_setup(
+    sim, objects: Sequence, skipped: dict[str, str], model_seeds: list[int], after_from_report: bool
+) -> dict:
+    """The metrics' ``setup``: base size, whether the ``after`` ratio came from the AP report, the
+    object count and attempts per object, the test shapes and user objects among ``objects``, the
+    user's meshes skipped (file → why), camera height (m), sensor noise on or off, training seeds.
+    ``sim``: the ``sim`` params section (``SimParams``)."""
+    return {
+        "base_size": sim.base_size,
+        "after_ratio_from_report": after_from_report,
+        "objects": len(objects),
+        "attempts": sim.attempts,
+        "test_shapes": [o.name for o in objects if o.kind == "test_shape"],
+        "user_objects": [o.name for o in objects if o.kind == "user"],
+        "skipped_meshes": skipped,
+        "camera_height": sim.cell.camera_height,
+        "sensor_noise": sim.sensor.enabled,
+        "model_seeds": model_seeds,
+    }
+
+
+def summarize(trials: pd.DataFrame, objects: Sequence, chosen: dict, setup: dict, n_boot: int, seed: int) -> dict:
+    """The experiment's metrics: setup, per-arm rates (Wilson), the contrasts (paired, bootstrap
+    over objects), before vs after per training seed, per-object rates. ``objects``: the
+    :class:`~graspaug.experiments.sim.PreparedObject` of the trials; ``chosen``: arm → (pool, ratio)."""
+    model_seeds = setup["model_seeds"]
+    metrics = {
+        "setup": setup,
+        "arms": {
+            arm: {"pool": pool, "ratio": ratio, **rate_summary(trials.success[trials.arm == arm])}
+            for arm, (pool, ratio) in chosen.items()
+        },
+        "contrasts": {
+            name: trial_contrast(trials, arm, ref, n_boot, seed)
+            for name, (arm, ref) in CONTRASTS.items()
+            if arm in chosen and ref in chosen
+        },
+        "same_network": chosen["before"] == chosen["after"],
+        "per_seed": {str(s): compare(trials[trials.seed == s]) for s in model_seeds},
+        "per_object": {},
+    }
+    for obj in objects:
+        sel = trials.object == obj.name
+        rates = {arm: rate_summary(trials.success[sel & (trials.arm == arm)]) for arm in chosen}
+        metrics["per_object"][obj.name] = {
+            "kind": obj.kind,
+            "mass": round(obj.body.mass, 4),
+            "friction": round(obj.body.lateral_friction, 4),
+            **rates,
+        }
+    return metrics
+
+
+def objects_table(objects: Sequence) -> pd.DataFrame:
+    """One row per object (:class:`~graspaug.experiments.sim.PreparedObject`): name, kind, extents (m),
+    density (kg/m³), mass (kg), friction, the convex hulls of its collision file and that file's name."""
+    return pd.DataFrame(
+        [
+            {
+                "object": o.name,
+                "kind": o.kind,
+                "extent_x": o.extents[0],
+                "extent_y": o.extents[1],
+                "extent_z": o.extents[2],
+                "density": round(o.density, 1),
+                "mass": o.body.mass,
+                "friction": o.body.lateral_friction,
+                "convex_hulls": ("\n" + o.body.collision.read_text()).count("\no "),
+                "collision_file": o.body.collision.name,
+            }
+            for o in objects
+        ]
+    )
+
+
+def success_table(metrics: dict, arms: Sequence[str]) -> pd.DataFrame:
+    """Success rate per object (rows) and arm (columns) of the :func:`summarize` metrics."""
+    return pd.DataFrame(
+        [
+            {"object": name, **{arm: row[arm]["success_rate"] for arm in arms}}
+            for name, row in metrics["per_object"].items()
+        ]
+    )
+
+
+def success_bar_data(metrics: dict, chosen: dict) -> tuple[list[str], dict[str, tuple[np.ndarray, ...]]]:
+    """What :func:`graspaug.plots.success_bars` draws: the objects and ``all``, and per arm's label
+    (rate, Wilson low, Wilson high), each (objects + 1,)."""
+    names = [*metrics["per_object"], "all"]
+    bars = {}
+    for arm, (pool, ratio) in chosen.items():
+        label = "random antipodal grasp (no network)" if pool is None else f"{arm} ({pool}, ratio {ratio:g})"
+        stats = [metrics["per_object"][n][arm] for n in names[:-1]] + [metrics["arms"][arm]]
+        bars[label] = tuple(np.array([s[key] for s in stats]) for key in ("success_rate", "wilson_low", "wilson_high"))
+    return names, bars
+
+
+def _interval(c: dict) -> str:
+    return f"{c['mean']:+.3f} [{c['ci_low']:+.3f}, {c['ci_high']:+.3f}]"
+
+
+def _verdict(name: str, c: dict) -> str:
+    arm, reference = CONTRASTS[name]
+    evidence = f"({_interval(c)}, {c['n_trials']} paired drops)."
+    if c["ci_low"] > 0:
+        return f"`{name}` excludes zero: {arm} succeeds more often than {reference} {evidence}"
+    if c["ci_high"] < 0:
+        return f"`{name}` excludes zero: {arm} succeeds less often than {reference} {evidence}"
+    return f"`{name}` includes zero: no difference shown between {arm} and {reference} {evidence}"
+
+
+def report_text(metrics: dict, trials: pd.DataFrame, calibration_table: pd.DataFrame, scores_file: str) -> str:
+    """The report (markdown): rates, contrasts with their verdicts, per seed and per object,
+    outcomes, and the calibration table. ``scores_file``: where the graspness labels come from
+    (named in the calibration's text)."""
+    setup, arms = metrics["setup"], metrics["arms"]
+    noise = "D435-like noise, missing pixels and 1 mm steps" if setup["sensor_noise"] else "exact depth"
+    lines = [
+        "# Simulated robot trials",
+        "",
+        f"Franka Panda in pybullet, overhead depth camera {setup['camera_height']} m above the table "
+        f"({noise}), "
+        f"{setup['objects']} objects × {setup['attempts']} seeded drops, the same drops and planner seeds for every "
+        f"arm; networks of training seeds {setup['model_seeds']} (B = {setup['base_size']}). "
+        "Success = the object ends inside the bin.",
+        "",
+        "| arm | planner | successes | rate | 95% Wilson interval |",
+        "|---|---|---|---|---|",
+    ]
+    for arm, a in arms.items():
+        planner = (
+            "a random antipodal seed grasp, no network"
+            if arm == "antipodal"
+            else f"{a['pool']} B = {setup['base_size']}, ratio {a['ratio']:g}"
+        )
+        lines.append(
+            f"| {arm} | {planner} | {a['successes']}/{a['attempts']} | {a['success_rate']:.2f} | "
+            f"[{a['wilson_low']:.2f}, {a['wilson_high']:.2f}] |"
+        )
+    lines += [
+        "",
+        "## Contrasts",
+        "",
+        "Paired success difference (arm − reference) over the attempts of every "
+        "training seed; 95% percentile bootstrap interval with the objects as the unit (each resampled object "
+        "brings all its attempts), and the 95% t-interval over training seeds of the per-seed differences. "
+        "Against the antipodal arm (one run per drop) a drop counts once, the network's outcomes averaged over "
+        "the seeds; McNemar's test applies only to 0/1 pairs.",
+        "",
+        "| contrast | difference | 95% bootstrap (objects) | 95% t (seeds) | paired drops | objects | McNemar p |",
+        "|---|---|---|---|---|---|---|",
+    ]
+    for name, c in metrics["contrasts"].items():
+        t = "–" if c["t_ci_low"] is None else f"[{c['t_ci_low']:+.3f}, {c['t_ci_high']:+.3f}]"
+        p = "–" if c["mcnemar_p"] is None else f"{c['mcnemar_p']:.3g}"
+        lines.append(
+            f"| {name} | {c['mean']:+.3f} | [{c['ci_low']:+.3f}, {c['ci_high']:+.3f}] | {t} | "
+            f"{c['n_trials']} | {c['n_objects']} | {p} |"
+        )
+    lines += [""] + [f"- {_verdict(name, c)}" for name, c in metrics["contrasts"].items()]
+    if metrics["same_network"]:
+        lines.append(
+            f'- The best ratio on validation AP for B = {setup["base_size"]} is 0: "after" is the same '
+            'network as "before".'
+        )
+    seeds = metrics["per_seed"]
+    if len(seeds) > 1:
+        lines += ["", "| training seed | before | after | difference | McNemar p |", "|---|---|---|---|---|"]
+        for seed, row in seeds.items():
+            before, after = row["before"], row["after"]
+            lines.append(
+                f"| {seed} | {before['successes']}/{before['attempts']} | {after['successes']}/"
+                f"{after['attempts']} | {row['difference']:+.2f} | {row['paired']['p_value']:.3g} |"
+            )
+        if len({np.sign(row["difference"]) for row in seeds.values()} - {0.0}) > 1:
+            lines.append("\nThe sign of after − before changes with the training seed.")
+    names = list(arms)
+    lines += [
+        "",
+        "| object | kind | mass (kg) | friction | " + " | ".join(names) + " |",
+        "|---|---|---|---|" + "---|" * len(names),
+    ]
+    for name, row in metrics["per_object"].items():
+        lines.append(
+            f"| {name} | {row['kind']} | {row['mass']:.3f} | {row['friction']:.2f} | "
+            + " | ".join(f"{row[arm]['successes']}/{row[arm]['attempts']}" for arm in names)
+            + " |"
+        )
+    counts = trials.groupby(["arm", "outcome"]).size().unstack(fill_value=0)
+    lines += [
+        "",
+        "Outcomes (no_grasp: no antipodal pair on the image; collision: the hand pressed on the object, the "
+        "table or the bin before closing; not_lifted: the object stayed on the table; dropped: lost on the way; "
+        "outside_bin: released but not in the bin):",
+        "",
+        "| arm | " + " | ".join(counts.columns) + " |",
+        "|---|" + "---|" * len(counts.columns),
+    ]
+    for arm, row in counts.iterrows():
+        lines.append(f"| {arm} | " + " | ".join(str(int(v)) for v in row) + " |")
+    cal = metrics["calibration"]
+    rho = (
+        "not computed (fewer than 3 labelled objects or no spread)"
+        if cal["spearman"] is None
+        else f"{cal['spearman']:+.2f} (p = {cal['p_value']:.3g})"
+    )
+    lines += [
+        "",
+        "## Calibration",
+        "",
+        "Does the cell reward what the labels call a good grasp? The random "
+        "antipodal arm's success per object against the object's graspness (share of its sampled grasps with "
+        f"robust ε above the grasp threshold, `{scores_file}`; n/a for objects without labels). Spearman "
+        f"correlation over {cal['n_objects']} labelled objects: {rho}.",
+        "",
+        "| object | kind | attempts | sim success (antipodal) | graspness |",
+        "|---|---|---|---|---|",
+    ]
+    for row in calibration_table.itertuples():
+        label = "n/a" if np.isnan(row.graspness) else f"{row.graspness:.2f}"
+        lines.append(f"| {row.object} | {row.kind} | {row.attempts} | {row.sim_success:.2f} | {label} |")
+    return "\n".join(lines) + "\n"
+
+
+def planning_timing(trials: pd.DataFrame, arms: list[str]) -> dict:
+    """Planning time per grasp (s): mean, median, max over the trials, mean per arm; the stage
+    fills in ``stage_seconds``."""
+    planning = trials.planning_time.dropna()
+
+    def mean(values: pd.Series) -> float | None:
+        values = values.dropna()
+        return float(values.mean()) if len(values) else None
+
+    return {
+        "planning_time_mean": mean(planning),
+        "planning_time_median": float(planning.median()) if len(planning) else None,
+        "planning_time_max": float(planning.max()) if len(planning) else None,
+        "planning_time_by_arm": {arm: mean(trials.planning_time[trials.arm == arm]) for arm in arms},
+        "trials": int(len(trials)),
+        "stage_seconds": None,
+    }

@@ -1,0 +1,33 @@
+"""The networks of the GQ-CNN experiment, by name: a :class:`Variant` is (pool, base size B,
+ratio R), and its name is its folder in its training seed's folder (plain data, no I/O).
+
+Pools: ``targeted`` / ``random`` (generated shapes), ``real`` (more real train shapes) and the
+``ceiling`` (every train shape outside validation; no base size or ratio). Ratio 0 of any pool
+but the ceiling is the base set alone: the ``targeted`` network (:func:`network_variant`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+POOLS = ("targeted", "random", "real")
+
+
+@dataclass(frozen=True, order=True)
+class Variant:
+    """One network of a seed: ``pool`` (targeted, random, real or ceiling), base size, ratio."""
+
+    pool: str
+    base_size: int = 0
+    ratio: float = 0.0
+
+    @property
+    def name(self) -> str:
+        """``<pool>/<B>-<R>`` (R as ``%g``: ``50-0.5``, ``200-1``), or ``ceiling``: the network's folder
+        in its seed's folder."""
+        return "ceiling" if self.pool == "ceiling" else f"{self.pool}/{self.base_size}-{float(self.ratio):g}"
+
+
+def network_variant(pool: str, base_size: int, ratio: float) -> Variant:
+    """The network trained for (pool, B, R): ratio 0 of any pool but the ceiling is the targeted network."""
+    return Variant("targeted" if pool != "ceiling" and float(ratio) == 0.0 else pool, base_size, ratio)

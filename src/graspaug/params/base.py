@@ -1,0 +1,215 @@
+"""Reading ``params.yaml`` into settings classes: the keys every stage shares, and a loader that
+validates only the sections a stage reads.
+
+A stage declares its params model with :func:`params_model` (the shared keys plus its sections),
+so it imports, and DVC tracks, only the settings modules of those sections: editing the robot
+cell's settings re-runs the robot trials, not the pipeline before them. Sections a stage does
+not read are not validated by it (their own stage, ``graspaug profile`` and the tests do); a
+top-level key that names no section is an error everywhere. pydantic checks types, ranges and
+unknown keys; the first problem becomes a :class:`ParamsError`, one line naming the key.
+"""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any, Literal
+
+import yaml
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, create_model, model_validator
+
+#: Every section of params.yaml, in the order the pipeline runs.
+SECTIONS = (
+    "data",
+    "ingest",
+    "voxelize",
+    "ae",
+    "embed",
+    "critic_eval",
+    "grasps",
+    "score",
+    "generate",
+    "render",
+    "gqcnn",
+    "sim",
+)
+
+
+class ParamsError(ValueError):
+    """Invalid params; the message is one line naming the key."""
+
+
+def _get(params: Any, key: str) -> Any:
+    for part in key.split("."):
+        params = getattr(params, part)
+    return params
+
+
+def _subset(key: str, other: str) -> Callable[[Any], str | None]:
+    def check(p: Any) -> str | None:
+        value, allowed = _get(p, key), _get(p, other)
+        if not set(value) <= set(allowed):
+            return f"{key}: must be among {other} {list(allowed)}; got {list(value)}"
+        return None
+
+    return check
+
+
+def _member(key: str, other: str) -> Callable[[Any], str | None]:
+    def check(p: Any) -> str | None:
+        value, allowed = _get(p, key), _get(p, other)
+        return None if value in allowed else f"{key}: must be one of {other} {list(allowed)}; got {value}"
+
+    return check
+
+
+def _equal(key: str, other: str) -> Callable[[Any], str | None]:
+    def check(p: Any) -> str | None:
+        value, expected = _get(p, key), _get(p, other)
+        return None if value == expected else f"{key}: must equal {other} ({expected}); got {value}"
+
+    return check
+
+
+#: Values that must agree across sections: (sections involved, check → message or None). A stage
+#: runs the checks whose sections it reads.
+CROSS_CHECKS: tuple[tuple[tuple[str, ...], Callable[[Any], str | None]], ...] = (
+    (("ae", "voxelize"), _equal("ae.net.resolution", "voxelize.resolution")),
+    (("gqcnn", "render"), _equal("gqcnn.net.image_size", "render.crop.out_size")),
+    (("sim", "grasps"), _equal("sim.sampler.max_width", "grasps.gripper.max_width")),
+    (("gqcnn", "generate"), _subset("gqcnn.augment_base_sizes", "generate.base_sizes")),
+    (("sim", "gqcnn"), _member("sim.base_size", "gqcnn.augment_base_sizes")),
+)
+
+
+class BaseParams(BaseModel):
+    """The keys every stage shares; a stage's model adds its sections (:func:`params_model`)."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+    seed: int = Field(
+        0,
+        ge=0,
+        description="Seeds every random choice: the split, network initialisation and batches, critic-study pairs, "
+        "t-SNE, grasp sampling and perturbations.",
+    )
+    device: Literal["auto", "cpu", "cuda"] = Field(
+        "auto", description="Torch device: `auto` (CUDA when present), `cpu` or `cuda`."
+    )
+    n_jobs: int = Field(2, ge=-1, description="Worker processes for per-shape loops (-1: all cores).")
+    executor: Literal["joblib", "dask"] = Field(
+        "joblib",
+        description="Where per-shape loops (ingest, voxelize, grasps, generate, render, sim) run: `joblib` (n_jobs "
+        "local processes) or `dask` (the Dask cluster at `scheduler`; needs `pip install 'graspaug[dask]'` and "
+        "workers that see the project at the same path).",
+    )
+    scheduler: str | None = Field(
+        None, description="Dask scheduler address when executor is `dask`, e.g. tcp://10.0.0.5:8786."
+    )
+
+    @model_validator(mode="after")
+    def _consistent(self) -> BaseParams:
+        """Checks across keys: values that must agree are named in both places."""
+        if self.n_jobs == 0:
+            raise ValueError("n_jobs: must be >= 1, or -1 for all cores; got 0")
+        if self.executor == "dask" and not self.scheduler:
+            raise ValueError("scheduler: required when executor is dask (e.g. tcp://10.0.0.5:8786)")
+        present = set(type(self).model_fields)
+        for sections, check in CROSS_CHECKS:
+            problem = check(self) if set(sections) <= present else None
+            if problem:
+                raise ValueError(problem)
+        return self
+
+    @property
+    def workers(self):
+        """Where per-shape loops run (``graspaug.parallel.Workers``); not a DVC param: results do not depend on it."""
+        from graspaug.parallel import Workers
+
+        return Workers(n_jobs=self.n_jobs, executor=self.executor, scheduler=self.scheduler)
+
+
+def params_model(doc: str, **sections: type | tuple[type, str]) -> type[BaseParams]:
+    """A params model named ``Params`` in the calling module (bind it to that name there): the
+    shared keys plus ``sections`` (section name → settings class, or (class, description); each
+    defaulted by its class, described by its docstring unless given)."""
+    unknown = set(sections) - set(SECTIONS)
+    if unknown:
+        raise ValueError(f"not sections of params.yaml: {sorted(unknown)}")
+    fields = {}
+    for key in sorted(sections, key=SECTIONS.index):
+        cls, description = sections[key] if isinstance(sections[key], tuple) else (sections[key], sections[key].__doc__)
+        fields[key] = (cls, Field(default_factory=cls, description=description))
+    return create_model(
+        "Params", __base__=BaseParams, __doc__=doc, __module__=sys._getframe(1).f_globals["__name__"], **fields
+    )
+
+
+def _section_class(model: type, loc: tuple) -> type | None:
+    """The settings class at ``loc`` (a path of field names or aliases) inside ``model``."""
+    cls: Any = model
+    for part in loc:
+        fields = getattr(cls, "model_fields", None) or getattr(cls, "__pydantic_fields__", {})
+        match = next((info for name, info in fields.items() if part in (name, info.alias)), None)
+        if match is None:
+            return None
+        cls = match.annotation
+    return cls
+
+
+def _one_line(error: dict, model: type) -> str:
+    """One line naming the key: ``gqcnn.train.steps: Input should be greater than or equal to 1; got 0``."""
+    loc = error["loc"]
+    key = ".".join(str(p) for p in loc) or "params"
+    message = error["msg"].removeprefix("Value error, ")
+    if error["type"] == "value_error":  # our own checks name their keys
+        head = message.split(": ")[0]
+        if " " in head or ": " not in message:
+            return f"{key}: {message}"
+        if not loc or head.split(".")[0] == str(loc[0]):
+            return message  # named from the top (``critic_eval.alphas: …``)
+        return f"{key}.{message}"  # a settings class names its own field: put its section in front
+    if error["type"] in ("extra_forbidden", "unexpected_keyword_argument"):
+        section = _section_class(model, tuple(loc[:-1]))
+        fields = getattr(section, "model_fields", None) or getattr(section, "__pydantic_fields__", {})
+        allowed = ", ".join(info.alias or name for name, info in fields.items())
+        return f"{key}: unknown key; allowed here: {allowed}"
+    return f"{key}: {message}; got {error.get('input')!r}"
+
+
+def parse(raw: Any, model: type[BaseParams]) -> BaseParams:
+    """``model`` from a parsed params.yaml mapping; sections ``model`` does not hold are left
+    unread. Raises :class:`ParamsError`."""
+    if raw is not None and not isinstance(raw, dict):
+        raise ParamsError(f"params: expected a mapping of keys, got {raw!r}")
+    raw = dict(raw or {})
+    known = set(BaseParams.model_fields) | set(SECTIONS)
+    for key in raw:
+        if key not in known:
+            allowed = ", ".join([*BaseParams.model_fields, *SECTIONS])
+            raise ParamsError(f"{key}: unknown key; allowed here: {allowed}")
+    raw = {key: value for key, value in raw.items() if key in model.model_fields}
+    try:
+        return model.model_validate(raw)
+    except ValidationError as exc:
+        raise ParamsError(_one_line(exc.errors()[0], model)) from None
+
+
+def read_yaml(path: str | Path) -> Any:
+    """The parsed params file; raises :class:`ParamsError` for a missing or broken file (with the line)."""
+    path = Path(path)
+    if not path.exists():
+        raise ParamsError(f"{path}: params file not found")
+    try:
+        return yaml.safe_load(path.read_text())
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark is not None else ""
+        problem = getattr(exc, "problem", None) or str(exc).splitlines()[0]
+        raise ParamsError(f"{path}: not valid YAML{where} ({problem})") from None
+
+
+def load(path: str | Path, model: type[BaseParams]) -> BaseParams:
+    """Read and check the sections of ``model`` in the params file at ``path``; raises :class:`ParamsError`."""
+    return parse(read_yaml(path), model)

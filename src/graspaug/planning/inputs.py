@@ -1,0 +1,71 @@
+"""The planner's inputs from files: a depth image and the camera intrinsics."""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+
+import numpy as np
+
+from graspaug.planning.errors import PlanningError
+
+
+def read_depth_image(path: str | os.PathLike) -> np.ndarray:
+    """A depth image (H, W) float64 m from a ``.npy`` file (meters) or a 16-bit PNG
+    (millimeters; 0 = no reading, returned as NaN)."""
+    path = Path(path)
+    if not path.is_file():
+        raise PlanningError(f"{path}: no such file")
+    suffix = path.suffix.lower()
+    if suffix == ".npy":
+        try:
+            return np.load(path, allow_pickle=False)
+        except ValueError as exc:
+            raise PlanningError(f"{path}: not a numeric .npy array ({str(exc).splitlines()[0]})") from None
+    if suffix == ".png":
+        from PIL import Image
+
+        with Image.open(path) as image:
+            pixels = np.asarray(image)
+        if pixels.dtype != np.uint16 and not (pixels.dtype == np.int32 and pixels.max() < 2**16):
+            raise PlanningError(f"{path}: a depth PNG must be 16-bit grayscale in millimeters, got mode {image.mode}")
+        depth = pixels.astype(np.float64) / 1000.0
+        depth[pixels == 0] = np.nan
+        return depth
+    raise PlanningError(
+        f"{path}: depth images are .npy (meters) or 16-bit .png (millimeters), got {suffix or 'no suffix'}"
+    )
+
+
+def read_intrinsics(
+    path: str | os.PathLike | None,
+    fx: float | None,
+    fy: float | None,
+    cx: float | None,
+    cy: float | None,
+    shape: tuple[int, ...],
+) -> dict:
+    """Intrinsics (px) from a JSON file (fx, fy, cx, cy; width and height optional) or from
+    values: fy defaults to fx, the principal point to the image center of ``shape`` (H, W)."""
+    if path is not None:
+        if any(v is not None for v in (fx, fy, cx, cy)):
+            raise PlanningError("give the intrinsics as a JSON file or as --fx/--fy/--cx/--cy, not both")
+        try:
+            values = json.loads(Path(path).read_text())
+        except (OSError, ValueError) as exc:
+            raise PlanningError(
+                f"{path}: not a readable JSON file of fx, fy, cx, cy ({str(exc).splitlines()[0]})"
+            ) from None
+        if not isinstance(values, dict):
+            raise PlanningError(f"{path}: must hold a JSON object with fx, fy, cx, cy (px)")
+        return values
+    if fx is None:
+        raise PlanningError("intrinsics missing: give --fx (and --fy, --cx, --cy) or --intrinsics camera.json")
+    h, w = (shape[0], shape[1]) if len(shape) >= 2 else (1, 1)
+    return {
+        "fx": fx,
+        "fy": fx if fy is None else fy,
+        "cx": (w - 1) / 2 if cx is None else cx,
+        "cy": (h - 1) / 2 if cy is None else cy,
+    }

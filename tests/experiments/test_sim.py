@@ -1,0 +1,49 @@
+"""The sim experiment's arms and pictures, on networks and rows made by hand in a temporary folder."""
+
+import numpy as np
+import pytest
+
+from graspaug.errors import DataError
+from graspaug.experiments.sim import arms, model_path, trial_picture
+
+
+def seed_dirs_with(tmp_path, networks: list[str], seeds=(0, 1)) -> dict:
+    """Training seed → its folder, holding an empty ``model.pt`` for each network name."""
+    dirs = {s: tmp_path / f"s{s}" for s in seeds}
+    for folder in dirs.values():
+        for name in networks:
+            (folder / name).mkdir(parents=True, exist_ok=True)
+            (folder / name / "model.pt").write_bytes(b"")
+    return dirs
+
+
+def test_arms_pair_before_and_after_and_add_real_only_when_every_seed_has_it(tmp_path):
+    dirs = seed_dirs_with(tmp_path, ["targeted/50-0", "targeted/50-1.5"])
+    assert model_path(dirs[0], 50, 0.0, "real") == dirs[0] / "targeted/50-0/model.pt"  # ratio 0 is the targeted network
+    assert arms(1.5, 50, dirs) == {"before": ("targeted", 0.0), "after": ("targeted", 1.5), "antipodal": (None, None)}
+    seed_dirs_with(tmp_path, ["real/50-1.5"])
+    assert arms(1.5, 50, dirs)["real"] == ("real", 1.5)
+    with pytest.raises(DataError, match=r"s0/targeted/50-2/model.pt is missing"):
+        arms(2.0, 50, dirs)
+
+
+def test_a_picture_shows_the_jaws_around_the_grasp_and_blanks_missing_pixels():
+    depth = np.full((100, 200), 0.6)
+    depth[0, 0] = 0.0
+    row = {
+        "_depth": depth,
+        "u": 150.0,
+        "v": 40.0,
+        "angle": 0.0,
+        "width_px": 20.0,
+        "quality": 0.8,
+        "object": "duck",
+        "arm": "after",
+        "seed": 1,
+        "outcome": "success",
+        "_frames": [],
+    }
+    picture = trial_picture(row, 1.5)
+    np.testing.assert_allclose(picture["jaw"], [[140.0, 40.0], [160.0, 40.0]])
+    assert np.isnan(picture["depth"][0, 0]) and picture["window"] == (100, 0, 200, 100)
+    assert picture["title"] == "duck, arm after (ratio 1.5, training seed 1), attempt 0: Q = 0.800 → success"

@@ -1,0 +1,78 @@
+"""The experiments' statistics: t-intervals over seeds, the object bootstrap (test objects,
+trial objects), weighted AP, Wilson intervals and McNemar's test."""
+
+import numpy as np
+import pytest
+from scipy import stats as scipy_stats
+from sklearn.metrics import average_precision_score
+
+from graspaug.experiments.stats import (
+    ObjectBootstrap,
+    mcnemar_test,
+    percentile_interval,
+    t_interval,
+    weighted_average_precision,
+    wilson_interval,
+)
+
+
+def test_t_interval_on_a_hand_made_table():
+    result = t_interval([0.01, 0.03, 0.02])  # mean 0.02, SD 0.01, t(0.975, 2) = 4.3027
+    assert result["mean"] == pytest.approx(0.02) and result["n_seeds"] == 3
+    half = 4.302653 * 0.01 / np.sqrt(3)
+    assert (result["ci_low"], result["ci_high"]) == pytest.approx((0.02 - half, 0.02 + half), abs=1e-6)
+    five = t_interval([0.1, 0.2, 0.3, 0.4, 0.5])
+    assert five["ci_high"] - five["mean"] == pytest.approx(
+        scipy_stats.t.ppf(0.975, 4) * np.std([0.1, 0.2, 0.3, 0.4, 0.5], ddof=1) / np.sqrt(5)
+    )
+    assert t_interval([0.05])["ci_low"] is None and t_interval([None, 0.05, float("nan")])["n_seeds"] == 1
+
+
+def test_the_bootstrap_resamples_objects_not_datapoints():
+    rng = np.random.default_rng(0)
+    objects = np.repeat([f"obj{i}" for i in range(12)], rng.integers(5, 40, 12))  # uneven datapoints per object
+    boot = ObjectBootstrap(objects, n_resamples=200, seed=1)
+    weights = boot.object_counts[:, boot.object_index]
+    for name in np.unique(objects):  # every datapoint of an object is drawn together, as often as its object
+        rows = weights[:, objects == name]
+        assert (rows == rows[:, :1]).all()
+    assert (boot.object_counts.sum(axis=1) == 12).all()  # 12 objects drawn per resample, not len(objects) datapoints
+    assert not np.allclose(weights.sum(axis=1), len(objects))  # so the datapoint count varies
+    labels = rng.integers(0, 2, len(objects))
+    scores = rng.random(len(objects)) + 0.3 * labels
+    order = np.argsort(-scores)
+    plain = weighted_average_precision(labels[order].astype(float), np.ones(len(objects)))
+    assert plain == pytest.approx(average_precision_score(labels, scores))  # unweighted, it is sklearn's AP
+    resampled = boot.average_precision(labels, scores)
+    assert resampled.shape == (200,) and resampled.std() > 0
+    keep = boot.object_counts[0, boot.object_index]  # one resample's AP is the AP of its objects, repeated
+    repeated = np.repeat(np.arange(len(objects)), keep.astype(int))
+    assert resampled[0] == pytest.approx(average_precision_score(labels[repeated], scores[repeated]))
+
+
+def test_bootstrap_over_objects_covers_the_mean_and_sees_object_spread():
+    objects = np.repeat(np.arange(30), 6)
+    same = np.tile([1.0, 0.0, 0.0, 0.0, 0.0, 0.0], 30)  # every object +1/6
+    low, high = percentile_interval(ObjectBootstrap(objects, 1000, 0).means(same))
+    assert low == pytest.approx(1 / 6) and high == pytest.approx(1 / 6)  # no spread between objects: no width
+    mixed = np.where(objects % 2 == 0, 1.0, -0.5)  # half the objects gain, half lose
+    low, high = percentile_interval(ObjectBootstrap(objects, 2000, 1).means(mixed))
+    assert low < 0.25 < high and 0.35 < high - low < 0.7  # 2 × 1.96 × 0.75 / √30 = 0.54
+
+
+def test_wilson_interval_known_values():
+    # 8 of 10: p = 0.8, z = 1.96 -> (0.490, 0.943) (Wilson 1927; e.g. Newcombe 1998 table I)
+    low, high = wilson_interval(8, 10)
+    assert low == pytest.approx(0.4902, abs=1e-4) and high == pytest.approx(0.9433, abs=1e-4)
+    low, high = wilson_interval(10, 10)
+    assert high == pytest.approx(1.0) and low == pytest.approx(0.7225, abs=1e-4)
+    assert wilson_interval(0, 0) == (0.0, 1.0)
+
+
+def test_paired_test_counts_discordant_attempts():
+    before = np.array([1, 1, 1, 0, 0, 1, 1, 1], bool)
+    after = np.array([1, 0, 0, 0, 1, 1, 0, 0], bool)
+    result = mcnemar_test(before, after)
+    assert result["only_before"] == 4 and result["only_after"] == 1
+    assert result["p_value"] == pytest.approx(0.375)  # two-sided binomial, 1 of 5 at 0.5
+    assert mcnemar_test(before, before)["p_value"] == 1.0

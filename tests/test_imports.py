@@ -1,0 +1,98 @@
+"""The import graph of graspaug: arrows point one way.
+
+Edges come from the source (``ast``; imports inside functions count too): ``import a.b`` and
+``from a.b import name`` are edges to the module ``a.b`` (and to ``a.b.name`` when that is a
+module). A package's ``__init__`` is a node of its own, reached only by importing a name it
+defines, so a package that re-exports its modules' names is no cycle by itself.
+"""
+
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+import networkx as nx
+
+SRC = Path(__file__).resolve().parents[1] / "src"
+
+
+def module_name(path: Path, src: Path) -> str:
+    parts = list(path.relative_to(src).with_suffix("").parts)
+    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+
+
+def module_file(module: str, src: Path) -> Path | None:
+    base = src.joinpath(*module.split("."))
+    return next((f for f in (base.with_suffix(".py"), base / "__init__.py") if f.is_file()), None)
+
+
+def import_graph(src: Path, root: str = "graspaug") -> nx.DiGraph:
+    """Module → the modules of ``root`` it imports."""
+    graph = nx.DiGraph()
+    for path in sorted((src / root).rglob("*.py")):
+        module = module_name(path, src)
+        package = module if path.name == "__init__.py" else module.rpartition(".")[0]
+        graph.add_node(module)
+        for node in ast.walk(ast.parse(path.read_text(), str(path))):
+            targets: list[str] = []
+            if isinstance(node, ast.Import):
+                targets = [alias.name for alias in node.names]
+            elif isinstance(node, ast.ImportFrom):
+                base = package.split(".")[: len(package.split(".")) - node.level + 1] if node.level else []
+                origin = ".".join(base + ([node.module] if node.module else []))
+                submodules = [f"{origin}.{a.name}" for a in node.names if module_file(f"{origin}.{a.name}", src)]
+                names = [a.name for a in node.names if not module_file(f"{origin}.{a.name}", src)]
+                targets = submodules + ([origin] if names or not node.names else [])
+            for target in targets:
+                if target.split(".")[0] == root and module_file(target, src) and target != module:
+                    graph.add_edge(module, target)
+    return graph
+
+
+def test_no_import_cycle():
+    cycles = [sorted(c) for c in nx.strongly_connected_components(import_graph(SRC)) if len(c) > 1]
+    assert not cycles, f"modules that import each other (directly or through others): {cycles}"
+
+
+def test_a_planted_cycle_is_found(tmp_path):
+    for name, text in {
+        "pkg/__init__.py": "",
+        "pkg/a.py": "from pkg.b import f\n",
+        "pkg/b.py": "def f():\n    from pkg import a\n",
+    }.items():
+        (tmp_path / name).parent.mkdir(parents=True, exist_ok=True)
+        (tmp_path / name).write_text(text)
+    cycles = [c for c in nx.strongly_connected_components(import_graph(tmp_path, "pkg")) if len(c) > 1]
+    assert cycles == [{"pkg.a", "pkg.b"}]
+
+
+def test_planning_does_not_import_sim_or_experiments():
+    """The planner is a library the robot cell uses; it never reaches back into the cell or the experiments."""
+    graph = import_graph(SRC)
+    planning = [m for m in graph if m == "graspaug.planning" or m.startswith("graspaug.planning.")]
+    assert planning, "graspaug.planning is a package"
+    reached = set().union(*(nx.descendants(graph, m) for m in planning))
+    bad = sorted(m for m in reached if (m.split(".") + [""])[1] in ("sim", "experiments", "stages", "cli", "config"))
+    assert not bad, f"graspaug.planning reaches {bad}"
+
+
+def test_libraries_know_no_file_layout():
+    """Only stages and the CLI know file names (graspaug.paths) and raise StageError."""
+    graph = import_graph(SRC)
+    users = {m for m in graph.predecessors("graspaug.paths")}
+    assert {m for m in users if not (m.startswith("graspaug.stages") or m == "graspaug.cli")} == set()
+    for path in sorted((SRC / "graspaug").rglob("*.py")):
+        module = module_name(path, SRC)
+        if module.startswith("graspaug.stages") or module in ("graspaug.cli", "graspaug.errors"):
+            continue
+        assert "StageError" not in path.read_text(), f"{module} uses StageError (libraries raise DataError)"
+
+
+def test_settings_modules_are_plain_data():
+    """A settings module imports only other settings modules (its section is data, not code)."""
+    graph = import_graph(SRC)
+    data = {m for m in graph if m.endswith(".settings") or m.startswith("graspaug.params.")} - {"graspaug.params.base"}
+    allowed = data | {"graspaug.settings", "graspaug.params", "graspaug.sim.catalog", "graspaug.grasping.gripper"}
+    for module in sorted(data):
+        reached = nx.descendants(graph, module)
+        assert reached <= allowed, f"{module} imports code: {sorted(reached - allowed)}"

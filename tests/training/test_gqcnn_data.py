@@ -1,0 +1,35 @@
+"""The GQ-CNN experiment's datasets: object-wise validation, the same for every variant."""
+
+import pytest
+
+from graspaug.experiments.networks import seed_variants
+from graspaug.training.gqcnn_data import experiment_split, training_shapes
+
+TRAIN = [f"rnd_{i:03d}" for i in range(60)]
+BASE = {10: TRAIN[:10], 20: TRAIN[:20]}  # nested, as generate draws them
+
+
+def test_validation_is_disjoint_from_every_training_set_and_the_same_for_every_variant():
+    split = experiment_split(TRAIN, BASE, n_validation=8, seed=3)
+    assert split == experiment_split(TRAIN, BASE, n_validation=8, seed=3)  # no training seed, variant or pool enters
+    assert len(split.validation) == 8 and not set(split.validation) & set(BASE[20])
+    assert set(split.real_pool) == set(TRAIN) - set(BASE[20]) - set(split.validation)
+    assert set(split.ceiling) == set(TRAIN) - set(split.validation)
+    for variant in seed_variants([10, 20], [0.0, 0.5, 1.0], [10, 20], ceiling=True):
+        shapes, generated = training_shapes(variant, split)
+        assert not set(shapes) & set(split.validation), variant
+        assert set(BASE[variant.base_size]) <= set(shapes) if variant.pool != "ceiling" else len(shapes) == 52
+        if variant.pool == "real":
+            assert len(shapes) == variant.base_size + round(variant.ratio * variant.base_size) and generated == 0
+        elif variant.pool in ("targeted", "random"):
+            assert generated == round(variant.ratio * variant.base_size)
+    assert experiment_split(TRAIN, BASE, 8, seed=4).validation != split.validation  # the global seed draws it
+
+
+def test_a_real_pool_too_small_names_the_keys_to_change():
+    split = experiment_split(TRAIN, BASE, n_validation=30, seed=0)  # 10 shapes left for the real pool
+    variant = next(v for v in seed_variants([20], [1.0], [20], False) if v.pool == "real")
+    with pytest.raises(ValueError, match="needs 20 more train shapes; 10 lie outside.*gqcnn.val_shapes"):
+        training_shapes(variant, split)
+    with pytest.raises(ValueError, match="gqcnn.val_shapes = 41, but only 40"):
+        experiment_split(TRAIN, BASE, n_validation=41, seed=0)
