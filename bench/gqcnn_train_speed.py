@@ -147,7 +147,8 @@ def main() -> None:
 
     bf16 = "with" if has_native_bfloat16(torch.device("cpu")) else "WITHOUT (bfloat16 is emulated, slow)"
     print(
-        f"{args.datapoints} datapoints, {args.steps} steps per network, {os.cpu_count()} cores {bf16} bfloat16 instructions, "
+        f"{args.datapoints} datapoints, {args.steps} steps per network, {os.cpu_count()} cores {bf16} bfloat16 "
+        "instructions, "
         f"{args.rounds} rounds, one fresh process per run"
     )
     ratios: dict[str, list[float]] = {"float32": [], "bfloat16": []}
@@ -155,14 +156,19 @@ def main() -> None:
         order = LOOPS[r % 3 :] + LOOPS[: r % 3]
         got = {which: run(which, args) for which in order}
         ref = got["reference"]
-        line = f"round {r + 1}: reference (batch 64, {ref['threads']} threads) {ref['samples_per_second']:6.0f} samples/s, {ref['faults_per_step']:4.0f} page faults/step"
+        line = (
+            f"round {r + 1}: reference (batch 64, {ref['threads']} threads) {ref['samples_per_second']:6.0f} "
+            f"samples/s, {ref['faults_per_step']:4.0f} page faults/step"
+        )
         for precision in ratios:
             ratios[precision].append(got[precision]["samples_per_second"] / ref["samples_per_second"])
-            line += f"; current {precision} {got[precision]['samples_per_second']:6.0f} ({got[precision]['faults_per_step']:4.0f}): {ratios[precision][-1]:.2f}x"
+            speed, faults = got[precision]["samples_per_second"], got[precision]["faults_per_step"]
+            line += f"; current {precision} {speed:6.0f} ({faults:4.0f}): {ratios[precision][-1]:.2f}x"
         print(line, flush=True)
     for precision, values in ratios.items():
         print(
-            f"current loop, {precision}: median ratio over {args.rounds} rounds {np.median(values):.2f}x (rounds: {', '.join(f'{x:.2f}' for x in values)})"
+            f"current loop, {precision}: median ratio over {args.rounds} rounds {np.median(values):.2f}x (rounds: "
+            f"{', '.join(f'{x:.2f}' for x in values)})"
         )
 
 

@@ -66,7 +66,8 @@ def main() -> None:
         jobs.append((shape, grasps))
         total += len(grasps)
     print(
-        f"{total} grasps on {len(jobs)} default shapes, {noise.n_samples} perturbed samples each ({total * noise.n_samples} wrench sets)"
+        f"{total} grasps on {len(jobs)} default shapes, {noise.n_samples} perturbed samples each "
+        f"({total * noise.n_samples} wrench sets)"
     )
 
     ferrari_canny(np.zeros((1, 2 * cfg.quality.cone_faces + 4, 6)))  # compile (cached on disk) before timing
@@ -88,12 +89,14 @@ def main() -> None:
         )
         print(
             f"{name:>16}: robust ε in {results[name][0]:7.2f} s, of which ε {timed.seconds:7.2f} s "
-            f"({1e6 * timed.seconds / len(results[name][3]):.0f} µs per wrench set, {len(results[name][3])} not slipping)"
+            f"({1e6 * timed.seconds / len(results[name][3]):.0f} µs per wrench set, {len(results[name][3])} not "
+            "slipping)"
         )
     (t_ref, e_ref, robust_ref, eps_ref), (t_ours, e_ours, robust_ours, eps_ours) = results.values()
     print(f"speed ratio: {t_ref / t_ours:.1f}x on the whole robust metric, {e_ref / e_ours:.1f}x on ε alone")
     print(
-        f"largest difference: ε {np.abs(eps_ref - eps_ours).max():.2e}, robust ε {np.abs(robust_ref - robust_ours).max():.2e}"
+        f"largest difference: ε {np.abs(eps_ref - eps_ours).max():.2e}, robust ε "
+        f"{np.abs(robust_ref - robust_ours).max():.2e}"
     )
     print(
         f"robust ε > {cfg.threshold}: {np.mean(robust_ours > cfg.threshold):.1%} of grasps (same label for "

@@ -60,7 +60,8 @@ def main() -> None:
         jobs += [(shape.mesh, scene) for scene in scenes]
     n_grasps = sum(len(scene.grasp_index) for _, scene in jobs)
     print(
-        f"{len(shapes)} shapes, {len(jobs)} scenes, {n_grasps} crops ({settings.intrinsics.width}x{settings.intrinsics.height}, "
+        f"{len(shapes)} shapes, {len(jobs)} scenes, {n_grasps} crops "
+        f"({settings.intrinsics.width}x{settings.intrinsics.height}, "
         f"{settings.crop.crop_size}->{settings.crop.out_size} px)"
     )
 
@@ -136,22 +137,27 @@ def main() -> None:
     table_mask = ~ndimage.binary_dilation(object_mask, structure=np.ones((1, 3, 3), bool))
 
     print(
-        f"full-image reference (TinyRenderer + rotate/crop/resize): {reference_time:.2f} s ({1e3 * reference_time / len(jobs):.1f} ms per scene)"
+        f"full-image reference (TinyRenderer + rotate/crop/resize): {reference_time:.2f} s "
+        f"({1e3 * reference_time / len(jobs):.1f} ms per scene)"
     )
     print(
-        f"ours (ray-cast crops): {ours_time:.2f} s ({1e3 * ours_time / len(jobs):.2f} ms per scene, {rays / n_grasps:.0f} rays per crop "
-        f"vs {settings.intrinsics.width * settings.intrinsics.height / (n_grasps / len(jobs)):.0f} pixels per crop for a full image)"
+        f"ours (ray-cast crops): {ours_time:.2f} s ({1e3 * ours_time / len(jobs):.2f} ms per scene, "
+        f"{rays / n_grasps:.0f} rays per crop "
+        f"vs {settings.intrinsics.width * settings.intrinsics.height / (n_grasps / len(jobs)):.0f} pixels per crop "
+        "for a full image)"
     )
     print(f"speed ratio: {reference_time / ours_time:.1f}x (target >= 20x)")
     diff = np.abs(ours_all - pybullet_all)
     print(
-        f"vs TinyRenderer crops: mean |diff| {1e3 * diff.mean():.3f} mm (target <= 1 mm), table pixels max {1e3 * diff[table_mask].max():.4f} mm "
+        f"vs TinyRenderer crops: mean |diff| {1e3 * diff.mean():.3f} mm (target <= 1 mm), table pixels max "
+        f"{1e3 * diff[table_mask].max():.4f} mm "
         f"({table_mask.mean():.0%} of pixels; target <= 0.1 mm)"
     )
     diff = np.abs(ours_all - raycast_all)
     print(f"vs full ray-cast crops: mean |diff| {1e3 * diff.mean():.2e} mm, max {1e3 * diff.max():.2e} mm")
     print(
-        f"stable poses of the {len(shapes)} shapes: trimesh {trimesh_time:.2f} s, ours {poses_time:.3f} s, {trimesh_time / poses_time:.0f}x; "
+        f"stable poses of the {len(shapes)} shapes: trimesh {trimesh_time:.2f} s, ours {poses_time:.3f} s, "
+        f"{trimesh_time / poses_time:.0f}x; "
         f"same poses and probabilities: {same}"
     )
 

@@ -60,14 +60,16 @@ def main() -> None:
     ours_ref = np.array([iou(o, r) for o, r in zip(ours, refs)])
     theirs_ref = np.array([iou(t, r) for t, r in zip(theirs, refs)])
     print(
-        f"{len(shapes)} default shapes at {args.resolution}³ (median {int(np.median([len(s.mesh.faces) for s in shapes]))} faces), one process"
+        f"{len(shapes)} default shapes at {args.resolution}³ (median "
+        f"{int(np.median([len(s.mesh.faces) for s in shapes]))} faces), one process"
     )
     print(f"trimesh voxelized(pitch).fill(): {t_ref:.2f} s ({1000 * t_ref / len(shapes):.1f} ms/shape)")
     print(f"graspaug voxelize_solid:        {t_ours:.3f} s ({1000 * t_ours / len(shapes):.2f} ms/shape)")
     print(f"speed ratio: {t_ref / t_ours:.1f}x")
     print(f"IoU ours vs trimesh: mean {ious.mean():.4f}, min {ious.min():.4f}")
     print(
-        f"IoU vs the half-space reference (source convex parts): ours mean {ours_ref.mean():.4f} (min {ours_ref.min():.4f}), "
+        f"IoU vs the half-space reference (source convex parts): ours mean {ours_ref.mean():.4f} (min "
+        f"{ours_ref.min():.4f}), "
         f"trimesh mean {theirs_ref.mean():.4f} (min {theirs_ref.min():.4f})"
     )
 

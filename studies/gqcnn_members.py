@@ -34,11 +34,11 @@ from graspaug.experiments.networks import (
     members_digest,
     network_dir,
     seed_members,
-    seed_variants,
     stream_seeds,
     train_network,
 )
 from graspaug.experiments.stats import t_interval
+from graspaug.experiments.variants import seed_variants
 from graspaug.io.tables import read_table
 from graspaug.paths import SHAPES_TABLE, gqcnn_dir, gqcnn_seed_dir
 from graspaug.training.gqcnn_data import Corpora, load_split, shapes_datapoints, test_set
@@ -54,7 +54,8 @@ def train_members(params, split, variants, val, test, members: int, out: Path, c
             saved = json.loads((network_dir(gqcnn_seed_dir(seed), v) / "summary.json").read_text())["init_digest"]
             if saved != expected:
                 raise SystemExit(
-                    f"models/gqcnn/s{seed}/{v.name} was not trained with these params' members: rerun `dvc repro train_gqcnn`"
+                    f"models/gqcnn/s{seed}/{v.name} was not trained with these params' members: rerun `dvc repro "
+                    "train_gqcnn`"
                 )
         for m in range(cfg.members, members):
             weight_seed, noise_seed = stream_seeds(params.seed, seed, m)
@@ -65,7 +66,8 @@ def train_members(params, split, variants, val, test, members: int, out: Path, c
                 job = NetworkJob(v, split, cfg.net, cfg.train, (init,), (noise_seed,), seed, "cpu", folder, corpora)
                 r = train_network(job, val, test)
                 print(
-                    f"  s{seed} m{m} {v.name}: validation AP {r['validation']['ap']:.4f}, test AP {r['test']['ap']:.4f} "
+                    f"  s{seed} m{m} {v.name}: validation AP {r['validation']['ap']:.4f}, test AP "
+                    f"{r['test']['ap']:.4f} "
                     f"({r['train_seconds']:.0f} s)",
                     flush=True,
                 )

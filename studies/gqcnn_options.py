@@ -101,35 +101,44 @@ def main() -> None:
                     val.labels, predict(net, val, torch.device("cpu"), cfg.train.eval_batch)
                 )["ap"]
                 print(
-                    f"  {name:38s} B = {b:4d} seed {seed}: validation AP {val_ap[name, b, seed]:.4f} ({fit['steps']} steps, kept {fit['best_step']})",
+                    f"  {name:38s} B = {b:4d} seed {seed}: validation AP {val_ap[name, b, seed]:.4f} ({fit['steps']} "
+                    f"steps, kept {fit['best_step']})",
                     flush=True,
                 )
     default = next(iter(options))
-    fmt = lambda t: (
-        f"{t['mean']:+.4f} [{t['ci_low']:+.4f}, {t['ci_high']:+.4f}]"
-        if t["ci_low"] is not None
-        else f"{t['mean']:+.4f}"
-    )  # noqa: E731
+
+    def fmt(t):
+        return (
+            f"{t['mean']:+.4f} [{t['ci_low']:+.4f}, {t['ci_high']:+.4f}]"
+            if t["ci_low"] is not None
+            else f"{t['mean']:+.4f}"
+        )  # noqa: E731
+
     print(
-        "\noption                                 B     validation AP (95% t)          vs default (paired, 95% t)      samples/s"
+        "\noption                                 B     validation AP (95% t)          vs default (paired, 95% t)    "
+        "  samples/s"
     )
     for name in options:
         for b in args.base_sizes:
             own = t_interval([val_ap[name, b, s] for s in args.seeds])
             diff = t_interval([val_ap[name, b, s] - val_ap[default, b, s] for s in args.seeds])
             print(
-                f"{name:38s} {b:4d}  {fmt(own):30s} {fmt(diff) if name != default else '':30s} {np.median(speed[name]):8.0f}"
+                f"{name:38s} {b:4d}  {fmt(own):30s} {fmt(diff) if name != default else '':30s} "
+                f"{np.median(speed[name]):8.0f}"
             )
     if len(args.base_sizes) > 1:  # the positive control on validation: largest minus smallest base set, per seed
         small, large = min(args.base_sizes), max(args.base_sizes)
         print(
-            f"\noption                                 validation AP(B = {large}) - AP(B = {small}): mean [95% t], SD over seeds"
+            f"\noption                                 validation AP(B = {large}) - AP(B = {small}): mean [95% t], SD "
+            "over seeds"
         )
         for name in options:
             gains = [val_ap[name, large, s] - val_ap[name, small, s] for s in args.seeds]
             print(
-                f"{name:38s} {fmt(t_interval(gains)):30s} SD {np.std(gains, ddof=1) if len(gains) > 1 else float('nan'):.4f}  "
-                f"SD of AP(B = {small}) {np.std([val_ap[name, small, s] for s in args.seeds], ddof=1) if len(args.seeds) > 1 else float('nan'):.4f}"
+                f"{name:38s} {fmt(t_interval(gains)):30s} SD "
+                f"{np.std(gains, ddof=1) if len(gains) > 1 else float('nan'):.4f}  "
+                f"SD of AP(B = {small}) "
+                f"{np.std([val_ap[name, small, s] for s in args.seeds], ddof=1) if len(args.seeds) > 1 else np.nan:.4f}"
             )
 
 

@@ -265,7 +265,7 @@ def test_dvc_repro_gqcnn_matrix_and_report(tiny_repo):
             and not set(split["validation"]) & set(split["real_pool"])
         )
         assert (work / f"reports/gqcnn/validation/s{seed}.png").stat().st_size > 0
-    # paired: every network of a seed starts from the same weights, seeds from different ones; one validation set for all
+    # paired: every network of a seed starts from the same weights, seeds from different ones; one validation set
     assert len(digests[0]) == len(digests[1]) == 1 and digests[0] != digests[1]
     assert len(validation[0] | validation[1]) == 1
     real = json.loads((work / "models/gqcnn/s0/real/6-1/summary.json").read_text())["train"]
@@ -369,7 +369,7 @@ def test_dvc_repro_sim(tiny_repo, tmp_path):
     assert metrics["arms"]["antipodal"]["attempts"] == 4  # the reference arm without a network runs once
     for name in ("after_vs_before", "network_vs_antipodal") + (("after_vs_real",) if after_ratio > 0 else ()):
         c = metrics["contrasts"][name]
-        # against the antipodal arm (one run per drop) each of the 4 drops counts once; network arms pair 2 seeds × 4 drops
+        # against the antipodal arm (one run per drop) each of the 4 drops counts once; network arms: 2 seeds × 4 drops
         assert (
             c["n_trials"] == (4 if name == "network_vs_antipodal" else 8) and c["ci_low"] <= c["mean"] <= c["ci_high"]
         )

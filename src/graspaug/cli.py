@@ -17,8 +17,7 @@ from typer.core import TyperCommand
 
 app = typer.Typer(
     help="graspaug: augment a grasp planner's training objects with generated shapes.\n\n"
-    "Each command runs one stage of the DVC pipeline with the settings in params.yaml; "
-    "`dvc repro` runs them in order.",
+    "Each command runs one stage of the DVC pipeline with the settings in params.yaml; `dvc repro` runs them in order.",
     rich_markup_mode="markdown",
     no_args_is_help=True,
     add_completion=False,
@@ -85,27 +84,26 @@ def stage_command(name: str, help: str, *sections: str) -> None:
 
 stage_command(
     "ingest",
-    "Load the shape corpus, reject broken meshes with a reason, rebuild one closed outer surface "
-    "per shape, center and scale it, and split train/test.\n\n"
-    "Writes `data/shapes/<shape_id>.ply`, `data/shapes.parquet`, `data/rejects.parquet`.\n\n"
-    "{params}\n\nAlso `seed` (split) and `n_jobs`.",
+    "Load the shape corpus, reject broken meshes with a reason, rebuild one closed outer surface per shape, center and "
+    "scale it, and split train/test.\n\nWrites `data/shapes/<shape_id>.ply`, `data/shapes.parquet`, "
+    "`data/rejects.parquet`.\n\n{params}\n\nAlso `seed` (split) and `n_jobs`.",
     "data",
     "ingest",
 )
 stage_command(
     "voxelize",
-    "Voxelize every shape's closed surface into a solid R×R×R occupancy grid (voxel centers "
-    "inside the surface), scaled to fit with a margin; pitch and origin are kept to go back to meters.\n\n"
-    "Writes `data/voxels.npz`.\n\n{params}\n\nAlso `n_jobs`.",
+    "Voxelize every shape's closed surface into a solid R×R×R occupancy grid (voxel centers inside the surface), "
+    "scaled to fit with a margin; pitch and origin are kept to go back to meters.\n\nWrites "
+    "`data/voxels.npz`.\n\n{params}\n\nAlso `n_jobs`.",
     "voxelize",
 )
 stage_command(
     "train-ae",
-    "Train the AutoEncoder (phase 1, binary cross-entropy), then from it the AE-Critic (phase 2, eqs. (1)-(2) "
-    "of the paper) and its control (phase 2 with λ = 0) on the train split's voxel grids; test shapes stay unseen.\n\n"
-    "Writes `models/ae.pt`, `models/ae_extra.pt` (control), `models/ae_critic.pt`, DVCLive logs in `metrics/train_ae/`, "
-    "and `metrics/train_ae.json` (test/train reconstruction IoU, the critic's AUC on held-out shapes).\n\n{params}\n\n"
-    "Also `seed`, `device`.",
+    "Train the AutoEncoder (phase 1, binary cross-entropy), then from it the AE-Critic (phase 2, eqs. (1)-(2) of the "
+    "paper) and its control (phase 2 with λ = 0) on the train split's voxel grids; test shapes stay unseen.\n\nWrites "
+    "`models/ae.pt`, `models/ae_extra.pt` (control), `models/ae_critic.pt`, DVCLive logs in `metrics/train_ae/`, and "
+    "`metrics/train_ae.json` (test/train reconstruction IoU, the critic's AUC on held-out shapes).\n\n{params}\n\nAlso "
+    "`seed`, `device`.",
     "ae",
 )
 stage_command(
@@ -116,10 +114,10 @@ stage_command(
 )
 stage_command(
     "critic-eval",
-    "The paper's critic study: decode interpolations of random train pairs with the AE, its λ = 0 control and "
-    "the AE-Critic, cluster each with DBSCAN, report the mean outlier percentage per α with bootstrap intervals, "
-    "the paired difference AE-Critic − control and the critic's AUC (`metrics/critic_eval.json`) with plots "
-    "in `reports/critic_eval/`.\n\n{params}",
+    "The paper's critic study: decode interpolations of random train pairs with the AE, its λ = 0 control and the "
+    "AE-Critic, cluster each with DBSCAN, report the mean outlier percentage per α with bootstrap intervals, the "
+    "paired difference AE-Critic − control and the critic's AUC (`metrics/critic_eval.json`) with plots in "
+    "`reports/critic_eval/`.\n\n{params}",
     "critic_eval",
 )
 
@@ -127,11 +125,10 @@ stage_command(
 @app.command(
     name="grasps",
     help="Sample antipodal grasps on every shape of a corpus (Dex-Net's sampler, Franka Panda opening) and label "
-    "each with robust Ferrari-Canny: the mean ε over perturbed grasp poses, object poses and friction.\n\n"
-    "Writes `data/grasps/<corpus>.parquet` (one row per grasp) and `metrics/grasps/<corpus>.json`; corpus "
-    "`original` is the ingested shapes, `gen_<B>` the shapes generated for base size B. "
-    "A shape without any grasp gets no rows and a warning with the reason.\n\n"
-    "{params}\n\nAlso `seed` and `n_jobs`.",
+    "each with robust Ferrari-Canny: the mean ε over perturbed grasp poses, object poses and friction.\n\nWrites "
+    "`data/grasps/<corpus>.parquet` (one row per grasp) and `metrics/grasps/<corpus>.json`; corpus `original` is the "
+    "ingested shapes, `gen_<B>` the shapes generated for base size B. A shape without any grasp gets no rows and a "
+    "warning with the reason.\n\n{params}\n\nAlso `seed` and `n_jobs`.",
     cls=_with_params("grasps", "grasps"),
 )
 def grasps_command(
@@ -149,10 +146,10 @@ def grasps_command(
 
 stage_command(
     "score",
-    "Score every original shape: rarity (eq. (3)-(4) of the paper on the AE-Critic latents, relative to the "
-    "train split) and graspness (share of its grasps with robust ε above the threshold).\n\n"
-    "Writes `data/scores.parquet`, `metrics/score.json`, and histograms and a grasp picture in `reports/score/`.\n\n"
-    "{params}\n\nAlso `grasps.threshold` (for labels).",
+    "Score every original shape: rarity (eq. (3)-(4) of the paper on the AE-Critic latents, relative to the train "
+    "split) and graspness (share of its grasps with robust ε above the threshold).\n\nWrites `data/scores.parquet`, "
+    "`metrics/score.json`, and histograms and a grasp picture in `reports/score/`.\n\n{params}\n\nAlso "
+    "`grasps.threshold` (for labels).",
     "score",
 )
 
@@ -161,12 +158,12 @@ stage_command(
     name="generate",
     help="Generate new shapes for one base set of B train shapes (paper Section III-C): pair its rare shapes, and "
     "separately its graspable ones, with their N-th to (N+K)-th nearest neighbours in latent space, decode the "
-    "interpolated latents with the AE-Critic and mesh them (fill, opening, marching cubes, Humphrey smoothing); "
-    "also a random-pair pool of the same size as the baseline. Each pool holds max(ratios) × B shapes in order: "
-    "the first round(R × B) are the set for ratio R.\n\n"
-    "Writes `data/generated/<B>/` (`meshes/*.obj`, `index.parquet`, `rejects.parquet`, `base.parquet`), "
-    "`metrics/generate/<B>.json` and `reports/generate/<B>/{pairs,tsne}.png`.\n\n"
-    "{params}\n\nAlso `score.k` (rarity on the base set), `seed`, `device`, `n_jobs`.",
+    "interpolated latents with the AE-Critic and mesh them (fill, opening, marching cubes, Humphrey smoothing); also a "
+    "random-pair pool of the same size as the baseline. Each pool holds max(ratios) × B shapes in order: the first "
+    "round(R × B) are the set for ratio R.\n\nWrites `data/generated/<B>/` (`meshes/*.obj`, `index.parquet`, "
+    "`rejects.parquet`, `base.parquet`), `metrics/generate/<B>.json` and "
+    "`reports/generate/<B>/{pairs,tsne}.png`.\n\n{params}\n\nAlso `score.k` (rarity on the base set), `seed`, "
+    "`device`, `n_jobs`.",
     cls=_with_params("generate", "generate"),
 )
 def generate_command(
@@ -181,13 +178,13 @@ def generate_command(
     name="render",
     help="Render a Dex-Net 2.0 style grasp image dataset for a corpus: each shape in its most probable stable poses "
     "on a table, random depth-camera views from above, and for every grasp whose jaw axis is near parallel to the "
-    "table a 96×96 crop centered on it, turned so the jaws are horizontal, averaged down to 32×32, with the "
-    "gripper depth, an approach collision check of the Panda and the label (collision free and robust ε above "
-    "the grasps threshold). Crops come from rays cast only where they are needed; they equal crops cut from "
-    "full 640×480 renders (tests/render).\n\n"
-    "Writes `data/gqcnn/<corpus>/` (.npy shards of images, z, labels, ε; `index.parquet`; `skipped.parquet`), "
-    "`metrics/render/<corpus>.json` and `reports/render/<corpus>/examples.png`.\n\n"
-    "{params}\n\nAlso `grasps.gripper` (the hand), `grasps.threshold` (labels), `seed` and `n_jobs`.",
+    "table a 96×96 crop centered on it, turned so the jaws are horizontal, averaged down to 32×32, with the gripper "
+    "depth, an approach collision check of the Panda and the label (collision free and robust ε above the grasps "
+    "threshold). Crops come from rays cast only where they are needed; they equal crops cut from full 640×480 renders "
+    "(tests/render).\n\nWrites `data/gqcnn/<corpus>/` (.npy shards of images, z, labels, ε; `index.parquet`; "
+    "`skipped.parquet`), `metrics/render/<corpus>.json` and "
+    "`reports/render/<corpus>/examples.png`.\n\n{params}\n\nAlso `grasps.gripper` (the hand), `grasps.threshold` "
+    "(labels), `seed` and `n_jobs`.",
     cls=_with_params("render", "render"),
 )
 def render_command(
@@ -206,11 +203,12 @@ def render_command(
 @app.command(
     name="export-dexnet",
     help="Export a rendered dataset in Dex-Net 2.0's tensor layout for Berkeley's gqcnn tools: "
-    "`<out>/tensors/{depth_ims_tf_table,hand_poses,robust_ferrari_canny,collision_free,obj_labels,pose_labels,image_labels}_%05d.npz` "
-    "(key `arr_0`, 1000 rows per file) and `<out>/config.json`. As in Dex-Net, robust_ferrari_canny is 0 for "
-    "colliding grasps (so `metric > threshold` is the label); robust_ferrari_canny_raw keeps the robust ε. hand_poses "
-    "rows are (center row, center column, depth z, jaw angle, row − cy, column − cx, open jaws in px); obj_labels "
-    "index config.json's `obj_ids`, pose_labels its `pose_ids`. Run from the project folder after the render stage.",
+    "`<out>/tensors/{depth_ims_tf_table,hand_poses,robust_ferrari_canny,collision_free,obj_labels,pose_labels,"
+    "image_labels}_%05d.npz` "
+    "(key `arr_0`, 1000 rows per file) and `<out>/config.json`. As in Dex-Net, robust_ferrari_canny is 0 for colliding "
+    "grasps (so `metric > threshold` is the label); robust_ferrari_canny_raw keeps the robust ε. hand_poses rows are "
+    "(center row, center column, depth z, jaw angle, row − cy, column − cx, open jaws in px); obj_labels index "
+    "config.json's `obj_ids`, pose_labels its `pose_ids`. Run from the project folder after the render stage.",
 )
 def export_dexnet_command(
     corpus: str = typer.Argument(..., help="Rendered corpus: `original` or `gen_<B>`."),
@@ -230,18 +228,18 @@ def export_dexnet_command(
 
 @app.command(
     name="train-gqcnn",
-    help="Train every GQ-CNN (Dex-Net 2.0) of one training seed as a paired set (paper Section IV-C): `targeted` at every "
-    "base size B × ratio R of `generate` (the B base shapes' rendered grasps + those of the first round(R × B) shapes of B's "
-    "targeted pool), `random` (random-pair interpolants) and `real` (round(R × B) more real train shapes) at every nonzero "
-    "ratio of `gqcnn.augment_base_sizes`, and the `ceiling` (every train shape outside validation). Every network of the "
-    "seed starts from the same weights and noise stream and is validated on the same `gqcnn.val_shapes` train shapes; it "
-    "trains `gqcnn.train.epochs` passes over its own set (within min/max steps), the learning rate annealed along a "
-    "cosine, and keeps the weights with the best validation AP. With `gqcnn.members` K > 1 each network is an ensemble of "
-    "K such GQ-CNNs (member m starts from the same weights in every network of the seed) whose mean P(success) is "
-    "validated, tested and planned with. Test = every test-split grasp of the original corpus.\n\n"
-    "Writes `models/gqcnn/s<seed>/<pool>/<B>-<R>/` (model.pt, predictions, history.csv), `metrics/gqcnn/s<seed>.json` "
-    "(validation and test AP per network) and `reports/gqcnn/validation/s<seed>.png` (validation AP vs step).\n\n"
-    "{params}\n\nAlso `seed`, `device`, `n_jobs`.",
+    help="Train every GQ-CNN (Dex-Net 2.0) of one training seed as a paired set (paper Section IV-C): `targeted` at "
+    "every base size B × ratio R of `generate` (the B base shapes' rendered grasps + those of the first round(R × B) "
+    "shapes of B's targeted pool), `random` (random-pair interpolants) and `real` (round(R × B) more real train "
+    "shapes) at every nonzero ratio of `gqcnn.augment_base_sizes`, and the `ceiling` (every train shape outside "
+    "validation). Every network of the seed starts from the same weights and noise stream and is validated on the same "
+    "`gqcnn.val_shapes` train shapes; it trains `gqcnn.train.epochs` passes over its own set (within min/max steps), "
+    "the learning rate annealed along a cosine, and keeps the weights with the best validation AP. With "
+    "`gqcnn.members` K > 1 each network is an ensemble of K such GQ-CNNs (member m starts from the same weights in "
+    "every network of the seed) whose mean P(success) is validated, tested and planned with. Test = every test-split "
+    "grasp of the original corpus.\n\nWrites `models/gqcnn/s<seed>/<pool>/<B>-<R>/` (model.pt, predictions, "
+    "history.csv), `metrics/gqcnn/s<seed>.json` (validation and test AP per network) and "
+    "`reports/gqcnn/validation/s<seed>.png` (validation AP vs step).\n\n{params}\n\nAlso `seed`, `device`, `n_jobs`.",
     cls=_with_params("train_gqcnn", "gqcnn"),
 )
 def train_gqcnn_command(
@@ -259,23 +257,24 @@ stage_command(
     "targeted_vs_none, at the mean over ratios and at the ratio chosen on validation; targeted_vs_random; "
     "targeted_vs_real), each with a 95% t-interval over seeds and a 95% bootstrap interval over test objects, AP vs "
     "ratio (Fig. 7), the per-object AP change of the validation-chosen ratio by rarity and graspness (Fig. 8), a t-SNE "
-    "of original and generated latents by graspness (Fig. 1), and the verdicts in words.\n\n"
-    "Writes `metrics/ap.json`, `reports/gqcnn/{report.md,ap_table.csv,ap_vs_ratio.png,improvement_by_score.png,tsne_graspness.png}`.\n\n"
-    "Reads params `generate.base_sizes`, `generate.ratios`, `gqcnn.seeds`, `gqcnn.augment_base_sizes`, `gqcnn.ceiling`, `gqcnn.val_shapes`, `score.k`, `embed.perplexity`, `seed`.",
+    "of original and generated latents by graspness (Fig. 1), and the verdicts in words.\n\nWrites `metrics/ap.json`, "
+    "`reports/gqcnn/{report.md,ap_table.csv,ap_vs_ratio.png,improvement_by_score.png,tsne_graspness.png}`.\n\nReads "
+    "params `generate.base_sizes`, `generate.ratios`, `gqcnn.seeds`, `gqcnn.augment_base_sizes`, `gqcnn.ceiling`, "
+    "`gqcnn.val_shapes`, `score.k`, `embed.perplexity`, `seed`.",
 )
 
 stage_command(
     "sim",
     "Simulated robot trials (paper Section IV-E): a pybullet Franka Panda picks each object (everyday objects of "
-    "pybullet_data, `sim.n_test_objects` held-out test shapes and the meshes of `sim.objects_path`, with mass and friction "
-    "drawn per object, dropped from seeded poses) from the table into a bin, with grasps planned on a D435-like noisy "
-    "overhead depth image: antipodal seeds on depth edges, cross-entropy refinement by the GQ-CNN. Arms: `before` (B-0), "
-    "`after` (B at the ratio chosen on validation AP), `real` (the real pool there, when trained) and `antipodal` (a random "
-    "antipodal grasp, no network), the same drops for all.\n\n"
-    "Writes `metrics/sim.json` (success per arm and object with 95% Wilson intervals; `contrasts` after_vs_before, "
+    "pybullet_data, `sim.n_test_objects` held-out test shapes and the meshes of `sim.objects_path`, with mass and "
+    "friction drawn per object, dropped from seeded poses) from the table into a bin, with grasps planned on a "
+    "D435-like noisy overhead depth image: antipodal seeds on depth edges, cross-entropy refinement by the GQ-CNN. "
+    "Arms: `before` (B-0), `after` (B at the ratio chosen on validation AP), `real` (the real pool there, when "
+    "trained) and `antipodal` (a random antipodal grasp, no network), the same drops for all.\n\nWrites "
+    "`metrics/sim.json` (success per arm and object with 95% Wilson intervals; `contrasts` after_vs_before, "
     "network_vs_antipodal, after_vs_real with bootstrap intervals over objects; calibration) and `reports/sim/` "
-    "(`report.md`, `trials.csv`, `success.csv/.png`, `objects.csv`, `calibration.csv`, `timing.json`, `trials/<arm>-<object>.png`).\n\n"
-    "{params}",
+    "(`report.md`, `trials.csv`, `success.csv/.png`, `objects.csv`, `calibration.csv`, `timing.json`, "
+    "`trials/<arm>-<object>.png`).\n\n{params}",
     "sim",
 )
 
@@ -283,12 +282,12 @@ stage_command(
 @app.command(
     name="plan",
     help="Plan a grasp on one depth image with a trained GQ-CNN (the planner the simulated robot uses: antipodal pairs "
-    "on depth edges, GQ-CNN scores, cross-entropy refinement; a grasp is kept only if the image shows it antipodal "
-    "and reachable). DEPTH is a `.npy` array in meters or a 16-bit PNG in millimeters (0 = no reading), from a camera "
+    "on depth edges, GQ-CNN scores, cross-entropy refinement; a grasp is kept only if the image shows it antipodal and "
+    "reachable). DEPTH is a `.npy` array in meters or a 16-bit PNG in millimeters (0 = no reading), from a camera "
     "looking (nearly) straight down. The model card in `model.pt` says which camera the network was trained for; "
-    "another focal length or camera distance is resampled to it where that is sound, else refused.\n\n"
-    "Writes `<out>/grasp.json` (the grasps, best first: image center, angle, depth, width; camera-frame pose and "
-    "width in m; quality; the model card) and `<out>/grasp.png` (the image with the grasps drawn).",
+    "another focal length or camera distance is resampled to it where that is sound, else refused.\n\nWrites "
+    "`<out>/grasp.json` (the grasps, best first: image center, angle, depth, width; camera-frame pose and width in m; "
+    "quality; the model card) and `<out>/grasp.png` (the image with the grasps drawn).",
 )
 def plan_command(
     depth: Path = typer.Argument(..., help="Depth image: .npy (meters) or 16-bit .png (millimeters)."),
@@ -392,9 +391,9 @@ def export_model_command(
 @app.command(
     name="profile",
     help="Write params.yaml for a profile: the defaults plus the few keys `profiles/<name>.yaml` changes "
-    "(`default`: the defaults alone). Profiles: `tiny` (every stage in minutes, for trying changes), `study` "
-    "(the GQ-CNN experiment over several seeds), `paper` (the paper's sizes, for a GPU). Every key is written, "
-    "commented, so DVC tracks each value; `graspaug profile default` restores the defaults.",
+    "(`default`: the defaults alone). Profiles: `tiny` (every stage in minutes, for trying changes), `study` (the "
+    "GQ-CNN experiment over several seeds), `paper` (the paper's sizes, for a GPU). Every key is written, commented, "
+    "so DVC tracks each value; `graspaug profile default` restores the defaults.",
 )
 def profile_command(
     name: str = typer.Argument(..., help="Profile name: `default` or a file stem in profiles/."),
@@ -418,7 +417,8 @@ def profile_command(
 @app.command(
     name="schema",
     help="Write the JSON Schema of params.yaml (every key's type, range, default and meaning), for editors: "
-    "params.yaml's first line `# yaml-language-server: $schema=params.schema.json` makes VS Code's YAML extension check and complete it.",
+    "params.yaml's first line `# yaml-language-server: $schema=params.schema.json` makes VS Code's YAML extension "
+    "check and complete it.",
 )
 def schema_command(out: Path = typer.Option(Path("params.schema.json"), "--out", "-o", help="File to write.")) -> None:
     from graspaug.config import json_schema

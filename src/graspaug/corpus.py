@@ -46,7 +46,9 @@ def file_problem(path: Path) -> str | None:
     return f"not a regular file: {'symlink to ' + kind + ' ' + os.path.realpath(path) if link else kind}"
 
 
-NEAR_DUPLICATE_IOU = 0.99  # voxel IoU (32³) from which two shapes of equal extents are the same geometry (0.95 would pair distinct random_urdfs plates)
+#: Voxel IoU (32³) from which two shapes of equal extents are the same geometry (0.95 would pair distinct random_urdfs
+#: plates).
+NEAR_DUPLICATE_IOU = 0.99
 NEAR_DUPLICATE_EXTENT = 0.001  # m: ... and their normalized extents differ by at most this
 
 
@@ -165,6 +167,7 @@ def closing_summary(shapes: pd.DataFrame) -> str:
     closed = shapes["closed_by"].value_counts()
     lowest = shapes.loc[shapes["hull_fill"].idxmin()]
     return (
-        f"closed_by as_is {closed.get('as_is', 0)}, merged {closed.get('merged', 0)}, filled {closed.get('filled', 0)}; "
+        f"closed_by as_is {closed.get('as_is', 0)}, merged {closed.get('merged', 0)}, filled "
+        f"{closed.get('filled', 0)}; "
         f"hull_fill median {shapes['hull_fill'].median():.2f}, lowest {lowest['hull_fill']:.2f} ({lowest['shape_id']})"
     )

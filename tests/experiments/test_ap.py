@@ -8,7 +8,7 @@ import pytest
 from graspaug.errors import DataError
 from graspaug.experiments import ap
 from graspaug.experiments.ap import collect, declared_contrasts
-from graspaug.experiments.networks import seed_variants
+from graspaug.experiments.variants import seed_variants
 
 
 def test_the_declared_contrasts():
@@ -86,3 +86,85 @@ def test_networks_are_read_from_the_seed_folders_given(tmp_path):
     assert ap.test_predictions(seed_dirs[3], ("random", 50, 0.0)).tolist() == pytest.approx([0.1, 0.9])
     with pytest.raises(DataError, match=r"s3/targeted/50-1/summary.json is missing"):
         collect(seed_dirs, seed_variants([50], [0.0, 1.0], [50], ceiling=False))
+
+
+def _seed_folders(tmp_path, variants, seeds=(0, 1)):
+    """Seed folders of hand-made networks (summary, test predictions) and the original corpus's index."""
+    import pandas as pd
+
+    rng = np.random.default_rng(0)
+    n = 40
+    labels = (np.arange(n) % 3 == 0).astype(int)
+    index = pd.DataFrame(
+        {
+            "label": np.concatenate([labels, [0, 1]]),
+            "shape_id": [f"s{i % 5}" for i in range(n)] + ["t0", "t1"],
+            "split": ["test"] * n + ["train", "train"],
+        }
+    )
+    (tmp_path / "original").mkdir()
+    index.to_parquet(tmp_path / "original" / "index.parquet", index=False)
+    seed_dirs = {s: tmp_path / f"s{s}" for s in seeds}
+    for seed_dir in seed_dirs.values():
+        seed_dir.mkdir()
+        np.save(seed_dir / "test_rows.npy", np.arange(n))
+        for v in variants:
+            folder = seed_dir / v.name
+            folder.mkdir(parents=True)
+            p = rng.random(n).astype(np.float32)
+            summary = {"validation": {"ap": float(rng.random())}, "test": {"ap": float(rng.random()), "roc_auc": 0.5}}
+            (folder / "summary.json").write_text(json.dumps(summary))
+            np.save(folder / "test_predictions.npy", p)
+    return seed_dirs, index
+
+
+def test_evaluate_networks_is_the_report_chain_step_by_step(tmp_path):
+    from types import SimpleNamespace
+
+    import pandas as pd
+
+    generate = SimpleNamespace(base_sizes=[10, 20], ratios=[0.0, 1.0])
+    gqcnn = SimpleNamespace(augment_base_sizes=[10], ceiling=True, val_shapes=1)
+    variants = seed_variants(generate.base_sizes, generate.ratios, gqcnn.augment_base_sizes, gqcnn.ceiling)
+    seed_dirs, index = _seed_folders(tmp_path, variants)
+    ev = ap.evaluate_networks(seed_dirs, tmp_path / "original", generate, gqcnn, seed=5, n_resamples=50)
+
+    runs = collect(seed_dirs, variants)
+    chosen = ap.choose_ratios(runs, gqcnn.augment_base_sizes)
+    contrasts = declared_contrasts(generate.base_sizes, generate.ratios, gqcnn.augment_base_sizes, chosen)
+    rows = ap.test_rows(seed_dirs[0])
+    labels, object_ids = index.label.to_numpy()[rows], index.shape_id.to_numpy()[rows]
+    results = ap.evaluate_contrasts(contrasts, runs, seed_dirs, labels, object_ids, n_resamples=50, seed=5)
+    per_object, by_network = ap.per_object_aps(seed_dirs, variants, labels, object_ids)
+    assert ev.chosen == chosen and ev.contrasts == results
+    pd.testing.assert_frame_equal(ev.table, ap.network_table(runs, per_object))
+    assert ev.by_network.keys() == by_network.keys() and np.array_equal(ev.labels, labels)
+    assert ev.ceiling_shapes == 2 - 1  # the train shapes t0, t1 but one validation shape
+
+    predictions = ap.compared_predictions(seed_dirs[0], 10, 1.0, ceiling=True)
+    assert list(predictions) == ["B = 10, 1:0", "B = 10, 1:1", "ceiling"]
+    np.testing.assert_array_equal(predictions["B = 10, 1:1"], ap.test_predictions(seed_dirs[0], ("targeted", 10, 1.0)))
+    assert list(ap.compared_predictions(seed_dirs[0], 10, 1.0, ceiling=False)) == ["B = 10, 1:0", "B = 10, 1:1"]
+
+
+def test_the_augmentation_set_is_the_targeted_pools_first_rows():
+    import pandas as pd
+
+    from graspaug.generation import ratio_count
+
+    generated = pd.DataFrame({"pool": ["targeted"] * 6 + ["random"] * 6, "order": list(range(6)) * 2})
+    chosen = ap.augmentation_set(generated, 4, 0.5)
+    assert (chosen.pool == "targeted").all() and list(chosen.order) == list(range(ratio_count(0.5, 4)))
+
+
+def test_the_pr_roc_figure_draws_the_compared_networks(tmp_path):
+    from types import SimpleNamespace
+
+    from graspaug.experiments.ap_figures import draw_pr_roc
+
+    generate, gqcnn = SimpleNamespace(base_sizes=[10], ratios=[0.0, 1.0]), SimpleNamespace(augment_base_sizes=[10])
+    variants = seed_variants(generate.base_sizes, generate.ratios, gqcnn.augment_base_sizes, ceiling=False)
+    seed_dirs, index = _seed_folders(tmp_path, variants, seeds=(0,))
+    labels = index.label.to_numpy()[ap.test_rows(seed_dirs[0])]
+    draw_pr_roc(labels, seed_dirs[0], 0, 10, 1.0, False, tmp_path / "pr_roc.png")
+    assert (tmp_path / "pr_roc.png").stat().st_size > 0

@@ -1,7 +1,22 @@
 import numpy as np
+import pandas as pd
 import pytest
 
-from graspaug.experiments.critic import interpolate, outlier_contrast, outlier_table, random_pairs, summarize
+from graspaug.experiments.critic import (
+    EXAMPLE_ALPHAS,
+    MODEL_LABELS,
+    contrast_text,
+    example_rows,
+    finite_or_none,
+    interpolate,
+    outlier_columns,
+    outlier_contrast,
+    outlier_lines,
+    outlier_table,
+    random_pairs,
+    study_metrics,
+    summarize,
+)
 from graspaug.experiments.stats import PairBootstrap
 
 
@@ -59,3 +74,39 @@ def test_all_empty_column_gives_nulls():
         "ci_low": None,
         "ci_high": None,
     }
+
+
+def test_study_metrics_tables_every_model_and_contrast():
+    """A constant 2-point gap between the AE-Critic and the control shows as an exact contrast; empty grids are
+    counted; the wide table and its picture data carry the same means."""
+    rng = np.random.default_rng(2)
+    keys = ["0.00", "0.50"]
+    base = rng.exponential(3.0, (6, 2))
+    pct = {"ae": base + 1.0, "ae_extra": base.copy(), "ae_critic": base + 2.0}
+    pct["ae"][0, 0] = np.nan
+    critic = finite_or_none({"auc": 0.75, "real_mean": float("nan")})
+    assert critic == {"auc": 0.75, "real_mean": None}
+    metrics = study_metrics(pct, PairBootstrap(6, 200, rng), keys, critic, 200)
+    assert metrics["n_pairs"] == 6 and metrics["n_decoded_per_model"] == 12 and metrics["critic_auc"] == 0.75
+    assert metrics["empty_grids"] == {"ae": 1, "ae_extra": 0, "ae_critic": 0}
+    assert list(metrics["outlier_pct"]) == list(MODEL_LABELS)
+    gap = metrics["contrast"]["critic_vs_control"]
+    assert all(gap[k]["mean"] == pytest.approx(2.0) == gap[k]["ci_low"] for k in keys)
+    assert contrast_text(gap, keys) == ["+2.00 [+2.00, +2.00]"] * 2
+    assert contrast_text({"0.00": {"mean": None}}, ["0.00"]) == [None]
+
+    wide = pd.DataFrame(outlier_columns(metrics["outlier_pct_ci"], [0.0, 0.5], keys))
+    series, intervals = outlier_lines(wide)
+    assert list(series) == list(intervals) == list(MODEL_LABELS.values())
+    assert series["AE-Critic"][1] == pytest.approx(metrics["outlier_pct"]["ae_critic"]["0.50"])
+    low, high = intervals["AE"]
+    assert np.all(low <= series["AE"]) and np.all(series["AE"] <= high)
+
+
+def test_example_rows_one_row_per_pair_and_model():
+    grids = np.zeros((2, len(EXAMPLE_ALPHAS), 4, 4, 4), bool)
+    grids[..., 1:3, 1:3, 1:3] = True
+    rows, row_labels, col_labels = example_rows({m: grids for m in MODEL_LABELS})
+    assert len(rows) == 6 and len(rows[0]) == len(col_labels) == 7
+    assert row_labels[:3] == ["pair 1 AE", "pair 1 AE + extra epochs", "pair 1 AE-Critic"]
+    assert col_labels[0] == "α=0.00" and col_labels[-1] == "α=1.00"

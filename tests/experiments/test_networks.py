@@ -29,3 +29,42 @@ def test_members_of_a_seed_start_apart_and_member_zero_is_the_seeds_own_network(
     assert len({weights_digest(w) for w in inits}) == 3 and seed_members(config, 0, 1, 3)[1] == noise_seeds
     streams = {s for seed in range(4) for m in range(8) for s in stream_seeds(0, seed, m)}
     assert len(streams) == 4 * 8 * 2  # no member's stream is another seed's or member's
+
+
+def _summary(pool, base, ratio, val_ap, test_ap):
+    return {
+        "pool": pool,
+        "base_size": base,
+        "ratio": ratio,
+        "train": {"datapoints": 100, "steps": 20, "best_step": 10},
+        "validation": {"ap": val_ap},
+        "test": {"ap": test_ap},
+        "samples_per_second": 50.0 if pool == "ceiling" else 30.0,
+        "train_seconds": 1.26,
+    }
+
+
+def test_a_seeds_lines_timing_and_split_files(tmp_path):
+    import json
+
+    import numpy as np
+
+    from graspaug.experiments.networks import precision_warning, result_lines, save_seed_split, seed_timing
+    from graspaug.training.gqcnn_data import experiment_split
+
+    results = [_summary("targeted", 50, 1.5, 0.5, None), _summary("ceiling", 0, 0.0, 0.61234, 0.7)]
+    assert result_lines(results) == [
+        "ceiling 0-0: 100 datapoints, 20 steps (kept 10); validation AP 0.6123, test AP 0.7000",
+        "targeted 50-1.5: 100 datapoints, 20 steps (kept 10); validation AP 0.5000, test AP nan",
+    ]
+    timing = seed_timing(results, 12.345)
+    assert timing["seconds"] == 12.3 and timing["networks"] == 2 and timing["samples_per_second_median"] == 40.0
+    assert timing["train_seconds"] == {"targeted/50-1.5": 1.3, "ceiling/0-0": 1.3}
+    assert timing["threads"] == torch.get_num_threads()
+    assert precision_warning("float32", torch.device("cpu")) is None
+
+    split = experiment_split([f"s{i}" for i in range(6)], {2: ["s0", "s1"]}, 2, seed=0)
+    save_seed_split(tmp_path, split, np.arange(3), np.arange(2))
+    assert np.load(tmp_path / "test_rows.npy").tolist() == [0, 1, 2]
+    assert np.load(tmp_path / "val_rows.npy").tolist() == [0, 1]
+    assert json.loads((tmp_path / "split.json").read_text())["base"] == {"2": ["s0", "s1"]}

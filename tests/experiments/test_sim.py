@@ -47,3 +47,34 @@ def test_a_picture_shows_the_jaws_around_the_grasp_and_blanks_missing_pixels():
     np.testing.assert_allclose(picture["jaw"], [[140.0, 40.0], [160.0, 40.0]])
     assert np.isnan(picture["depth"][0, 0]) and picture["window"] == (100, 0, 200, 100)
     assert picture["title"] == "duck, arm after (ratio 1.5, training seed 1), attempt 0: Q = 0.800 → success"
+
+
+def test_the_after_ratio_comes_from_the_report_or_is_the_largest():
+    from graspaug.experiments.sim import after_ratio
+
+    assert after_ratio({"summary": {"50": {"best_ratio": 1.5}}}, 50, [0.0, 0.5, 2.0]) == (1.5, True)
+    assert after_ratio({"summary": {"100": {"best_ratio": 1.5}}}, 50, [0.0, 0.5, 2.0]) == (2.0, False)
+    assert after_ratio({}, 50, [0, 1]) == (1.0, False)
+
+
+def test_no_user_folder_gives_no_meshes_and_a_bad_one_is_a_data_error(tmp_path):
+    from types import SimpleNamespace
+
+    from graspaug.experiments.sim import user_meshes
+
+    ingest = SimpleNamespace(surface=None, max_faces=10, max_file_mb=1.0)
+    assert user_meshes(None, ingest) == ([], {})
+    with pytest.raises(DataError, match="holds no mesh file"):
+        user_meshes(tmp_path, ingest)
+
+
+def test_the_plan_line_counts_objects_arms_and_seeds():
+    from types import SimpleNamespace
+
+    from graspaug.experiments.sim import trials_plan
+
+    chosen = {"before": ("targeted", 0.0), "after": ("targeted", 1.5), "antipodal": (None, None)}
+    objects = [SimpleNamespace(name="a"), SimpleNamespace(name="b")]
+    assert trials_plan(objects, chosen, 3, 2, {"x.obj": "empty"}) == (
+        "2 objects × 3 attempts; arms before, after, antipodal × 2 training seeds (after = ratio 1.5); 1 skipped meshes"
+    )

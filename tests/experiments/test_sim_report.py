@@ -110,3 +110,16 @@ def test_calibration_correlates_sim_success_with_graspness():
     assert list(table.columns) == ["object", "kind", "attempts", "sim_success", "graspness"]
     _, none = calibration(trials, pd.Series(dtype=float))
     assert none == {"n_objects": 0, "spearman": None, "p_value": None}
+
+
+def test_the_outcome_line_gives_rates_contrasts_and_planning_time():
+    from graspaug.experiments.sim_report import outcome_words
+
+    metrics = {
+        "arms": {"before": {"successes": 3, "attempts": 4}, "after": {"successes": 4, "attempts": 4}},
+        "contrasts": {"after_vs_before": {"mean": 0.25, "ci_low": -0.125, "ci_high": 0.5}},
+    }
+    timing = {"planning_time_mean": 0.01234, "planning_time_max": None}
+    assert outcome_words(metrics, timing) == (
+        "before 3/4, after 4/4; after_vs_before +0.25 [-0.12, +0.50]; planning 0.012 s per grasp (max 0.000)"
+    )

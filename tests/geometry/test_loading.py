@@ -21,7 +21,8 @@ def write_broken_corpus(folder):
     (folder / "empty.stl").write_bytes(b"")
     trimesh.creation.icosphere(subdivisions=6, radius=0.03).export(folder / "huge.ply")  # 81,920 faces
     (folder / "points.ply").write_text(
-        "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nend_header\n0 0 0\n1 0 0\n0 1 0\n"
+        "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float "
+        "z\nend_header\n0 0 0\n1 0 0\n0 1 0\n"
     )
     return {
         "garbage": "no triangles",

@@ -193,7 +193,8 @@ def test_planned_pick_same_seed_same_outcome(duck):
 
 def test_jaw_angle_convention_on_a_long_bar(sim_cache):
     """A 3 × 12 × 3 cm bar: closing across its width lifts it, closing along its length (wider than
-    the 8 cm opening) cannot: a finger comes down on the bar. A jaw angle off by 90° or a flipped axis would swap the outcomes."""
+    the 8 cm opening) cannot: a finger comes down on the bar. A jaw angle off by 90° or a flipped
+    axis would swap the outcomes."""
     import trimesh
 
     from graspaug.sim.objects import prepare_object

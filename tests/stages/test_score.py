@@ -1,12 +1,12 @@
-"""The score stage's table logic and its handling of corpora without grasps."""
+"""The score tables (graspaug.score_tables) and their handling of corpora without grasps."""
 
 import numpy as np
 import pandas as pd
 import pytest
 
+from graspaug.errors import DataError
+from graspaug.score_tables import example_shapes, histogram_bars, histogram_table, score_summary, shape_scores
 from graspaug.scores import rarity
-from graspaug.stages import StageError
-from graspaug.stages.score import example_shapes, shape_scores
 
 
 def tables(seed=0):
@@ -36,8 +36,19 @@ def test_no_grasps_and_missing_latents():
     shapes, latents, grasps, _ = tables()
     scores = shape_scores(shapes, latents, grasps.iloc[:0], k=3)
     assert (scores.graspness == 0).all() and example_shapes(scores) == []
-    with pytest.raises(StageError, match="have no latent"):
+    with pytest.raises(DataError, match="have no latent"):
         shape_scores(shapes, latents.iloc[1:], grasps, k=3)
+
+
+def test_histogram_bars_and_summary():
+    shapes, latents, grasps, _ = tables()
+    scores = shape_scores(shapes, latents, grasps, k=3)
+    counts, edges = histogram_bars(histogram_table(scores.graspness.to_numpy(), 4, 0.0, 1.0))
+    np.testing.assert_array_equal(counts, [10, 0, 1, 1])
+    np.testing.assert_allclose(edges, [0, 0.25, 0.5, 0.75, 1])
+    summary = score_summary(scores[scores.split == "train"])
+    assert summary["n_train"] == 8 and summary["train_shapes_without_success"] == 6
+    assert summary["graspness_train_mean"] == round(1.5 / 8, 4)
 
 
 def test_empty_grasp_picture_is_still_a_picture(tmp_path):

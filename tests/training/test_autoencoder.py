@@ -109,7 +109,8 @@ def _normalization_buffers(module: torch.nn.Module) -> dict[str, torch.Tensor]:
 
 
 def test_phase_2_leaves_the_decoders_normalization_statistics_unchanged():
-    """Interpolated latents (and phase 2 at all) never enter the decoder's BatchNorm statistics; its weights still learn."""
+    """Interpolated latents (and phase 2 at all) never enter the decoder's BatchNorm statistics;
+    its weights still learn."""
     torch.manual_seed(0)
     x = primitive_grids(16)
     cfg = AEConfig(resolution=16, z_dim=16, base_width=4, top_width=16)

@@ -2,7 +2,7 @@
 
 import pytest
 
-from graspaug.experiments.networks import seed_variants
+from graspaug.experiments.variants import seed_variants
 from graspaug.training.gqcnn_data import experiment_split, training_shapes
 
 TRAIN = [f"rnd_{i:03d}" for i in range(60)]
@@ -33,3 +33,15 @@ def test_a_real_pool_too_small_names_the_keys_to_change():
         training_shapes(variant, split)
     with pytest.raises(ValueError, match="gqcnn.val_shapes = 41, but only 40"):
         experiment_split(TRAIN, BASE, n_validation=41, seed=0)
+
+
+def test_split_ids_are_plain_data_by_role():
+    from graspaug.training.gqcnn_data import split_ids
+
+    split = experiment_split(TRAIN, BASE, n_validation=8, seed=3)
+    ids = split_ids(split)
+    assert ids == {
+        "validation": split.validation,
+        "real_pool": split.real_pool,
+        "base": {"10": split.base[10], "20": split.base[20]},
+    }

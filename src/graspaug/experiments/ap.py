@@ -28,7 +28,8 @@ from sklearn.metrics import average_precision_score
 
 from graspaug.errors import DataError
 from graspaug.experiments.stats import ObjectBootstrap, percentile_interval, t_interval
-from graspaug.experiments.variants import network_variant
+from graspaug.experiments.variants import network_variant, seed_variants
+from graspaug.io.tables import read_table
 
 Key = tuple[str, int, float]  # (pool, base size, ratio); ratio 0 of any pool is ("targeted", B, 0.0)
 
@@ -135,6 +136,19 @@ def test_rows(seed_dir: Path) -> np.ndarray:
     return np.load(Path(seed_dir) / "test_rows.npy")
 
 
+def test_labels(index: pd.DataFrame, seed_dir: Path) -> tuple[np.ndarray, np.ndarray]:
+    """The test datapoints' labels (N,) and objects (N,): the rows of the seed in ``seed_dir``
+    (:func:`test_rows`) in the original corpus's ``index`` (columns ``label``, ``shape_id``)."""
+    rows = test_rows(seed_dir)
+    return index.label.to_numpy()[rows], index.shape_id.to_numpy()[rows]
+
+
+def ceiling_shapes(index: pd.DataFrame, val_shapes: int) -> int:
+    """How many train shapes the ceiling trains on: the train shapes of the original corpus's
+    ``index`` but the ``val_shapes`` validation shapes."""
+    return len(index[index.split == "train"].shape_id.unique()) - val_shapes
+
+
 def choose_ratios(runs: pd.DataFrame, base_sizes) -> dict[int, float]:  # base sizes with augmented networks
     """Per base size, the nonzero ratio with the highest mean validation AP of the targeted networks."""
     out = {}
@@ -148,6 +162,43 @@ def choose_ratios(runs: pd.DataFrame, base_sizes) -> dict[int, float]:  # base s
         if len(rows):
             out[int(b)] = float(rows.idxmax())
     return out
+
+
+@dataclass(frozen=True)
+class Evaluation:
+    """Every network of every seed evaluated (:func:`evaluate_networks`): ``chosen`` (base size →
+    ratio chosen on validation AP), ``contrasts`` (:func:`evaluate_contrasts`), ``table``
+    (:func:`network_table`), ``by_network`` (:func:`per_object_aps`), the test labels (N,) and
+    ``ceiling_shapes`` (:func:`ceiling_shapes`)."""
+
+    chosen: dict[int, float]
+    contrasts: dict
+    table: pd.DataFrame
+    by_network: dict[tuple, pd.Series]
+    labels: np.ndarray
+    ceiling_shapes: int
+
+
+def evaluate_networks(
+    seed_dirs: Mapping[int, Path], original: Path, generate, gqcnn, seed: int, n_resamples: int = 1000
+) -> Evaluation:
+    """Read every network of every seed (:func:`~graspaug.experiments.variants.seed_variants` of the
+    ``generate`` and ``gqcnn`` params) in its seed's folder (``seed_dirs``: training seed → folder;
+    a missing network is a :class:`DataError`), choose the ratios on validation AP, evaluate the
+    declared contrasts (``n_resamples`` bootstrap resamples of the test objects, seeded by the
+    global ``seed``) on the test datapoints of the first seed in the original corpus's dataset
+    folder ``original`` (its ``index.parquet``), and tabulate AP and per-object AP per network."""
+    base_sizes, ratios, augment_base_sizes = generate.base_sizes, generate.ratios, gqcnn.augment_base_sizes
+    variants = seed_variants(base_sizes, ratios, augment_base_sizes, gqcnn.ceiling)
+    runs = collect(seed_dirs, variants)
+    chosen = choose_ratios(runs, augment_base_sizes)
+    contrasts = declared_contrasts(base_sizes, ratios, augment_base_sizes, chosen)
+    index = read_table(Path(original) / "index.parquet")
+    labels, object_ids = test_labels(index, seed_dirs[next(iter(seed_dirs))])
+    results = evaluate_contrasts(contrasts, runs, seed_dirs, labels, object_ids, n_resamples=n_resamples, seed=seed)
+    per_object, by_network = per_object_aps(seed_dirs, variants, labels, object_ids)
+    table = network_table(runs, per_object)
+    return Evaluation(chosen, results, table, by_network, labels, ceiling_shapes(index, gqcnn.val_shapes))
 
 
 def per_object_ap(labels: np.ndarray, probability: np.ndarray, shape_ids: np.ndarray) -> pd.Series:
@@ -302,7 +353,8 @@ def gain_sentences(
         )  # mean over R of AP(real, B, R) - AP(B, 1:0)
         if real_gain:
             out.append(
-                f"At B = {b}, generated shapes give {t['mean'] / real_gain:.0%} of the gain of the same number of real shapes "
+                f"At B = {b}, generated shapes give {t['mean'] / real_gain:.0%} of the gain of the same number of "
+                "real shapes "
                 f"({t['mean']:+.4f} vs {real_gain:+.4f} AP, mean over ratios; a ratio of means, no interval)."
             )
     nets = table.set_index(["pool", "base_size", "ratio"])
@@ -316,11 +368,13 @@ def gain_sentences(
         head = f"B = {b}: the ceiling (all {ceiling_shapes} train shapes outside validation) reaches {top:.4f}"
         if abs(top - none) <= half:
             out.append(
-                f"{head}, within its 95% interval (±{half:.4f}) of 1:0 ({none:.4f}): no gap for augmentation to close at this budget."
+                f"{head}, within its 95% interval (±{half:.4f}) of 1:0 ({none:.4f}): no gap for augmentation to close "
+                "at this budget."
             )
         elif top < none:
             out.append(
-                f"{head}, below 1:0 ({none:.4f}): at this budget more shapes do not raise AP beyond B = {b}; no gap to close."
+                f"{head}, below 1:0 ({none:.4f}): at this budget more shapes do not raise AP beyond B = {b}; no gap "
+                "to close."
             )
         else:
             out.append(
@@ -341,7 +395,8 @@ def verdict(name: str, c: dict) -> str:
     )
     word = {"above zero": "a real gain", "below zero": "a real loss"}.get(t_side, "no effect we can claim")
     return (
-        f"`{name}` ({c['meaning']}): {c['mean']:+.4f} AP, 95% t-interval over {c['n_seeds']} seeds [{c['ci_low']:+.4f}, {c['ci_high']:+.4f}] "
+        f"`{name}` ({c['meaning']}): {c['mean']:+.4f} AP, 95% t-interval over {c['n_seeds']} seeds "
+        f"[{c['ci_low']:+.4f}, {c['ci_high']:+.4f}] "
         f"({t_side}), bootstrap over test objects [{c['boot_low']:+.4f}, {c['boot_high']:+.4f}] ({b_side}): {word}."
     )
 
@@ -391,6 +446,26 @@ def improvement_panels(
     return panels
 
 
+def compared_predictions(seed_dir: Path, base_size: int, ratio: float, ceiling: bool) -> dict[str, np.ndarray]:
+    """The test predictions (N,) P(success) of the networks the robot trials compare, by label, of the
+    seed in ``seed_dir``: targeted at 1:0 and 1:``ratio`` for ``base_size``, and the ceiling when
+    trained (``ceiling``)."""
+    compared = {
+        f"B = {base_size}, 1:0": ("targeted", base_size, 0.0),
+        f"B = {base_size}, 1:{ratio:g}": ("targeted", base_size, ratio),
+        "ceiling": ("ceiling", 0, 0.0),
+    }
+    return {name: test_predictions(seed_dir, key) for name, key in compared.items() if ceiling or key[0] != "ceiling"}
+
+
+def augmentation_set(generated: pd.DataFrame, base_size: int, ratio: float) -> pd.DataFrame:
+    """The rows of the generated index ``generated`` (of base size ``base_size``) that the targeted
+    network at 1:``ratio`` trains on: the targeted pool's first ``ratio_count(ratio, base_size)``."""
+    from graspaug.generation import ratio_count
+
+    return generated[(generated.pool == "targeted") & (generated.order < ratio_count(ratio, base_size))]
+
+
 def score_panels(
     improvement: pd.Series,
     base_set: pd.DataFrame,
@@ -424,6 +499,28 @@ def score_panels(
         improvement.to_numpy(),
     )
     return panels, generated_graspness
+
+
+def improvement_data(
+    by_network: dict[tuple, pd.Series],
+    seeds,
+    base_size: int,
+    ratio: float,
+    base_set: pd.DataFrame,
+    generated: pd.DataFrame,
+    grasps: pd.DataFrame,
+    latents: pd.DataFrame,
+    scores: pd.DataFrame,
+    k: int,
+) -> tuple[pd.Series, pd.DataFrame, list[dict], np.ndarray]:
+    """Fig. 8's data: the per-object AP change of 1:``ratio`` over 1:0 at ``base_size``
+    (:func:`object_improvement`), the augmentation set (:func:`augmentation_set` of the generated
+    index ``generated``), its panels and the generated shapes' graspness (:func:`score_panels`;
+    the test objects' rarity against the base set, as the selected shapes', ``k`` neighbours)."""
+    improvement = object_improvement(by_network, base_size, ratio, seeds)
+    augmentation = augmentation_set(generated, base_size, ratio)
+    panels, generated_graspness = score_panels(improvement, base_set, augmentation, grasps, latents, scores, k)
+    return improvement, augmentation, panels, generated_graspness
 
 
 def latent_map(
@@ -462,7 +559,8 @@ def training_words(t, members: int = 1) -> str:
         else f"Each network is an ensemble of {members} GQ-CNNs (their mean P(success)); each member"
     )
     return (
-        f"{what} trains {t.epochs:g} passes over its own training set ({t.min_steps}-{t.max_steps} steps of {t.batch_size}), "
+        f"{what} trains {t.epochs:g} passes over its own training set ({t.min_steps}-{t.max_steps} steps of "
+        f"{t.batch_size}), "
         f"the learning rate annealed to {t.final_lr:g} of its start, and keeps the weights with the best validation AP."
     )
 
@@ -480,9 +578,12 @@ def report_markdown(
     lines = [
         "# GQ-CNN augmentation experiment",
         "",
-        f"Every number is test Average Precision on every test-split grasp of the original corpus, over training seeds {list(seeds)}; "
-        f"± is the 95% t-interval half-width over seeds. {train_words} A predictor without skill has AP = the positive share, "
-        f"{positive_share:.4f}. Ratios are chosen on validation AP (train shapes no network trains on), never on the test set. "
+        "Every number is test Average Precision on every test-split grasp of the original corpus, over training "
+        f"seeds {list(seeds)}; "
+        f"± is the 95% t-interval half-width over seeds. {train_words} A predictor without skill has AP = the "
+        "positive share, "
+        f"{positive_share:.4f}. Ratios are chosen on validation AP (train shapes no network trains on), never on the "
+        "test set. "
         "Paper (Fig. 7): best ratios 1:0.5, 1:1.5, 1:2 for B = 50, 100, 200.",
         "",
         "| pool | B | ratio | test AP | per-object AP | validation AP | ROC AUC |",
@@ -493,7 +594,8 @@ def report_markdown(
         base = "-" if r.pool == "ceiling" else str(r.base_size)
         ci = "" if not np.isfinite(r.test_ap_ci) else f" ± {r.test_ap_ci:.4f}"
         lines.append(
-            f"| {r.pool} | {base} | {ratio} | {_fmt(r.test_ap)}{ci} | {_fmt(r.per_object_ap)} | {_fmt(r.val_ap)} | {_fmt(r.test_roc_auc)} |"
+            f"| {r.pool} | {base} | {ratio} | {_fmt(r.test_ap)}{ci} | {_fmt(r.per_object_ap)} | {_fmt(r.val_ap)} | "
+            f"{_fmt(r.test_roc_auc)} |"
         )
     lines += [
         "",
@@ -512,7 +614,8 @@ def report_markdown(
         "",
         "## What the numbers say",
         "",
-        f"- Contrasts whose t-interval excludes zero: {', '.join(f'`{n}`' for n in excluding) if excluding else 'none'}.",
+        "- Contrasts whose t-interval excludes zero: "
+        f"{', '.join(f'`{n}`' for n in excluding) if excluding else 'none'}.",
     ]
     lines += [f"- {verdict(n, c)}" for n, c in contrasts.items()]
     if chosen:

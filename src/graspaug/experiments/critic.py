@@ -10,12 +10,24 @@ Intervals are percentile bootstraps that resample pairs (one
 from __future__ import annotations
 
 import numpy as np
+import pandas as pd
 import torch
 
 from graspaug.experiments.stats import PairBootstrap, mean_interval, paired_contrast
 from graspaug.geometry.clusters import largest_cluster, outlier_percentage
 from graspaug.nets.ae_critic import AutoEncoder
-from graspaug.training.autoencoder import decode
+from graspaug.training.autoencoder import decode, encode
+
+# the three models of the study, in the order they are decoded, tabled and drawn
+MODEL_LABELS = {"ae": "AE", "ae_extra": "AE + extra epochs (λ = 0)", "ae_critic": "AE-Critic"}
+# paired contrasts: name → (model A, model B), A − B
+CONTRASTS = {
+    "critic_vs_control": ("ae_critic", "ae_extra"),
+    "critic_vs_ae": ("ae_critic", "ae"),
+    "control_vs_ae": ("ae_extra", "ae"),
+}
+# (S,) the interpolation weights of the example pairs' figure
+EXAMPLE_ALPHAS = np.linspace(0, 1, 7, dtype=np.float32)
 
 
 def random_pairs(n: int, n_shapes: int, n_pairs: int, rng: np.random.Generator) -> np.ndarray:
@@ -78,3 +90,97 @@ def interpolation_rows(sequences: dict[str, np.ndarray], labels: dict[str, str])
             rows.append([(g, largest_cluster(g)) for g in sequences[name][p]])
             row_labels.append(f"pair {p + 1} {label}")
     return rows, row_labels
+
+
+def model_interpolations(
+    ae: AutoEncoder,
+    grids: torch.Tensor,
+    pairs: np.ndarray,
+    examples: np.ndarray,
+    alphas: np.ndarray,
+    example_alphas: np.ndarray,
+    threshold: float,
+    device: torch.device,
+) -> tuple[np.ndarray, np.ndarray]:
+    """One model's part of the study: the train ``grids`` (N, 1, R, R, R) uint8, encoded once, interpolated
+    and decoded twice.
+
+    Returns
+    -------
+    pct : (P, A) float — outlier % of every pair of ``pairs`` (P, 2) decoded at ``alphas`` (A,)
+        (NaN for an empty grid; see :func:`outlier_table`).
+    sequences : (E, S, R, R, R) bool — the ``examples`` (E, 2) pairs decoded at ``example_alphas`` (S,),
+        thresholded at ``threshold`` (occupancy probability).
+    """
+    z = encode(ae, grids, device)
+    pct = outlier_table(decoded_interpolations(ae, z, pairs, alphas, threshold, device))
+    return pct, decoded_interpolations(ae, z, examples, example_alphas, threshold, device)
+
+
+def finite_or_none(values: dict[str, float]) -> dict[str, float | None]:
+    """``values`` with every non-finite number (NaN, ±inf: not JSON) replaced by None."""
+    return {k: v if np.isfinite(v) else None for k, v in values.items()}
+
+
+def study_metrics(
+    pct: dict[str, np.ndarray], boot: PairBootstrap, keys: list[str], critic: dict, n_bootstrap: int
+) -> dict:
+    """The critic study's metrics (``metrics/critic_eval.json``).
+
+    Parameters
+    ----------
+    pct : model → (P, A) outlier % (NaN: empty grid), every model on the same pairs, in
+        :data:`MODEL_LABELS` order.
+    boot : the pairs' bootstrap, shared by every model (the contrasts stay paired).
+    keys : (A,) the α's names (``"0.10"``).
+    critic : the AE-Critic's :func:`~graspaug.training.autoencoder.critic_separation`, non-finite as None.
+    n_bootstrap : resamples in ``boot`` (reported).
+
+    Returns
+    -------
+    dict — ``n_pairs``, ``n_decoded_per_model``, ``n_bootstrap``, ``critic_auc``, ``critic``,
+    ``outlier_pct`` (model → α key → mean %), ``outlier_pct_ci`` (model → α key →
+    :func:`~graspaug.experiments.stats.mean_interval` dict), ``contrast`` (:data:`CONTRASTS` name → α key →
+    :func:`~graspaug.experiments.stats.paired_contrast` dict, percentage points) and ``empty_grids`` (model → count).
+    """
+    summary = {name: dict(zip(keys, summarize(pct[name], boot))) for name in pct}
+    contrast = {c: dict(zip(keys, outlier_contrast(pct[a], pct[b], boot))) for c, (a, b) in CONTRASTS.items()}
+    return {
+        "n_pairs": int(len(pct["ae"])),
+        "n_decoded_per_model": int(pct["ae"].size),
+        "n_bootstrap": n_bootstrap,
+        "critic_auc": critic["auc"],
+        "critic": critic,
+        "outlier_pct": {name: {k: v["mean"] for k, v in summary[name].items()} for name in pct},
+        "outlier_pct_ci": summary,
+        "contrast": contrast,
+        "empty_grids": {name: int(np.isnan(pct[name]).sum()) for name in pct},
+    }
+
+
+def outlier_lines(wide: pd.DataFrame) -> tuple[dict[str, np.ndarray], dict[str, tuple[np.ndarray, np.ndarray]]]:
+    """What :func:`graspaug.plots.lines` draws of the :func:`outlier_columns` table ``wide`` (one row per α):
+    per model label, its (A,) mean outlier % and its (low, high) interval ends, (A,) each."""
+    series = {label: wide[m].to_numpy(dtype=float) for m, label in MODEL_LABELS.items()}
+    intervals = {
+        label: (wide[f"{m}_low"].to_numpy(dtype=float), wide[f"{m}_high"].to_numpy(dtype=float))
+        for m, label in MODEL_LABELS.items()
+    }
+    return series, intervals
+
+
+def example_rows(sequences: dict[str, np.ndarray]) -> tuple[list[list[tuple]], list[str], list[str]]:
+    """What :func:`graspaug.plots.voxel_rows` draws of the example pairs' ``sequences`` (model → (E, S, R, R, R)
+    bool, decoded at :data:`EXAMPLE_ALPHAS`): the :func:`interpolation_rows` cells and row labels (the models'
+    short names: their label up to `` (``), and the column labels (``α=0.50``)."""
+    rows, row_labels = interpolation_rows(sequences, {m: label.split(" (")[0] for m, label in MODEL_LABELS.items()})
+    return rows, row_labels, [f"α={a:.2f}" for a in EXAMPLE_ALPHAS]
+
+
+def contrast_text(contrast: dict[str, dict], keys: list[str]) -> list[str | None]:
+    """Per α key, one contrast (α key → :func:`~graspaug.experiments.stats.paired_contrast` dict) as
+    ``"+1.23 [+0.45, +2.01]"`` (percentage points), or None where it has no mean."""
+    return [
+        None if d["mean"] is None else f"{d['mean']:+.2f} [{d['ci_low']:+.2f}, {d['ci_high']:+.2f}]"
+        for d in (contrast[k] for k in keys)
+    ]

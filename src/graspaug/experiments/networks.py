@@ -22,28 +22,24 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import torch
+from tqdm import tqdm
 
+from graspaug.device import has_native_bfloat16
+from graspaug.errors import DataError
 from graspaug.experiments.variants import Variant
-from graspaug.io.checkpoints import finish_gqcnn_card, save_gqcnn
+from graspaug.io.checkpoints import finish_gqcnn_card, gqcnn_card, save_gqcnn
 from graspaug.nets.gqcnn import GQCNN, GQCNNEnsemble
 from graspaug.nets.settings import GQCNNConfig
 from graspaug.training.gqcnn import GraspArrays, classification_metrics, predict, train_gqcnn
-from graspaug.training.gqcnn_data import Corpora, ExperimentSplit, shapes_datapoints, test_set, training_set
+from graspaug.training.gqcnn_data import (
+    Corpora,
+    ExperimentSplit,
+    shapes_datapoints,
+    split_ids,
+    test_set,
+    training_set,
+)
 from graspaug.training.settings import TrainSettings
-
-
-def seed_variants(base_sizes, ratios, augment_base_sizes, ceiling: bool) -> list[Variant]:
-    """Every network of a seed: 1:0 at every base size; targeted, random and real at every
-    nonzero ratio of ``augment_base_sizes``; the ceiling."""
-    out = [Variant("targeted", b, 0.0) for b in base_sizes]
-    out += [
-        Variant(p, b, float(r))
-        for p in ("targeted", "random", "real")
-        for b in augment_base_sizes
-        for r in ratios
-        if r > 0
-    ]
-    return out + ([Variant("ceiling")] if ceiling else [])
 
 
 def stream_seeds(global_seed: int, seed: int, member: int = 0) -> tuple[int, int]:
@@ -184,8 +180,29 @@ def train_network(job: NetworkJob, val: GraspArrays | None = None, test: GraspAr
     }
 
 
+def seed_card(render, grasps, global_seed: int) -> dict:
+    """The model card's data part of every network (:func:`graspaug.io.checkpoints.gqcnn_card`) from the
+    ``render`` params (crop, intrinsics, viewpoints), the ``grasps`` params (gripper, label threshold) and
+    the global seed."""
+    return gqcnn_card(render.crop, render.intrinsics, render.viewpoints, grasps.gripper, grasps.threshold, global_seed)
+
+
+def train_jobs(jobs: list[NetworkJob], val: GraspArrays, test: GraspArrays, desc: str) -> list[dict]:
+    """Train the networks of ``jobs`` one after another (:func:`train_network`, progress bar ``desc``)
+    on the seed's validation and test datapoints; their summaries. A network that cannot be
+    trained (a ValueError) is a :class:`~graspaug.errors.DataError` (one line)."""
+    results = []
+    for job in tqdm(jobs, desc=desc, unit="network"):
+        try:
+            results.append(train_network(job, val, test))
+        except ValueError as exc:
+            raise DataError(str(exc)) from None
+    return results
+
+
 def _by_member(value):
-    """A per-member list as {"m0": …, "m1": …} (``dvc metrics`` shows dicts and numbers, not lists); a number as it is."""
+    """A per-member list as {"m0": …, "m1": …} (``dvc metrics`` shows dicts and numbers, not lists); a number
+    as it is."""
     return {f"m{m}": v for m, v in enumerate(value)} if isinstance(value, list) else value
 
 
@@ -218,3 +235,69 @@ def read_history(seed_dir: Path, variants: list[Variant]) -> pd.DataFrame:
     return (
         pd.concat(frames, ignore_index=True)[["network", "step", "val_ap", "loss", "lr"]] if frames else pd.DataFrame()
     )
+
+
+def seed_plan(variants: list[Variant], members: int, n_validation: int, val_rows, test_rows, device) -> str:
+    """One line on a seed's training: the networks and members, the validation shapes
+    (``n_validation``) and datapoints (``val_rows`` (N,)), the test datapoints (``test_rows`` (M,))
+    and the torch ``device``."""
+    return (
+        "%d networks of %d member(s); validation %d shapes (%d datapoints), test %d datapoints; one at a time on %s"
+        % (len(variants), members, n_validation, len(val_rows), len(test_rows), device)
+    )
+
+
+def precision_warning(precision: str, device: torch.device) -> str | None:
+    """The warning for ``gqcnn.train.precision`` bfloat16 on a ``device`` without bfloat16
+    instructions (emulated: slower than float32), else None."""
+    if precision == "bfloat16" and not has_native_bfloat16(device):
+        return (
+            "gqcnn.train.precision: bfloat16, but this %s has no bfloat16 instructions: training is emulated "
+            "and slower than float32 (-S gqcnn.train.precision=float32)" % device.type.upper()
+        )
+    return None
+
+
+def save_seed_split(seed_dir: Path, split: ExperimentSplit, test_rows: np.ndarray, val_rows: np.ndarray) -> None:
+    """Write the seed's ``test_rows.npy`` / ``val_rows.npy`` ((N,) rows of the original corpus's
+    index) and ``split.json`` (shape ids by role, :func:`graspaug.training.gqcnn_data.split_ids`)
+    into its folder ``seed_dir``."""
+    seed_dir = Path(seed_dir)
+    np.save(seed_dir / "test_rows.npy", test_rows)
+    np.save(seed_dir / "val_rows.npy", val_rows)
+    (seed_dir / "split.json").write_text(json.dumps(split_ids(split), indent=1) + "\n")
+
+
+def seed_timing(results: list[dict], seconds: float) -> dict:
+    """A seed's timing file: ``seconds`` (s, rounded to 0.1), the network count, torch's thread
+    count, the median training samples per second over ``results`` (:func:`train_network`'s
+    summaries) and each network's training seconds by ``<pool>/<B>-<R>``."""
+    speed = [r["samples_per_second"] for r in results]
+    return {
+        "seconds": round(seconds, 1),
+        "networks": len(results),
+        "threads": torch.get_num_threads(),
+        "samples_per_second_median": round(float(np.median(speed)), 1),
+        "train_seconds": {
+            f"{r['pool']}/{r['base_size']}-{r['ratio']:g}": round(r["train_seconds"], 1) for r in results
+        },
+    }
+
+
+def result_lines(results: list[dict]) -> list[str]:
+    """One line per network of ``results`` (:func:`train_network`'s summaries), sorted by pool, base
+    size and ratio: ``<pool> <B>-<R>``, its datapoints, steps, kept step, validation and test AP."""
+    return [
+        "%s %d-%g: %d datapoints, %d steps (kept %s); validation AP %.4f, test AP %.4f"
+        % (
+            r["pool"],
+            r["base_size"],
+            r["ratio"],
+            r["train"]["datapoints"],
+            r["train"]["steps"],
+            r["train"]["best_step"],
+            r["validation"]["ap"] or float("nan"),
+            r["test"]["ap"] or float("nan"),
+        )
+        for r in sorted(results, key=lambda r: (r["pool"], r["base_size"], r["ratio"]))
+    ]

@@ -83,6 +83,29 @@ def arms(
     return chosen
 
 
+def after_ratio(ap_metrics: dict, base_size: int, ratios) -> tuple[float, bool]:
+    """The ``after`` arm's ratio for ``base_size`` and whether it came from the AP report: the ratio
+    chosen on validation AP in the report's metrics ``ap_metrics`` (``summary`` → base size →
+    ``best_ratio``), else the largest of ``ratios`` (the ``generate.ratios``)."""
+    summary = ap_metrics.get("summary", {}).get(str(base_size))
+    best = float(max(ratios)) if summary is None else float(summary["best_ratio"])
+    return best, summary is not None
+
+
+def user_meshes(folder: str | Path | None, ingest) -> tuple[list[tuple[str, object]], dict[str, str]]:
+    """The user's meshes (name, trimesh) of the folder ``sim.objects_path`` (none when it is None), prepared
+    as the corpus's shapes with the ``ingest`` params' surface and size limits, and the files skipped
+    (file name → why). An empty or unreadable folder is a :class:`DataError` (one line)."""
+    if folder is None:
+        return [], {}
+    from graspaug.sim.objects import folder_meshes
+
+    try:
+        return folder_meshes(Path(folder), ingest.surface, ingest.max_faces, ingest.max_file_mb)
+    except ValueError as exc:  # an empty or unreadable folder: one line, not a traceback
+        raise DataError(str(exc)) from None
+
+
 def test_shape_ids(shapes: pd.DataFrame, n: int, seed: int) -> list[str]:
     """The held-out shapes picked in the trials: a seeded choice of ``n`` from the test split of ``shapes``."""
     if n == 0:
@@ -143,6 +166,22 @@ def prepare_objects(
         )
     work = functools.partial(_prepare_one, physics=physics, seed=seed, vhacd_resolution=vhacd_resolution, cache=cache)
     return parallel_map(work, meshes, workers, "sim objects")
+
+
+def trial_objects(
+    sim, shapes: pd.DataFrame, shapes_dir: Path, ingest, seed: int, workers=1
+) -> tuple[list[PreparedObject], dict[str, str]]:
+    """Every object of the trials of the ``sim`` params section (:func:`prepare_objects`): the everyday
+    objects of ``sim.objects``, ``sim.n_test_objects`` test shapes of the table ``shapes``
+    (:func:`test_shape_ids`; meshes in ``shapes_dir``) and the meshes of ``sim.objects_path``
+    (:func:`user_meshes` with the ``ingest`` params), with the global ``seed`` and ``workers``; and
+    the user's files skipped (file name → why)."""
+    test_shapes = test_shape_ids(shapes, sim.n_test_objects, seed)
+    user, skipped = user_meshes(sim.objects_path, ingest)
+    objects = prepare_objects(
+        sim.objects, test_shapes, shapes_dir, sim.physics, seed, sim.vhacd_resolution, user, workers=workers
+    )
+    return objects, skipped
 
 
 def object_jobs(
@@ -271,6 +310,40 @@ def run_object(
             }
         )
     return rows
+
+
+def trials_plan(objects: Sequence, chosen: dict, attempts: int, n_seeds: int, skipped: dict[str, str]) -> str:
+    """One line on what :func:`run_trials` will run: objects × attempts, the arms (``chosen``: arm →
+    (pool, ratio)) × training seeds, the ``after`` ratio and the count of skipped user meshes."""
+    return "%d objects × %d attempts; arms %s × %d training seeds (after = ratio %g); %d skipped meshes" % (
+        len(objects),
+        attempts,
+        ", ".join(chosen),
+        n_seeds,
+        chosen["after"][1],
+        len(skipped),
+    )
+
+
+def run_trials(jobs: Sequence[ObjectJob], sim, crop, workers) -> list[dict]:
+    """Every attempt of every job (:func:`run_object` on ``workers``, a process count or
+    :class:`graspaug.parallel.Workers`): the rows of the jobs in order, one per attempt. ``sim``: the
+    ``sim`` params section (cell, hand, sampler, CEM, trial settings, sensor); ``crop``: the render
+    params' crop (``crop_size``, ``out_size`` px)."""
+    from graspaug.parallel import parallel_map
+
+    work = functools.partial(
+        run_object,
+        layout=sim.cell,
+        hand=sim.hand,
+        sampler=sim.sampler,
+        cem=sim.cem,
+        crop_size=crop.crop_size,
+        out_size=crop.out_size,
+        trial_settings=sim.trial,
+        sensor=sim.sensor,
+    )
+    return [row for rows in parallel_map(work, jobs, workers, "sim") for row in rows]
 
 
 def trials_table(rows: list[dict], chosen: dict[str, tuple[str | None, float | None]]) -> pd.DataFrame:

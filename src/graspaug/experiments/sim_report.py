@@ -375,3 +375,19 @@ def planning_timing(trials: pd.DataFrame, arms: list[str]) -> dict:
         "trials": int(len(trials)),
         "stage_seconds": None,
     }
+
+
+def outcome_words(metrics: dict, timing: dict) -> str:
+    """One line on the trials: successes/attempts per arm, each contrast's mean [95 % bootstrap
+    interval] (:func:`summarize` metrics) and the planning time per grasp, mean and max (s;
+    :func:`planning_timing`)."""
+    rates = ", ".join(f"{arm} {a['successes']}/{a['attempts']}" for arm, a in metrics["arms"].items())
+    contrasts = ", ".join(
+        f"{n} {c['mean']:+.2f} [{c['ci_low']:+.2f}, {c['ci_high']:+.2f}]" for n, c in metrics["contrasts"].items()
+    )
+    return "%s; %s; planning %.3f s per grasp (max %.3f)" % (
+        rates,
+        contrasts,
+        timing["planning_time_mean"] or 0,
+        timing["planning_time_max"] or 0,
+    )

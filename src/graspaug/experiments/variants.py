@@ -31,3 +31,17 @@ class Variant:
 def network_variant(pool: str, base_size: int, ratio: float) -> Variant:
     """The network trained for (pool, B, R): ratio 0 of any pool but the ceiling is the targeted network."""
     return Variant("targeted" if pool != "ceiling" and float(ratio) == 0.0 else pool, base_size, ratio)
+
+
+def seed_variants(base_sizes, ratios, augment_base_sizes, ceiling: bool) -> list[Variant]:
+    """Every network of a seed: 1:0 at every base size; targeted, random and real at every
+    nonzero ratio of ``augment_base_sizes``; the ceiling."""
+    out = [Variant("targeted", b, 0.0) for b in base_sizes]
+    out += [
+        Variant(p, b, float(r))
+        for p in ("targeted", "random", "real")
+        for b in augment_base_sizes
+        for r in ratios
+        if r > 0
+    ]
+    return out + ([Variant("ceiling")] if ceiling else [])

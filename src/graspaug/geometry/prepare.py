@@ -55,7 +55,8 @@ def prepare_shape(loaded: LoadedShape, settings: SurfaceSettings) -> PreparedSha
             if closed.enclosed < MIN_ENCLOSED:
                 raise MeshRejected(
                     f"open: {1 - closed.enclosed:.0%} of the surface encloses nothing, a hole wider than "
-                    f"max_gap={settings.max_gap:g} of the largest extent ({1000 * closed.gap_m:.1f} mm) would have to be bridged"
+                    f"max_gap={settings.max_gap:g} of the largest extent ({1000 * closed.gap_m:.1f} mm) would have to "
+                    "be bridged"
                 )
     if len(surface.faces) == 0 or not surface.volume > 0:
         raise MeshRejected("degenerate: the rebuilt solid has no volume")

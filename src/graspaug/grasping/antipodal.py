@@ -1,11 +1,12 @@
 """Dex-Net's antipodal grasp sampler on a closed mesh (lengths in meters).
 
 Per round: sample up to ``max_surface_points`` surface points (area-weighted), draw
-``tries_per_point`` grasp axes inside each point's friction cone, find the opposite contact with the jaw that closes from ``max_width`` away,
-re-find both contacts as the closing jaws meet the surface, keep grasps whose contacts are
-far enough apart and in force closure, drop grasps whose centers are closer than
-``coverage_dist`` to a kept one; oversample ×``oversample`` and double that every round
-until ``n_grasps`` are kept or ``max_rounds`` have run, then shuffle and truncate.
+``tries_per_point`` grasp axes inside each point's friction cone, find the opposite contact
+with the jaw that closes from ``max_width`` away, re-find both contacts as the closing jaws
+meet the surface, keep grasps whose contacts are far enough apart and in force closure, drop
+grasps whose centers are closer than ``coverage_dist`` to a kept one; oversample
+×``oversample`` and double that every round until ``n_grasps`` are kept or ``max_rounds``
+have run, then shuffle and truncate.
 
 Unlike Dex-Net, surface points come from the exact mesh surface rather than SDF grid cells
 (so no point jitter is needed), contact normals are the hit triangles' normals rather than

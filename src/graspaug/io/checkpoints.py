@@ -51,7 +51,8 @@ def load_autoencoder(path: str | os.PathLike, expected: AEConfig) -> tuple[AutoE
     state = torch.load(path, map_location="cpu", weights_only=True)
     if "critic" in state and state.get("format") != FORMAT:  # the autoencoder's layout is the same in /1
         raise CheckpointMismatch(
-            f"{path} holds a critic of format {state.get('format')}, this code reads {FORMAT}; retrain it with `dvc repro train_ae`"
+            f"{path} holds a critic of format {state.get('format')}, this code reads {FORMAT}; retrain it with `dvc "
+            "repro train_ae`"
         )
     saved = AEConfig(**state["config"])
     if saved != expected:

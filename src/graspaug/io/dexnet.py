@@ -110,8 +110,8 @@ def export_dexnet(source: str | os.PathLike, out: str | os.PathLike, rows_per_fi
             "center_col_minus_cx",
             "width_px",
         ],
-        "label_rule": f"robust_ferrari_canny > {info['grasps_threshold']} (robust_ferrari_canny is 0 for colliding grasps, as in Dex-Net; "
-        "robust_ferrari_canny_raw keeps the robust epsilon before that)",
+        "label_rule": f"robust_ferrari_canny > {info['grasps_threshold']} (robust_ferrari_canny is 0 for colliding "
+        "grasps, as in Dex-Net; robust_ferrari_canny_raw keeps the robust epsilon before that)",
     }
     with atomic_path(out, directory=True) as folder:
         write_tensor_dataset(folder, fields, rows_per_file, extra)

@@ -148,7 +148,8 @@ def folder_meshes(
             log.warning("sim: skipping %s: %s", path, skipped[path.name])
     if not meshes:
         raise ValueError(
-            f"sim.objects_path: no usable mesh in {folder} ({len(skipped)} skipped: {'; '.join(f'{k}: {v}' for k, v in skipped.items())})"
+            f"sim.objects_path: no usable mesh in {folder} ({len(skipped)} skipped: "
+            f"{'; '.join(f'{k}: {v}' for k, v in skipped.items())})"
         )
     return meshes, skipped
 

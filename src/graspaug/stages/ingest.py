@@ -57,7 +57,8 @@ def run(params: Params) -> None:
         if len(shapes) < cfg.min_shapes:
             reasons = "; ".join(f"{n}× {r}" for r, n in Counter(rejects["reason"]).most_common(3))
             raise StageError(
-                f"only {len(shapes)} of {len(sources)} shapes are usable, ingest.min_shapes={cfg.min_shapes} ({reasons})"
+                f"only {len(shapes)} of {len(sources)} shapes are usable, "
+                f"ingest.min_shapes={cfg.min_shapes} ({reasons})"
             )
         split = assign_split(
             list(shapes["shape_id"]), cfg.test_fraction, params.seed, dict(zip(shapes.shape_id, shapes.duplicate_of))

@@ -72,6 +72,16 @@ def experiment_split(train_ids: list[str], base: dict[int, list[str]], n_validat
     )
 
 
+def split_ids(split: ExperimentSplit) -> dict:
+    """The shape ids of ``split`` by role as plain data (a seed's ``split.json``): ``validation``,
+    ``real_pool`` (in its seeded order) and ``base`` (base size as text → its base shapes)."""
+    return {
+        "validation": split.validation,
+        "real_pool": split.real_pool,
+        "base": {str(b): ids for b, ids in split.base.items()},
+    }
+
+
 def load_split(
     original: Path, shapes: pd.DataFrame, base_sizes: list[int], n_validation: int, seed: int
 ) -> ExperimentSplit:

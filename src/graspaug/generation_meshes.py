@@ -1,0 +1,211 @@
+"""The ``generate`` stage's work on one base set: decode candidates to meshes with the AE-Critic,
+fill the targeted and random pools, and assemble their tables, metrics and picture data.
+
+Kept apart from :mod:`graspaug.generation` (base sets, candidate streams, pool rules), which the
+GQ-CNN experiment imports too, so that decoder and meshing code is code of ``generate`` alone.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+from graspaug.embedding import tsne_2d
+from graspaug.errors import DataError
+from graspaug.generation import (
+    BASE_SEED,
+    Candidate,
+    Decoded,
+    PoolExhausted,
+    RandomStream,
+    TargetedStream,
+    base_scores_table,
+    draw_base_sets,
+    fill_pool,
+    pool_size,
+    pool_summary,
+    pool_tables,
+)
+from graspaug.geometry.from_voxels import mesh_decoded
+from graspaug.params.generate import GenerateParams
+from graspaug.scores import rarity
+from graspaug.training.autoencoder import decode
+
+LOW_YIELD = 0.95  # a pool keeping a smaller share of its decodes is warned about
+REJECT_COLUMNS = ["pool", "parent_a", "parent_b", "alpha", "selected_by", "reason"]
+
+
+def base_ids(shapes: pd.DataFrame, base_sizes: Sequence[int], base_size: int, seed: int) -> np.ndarray:
+    """The (``base_size``,) shape ids of the base set of ``base_size``, one of ``base_sizes``
+    (``generate.base_sizes``), drawn from the train split of ``shapes`` (the ingested shape table)
+    by :func:`graspaug.generation.draw_base_sets` with the global ``seed``; a
+    :class:`graspaug.errors.DataError` if the size is not listed or the train split is too small."""
+    if base_size not in base_sizes:
+        raise DataError(f"base size {base_size} is not in generate.base_sizes {list(base_sizes)}")
+    n_train = int((shapes.split == "train").sum())
+    if n_train < max(base_sizes):
+        raise DataError(f"generate.base_sizes: {max(base_sizes)} is larger than the {n_train} train shapes")
+    return draw_base_sets(shapes, base_sizes, seed)[base_size]
+
+
+@dataclass(frozen=True)
+class BaseSet:
+    """One base set's inputs to generation, B shapes in base-set order.
+
+    ids : (B,) str — shape ids
+    z : (B, d) float32 — AE-Critic latents
+    rarity : (B,) float — rarity R, eq. (4), relative to this base set
+    graspness : (B,) float — share of successful grasps
+    pitch : (B,) float — voxel pitch, m (the shape's metric scale)
+    """
+
+    ids: np.ndarray
+    z: np.ndarray
+    rarity: np.ndarray
+    graspness: np.ndarray
+    pitch: np.ndarray
+
+
+def base_set(ids: np.ndarray, latents: pd.DataFrame, scores: pd.DataFrame, voxels, k: int) -> BaseSet:
+    """The :class:`BaseSet` of shapes ``ids`` (B,) from the latents table (``shape_id``, ``z``),
+    the scores table (``shape_id``, ``graspness``), the corpus' ``voxels`` (VoxelSet: ``shape_id``,
+    ``pitch`` in m) and the rarity's ``k`` neighbours."""
+    latent = latents.set_index("shape_id").z
+    graspness = scores.set_index("shape_id").graspness
+    pitch_of = dict(zip(voxels.shape_id, voxels.pitch))
+    z = np.stack(latent.loc[ids].to_numpy()).astype(np.float32)
+    base_rarity = rarity(z, k)  # relative to this base set
+    return BaseSet(ids, z, base_rarity, graspness.loc[ids].to_numpy(), np.array([pitch_of[s] for s in ids]))
+
+
+def mesh_batches(
+    ae, device, base: BaseSet, settings, workers: int, label: str
+) -> Callable[[list[Candidate]], list[Decoded]]:
+    """A batch runner for :func:`graspaug.generation.fill_pool`: decodes each candidate's
+    ``(1 - α) z_a + α z_b`` with the autoencoder ``ae`` on ``device`` and meshes the grid
+    (:func:`graspaug.geometry.from_voxels.mesh_decoded` with ``settings``, at the parents' pitches
+    interpolated the same way, m) on ``workers`` processes, ``label`` naming the progress."""
+    from graspaug.parallel import parallel_map
+
+    z, pitch = base.z, base.pitch
+
+    def run_batch(candidates: list[Candidate]) -> list[Decoded]:
+        a = np.array([c.a for c in candidates])
+        b = np.array([c.b for c in candidates])
+        alpha = np.array([c.alpha for c in candidates], dtype=np.float32)[:, None]
+        probability = decode(ae, (1 - alpha) * z[a] + alpha * z[b], device)
+        child_pitch = (1 - alpha[:, 0]) * pitch[a] + alpha[:, 0] * pitch[b]  # metric size: parents' interpolated
+        jobs = list(zip(probability, child_pitch))
+        out = parallel_map(lambda job: mesh_decoded(job[0], job[1], settings), jobs, workers, label)
+        return [
+            Decoded(c, np.packbits(grid.occupancy), mesh, reason) for c, (grid, mesh, reason) in zip(candidates, out)
+        ]
+
+    return run_batch
+
+
+Pools = dict[str, tuple[list[Decoded], list[Decoded]]]
+
+
+def fill_pools(
+    base: BaseSet, cfg: GenerateParams, seed: int, run_batch: Callable[[list[Candidate]], list[Decoded]]
+) -> tuple[Pools, TargetedStream, int]:
+    """Fill the targeted pool, then the random one (seeded by ``[seed, BASE_SEED, B]``), each to
+    ``pool_size(cfg.ratios, B)`` kept shapes with ``run_batch`` (:func:`mesh_batches`).
+
+    Returns (pools: name → (kept, rejected) Decoded lists, the targeted stream as widened, shapes
+    per pool); a :class:`graspaug.errors.DataError` if a pool's candidates run out first.
+    """
+    base_size = len(base.ids)
+    needed = pool_size(cfg.ratios, base_size)
+    targeted_stream = TargetedStream(
+        base.z, base.rarity, base.graspness, cfg.percentile, cfg.first_neighbour, cfg.extra_neighbours, cfg.alphas
+    )
+    random_stream = RandomStream(base_size, cfg.alphas, np.random.default_rng([seed, BASE_SEED, base_size]))
+    pools = {}
+    for name, stream in (("targeted", targeted_stream), ("random", random_stream)):
+        try:
+            pools[name] = fill_pool(stream, needed, run_batch)
+        except PoolExhausted as exc:
+            raise DataError(f"generate {base_size}, {name} pool: {exc}") from None
+    return pools, targeted_stream, needed
+
+
+@dataclass(frozen=True)
+class GeneratedSet:
+    """A base set's generated shapes, ready to write.
+
+    index : one row per kept shape in pool order (:func:`graspaug.generation.pool_tables` columns
+        plus ``rarity_vs_base``, the rarity of its latent against the base set)
+    rejects : one row per rejected decode (:data:`REJECT_COLUMNS`)
+    base_table : the base set with its scores (:func:`graspaug.generation.base_scores_table`)
+    kept : the kept decodes (Decoded, with their meshes in m), in ``index`` order
+    summary : the ``generate`` metrics (:func:`graspaug.generation.pool_summary`)
+    kept_share : pool name → share of its decodes that were kept
+    examples : the decodes to picture (:func:`example_decodes`)
+    notes : how the targeted stream was widened, in order
+    warnings : one message per pool whose kept share is below :data:`LOW_YIELD`
+    """
+
+    index: pd.DataFrame
+    rejects: pd.DataFrame
+    base_table: pd.DataFrame
+    kept: list[Decoded]
+    summary: dict
+    kept_share: dict[str, float]
+    examples: list[Decoded]
+    notes: list[str]
+    warnings: list[str]
+
+
+def generated_set(
+    base: BaseSet, pools: Pools, targeted: TargetedStream, needed: int, k: int, n_examples: int
+) -> GeneratedSet:
+    """The :class:`GeneratedSet` of ``pools`` (:func:`fill_pools`: the pools, the targeted stream
+    and the shapes per pool) for ``base``; ``k``: the rarity's neighbours; ``n_examples``: targeted
+    decodes to picture."""
+    base_size = len(base.ids)
+    rows, reject_rows = pool_tables(base.ids, base.z, pools, base_size)
+    index = pd.DataFrame(rows)
+    index["rarity_vs_base"] = rarity(base.z, k, query=np.stack(index.z.to_numpy()))
+    base_table = base_scores_table(base.ids, base.rarity, base.graspness, targeted.percentile)
+    summary, kept_share = pool_summary(base_size, needed, pools, targeted, index, reject_rows)
+    return GeneratedSet(
+        index,
+        pd.DataFrame(reject_rows, columns=REJECT_COLUMNS),
+        base_table,
+        pools["targeted"][0] + pools["random"][0],
+        summary,
+        kept_share,
+        example_decodes(pools, n_examples),
+        targeted.notes,
+        [
+            f"only {100 * share:.1f}% of the {name} pool's decodes were usable meshes"
+            for name, share in kept_share.items()
+            if share < LOW_YIELD
+        ],
+    )
+
+
+def generate_pools(
+    base: BaseSet, cfg: GenerateParams, seed: int, run_batch: Callable[[list[Candidate]], list[Decoded]], k: int
+) -> GeneratedSet:
+    """:func:`fill_pools` then :func:`generated_set` (``k``: the rarity's neighbours)."""
+    pools, targeted, needed = fill_pools(base, cfg, seed, run_batch)
+    return generated_set(base, pools, targeted, needed, k, cfg.n_examples)
+
+
+def example_decodes(pools: Pools, n_examples: int) -> list[Decoded]:
+    """The decodes to picture: the targeted pool's first ``n_examples`` kept, then the random pool's first 2."""
+    return pools["targeted"][0][:n_examples] + pools["random"][0][:2]
+
+
+def tsne_groups(base: BaseSet, index: pd.DataFrame, perplexity: float, seed: int) -> tuple[np.ndarray, list[str]]:
+    """(xy (B + G, 2), groups (B + G,)): the t-SNE of the base latents followed by the G generated
+    ones (``index.z``), and each point's group (``base`` or ``generated (<selected_by>)``)."""
+    xy = tsne_2d(np.concatenate([base.z, np.stack(index.z.to_numpy())]), perplexity, seed)
+    groups = ["base"] * len(base.ids) + [f"generated ({s})" for s in index.selected_by]
+    return xy, groups
