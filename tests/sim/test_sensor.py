@@ -7,7 +7,7 @@ import dataclasses
 import numpy as np
 import pytest
 
-from graspaug.render.camera import Intrinsics
+from graspaug.render.settings import Intrinsics
 from graspaug.sim.sensor import edge_band, noise_sd, sense_depth, surface_tilt
 from graspaug.sim.settings import DepthNoise
 
