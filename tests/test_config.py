@@ -181,3 +181,10 @@ def test_profile_command_writes_a_complete_params_file(repo_root, tmp_path):
     )  # every key written, for DVC
     missing = CliRunner().invoke(app, ["profile", "nope", "--out", str(out), "--profiles", str(repo_root / "profiles")])
     assert missing.exit_code == 2 and "profile 'nope' not found" in missing.output
+
+
+def test_a_yaml_syntax_error_names_its_line(tmp_path):
+    bad = tmp_path / "params.yaml"
+    bad.write_text("seed: 0\ngqcnn:\n  seeds: [0, 1\n  members: 3\n")
+    with pytest.raises(ParamsError, match=r"params.yaml: not valid YAML at line \d+, column \d+"):
+        load_params(bad)

@@ -315,20 +315,30 @@ def plan_command(
 
     import numpy as np
 
+    from graspaug.errors import CheckpointMismatch
     from graspaug.io.atomic import atomic_path
-    from graspaug.planning import PlanningError, load_planner, read_depth_image, read_intrinsics
+    from graspaug.planning import (
+        PlanningError,
+        check_depth,
+        intrinsics_for,
+        load_planner,
+        read_depth_image,
+        read_intrinsics,
+    )
     from graspaug.plots import planned_grasps
 
     try:
+        # one step per input, so that an error names what is at fault: the image, the camera, the model
         image = read_depth_image(depth)
-        camera = read_intrinsics(intrinsics, fx, fy, cx, cy, image.shape)
+        try:
+            shape = check_depth(image, fill_missing).shape
+        except PlanningError as exc:
+            raise PlanningError(f"{depth}: {exc}") from None
+        camera = intrinsics_for(shape, read_intrinsics(intrinsics, fx, fy, cx, cy, shape))
         planner = load_planner(model)
         grasps = planner.plan(image, camera, seed, top, camera_distance, fill_missing)
-    except (PlanningError, FileNotFoundError, OSError) as exc:
+    except (PlanningError, FileNotFoundError, CheckpointMismatch) as exc:
         typer.echo(f"error: {exc}", err=True)
-        raise typer.Exit(code=2) from None
-    except Exception as exc:  # noqa: BLE001 — a broken checkpoint is one line too
-        typer.echo(f"error: {model}: {type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else ''}", err=True)
         raise typer.Exit(code=2) from None
     out.mkdir(parents=True, exist_ok=True)
     with atomic_path(out / "grasp.json") as tmp:

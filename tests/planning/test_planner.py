@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -246,3 +247,44 @@ def test_export_model_gives_the_same_probabilities(model_path, tmp_path):
         exported = scripted(images, z)
     assert exported.shape == (7,) and torch.allclose(exported, expected, atol=1e-6)
     assert not torch.allclose(expected, expected[:1].expand(7))  # the inputs matter
+
+
+def test_each_refusal_names_its_culprit(scene, model_path, tmp_path):
+    """`graspaug plan` refuses bad input in one line that names what is at fault (the image, the
+    intrinsics or the model), never blaming the model for a bad image."""
+    depth = depth_of(scene)
+    good_image, good_model = tmp_path / "depth.npy", str(model_path)
+    np.save(good_image, depth)
+    (tmp_path / "empty.npy").write_bytes(b"")
+    (tmp_path / "text.npy").write_text("0.7 0.7 0.7\n")
+    np.save(tmp_path / "truncated.npy", depth)
+    (tmp_path / "truncated.npy").write_bytes((tmp_path / "truncated.npy").read_bytes()[:200])
+    Image.fromarray(np.round(depth).astype(np.uint16)).save(tmp_path / "meters.png")  # meters in a 16-bit PNG
+    (tmp_path / "empty.pt").write_bytes(b"")
+    (tmp_path / "junk.pt").write_text("not a checkpoint")
+    missing_model = str(tmp_path / "modle.pt")
+    cases = [  # (image, model, extra flags, text the one line must hold, culprit named)
+        (tmp_path / "empty.npy", missing_model, [], "the file is empty", "empty.npy"),
+        (tmp_path / "text.npy", missing_model, [], "not a numeric .npy array", "text.npy"),
+        (tmp_path / "truncated.npy", missing_model, [], "not a numeric .npy array", "truncated.npy"),
+        (tmp_path / "meters.png", missing_model, [], "looks like meters", "meters.png"),
+        (good_image, missing_model, ["--fx", "-525"], "fx must be a positive focal length", "intrinsics"),
+        (good_image, missing_model, ["--cx", "3000"], "cx = 3000 px lies outside the 640 px wide image", "intrinsics"),
+        (good_image, missing_model, [], "no such file", "modle.pt"),
+        (good_image, str(tmp_path / "empty.pt"), [], "the file is empty", "empty.pt"),
+        (good_image, str(tmp_path / "junk.pt"), [], "not a readable PyTorch checkpoint", "junk.pt"),
+    ]
+    runner = CliRunner()
+    for image, model, flags, text, culprit in cases:
+        fx = [] if "--fx" in flags else ["--fx", "525"]
+        args = ["plan", str(image), "--model", model, *fx, *flags, "--out", str(tmp_path / "out")]
+        result = runner.invoke(app, args)
+        line = result.output.strip()
+        assert result.exit_code == 2 and "\n" not in line, (image, result.output)
+        assert text in line and culprit in line, (image.name, flags, line)
+        assert "pickle" not in line and "dvc repro" not in line, line
+        if culprit != Path(model).name:
+            assert Path(model).name not in line, f"the model is blamed for {image.name}: {line}"
+    assert runner.invoke(
+        app, ["plan", str(good_image), "--model", good_model, "--fx", "525", "--out", str(tmp_path / "ok")]
+    ).exit_code in (0, 1)  # a grasp, or none: no refusal

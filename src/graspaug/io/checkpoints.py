@@ -144,10 +144,16 @@ def read_gqcnn(path: str | os.PathLike):
 
     path = Path(path)
     if not path.is_file():
-        raise FileNotFoundError(f"{path}: no GQ-CNN checkpoint (run `dvc repro train_gqcnn`)")
-    saved = torch.load(path, map_location="cpu", weights_only=True)
+        raise FileNotFoundError(f"model {path}: no such file (a trained GQ-CNN is a model.pt file)")
+    if path.stat().st_size == 0:
+        raise CheckpointMismatch(f"model {path}: the file is empty")
+    try:
+        saved = torch.load(path, map_location="cpu", weights_only=True)
+    except Exception as exc:  # noqa: BLE001 - torch raises many types for a file that is no checkpoint
+        why = f"{type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else 'truncated'}"
+        raise CheckpointMismatch(f"model {path}: not a readable PyTorch checkpoint ({why})") from None
     if not isinstance(saved, dict) or "state_dict" not in saved or "config" not in saved:
-        raise CheckpointMismatch(f"{path} is not a GQ-CNN checkpoint of graspaug (no config and state_dict)")
+        raise CheckpointMismatch(f"model {path}: not a GQ-CNN checkpoint of graspaug (no config and state_dict)")
     config = GQCNNConfig(
         **{"image_input": "depth", **saved["config"]}
     )  # checkpoints older than the option saw the depth crop

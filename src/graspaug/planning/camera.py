@@ -9,6 +9,7 @@ more than :data:`MAX_DISTANCE_RATIO` times off the training range.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -51,10 +52,22 @@ def intrinsics_for(depth_shape: tuple[int, int], intrinsics: Intrinsics | dict) 
         raise PlanningError(
             f"the depth image is {w}×{h} px but the intrinsics are for {values['width']}×{values['height']}"
         )
-    try:
-        return Intrinsics(**{k: (int(values[k]) if k in ("width", "height") else float(values[k])) for k in values})
-    except (ValueError, TypeError) as exc:
-        raise PlanningError(f"bad intrinsics {values}: {str(exc).splitlines()[0]}") from None
+    numbers = {}
+    for key, value in values.items():
+        try:
+            numbers[key] = int(value) if key in ("width", "height") else float(value)
+        except (ValueError, TypeError):
+            raise PlanningError(f"intrinsics: {key} must be a number (px), got {value!r}") from None
+    for key in ("fx", "fy"):
+        if not (math.isfinite(numbers[key]) and numbers[key] > 0):
+            raise PlanningError(f"intrinsics: {key} must be a positive focal length (px), got {numbers[key]:g}")
+    for key, size, side in (("cx", w, "wide"), ("cy", h, "high")):
+        if not (math.isfinite(numbers[key]) and -0.5 <= numbers[key] <= size - 0.5):
+            raise PlanningError(
+                f"intrinsics: {key} = {numbers[key]:g} px lies outside the {size} px {side} image "
+                f"(the principal point is near the image center, {(size - 1) / 2:g} px)"
+            )
+    return Intrinsics(**numbers)
 
 
 def check_depth(depth: np.ndarray, fill_missing: bool = False) -> np.ndarray:

@@ -10,26 +10,47 @@ import numpy as np
 
 from graspaug.planning.errors import PlanningError
 
+#: A 16-bit depth PNG whose median reading is below this (mm) holds some other unit (no camera sees
+#: a scene 2 cm away).
+MIN_PNG_MEDIAN_MM = 20
+
 
 def read_depth_image(path: str | os.PathLike) -> np.ndarray:
     """A depth image (H, W) float64 m from a ``.npy`` file (meters) or a 16-bit PNG
     (millimeters; 0 = no reading, returned as NaN)."""
     path = Path(path)
     if not path.is_file():
-        raise PlanningError(f"{path}: no such file")
+        raise PlanningError(f"depth image {path}: no such file")
+    if path.stat().st_size == 0:
+        raise PlanningError(f"depth image {path}: the file is empty")
     suffix = path.suffix.lower()
     if suffix == ".npy":
         try:
             return np.load(path, allow_pickle=False)
-        except ValueError as exc:
-            raise PlanningError(f"{path}: not a numeric .npy array ({str(exc).splitlines()[0]})") from None
+        except (ValueError, EOFError, OSError) as exc:
+            why = "it holds Python objects" if "pickle" in str(exc) else f"{type(exc).__name__}: {exc}".splitlines()[0]
+            raise PlanningError(
+                f"depth image {path}: not a numeric .npy array ({why}); "
+                "write one with numpy.save(path, depth_in_meters)"
+            ) from None
     if suffix == ".png":
-        from PIL import Image
+        from PIL import Image, UnidentifiedImageError
 
-        with Image.open(path) as image:
-            pixels = np.asarray(image)
+        try:
+            with Image.open(path) as image:
+                pixels, mode = np.asarray(image), image.mode
+        except (UnidentifiedImageError, OSError) as exc:
+            raise PlanningError(f"depth image {path}: not a readable PNG ({str(exc).splitlines()[0]})") from None
         if pixels.dtype != np.uint16 and not (pixels.dtype == np.int32 and pixels.max() < 2**16):
-            raise PlanningError(f"{path}: a depth PNG must be 16-bit grayscale in millimeters, got mode {image.mode}")
+            raise PlanningError(
+                f"depth image {path}: a depth PNG must be 16-bit grayscale in millimeters, got mode {mode}"
+            )
+        valid = pixels[pixels > 0]
+        if valid.size and np.median(valid) < MIN_PNG_MEDIAN_MM:
+            raise PlanningError(
+                f"depth image {path}: its median reading is {np.median(valid):g}, but a 16-bit depth PNG holds "
+                f"millimeters (a camera 0.7 m away reads 700): it looks like meters; save meters as .npy instead"
+            )
         depth = pixels.astype(np.float64) / 1000.0
         depth[pixels == 0] = np.nan
         return depth
