@@ -405,10 +405,56 @@ def test_dvc_repro_sim(tiny_repo, tmp_path):
     assert "Running stage" not in again.stdout
 
 
+DATA_PLOT_SUFFIXES = (".csv", ".tsv", ".json", ".yaml", ".yml")
+
+
+def declared_plots(dvc_yaml: dict) -> tuple[dict[str, list[tuple[str, str]]], list[tuple[str, dict]]]:
+    """dvc.yaml's top-level data plots (id → the (file, column) series its ``y`` names) and its stages'
+    data-file plots ((path, properties)); images and paths left for DVC to infer are not in either."""
+    top = {}
+    for entry in dvc_yaml.get("plots", []):
+        if not isinstance(entry, dict):
+            continue
+        ((name, props),) = entry.items()
+        assert props and {"x", "y"} <= set(props), f"top-level plot {name!r} must name x and y"
+        assert isinstance(props["y"], dict), f"top-level plot {name!r}: y must name its files"
+        top[name] = [
+            (file, column)
+            for file, columns in props["y"].items()
+            for column in ([columns] if isinstance(columns, str) else columns)
+        ]
+    staged = []
+    for stage in dvc_yaml["stages"].values():
+        for entry in stage.get("do", stage).get("plots", []):
+            path, props = next(iter(entry.items())) if isinstance(entry, dict) else (entry, {})
+            if path.endswith(DATA_PLOT_SUFFIXES):
+                staged.append((path, props))
+    return top, staged
+
+
+def draws(datapoint: dict, file: str, column: str) -> bool:
+    """Whether a datapoint of `dvc plots show --json` belongs to the series ``column`` of ``file``.
+    DVC tags each datapoint with what varies between a plot's series: ``filename::field``, ``field``
+    or ``filename`` (the file less the files' common prefix); with a single series, with nothing."""
+    if "dvc_inferred_y_value" not in datapoint and column not in datapoint:
+        return False
+    if "filename::field" in datapoint:
+        short, _, field = datapoint["filename::field"].rpartition("::")
+        return field == column and file.endswith(short)
+    if "field" in datapoint:
+        return datapoint["field"] == column
+    if "filename" in datapoint:
+        return file.endswith(datapoint["filename"])
+    return True
+
+
 def test_every_declared_plot_renders(tiny_repo):
     """`dvc plots show` on the finished tiny run: every plot dvc.yaml declares (per stage, for
-    whatever base sizes params name, and the top-level ones) has data or an image, no errors."""
+    whatever base sizes params name, and the top-level ones) has data or an image, no errors; every
+    data plot names its x and y, and draws each series it names; the HTML page needs no network."""
     import json
+
+    import yaml
 
     work, env = tiny_repo
     run(["dvc", "repro", "sim"], work, env)  # no-op after the tests above
@@ -427,6 +473,23 @@ def test_every_declared_plot_renders(tiny_repo):
     assert "reports/generate/6/pairs.png" in generated and not any(
         "generate/4/" in n for n in generated
     )  # the tiny profile's augmented base size
+
+    top, staged = declared_plots(yaml.safe_load((work / "dvc.yaml").read_text()))
+    for path, props in staged:  # drawn against the row index otherwise
+        assert {"x", "y"} <= set(props), f"stage plot {path} must name x and y (or be an out, not a plot)"
+    for name, series in top.items():
+        assert not set("'\"") & set(name), f"{name!r}: quotes break the HTML page's script"
+        (render,) = plots[name]
+        datapoints = render["anchor_definitions"]["<DVC_METRIC_DATA>"]
+        for file, column in series:
+            assert any(draws(d, file, column) for d in datapoints), f"{name!r} does not draw {column} of {file}"
+        if "ap_table.csv" in series[0][0]:  # long format: one line per pool
+            assert {d["pool"] for d in datapoints} >= {"targeted", "random", "real"}, name
+
+    run(["dvc", "plots", "show"], work, env)
+    page = (work / "dvc_plots/index.html").read_text()
+    assert "<script src=" not in page and "vegaEmbed(" in page  # Vega inline: draws with no network
+    assert "dvc_plots" not in run(["git", "status", "--porcelain"], work, env).stdout  # ignored
 
 
 def test_queued_two_point_sweep_lines_up_metrics(tiny_repo):
