@@ -301,7 +301,7 @@ def plan_command(
     fy: float | None = typer.Option(None, "--fy", help="Focal length along v (px; default: fx)."),
     cx: float | None = typer.Option(None, "--cx", help="Principal point u (px; default: the image center)."),
     cy: float | None = typer.Option(None, "--cy", help="Principal point v (px; default: the image center)."),
-    top: int = typer.Option(1, "--top", "-k", min=1, help="List the K best grasps."),
+    top: int = typer.Option(1, "--top", "-k", min=1, help="List the K best distinct grasps (near-duplicates dropped)."),
     seed: int = typer.Option(0, "--seed", help="Seed of the sampler."),
     camera_distance: float | None = typer.Option(
         None, "--camera-distance", help="Camera to table along the optical axis (m; default: the image's median depth)."
@@ -354,14 +354,20 @@ def plan_command(
             )
             + "\n"
         )
-    labels = [f"#{i + 1} Q = {g.quality:.3f}" for i, g in enumerate(grasps)]
+    labels = [f"#{i + 1}  Q = {g.quality:.3f}, {1000 * g.width:.0f} mm" for i, g in enumerate(grasps)]
     shown = np.where(np.isfinite(image) & (image > 0), image, np.nan) if image.dtype.kind == "f" else image
+    crops, openings = planner.network_crops(image, camera, grasps, camera_distance, fill_missing)
+    finger = float(planner.card.gripper.get("finger_width", 0.0))
     planned_grasps(
         np.nan_to_num(shown, nan=float(np.nanmax(shown))),
         [g.jaw_pixels for g in grasps],
         labels,
         out / "grasp.png",
-        f"{depth.name}: {len(grasps)} grasp(s), model {model.parent.name}/{model.name}",
+        f"{depth.name}: {len(grasps)} grasp(s), model {model.resolve().parent.name}/{model.name}",
+        finger_px=[finger * camera.fx / g.depth for g in grasps] if finger > 0 else None,
+        crops=crops,
+        crop_openings=openings,
+        px_per_cm=0.01 * camera.fx / grasps[0].depth if grasps else None,
     )
     if not grasps:
         typer.echo(

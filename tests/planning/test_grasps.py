@@ -4,7 +4,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from graspaug.planning.grasps import ImageGrasps, canonical_angles, grasp_features, grasps_from_features, jaw_endpoints
+from graspaug.planning.grasps import (
+    ImageGrasps,
+    canonical_angles,
+    distinct_grasps,
+    grasp_features,
+    grasps_from_features,
+    jaw_endpoints,
+)
 from graspaug.planning.planner import PlannedGrasp
 
 
@@ -57,3 +64,24 @@ def test_jaw_endpoints_are_those_of_the_features_and_of_a_planned_grasp():
         assert np.array_equal(planned.jaw_pixels, jaws[i])
         row = planned.grasp
         assert np.array_equal(jaw_endpoints(row.centers, row.angles, row.widths)[0], jaws[i])
+
+
+def test_distinct_grasps_drops_near_duplicates_of_better_grasps():
+    """Non-maximum suppression: a grasp goes when its center lies within a quarter of a kept
+    better grasp's opening (at least 4 px) and its jaw line within 15° of that grasp's (mod 180°)."""
+    ranked = ImageGrasps(
+        centers=np.array(
+            [[100, 100], [103, 100], [103, 100], [120, 100], [100, 102], [101, 100], [200, 50], [203.5, 50]]
+        ),
+        angles=np.array([0.0, np.radians(10), np.pi / 2, 0.0, np.pi - np.radians(3), 0.0, 1.0, 1.0]),
+        depths=np.full(8, 0.65),
+        widths=np.array([40.0, 40.0, 40.0, 40.0, 40.0, 8.0, 8.0, 8.0]),
+    )
+    # 1: 3 px and 10° from 0; 2: turned 90°; 3: 20 px away (> 40 / 4); 4: 2 px and 3° (mod 180°) from 0;
+    # 5: 1 px from 0, whose radius is its opening's quarter (10 px); 6: far; 7: 3.5 px from 6 (radius 4 px, not 2)
+    assert distinct_grasps(ranked, 10).tolist() == [0, 2, 3, 6]
+    assert distinct_grasps(ranked, 2).tolist() == [0, 2]
+    assert distinct_grasps(ranked, 1).tolist() == [0]
+    assert distinct_grasps(ranked.take(np.zeros(0, dtype=int)), 3).tolist() == []
+    moved = ImageGrasps(ranked.centers + np.array([[0, 0]] * 7 + [[1, 0]]), ranked.angles, ranked.depths, ranked.widths)
+    assert distinct_grasps(moved, 10).tolist() == [0, 2, 3, 6, 7]  # 4.5 px from 6: kept

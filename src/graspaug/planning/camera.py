@@ -133,6 +133,16 @@ class CameraAdapter:
         angles = canonical_angles(np.arctan2(axis[:, 1], axis[:, 0]))
         return ImageGrasps(centers, angles, grasps.depths - self.shift, np.linalg.norm(axis, axis=1))
 
+    def to_virtual(self, grasps: ImageGrasps) -> ImageGrasps:
+        """Original-image grasps → the virtual image (the inverse of :meth:`to_original`)."""
+        if self.identity:
+            return grasps
+        su, sv = self.scale
+        centers = (grasps.centers + 0.5) * np.array([su, sv]) - 0.5
+        axis = np.stack([np.cos(grasps.angles) * su, np.sin(grasps.angles) * sv], axis=1) * grasps.widths[:, None]
+        angles = canonical_angles(np.arctan2(axis[:, 1], axis[:, 0]))
+        return ImageGrasps(centers, angles, grasps.depths + self.shift, np.linalg.norm(axis, axis=1))
+
 
 def camera_adapter(card: ModelCard, intrinsics: Intrinsics, distance: float) -> CameraAdapter:
     """The resampling that makes a camera with ``intrinsics`` at ``distance`` m from the table

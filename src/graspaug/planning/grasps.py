@@ -77,3 +77,40 @@ def grasps_from_features(features: np.ndarray) -> ImageGrasps:
         depths=features[:, 4] / 100.0,
         widths=np.linalg.norm(axis, axis=1),
     )
+
+
+#: Near-duplicate rule of :func:`distinct_grasps`: centers closer than this share of the better grasp's opening ...
+DUPLICATE_CENTER_FRACTION = 0.25
+#: ... but never than this many pixels ...
+DUPLICATE_MIN_CENTER_PX = 4.0
+#: ... and jaw lines within this many degrees (mod 180°).
+DUPLICATE_ANGLE_DEG = 15.0
+
+
+def distinct_grasps(ranked: ImageGrasps, top: int) -> np.ndarray:
+    """Non-maximum suppression in the image: indices (ascending, at most ``top``) of the grasps of
+    ``ranked`` (best first) that are no near-duplicate of a better-ranked grasp kept before them.
+
+    A grasp is a near-duplicate of a kept grasp when both hold: its center lies closer than
+    ``max(DUPLICATE_CENTER_FRACTION × the kept grasp's opening, DUPLICATE_MIN_CENTER_PX)`` px
+    (a quarter of the opening, at least 4 px) to the kept grasp's center, and its jaw line is
+    within ``DUPLICATE_ANGLE_DEG`` (15°) of the kept grasp's (angles compared mod 180°: a
+    parallel-jaw grasp turned by 180° is the same grasp). Depth is not compared: two such grasps
+    look alike in the image. The first (best) grasp is always kept, so ``top=1`` gives ``[0]``;
+    nothing random is involved. Fewer than ``top`` come back when fewer grasps are distinct.
+    """
+    if top < 1 or len(ranked) == 0:
+        return np.zeros(0, dtype=int)
+    kept = [0]
+    radius = [max(DUPLICATE_CENTER_FRACTION * float(ranked.widths[0]), DUPLICATE_MIN_CENTER_PX)]
+    max_angle = np.radians(DUPLICATE_ANGLE_DEG)
+    for j in range(1, len(ranked)):
+        if len(kept) >= top:
+            break
+        near = np.linalg.norm(ranked.centers[kept] - ranked.centers[j], axis=1) < np.asarray(radius)
+        turn = np.abs(ranked.angles[kept] - ranked.angles[j]) % np.pi
+        parallel = np.minimum(turn, np.pi - turn) < max_angle
+        if not np.any(near & parallel):
+            kept.append(j)
+            radius.append(max(DUPLICATE_CENTER_FRACTION * float(ranked.widths[j]), DUPLICATE_MIN_CENTER_PX))
+    return np.asarray(kept, dtype=int)

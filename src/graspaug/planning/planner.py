@@ -132,9 +132,11 @@ class Planner:
         camera_distance: float | None = None,
         fill_missing: bool = False,
     ) -> list[PlannedGrasp]:
-        """Up to ``top`` grasps on ``depth`` (H, W) m, best first; [] when the image holds no
-        antipodal pair. ``camera_distance`` (m, the table's distance along the optical axis)
-        defaults to the image's median depth. Raises :class:`PlanningError` for bad input."""
+        """Up to ``top`` distinct grasps on ``depth`` (H, W) m, best first (near-duplicates of a
+        better grasp dropped: :func:`~graspaug.planning.grasps.distinct_grasps`; the best is the same
+        for every ``top``); [] when the image holds no antipodal pair. ``camera_distance`` (m, the
+        table's distance along the optical axis) defaults to the image's median depth. Raises
+        :class:`PlanningError` for bad input."""
         start = time.perf_counter()
         depth = check_depth(depth, fill_missing)
         intrinsics = intrinsics_for(depth.shape, intrinsics)
@@ -170,6 +172,34 @@ class Planner:
             self._planned(grasps.take([i]), float(quality[i]), elapsed, candidates, intrinsics)
             for i in range(len(grasps))
         ]
+
+    def network_crops(
+        self,
+        depth: np.ndarray,
+        intrinsics: Intrinsics | dict,
+        grasps: list[PlannedGrasp],
+        camera_distance: float | None = None,
+        fill_missing: bool = False,
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """What the network saw of each planned grasp: its depth crops (n, out, out) m, jaw axis
+        horizontal (:func:`~graspaug.render.crops.crops_from_depth_image` with the card's
+        geometry, on the image resampled to the training camera as :meth:`plan` does), and each
+        grasp's jaw opening (n,) in crop pixels. Same arguments as :meth:`plan`."""
+        from graspaug.render.crops import crops_from_depth_image
+
+        depth = check_depth(depth, fill_missing)
+        intrinsics = intrinsics_for(depth.shape, intrinsics)
+        geometry = self.card.geometry
+        if not grasps:
+            return np.zeros((0, geometry.out_size, geometry.out_size), np.float32), np.zeros(0)
+        distance = float(np.median(depth)) if camera_distance is None else float(camera_distance)
+        adapter = camera_adapter(self.card, intrinsics, distance)
+        image = ImageGrasps(
+            *(np.concatenate([getattr(g.grasp, k) for g in grasps]) for k in ("centers", "angles", "depths", "widths"))
+        )
+        virtual = adapter.to_virtual(image)
+        crops = crops_from_depth_image(adapter.image(depth), virtual.centers, virtual.angles, geometry)
+        return crops, virtual.widths / geometry.factor
 
     @staticmethod
     def _planned(
@@ -225,7 +255,7 @@ def plan_grasps(
     camera_distance: float | None = None,
     fill_missing: bool = False,
 ) -> list[PlannedGrasp]:
-    """The ``top`` best grasps (best first) on ``depth_m`` (H, W) m seen with ``intrinsics``;
+    """The ``top`` best distinct grasps (best first) on ``depth_m`` (H, W) m seen with ``intrinsics``;
     ``model`` is a :class:`Planner`, a ``model.pt`` path, a GQ-CNN or None (random antipodal)."""
     return _planner(model).plan(depth_m, intrinsics, np.random.default_rng(seed), top, camera_distance, fill_missing)
 

@@ -16,7 +16,7 @@ import torch
 from sklearn.mixture import GaussianMixture
 
 from graspaug.nets.gqcnn import GQCNN, GQCNNEnsemble
-from graspaug.planning.grasps import ImageGrasps, grasp_features, grasps_from_features
+from graspaug.planning.grasps import ImageGrasps, distinct_grasps, grasp_features, grasps_from_features
 from graspaug.planning.sampler import sample_antipodal_grasps
 from graspaug.planning.settings import CEMSettings, SamplerSettings
 from graspaug.render.crops import crops_from_depth_image
@@ -74,10 +74,12 @@ class CrossEntropyGraspPolicy:
     def plan_ranked(
         self, depth: np.ndarray, rng: np.random.Generator, top: int = 1, accept: Accept | None = None
     ) -> Ranked | None:
-        """The ``top`` best grasps of the last cross-entropy iteration, best first, their
+        """The ``top`` best distinct grasps of the last cross-entropy iteration, best first, their
         qualities and the number of grasps scored in all; None when the image has no antipodal
         pair at all. With ``accept`` (grasps → (N,) bool) the ranking holds only accepted grasps
-        of the last iteration and of the seeds (None when none is accepted)."""
+        of the last iteration and of the seeds (None when none is accepted). Near-duplicates of a
+        better grasp are dropped (:func:`~graspaug.planning.grasps.distinct_grasps`), so fewer
+        than ``top`` may come back; the best grasp is the same for every ``top``."""
         grasps = sample_antipodal_grasps(depth, self.intrinsics, self.sampler, self.cem.num_seed_samples, rng)
         if len(grasps) == 0:
             return None
@@ -115,7 +117,8 @@ class CrossEntropyGraspPolicy:
             if len(keep) == 0:
                 return None
             grasps, q = grasps.take(keep), q[keep]
-        order = np.argsort(-q, kind="stable")[:top]  # the first is np.argmax(q)
+        order = np.argsort(-q, kind="stable")  # the first is np.argmax(q)
+        order = order[distinct_grasps(grasps.take(order), top)]  # near-duplicates dropped; the first kept
         return grasps.take(order), q[order], scored
 
 
@@ -129,12 +132,15 @@ class RandomAntipodalPolicy:
     def plan_ranked(
         self, depth: np.ndarray, rng: np.random.Generator, top: int = 1, accept: Accept | None = None
     ) -> Ranked | None:
-        """``top`` antipodal seed grasps drawn at random (quality NaN), or None; with ``accept``,
-        ``top`` of the accepted ones among up to 20 × ``top`` seeds."""
-        count = top if accept is None else 20 * top
+        """Up to ``top`` distinct antipodal seed grasps drawn at random (quality NaN), or None: the
+        first ``top`` that are no near-duplicate of an earlier one
+        (:func:`~graspaug.planning.grasps.distinct_grasps`) among up to 20 × ``top`` seeds (among
+        the accepted ones with ``accept``). With ``top=1`` and no ``accept`` one seed is drawn."""
+        count = top if accept is None and top == 1 else 20 * top
         grasps = sample_antipodal_grasps(depth, self.intrinsics, self.sampler, count, rng)
         if accept is not None and len(grasps):
-            grasps = grasps.take(np.flatnonzero(accept(grasps))[:top])
+            grasps = grasps.take(np.flatnonzero(accept(grasps)))
+        grasps = grasps.take(distinct_grasps(grasps, top))
         if len(grasps) == 0:
             return None
         return grasps, np.full(len(grasps), np.nan), len(grasps)
