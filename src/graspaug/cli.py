@@ -331,12 +331,12 @@ def plan_command(
         # one step per input, so that an error names what is at fault: the image, the camera, the model
         image = read_depth_image(depth)
         try:
-            shape = check_depth(image, fill_missing).shape
+            checked = check_depth(image, fill_missing)  # missing pixels filled once, here
         except PlanningError as exc:
             raise PlanningError(f"{depth}: {exc}") from None
-        camera = intrinsics_for(shape, read_intrinsics(intrinsics, fx, fy, cx, cy, shape))
+        camera = intrinsics_for(checked.shape, read_intrinsics(intrinsics, fx, fy, cx, cy, checked.shape))
         planner = load_planner(model)
-        grasps = planner.plan(image, camera, seed, top, camera_distance, fill_missing)
+        grasps = planner.plan(checked, camera, seed, top, camera_distance)
     except (PlanningError, FileNotFoundError, CheckpointMismatch) as exc:
         typer.echo(f"error: {exc}", err=True)
         raise typer.Exit(code=2) from None

@@ -63,7 +63,7 @@ def run(params: Params) -> None:
     ev = evaluate_networks(seed_dirs, gqcnn_dir("original"), gen, cfg, params.seed)
     table, chosen, results, labels = ev.table, ev.chosen, ev.contrasts, ev.labels
     write_csv(table, REPORT_DIR / "ap_table.csv")
-    write_csv(ratio_curves(table), REPORT_DIR / "ap_vs_ratio.csv")  # for `dvc plots`
+    write_csv(ratio_curves(table), REPORT_DIR / "ap_vs_ratio.csv")  # the curves of ap_vs_ratio.png, one column each
     extras = gain_sentences(results, table, chosen, cfg.augment_base_sizes, ev.ceiling_shapes if cfg.ceiling else None)
     draw_ap_vs_ratio(table, seeds, REPORT_DIR / "ap_vs_ratio.png")
 
