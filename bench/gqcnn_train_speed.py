@@ -12,7 +12,15 @@ speeds up or slows down during the run shifts all; the ratios printed are the me
 rounds' ratios. Needs ``data/gqcnn/original`` (``dvc repro render@original`` with the default
 params).
 
-    python bench/gqcnn_train_speed.py [--steps 300] [--datapoints 20000] [--rounds 3]
+The limit: the network's arithmetic per training sample (forward and backward, counted from the
+layer shapes: :func:`flops_per_sample`) times samples/s is the loop's achieved FLOP/s, printed as
+a share of the machine's peak float32 FLOP/s, measured in the same run (a 2048² matrix product,
+torch's default threads, its own fresh process in every round). A fourth loop, ``members``,
+trains ``--members`` members of one network at once as one model, as the ``train_gqcnn`` stage
+does (``graspaug.training.gqcnn.train_members``: grouped convolutions, batched matrix
+products), each member on its own batches and noise; its samples/s count every member's.
+
+    python bench/gqcnn_train_speed.py [--steps 300] [--datapoints 20000] [--rounds 3] [--members 3]
 """
 
 from __future__ import annotations
@@ -27,7 +35,7 @@ from pathlib import Path
 
 import numpy as np
 
-LOOPS = ["reference", "float32", "bfloat16"]
+LOOPS = ["reference", "float32", "bfloat16", "members"]
 
 
 def load(n: int):
@@ -40,7 +48,46 @@ def load(n: int):
     return GraspArrays(data.images(rows), data.read("z", rows), data.read("labels", rows))
 
 
-def measure(which: str, steps: int, datapoints: int) -> dict:
+def flops_per_sample(config) -> dict[str, float]:
+    """Floating-point operations (multiply and add counted apart) of one training sample of a
+    GQ-CNN of ``config``: the forward pass, and the backward pass (each weighted layer's weight
+    gradient, and the input gradient of every layer but the first convolution, whose input is
+    data). Convolutions, the LRN's channel window (a 1×1 convolution) and the fully connected
+    layers; the element-wise work (ReLU, LRN power, pooling, noise) is not counted."""
+    s, c, side = config.image_size, config.filters, config.image_size // (4 if config.pool_after_conv2 else 2)
+    # (multiply-adds, has weights, needs the input gradient)
+    layers = [
+        (s * s * c * 49, True, False),  # conv1_1, 7×7 from 1 channel
+        (s * s * c * c * 25, True, True),  # conv1_2, 5×5
+        (s * s * c * c, False, True),  # LRN window
+        (2 * (s // 2) ** 2 * c * c * 9, True, True),  # conv2_1, conv2_2, 3×3
+        ((s // 2) ** 2 * c * c, False, True),  # LRN window
+        (c * side * side * config.fc, True, True),  # fc3
+        (config.pose_fc, True, False),  # pc1, from the gripper depth
+        (config.fc * config.fc + config.pose_fc * config.fc + config.fc * 2, True, True),  # fc4, fc5
+    ]
+    forward = 2.0 * sum(m for m, _, _ in layers)
+    backward = 2.0 * sum(m * (weights + grad_input) for m, weights, grad_input in layers)
+    return {"forward": forward, "backward": backward, "total": forward + backward}
+
+
+def measure_peak(n: int = 2048, reps: int = 10) -> dict:
+    """The machine's float32 FLOP/s in a large matrix product (n × n, torch's default threads):
+    the median over ``reps`` products after a warm-up."""
+    import torch
+
+    a, b = torch.randn(n, n), torch.randn(n, n)
+    for _ in range(3):
+        a @ b
+    times = []
+    for _ in range(reps):
+        start = time.perf_counter()
+        a @ b
+        times.append(time.perf_counter() - start)
+    return {"flops_per_second": 2 * n**3 / float(np.median(times)), "threads": torch.get_num_threads()}
+
+
+def measure(which: str, steps: int, datapoints: int, members: int) -> dict:
     """Train one network for ``steps`` steps in this process; samples/s and page faults per step."""
     import resource
     from types import SimpleNamespace
@@ -74,6 +121,17 @@ def measure(which: str, steps: int, datapoints: int) -> dict:
         net, batch = reference_network(GQCNNConfig()), 64
         start = time.perf_counter()
         train_gqcnn_reference(net, train, None, settings, torch.device("cpu"), gen)
+    elif which == "members":
+        from graspaug.device import keep_freed_memory
+        from graspaug.training.gqcnn import train_members
+
+        keep_freed_memory()
+        settings = TrainSettings(min_steps=steps, max_steps=steps, evals=1)
+        nets = [GQCNN(GQCNNConfig()) for _ in range(members)]
+        gens = [torch.Generator().manual_seed(m) for m in range(members)]
+        net, batch = nets[0], settings.batch_size * members  # every member's samples
+        start = time.perf_counter()
+        train_members(nets, train, None, settings, torch.device("cpu"), gens, progress=False)
     else:
         from graspaug.device import keep_freed_memory
         from graspaug.training.gqcnn import train_gqcnn
@@ -92,11 +150,12 @@ def measure(which: str, steps: int, datapoints: int) -> dict:
     }
 
 
-def same_function() -> None:
-    """The reference network computes what the current one does (same weights, same outputs)."""
+def same_function(members: int) -> None:
+    """The reference network and a stack of members compute what the current network does
+    (same weights, same outputs)."""
     import torch
 
-    from graspaug.nets.gqcnn import GQCNN
+    from graspaug.nets.gqcnn import GQCNN, GQCNNStack
     from graspaug.nets.settings import GQCNNConfig
 
     sys.path.insert(0, str(Path(__file__).parent))
@@ -109,24 +168,19 @@ def same_function() -> None:
     images, z = torch.rand(16, 1, 32, 32) * 0.05 + 0.6, torch.rand(16) * 0.05 + 0.6
     with torch.no_grad():
         torch.testing.assert_close(reference(images, z), current(images, z), rtol=1e-5, atol=1e-6)
+    nets = [GQCNN(GQCNNConfig()).eval() for _ in range(members)]
+    for m, net in enumerate(nets):
+        net.set_normalization(0.6 + m * 0.01, 0.02, 0.62, 0.03)
+    batches = torch.rand(members, 16, 1, 32, 32) * 0.05 + 0.6, torch.rand(members, 16) * 0.05 + 0.6
+    with torch.no_grad():
+        each = torch.stack([net(batches[0][m], batches[1][m]) for m, net in enumerate(nets)])
+        torch.testing.assert_close(GQCNNStack(nets)(*batches), each, rtol=1e-4, atol=1e-5)
 
 
 def run(which: str, args) -> dict:
-    out = subprocess.run(
-        [
-            sys.executable,
-            __file__,
-            "--measure",
-            which,
-            "--steps",
-            str(args.steps),
-            "--datapoints",
-            str(args.datapoints),
-        ],
-        check=True,
-        capture_output=True,
-        text=True,
-    )
+    command = [sys.executable, __file__, "--measure", which, "--steps", str(args.steps)]
+    command += ["--datapoints", str(args.datapoints), "--members", str(args.members)]
+    out = subprocess.run(command, check=True, capture_output=True, text=True)
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 
@@ -135,41 +189,60 @@ def main() -> None:
     parser.add_argument("--steps", type=int, default=300)
     parser.add_argument("--datapoints", type=int, default=20000)
     parser.add_argument("--rounds", type=int, default=3)
-    parser.add_argument("--measure", choices=LOOPS, help=argparse.SUPPRESS)  # one measurement (a child process)
+    parser.add_argument("--members", type=int, default=3, help="members of the members loop (default: gqcnn.members)")
+    parser.add_argument("--measure", choices=[*LOOPS, "peak"], help=argparse.SUPPRESS)  # one measurement (a child)
     args = parser.parse_args()
-    if args.measure:
-        print(json.dumps(measure(args.measure, args.steps, args.datapoints)))
+    if args.measure == "peak":
+        print(json.dumps(measure_peak()))
         return
-    same_function()
+    if args.measure:
+        print(json.dumps(measure(args.measure, args.steps, args.datapoints, args.members)))
+        return
+    same_function(args.members)
     import torch
 
     from graspaug.device import has_native_bfloat16
+    from graspaug.nets.settings import GQCNNConfig
 
+    flops = flops_per_sample(GQCNNConfig())
     bf16 = "with" if has_native_bfloat16(torch.device("cpu")) else "WITHOUT (bfloat16 is emulated, slow)"
     print(
         f"{args.datapoints} datapoints, {args.steps} steps per network, {os.cpu_count()} cores {bf16} bfloat16 "
-        "instructions, "
-        f"{args.rounds} rounds, one fresh process per run"
+        f"instructions, {args.rounds} rounds, one fresh process per run; the default GQ-CNN: "
+        f"{flops['total'] / 1e6:.2f} MFLOP per training sample ({flops['forward'] / 1e6:.2f} forward, "
+        f"{flops['backward'] / 1e6:.2f} backward)",
+        flush=True,
     )
-    ratios: dict[str, list[float]] = {"float32": [], "bfloat16": []}
+    loops = LOOPS[1:]
+    speeds: dict[str, list[float]] = {which: [] for which in LOOPS}
+    peaks: list[float] = []
     for r in range(args.rounds):
-        order = LOOPS[r % 3 :] + LOOPS[: r % 3]
+        order = ["peak", *LOOPS]
+        order = order[r % len(order) :] + order[: r % len(order)]
         got = {which: run(which, args) for which in order}
+        peaks.append(got["peak"]["flops_per_second"])
+        for which in LOOPS:
+            speeds[which].append(got[which]["samples_per_second"])
         ref = got["reference"]
         line = (
-            f"round {r + 1}: reference (batch 64, {ref['threads']} threads) {ref['samples_per_second']:6.0f} "
-            f"samples/s, {ref['faults_per_step']:4.0f} page faults/step"
+            f"round {r + 1}: peak {peaks[-1] / 1e9:.0f} GFLOP/s; reference (batch 64, {ref['threads']} threads) "
+            f"{ref['samples_per_second']:6.0f} samples/s"
         )
-        for precision in ratios:
-            ratios[precision].append(got[precision]["samples_per_second"] / ref["samples_per_second"])
-            speed, faults = got[precision]["samples_per_second"], got[precision]["faults_per_step"]
-            line += f"; current {precision} {speed:6.0f} ({faults:4.0f}): {ratios[precision][-1]:.2f}x"
+        for which in loops:
+            speed = got[which]["samples_per_second"]
+            line += f"; {which} {speed:6.0f} ({speed / ref['samples_per_second']:.2f}x)"
         print(line, flush=True)
-    for precision, values in ratios.items():
+    peak = float(np.median(peaks))
+    print(f"peak float32: median {peak / 1e9:.0f} GFLOP/s over {args.rounds} rounds")
+    for which in LOOPS:
+        speed = float(np.median(speeds[which]))
+        ratios = [s / ref for s, ref in zip(speeds[which], speeds["reference"], strict=True)]
+        achieved = speed * flops["total"]
         print(
-            f"current loop, {precision}: median ratio over {args.rounds} rounds {np.median(values):.2f}x (rounds: "
-            f"{', '.join(f'{x:.2f}' for x in values)})"
+            f"{which:9s}: median {speed:6.0f} samples/s, {np.median(ratios):.2f}x the reference (rounds: "
+            f"{', '.join(f'{x:.2f}' for x in ratios)}), {achieved / 1e9:.0f} GFLOP/s = {achieved / peak:.0%} of peak"
         )
+    print(f"at 100% of peak the network would train {peak / flops['total']:,.0f} samples/s")
 
 
 if __name__ == "__main__":

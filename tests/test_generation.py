@@ -12,6 +12,7 @@ from graspaug.generation import (
     TargetedStream,
     above_percentile,
     fill_pool,
+    generate_headline,
     neighbour_pairs,
     nested_base_sets,
     pool_size,
@@ -126,3 +127,8 @@ def test_fill_pool_replaces_rejects_widens_and_keeps_prefixes():
     assert stream.items[: len(small_stream.items)] == small_stream.items  # and so is the stream
     with pytest.raises(PoolExhausted, match="no more pairs or weights"):
         fill_pool(RandomStream(3, [0.5], np.random.default_rng(0)), 5, every_third_rejected)
+
+
+def test_the_generate_headline_counts_both_pools():
+    summary = {"targeted": {"kept": 50, "tried": 50, "alphas_used": [0.5]}, "random": {"kept": 50, "tried": 51}}
+    assert generate_headline(summary) == {"shapes": 100, "kept": round(100 / 101, 4)}

@@ -91,23 +91,26 @@ def test_dvc_repro_critic_eval_and_embed(tiny_repo):
         "metrics/train_ae/ae/metrics.json",
     ):
         assert (work / path).stat().st_size > 0, path
-    result = json.loads((work / "metrics/critic_eval.json").read_text())
+    result = json.loads((work / "reports/critic_eval/study.json").read_text())
     assert result["n_pairs"] == 3 and result["n_decoded_per_model"] == 18
     assert set(result["outlier_pct"]) == {"ae", "ae_extra", "ae_critic"}
     assert list(result["outlier_pct"]["ae"]) == ["0.00", "0.10", "0.20", "0.30", "0.40", "0.50"]
     assert set(result["contrast"]["critic_vs_control"]["0.50"]) == {"mean", "ci_low", "ci_high"}
     assert result["critic_auc"] is None or 0 <= result["critic_auc"] <= 1
+    headline = json.loads((work / "metrics/critic_eval.json").read_text())
+    assert set(headline) == {"mean", "lo", "hi", "auc"}  # the study's headline; its tables are in the report
     assert (work / "models/ae_extra.pt").stat().st_size > 0
-    summary = json.loads((work / "metrics/train_ae.json").read_text())
+    summary = json.loads((work / "reports/train_ae/summary.json").read_text())
     assert (
         0 <= summary["ae_iou_test"] <= 1 and "ae_shapes_per_s" not in summary
     )  # results only: timings go to reports/timing
+    assert json.loads((work / "metrics/train_ae.json").read_text())["iou_ae"] == summary["ae_iou_test"]
     assert json.loads((work / "reports/timing/train_ae.json").read_text())["ae_shapes_per_s"] > 0
     latents = pd.read_parquet(work / "data/latents.parquet")
     assert len(latents) == 20 and len(latents.z[0]) == 16
     assert set(latents.split) == {"train", "test"}
     shown = run(["dvc", "metrics", "show", "--json"], work, env)
-    assert "ae_critic_iou_test" in shown.stdout
+    assert "iou_critic" in shown.stdout
 
 
 def test_dvc_repro_score(tiny_repo):
@@ -129,10 +132,11 @@ def test_dvc_repro_score(tiny_repo):
         assert (work / f"reports/score/{name}.png").stat().st_size > 0
     hist = pd.read_csv(work / "reports/score/graspness_hist.csv")
     assert hist.shapes.sum() == (scores.split == "train").sum()
-    summary = json.loads((work / "metrics/score.json").read_text())
+    summary = json.loads((work / "reports/score/summary.json").read_text())
     assert summary["n_train"] == (scores.split == "train").sum()
+    assert json.loads((work / "metrics/score.json").read_text())["shapes"] == summary["n_train"]
     shown = run(["dvc", "metrics", "show", "--json"], work, env)
-    assert "success_share" in shown.stdout and "graspness_train_mean" in shown.stdout
+    assert "positive" in shown.stdout and "graspness" in shown.stdout
 
 
 def test_dvc_repro_generate_and_its_grasps(tiny_repo):
@@ -164,8 +168,9 @@ def test_dvc_repro_generate_and_its_grasps(tiny_repo):
         for shape_id in index.shape_id[:3]:
             mesh = trimesh.load(work / f"data/generated/{b}/meshes/{shape_id}.obj", force="mesh")
             assert mesh.is_watertight
-        summary = json.loads((work / f"metrics/generate/{b}.json").read_text())
+        summary = json.loads((work / f"reports/generate/{b}/summary.json").read_text())
         assert summary["targeted"]["kept"] == summary["random"]["kept"] == b
+        assert json.loads((work / f"metrics/generate/{b}.json").read_text())["shapes"] == 2 * b
         rejects = pd.read_parquet(work / f"data/generated/{b}/rejects.parquet")
         assert summary["targeted"]["tried"] + summary["random"]["tried"] == 2 * b + len(rejects)
         assert sum(summary["rejects"].values()) == len(rejects)
@@ -193,8 +198,9 @@ def test_dvc_repro_render(tiny_repo):
     assert not (work / "data/gqcnn/gen_4").exists()
     for corpus in ("original", "gen_6"):
         data = GraspImages.open(work / f"data/gqcnn/{corpus}")
-        summary = json.loads((work / f"metrics/render/{corpus}.json").read_text())
+        summary = json.loads((work / f"reports/render/{corpus}/summary.json").read_text())
         assert len(data) == summary["n_datapoints"] > 0
+        assert json.loads((work / f"metrics/render/{corpus}.json").read_text())["datapoints"] == len(data)
         assert data.images().shape == (len(data), 32, 32)
         index = data.index
         if corpus == "original":
@@ -224,7 +230,8 @@ def test_dvc_repro_gqcnn_matrix_and_report(tiny_repo):
     )
     digests, validation = {}, {}
     for seed in (0, 1):
-        metrics = json.loads((work / f"metrics/gqcnn/s{seed}.json").read_text())["networks"]
+        assert set(json.loads((work / f"metrics/gqcnn/s{seed}.json").read_text())) == {"test_ap", "val_ap"}
+        metrics = json.loads((work / f"reports/gqcnn/networks/s{seed}.json").read_text())["networks"]
         assert set(metrics) == {"targeted", "random", "real", "ceiling"} and set(metrics["targeted"]["6"]) == {
             "0",
             "0.5",
@@ -276,8 +283,10 @@ def test_dvc_repro_gqcnn_matrix_and_report(tiny_repo):
         and targeted["original_shapes"] == 6
         and 0 < targeted["positive_share"] < 1
     )
-    ap = json.loads((work / "metrics/ap.json").read_text())
+    ap = json.loads((work / "reports/gqcnn/ap.json").read_text())
     report = (work / "reports/gqcnn/report.md").read_text()
+    # one metrics file per declared contrast: its mean and t-interval ends
+    assert {p.stem for p in (work / "metrics/ap").glob("*.json")} == set(ap["contrasts"])
     assert set(ap["contrasts"]) - {"targeted_vs_none_chosen@6"} == {
         "real_data",
         "targeted_vs_none@6",
@@ -299,7 +308,7 @@ def test_dvc_repro_gqcnn_matrix_and_report(tiny_repo):
     for picture in ("ap_vs_ratio", "improvement_by_score", "tsne_graspness"):
         assert (work / f"reports/gqcnn/{picture}.png").stat().st_size > 0
     shown = run(["dvc", "metrics", "show", "--json"], work, env)
-    assert "metrics/gqcnn/s1.json" in shown.stdout and "real_data" in shown.stdout
+    assert "metrics/gqcnn/s1.json" in shown.stdout and "metrics/ap/real_data.json" in shown.stdout
     again = run(["dvc", "repro", "report"], work, env)
     assert "Running stage" not in again.stdout
 
@@ -350,8 +359,8 @@ def test_dvc_repro_sim(tiny_repo, tmp_path):
     work, env = tiny_repo
     env = {**env, "GRASPAUG_CACHE": str(tmp_path / "cache")}
     run(["dvc", "repro", "sim"], work, env)
-    metrics = json.loads((work / "metrics/sim.json").read_text())
-    ap = json.loads((work / "metrics/ap.json").read_text())
+    metrics = json.loads((work / "reports/sim/summary.json").read_text())
+    ap = json.loads((work / "reports/gqcnn/ap.json").read_text())
     after_ratio = (
         ap["summary"]["6"]["best_ratio"] if "6" in ap["summary"] else 1.0
     )  # no validation AP: the largest ratio
@@ -374,6 +383,8 @@ def test_dvc_repro_sim(tiny_repo, tmp_path):
             c["n_trials"] == (4 if name == "network_vs_antipodal" else 8) and c["ci_low"] <= c["mean"] <= c["ci_high"]
         )
         assert c["n_seeds"] == 2 and c["t_ci_low"] <= c["mean"] <= c["t_ci_high"]
+        headline = json.loads((work / f"metrics/sim/{name}.json").read_text())
+        assert headline == {"mean": round(c["mean"], 5), "lo": c["ci_low"], "hi": c["ci_high"]}
     trials = pd.read_csv(work / "reports/sim/trials.csv")
     assert len(trials) == 4 * len(network_arms) * 2 + 4 and set(trials.object) == {
         "cube",
@@ -403,6 +414,32 @@ def test_dvc_repro_sim(tiny_repo, tmp_path):
         assert (work / "reports/sim" / picture).stat().st_size > 0
     again = run(["dvc", "repro", "sim"], work, env)
     assert "Running stage" not in again.stdout
+
+
+def test_metrics_hold_few_scalars_and_fit_a_terminal(tiny_repo):
+    """Every metrics file of the finished tiny run holds numbers, strings, booleans or None (dicts of them), no
+    lists; `dvc metrics show` prints one table whose columns are the union of every file's keys: its rows stay
+    narrow enough for a terminal. Tables (per seed, per object, per network) are reports, not metrics."""
+    import json
+
+    work, env = tiny_repo
+    run(["dvc", "repro"], work, env)  # every stage (critic_eval is no dep of sim); a no-op after the tests above
+    shown = json.loads(run(["dvc", "metrics", "show", "--json"], work, env).stdout)
+    files = sorted(path for rev in shown.values() for path in rev["data"])
+    assert "metrics/train_ae.json" in files and "metrics/ap/real_data.json" in files and len(files) >= 15
+
+    def leaves(value, key=""):
+        if isinstance(value, dict):
+            return [leaf for k, v in value.items() for leaf in leaves(v, f"{key}.{k}".lstrip("."))]
+        assert isinstance(value, (int, float, str, bool, type(None))), f"{key} is a {type(value).__name__}"
+        return [key]
+
+    keys = set()
+    for path in files:  # the files as written: DVC itself would drop a list silently
+        keys |= set(leaves(json.loads((work / path).read_text())))
+    assert len(keys) <= 16, sorted(keys)  # shared names merge into one column
+    table = run(["dvc", "metrics", "show"], work, env).stdout.splitlines()
+    assert len(table) == len(files) + 1 and max(map(len, table)) <= 200, max(table, key=len)
 
 
 DATA_PLOT_SUFFIXES = (".csv", ".tsv", ".json", ".yaml", ".yml")
@@ -527,9 +564,9 @@ def test_queued_two_point_sweep_lines_up_metrics(tiny_repo):
     for name, force in (("grip-10", 10.0), ("grip-40", 40.0)):
         data = experiments[name]
         assert data["params"]["params.yaml"]["data"]["sim"]["hand"]["grip_force"] == force
-        sim = data["metrics"]["metrics/sim.json"]["data"]
-        ap = data["metrics"]["metrics/ap.json"]["data"]
-        assert sim["arms"]["before"]["attempts"] == 8 and "contrasts" in ap
+        sim = data["metrics"]["metrics/sim/after_vs_before.json"]["data"]
+        ap = data["metrics"]["metrics/ap/real_data.json"]["data"]
+        assert set(sim) == {"mean", "lo", "hi"} and set(ap) <= {"mean", "lo", "hi"}
     changed = json.loads(run(["dvc", "params", "diff", "grip-10", "grip-40", "--json"], work, env).stdout)
     assert list(changed["params.yaml"]) == ["sim.hand.grip_force"]
     assert (
@@ -537,11 +574,8 @@ def test_queued_two_point_sweep_lines_up_metrics(tiny_repo):
         changed["params.yaml"]["sim.hand.grip_force"]["new"],
     ) == (10.0, 40.0)
     diff = json.loads(run(["dvc", "metrics", "diff", "grip-10", "grip-40", "--json", "--all"], work, env).stdout)
-    assert diff["metrics/sim.json"]["arms.before.attempts"] == {
-        "old": 8,
-        "new": 8,
-        "diff": 0,
-    }  # --all lines up every metric
+    assert set(diff["metrics/sim/after_vs_before.json"]) == {"mean", "lo", "hi"}  # --all lines up every metric
+    assert set(diff["metrics/gqcnn/s0.json"]["val_ap"]) == {"old", "new", "diff"}  # tiny: no test AP, val AP
     run(["dvc", "queue", "stop"], work, env)
 
 

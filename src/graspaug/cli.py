@@ -102,7 +102,8 @@ stage_command(
     "Train the AutoEncoder (phase 1, binary cross-entropy), then from it the AE-Critic (phase 2, eqs. (1)-(2) of the "
     "paper) and its control (phase 2 with λ = 0) on the train split's voxel grids; test shapes stay unseen.\n\nWrites "
     "`models/ae.pt`, `models/ae_extra.pt` (control), `models/ae_critic.pt`, DVCLive logs in `metrics/train_ae/`, and "
-    "`metrics/train_ae.json` (test/train reconstruction IoU, the critic's AUC on held-out shapes).\n\n{params}\n\nAlso "
+    "`metrics/train_ae.json` (test IoU per model, the critic's AUC on held-out shapes; every figure in "
+    "`reports/train_ae/summary.json`).\n\n{params}\n\nAlso "
     "`seed`, `device`.",
     "ae",
 )
@@ -116,8 +117,9 @@ stage_command(
     "critic-eval",
     "The paper's critic study: decode interpolations of random train pairs with the AE, its λ = 0 control and the "
     "AE-Critic, cluster each with DBSCAN, report the mean outlier percentage per α with bootstrap intervals, the "
-    "paired difference AE-Critic − control and the critic's AUC (`metrics/critic_eval.json`) with plots in "
-    "`reports/critic_eval/`.\n\n{params}",
+    "paired difference AE-Critic − control and the critic's AUC (`reports/critic_eval/study.json`; the headline, "
+    "AE-Critic − control over the interpolants, in `metrics/critic_eval.json`) with plots in `reports/critic_eval/`."
+    "\n\n{params}",
     "critic_eval",
 )
 
@@ -126,7 +128,8 @@ stage_command(
     name="grasps",
     help="Sample antipodal grasps on every shape of a corpus (Dex-Net's sampler, Franka Panda opening) and label "
     "each with robust Ferrari-Canny: the mean ε over perturbed grasp poses, object poses and friction.\n\nWrites "
-    "`data/grasps/<corpus>.parquet` (one row per grasp) and `metrics/grasps/<corpus>.json`; corpus `original` is the "
+    "`data/grasps/<corpus>.parquet` (one row per grasp), `metrics/grasps/<corpus>.json` and "
+    "`reports/grasps/<corpus>.json`; corpus `original` is the "
     "ingested shapes, `gen_<B>` the shapes generated for base size B. A shape without any grasp gets no rows and a "
     "warning with the reason.\n\n{params}\n\nAlso `seed` and `n_jobs`.",
     cls=_with_params("grasps", "grasps"),
@@ -148,7 +151,7 @@ stage_command(
     "score",
     "Score every original shape: rarity (eq. (3)-(4) of the paper on the AE-Critic latents, relative to the train "
     "split) and graspness (share of its grasps with robust ε above the threshold).\n\nWrites `data/scores.parquet`, "
-    "`metrics/score.json`, and histograms and a grasp picture in `reports/score/`.\n\n{params}\n\nAlso "
+    "`metrics/score.json`, and a summary, histograms and a grasp picture in `reports/score/`.\n\n{params}\n\nAlso "
     "`grasps.threshold` (for labels).",
     "score",
 )
@@ -162,8 +165,8 @@ stage_command(
     "random-pair pool of the same size as the baseline. Each pool holds max(ratios) × B shapes in order: the first "
     "round(R × B) are the set for ratio R.\n\nWrites `data/generated/<B>/` (`meshes/*.obj`, `index.parquet`, "
     "`rejects.parquet`, `base.parquet`), `metrics/generate/<B>.json` and "
-    "`reports/generate/<B>/{pairs,tsne}.png`.\n\n{params}\n\nAlso `score.k` (rarity on the base set), `seed`, "
-    "`device`, `n_jobs`.",
+    "`reports/generate/<B>/{summary.json,pairs.png,tsne.png}`.\n\n{params}\n\nAlso `score.k` (rarity on the base "
+    "set), `seed`, `device`, `n_jobs`.",
     cls=_with_params("generate", "generate"),
 )
 def generate_command(
@@ -183,8 +186,8 @@ def generate_command(
     "threshold). Crops come from rays cast only where they are needed; they equal crops cut from full 640×480 renders "
     "(tests/render).\n\nWrites `data/gqcnn/<corpus>/` (.npy shards of images, z, labels, ε; `index.parquet`; "
     "`skipped.parquet`), `metrics/render/<corpus>.json` and "
-    "`reports/render/<corpus>/examples.png`.\n\n{params}\n\nAlso `grasps.gripper` (the hand), `grasps.threshold` "
-    "(labels), `seed` and `n_jobs`.",
+    "`reports/render/<corpus>/{summary.json,examples.png}`.\n\n{params}\n\nAlso `grasps.gripper` (the hand), "
+    "`grasps.threshold` (labels), `seed` and `n_jobs`.",
     cls=_with_params("render", "render"),
 )
 def render_command(
@@ -238,7 +241,8 @@ def export_dexnet_command(
     "`gqcnn.members` K > 1 each network is an ensemble of K such GQ-CNNs (member m starts from the same weights in "
     "every network of the seed) whose mean P(success) is validated, tested and planned with. Test = every test-split "
     "grasp of the original corpus.\n\nWrites `models/gqcnn/s<seed>/<pool>/<B>-<R>/` (model.pt, predictions, "
-    "history.csv), `metrics/gqcnn/s<seed>.json` (validation and test AP per network) and "
+    "history.csv), `metrics/gqcnn/s<seed>.json` (mean test and validation AP), `reports/gqcnn/networks/s<seed>.json` "
+    "(AP per network) and "
     "`reports/gqcnn/validation/s<seed>.png` (validation AP vs step).\n\n{params}\n\nAlso `seed`, `device`, `n_jobs`.",
     cls=_with_params("train_gqcnn", "gqcnn"),
 )
@@ -257,8 +261,9 @@ stage_command(
     "targeted_vs_none, at the mean over ratios and at the ratio chosen on validation; targeted_vs_random; "
     "targeted_vs_real), each with a 95% t-interval over seeds and a 95% bootstrap interval over test objects, AP vs "
     "ratio (Fig. 7), the per-object AP change of the validation-chosen ratio by rarity and graspness (Fig. 8), a t-SNE "
-    "of original and generated latents by graspness (Fig. 1), and the verdicts in words.\n\nWrites `metrics/ap.json`, "
-    "`reports/gqcnn/{report.md,ap_table.csv,ap_vs_ratio.png,improvement_by_score.png,tsne_graspness.png}`.\n\nReads "
+    "of original and generated latents by graspness (Fig. 1), and the verdicts in words.\n\nWrites "
+    "`metrics/ap/<contrast>.json` (mean, lo, hi), `reports/gqcnn/{ap.json,report.md,ap_table.csv,ap_vs_ratio.png,"
+    "improvement_by_score.png,tsne_graspness.png}`.\n\nReads "
     "params `generate.base_sizes`, `generate.ratios`, `gqcnn.seeds`, `gqcnn.augment_base_sizes`, `gqcnn.ceiling`, "
     "`gqcnn.val_shapes`, `score.k`, `embed.perplexity`, `seed`.",
 )
@@ -271,10 +276,10 @@ stage_command(
     "D435-like noisy overhead depth image: antipodal seeds on depth edges, cross-entropy refinement by the GQ-CNN. "
     "Arms: `before` (B-0), `after` (B at the ratio chosen on validation AP), `real` (the real pool there, when "
     "trained) and `antipodal` (a random antipodal grasp, no network), the same drops for all.\n\nWrites "
-    "`metrics/sim.json` (success per arm and object with 95% Wilson intervals; `contrasts` after_vs_before, "
-    "network_vs_antipodal, after_vs_real with bootstrap intervals over objects; calibration) and `reports/sim/` "
-    "(`report.md`, `trials.csv`, `success.csv/.png`, `objects.csv`, `calibration.csv`, `timing.json`, "
-    "`trials/<arm>-<object>.png`).\n\n{params}",
+    "`metrics/sim/<contrast>.json` (after_vs_before, network_vs_antipodal, after_vs_real: mean, lo, hi, bootstrap "
+    "over objects) and `reports/sim/` (`summary.json`: success per arm and object with 95% Wilson intervals, the "
+    "contrasts in full, calibration; `report.md`, `trials.csv`, `success.csv/.png`, `objects.csv`, "
+    "`calibration.csv`, `timing.json`, `trials/<arm>-<object>.png`).\n\n{params}",
     "sim",
 )
 
@@ -287,7 +292,9 @@ stage_command(
     "looking (nearly) straight down. The model card in `model.pt` says which camera the network was trained for; "
     "another focal length or camera distance is resampled to it where that is sound, else refused.\n\nWrites "
     "`<out>/grasp.json` (the grasps, best first: image center, angle, depth, width; camera-frame pose and width in m; "
-    "quality; the model card) and `<out>/grasp.png` (the image with the grasps drawn).",
+    "quality; the model card) and `<out>/grasp.png` (the image with the grasps drawn). A best grasp below the quality "
+    "floor (`--min-quality`) is written and drawn as rejected, with exit code 1; a warning says where the image lies "
+    "outside the training data (camera distance, object height above the table, gripper depth).",
 )
 def plan_command(
     depth: Path = typer.Argument(..., help="Depth image: .npy (meters) or 16-bit .png (millimeters)."),
@@ -309,6 +316,13 @@ def plan_command(
     fill_missing: bool = typer.Option(
         False, "--fill-missing", help="Give missing pixels (0, NaN) the nearest valid depth instead of stopping."
     ),
+    min_quality: float | None = typer.Option(
+        None,
+        "--min-quality",
+        help="Reject the plan (exit code 1) when the best grasp's P(success) is below this floor, in [0, 1]; 0 accepts "
+        "every grasp. Default: the model card's validation operating point (the threshold that maximises F1 on the "
+        "network's validation predictions), or 0.1 for a model without one.",
+    ),
     out: Path = typer.Option(Path("."), "--out", "-o", help="Folder for grasp.json and grasp.png."),
 ) -> None:
     import json
@@ -325,9 +339,12 @@ def plan_command(
         read_depth_image,
         read_intrinsics,
     )
+    from graspaug.planning.limits import quality_floor, range_warnings, rejected_line
     from graspaug.plots import planned_grasps
 
     try:
+        if min_quality is not None and not 0.0 <= min_quality <= 1.0:
+            raise PlanningError(f"--min-quality must lie in [0, 1] (a P(success)), got {min_quality:g}")
         # one step per input, so that an error names what is at fault: the image, the camera, the model
         image = read_depth_image(depth)
         try:
@@ -337,9 +354,14 @@ def plan_command(
         camera = intrinsics_for(checked.shape, read_intrinsics(intrinsics, fx, fy, cx, cy, checked.shape))
         planner = load_planner(model)
         grasps = planner.plan(checked, camera, seed, top, camera_distance)
+        warnings = range_warnings(planner.card, checked, camera, grasps, camera_distance)
     except (PlanningError, FileNotFoundError, CheckpointMismatch) as exc:
         typer.echo(f"error: {exc}", err=True)
         raise typer.Exit(code=2) from None
+    for warning in warnings:
+        typer.echo(f"warning: {warning}", err=True)
+    floor = quality_floor(planner.card, min_quality)
+    accepted = [floor.accepts(g.quality) for g in grasps]
     out.mkdir(parents=True, exist_ok=True)
     with atomic_path(out / "grasp.json") as tmp:
         tmp.write_text(
@@ -347,14 +369,21 @@ def plan_command(
                 {
                     "depth": str(depth),
                     "model": str(model),
-                    "grasps": [g.to_dict() for g in grasps],
+                    "accepted": bool(grasps) and accepted[0],  # the best grasp clears the quality floor
+                    "quality_floor": floor.to_dict(),
+                    "warnings": warnings,
+                    "grasps": [{**g.to_dict(), "accepted": ok} for g, ok in zip(grasps, accepted, strict=True)],
                     "model_card": planner.card.to_dict(),
                 },
                 indent=1,
             )
             + "\n"
         )
-    labels = [f"#{i + 1}  Q = {g.quality:.3f}, {1000 * g.width:.0f} mm" for i, g in enumerate(grasps)]
+    labels = [
+        f"#{i + 1}  Q = {g.quality:.3f}, {1000 * g.width:.0f} mm" + ("" if ok else f"  rejected (< {floor.value:.3f})")
+        for i, (g, ok) in enumerate(zip(grasps, accepted, strict=True))
+    ]
+    verdict = f"; rejected: Q < floor {floor.value:.3f}" if grasps and not accepted[0] else ""
     shown = np.where(np.isfinite(image) & (image > 0), image, np.nan) if image.dtype.kind == "f" else image
     crops, openings = planner.network_crops(image, camera, grasps, camera_distance, fill_missing)
     finger = float(planner.card.gripper.get("finger_width", 0.0))
@@ -363,7 +392,8 @@ def plan_command(
         [g.jaw_pixels for g in grasps],
         labels,
         out / "grasp.png",
-        f"{depth.name}: {len(grasps)} grasp(s), model {model.resolve().parent.name}/{model.name}",
+        f"{depth.name}: {len(grasps)} grasp(s), model {model.resolve().parent.name}/{model.name}{verdict}",
+        rejected=[not ok for ok in accepted],
         finger_px=[finger * camera.fx / g.depth for g in grasps] if finger > 0 else None,
         crops=crops,
         crop_openings=openings,
@@ -374,12 +404,18 @@ def plan_command(
             f"no grasp: no antipodal pair of depth edges in {depth} fits the gripper (wrote {out / 'grasp.json'})"
         )
         raise typer.Exit(code=1)
-    for i, g in enumerate(grasps):
+    for i, (g, ok) in enumerate(zip(grasps, accepted, strict=True)):
         typer.echo(
             f"#{i + 1}: center ({g.u:.1f}, {g.v:.1f}) px, angle {np.degrees(g.angle):.1f} deg, depth {g.depth:.3f} m, "
-            f"width {1000 * g.width:.1f} mm, quality {g.quality:.3f}"
+            f"width {1000 * g.width:.1f} mm, quality {g.quality:.3f}{'' if ok else ' (below the floor)'}"
         )
-    typer.echo(f"wrote {out / 'grasp.json'} and {out / 'grasp.png'} ({grasps[0].planning_time:.2f} s)")
+    if not accepted[0]:
+        typer.echo(f"{rejected_line(grasps[0].quality, floor)} (wrote {out / 'grasp.json'} and {out / 'grasp.png'})")
+        raise typer.Exit(code=1)
+    typer.echo(
+        f"wrote {out / 'grasp.json'} and {out / 'grasp.png'} ({grasps[0].planning_time:.2f} s; quality floor "
+        f"{floor.value:.3f}: {floor.source})"
+    )
 
 
 @app.command(

@@ -332,6 +332,14 @@ def pool_summary(
     return summary, kept_share
 
 
+def generate_headline(summary: dict) -> dict[str, float | int]:
+    """The stage's metrics from its :func:`pool_summary`: generated ``shapes`` kept (both pools) and the
+    share of decoded shapes kept (``kept``)."""
+    kept = summary["targeted"]["kept"] + summary["random"]["kept"]
+    tried = summary["targeted"]["tried"] + summary["random"]["tried"]
+    return {"shapes": kept, "kept": round(kept / tried, 4) if tried else None}
+
+
 def base_scores_table(base: np.ndarray, rarity: np.ndarray, graspness: np.ndarray, percentile: float):
     """``base.parquet``: the base set's shape ids, rarity (against the base set), graspness and
     whether each was selected by rarity and by graspness at ``percentile`` (the one finally used)."""

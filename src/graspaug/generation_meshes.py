@@ -143,7 +143,7 @@ class GeneratedSet:
     rejects : one row per rejected decode (:data:`REJECT_COLUMNS`)
     base_table : the base set with its scores (:func:`graspaug.generation.base_scores_table`)
     kept : the kept decodes (Decoded, with their meshes in m), in ``index`` order
-    summary : the ``generate`` metrics (:func:`graspaug.generation.pool_summary`)
+    summary : the ``generate`` summary (:func:`graspaug.generation.pool_summary`; its metrics: ``generate_headline``)
     kept_share : pool name → share of its decodes that were kept
     examples : the decodes to picture (:func:`example_decodes`)
     notes : how the targeted stream was widened, in order

@@ -55,6 +55,50 @@ def _in_folder(folder: str, fn: Callable[..., T], item: Any) -> T:
     return fn(item)
 
 
+def release_freed_memory() -> bool:
+    """Hand the memory this process has freed back to the operating system (glibc's
+    ``malloc_trim``); False where there is no glibc. A worker process calls it after each shape:
+    glibc keeps what a large mesh or scene freed, the worker's resident size then grows from shape
+    to shape, and joblib's loky executor, which restarts a worker grown 300 MB past its size after
+    its first task (its guard against memory leaks), would restart healthy workers with a warning."""
+    import ctypes
+    import ctypes.util
+    import sys
+
+    if not sys.platform.startswith("linux"):
+        return False
+    try:
+        ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6").malloc_trim(0)
+    except (OSError, AttributeError):
+        return False
+    return True
+
+
+_LEAK_GUARD = 2 << 30  # bytes
+
+
+def _relax_leak_guard() -> None:
+    """Raise loky's leak guard in this worker process from 300 MB to 2 GiB. A worker's resident size
+    also grows by what it legitimately keeps: libraries loaded on a shape's first use of them,
+    caches, a larger mesh's pages that glibc could not hand back; loky would read that as a leak
+    after one large shape. loky reads the limit, a module global, at every check."""
+    try:
+        from joblib.externals.loky import process_executor
+    except ImportError:
+        return
+    process_executor._MAX_MEMORY_LEAK_SIZE = max(getattr(process_executor, "_MAX_MEMORY_LEAK_SIZE", 0), _LEAK_GUARD)
+
+
+def _trimmed(fn: Callable[..., T], item: Any) -> T:
+    """``fn(item)`` in a worker process, then :func:`release_freed_memory`; the worker's leak guard
+    relaxed (:func:`_relax_leak_guard`)."""
+    _relax_leak_guard()
+    try:
+        return fn(item)
+    finally:
+        release_freed_memory()
+
+
 def parallel_map(fn: Callable[..., T], items: Sequence[Any], workers: int | Workers, desc: str) -> list[T]:
     """``[fn(item) for item in items]`` on ``workers`` (a process count or :class:`Workers`), in
     order, with a progress bar."""
@@ -73,7 +117,8 @@ def parallel_map(fn: Callable[..., T], items: Sequence[Any], workers: int | Work
                 (delayed(_in_folder)(os.getcwd(), fn, item) for item in items),
             )
         else:
-            backend, n_jobs, calls = contextlib.nullcontext(), workers.n_jobs, (delayed(fn)(item) for item in items)
+            backend, n_jobs = contextlib.nullcontext(), workers.n_jobs
+            calls = (delayed(_trimmed)(fn, item) for item in items)
         with backend:
             for result in Parallel(n_jobs=n_jobs, return_as="generator", batch_size="auto")(calls):
                 results.append(result)

@@ -17,13 +17,15 @@ AE_MODEL = Path("models/ae.pt")
 AE_EXTRA_MODEL = Path("models/ae_extra.pt")  # the critic study's control: phase 2 with λ = 0
 AE_CRITIC_MODEL = Path("models/ae_critic.pt")
 TRAIN_AE_LIVE = Path("metrics/train_ae")
-TRAIN_AE_SUMMARY = Path("metrics/train_ae.json")
+TRAIN_AE_SUMMARY = Path("metrics/train_ae.json")  # the headline: test IoU per arm, the critic's AUC
+TRAIN_AE_REPORT = Path("reports/train_ae/summary.json")  # everything the stage measured
 # embed
 LATENTS = Path("data/latents.parquet")
 TSNE_CSV = Path("reports/embed/tsne.csv")
 TSNE_PNG = Path("reports/embed/tsne.png")
 # critic_eval
 CRITIC_EVAL_METRICS = Path("metrics/critic_eval.json")
+CRITIC_EVAL_STUDY = Path("reports/critic_eval/study.json")
 OUTLIERS_CSV = Path("reports/critic_eval/outliers.csv")
 OUTLIERS_PNG = Path("reports/critic_eval/outliers.png")
 INTERPOLATIONS_PNG = Path("reports/critic_eval/interpolations.png")
@@ -54,6 +56,10 @@ def generate_reports(base_size: int) -> Path:
     return Path(f"reports/generate/{base_size}")
 
 
+def generate_summary(base_size: int) -> Path:
+    return generate_reports(base_size) / "summary.json"
+
+
 GENERATED_SUFFIX = ".obj"
 
 
@@ -77,9 +83,14 @@ def grasps_metrics(corpus: str) -> Path:
     return Path(f"metrics/grasps/{corpus}.json")
 
 
+def grasps_report(corpus: str) -> Path:
+    return Path(f"reports/grasps/{corpus}.json")
+
+
 # score
 SCORES = Path("data/scores.parquet")
 SCORE_METRICS = Path("metrics/score.json")
+SCORE_SUMMARY = Path("reports/score/summary.json")
 GRASPNESS_HIST_CSV = Path("reports/score/graspness_hist.csv")
 GRASPNESS_HIST_PNG = Path("reports/score/graspness_hist.png")
 RARITY_HIST_CSV = Path("reports/score/rarity_hist.csv")
@@ -100,6 +111,10 @@ def render_examples(corpus: str) -> Path:
     return Path(f"reports/render/{corpus}/examples.png")
 
 
+def render_report(corpus: str) -> Path:
+    return Path(f"reports/render/{corpus}/summary.json")
+
+
 # train_gqcnn (every network of one training seed) and report
 def gqcnn_seed_dir(seed: int) -> Path:
     """The networks of a training seed, one folder each (``<pool>/<B>-<R>``, named by
@@ -111,15 +126,21 @@ def gqcnn_seed_metrics(seed: int) -> Path:
     return Path(f"metrics/gqcnn/s{seed}.json")
 
 
+def gqcnn_seed_networks(seed: int) -> Path:
+    """Validation and test AP, steps and datapoints of every network of a seed (JSON)."""
+    return Path(f"reports/gqcnn/networks/s{seed}.json")
+
+
 def gqcnn_val_curves(seed: int) -> Path:
     """Validation AP vs step of every network of a seed (PNG; the CSV beside it)."""
     return Path(f"reports/gqcnn/validation/s{seed}.png")
 
 
-AP_METRICS = Path("metrics/ap.json")
+AP_METRICS = Path("metrics/ap")  # one file per declared contrast
 REPORT_DIR = Path("reports/gqcnn")
+AP_REPORT = REPORT_DIR / "ap.json"  # contrasts, networks, chosen ratios (sim reads it)
 # sim
-SIM_METRICS = Path("metrics/sim.json")
+SIM_METRICS = Path("metrics/sim")  # one file per contrast
 SIM_REPORT_DIR = Path("reports/sim")
 
 

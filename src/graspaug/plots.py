@@ -524,6 +524,7 @@ def planned_grasps(
     crops: np.ndarray | None = None,
     crop_openings: Sequence[float] | None = None,
     px_per_cm: float | None = None,
+    rejected: Sequence[bool] | None = None,
 ) -> None:
     """The planned grasps on the depth image (H, W) m, readable at a glance.
 
@@ -536,7 +537,9 @@ def planned_grasps(
     opening) joined by the closing line, in its rank's colour (:data:`GRASP_COLORS`), numbered
     beside the grasp and listed with its ``labels`` entry in the legend. ``crops`` (n, s, s) m
     with ``crop_openings`` (n,) px, when given, are the crops the network saw (jaw axis
-    horizontal), drawn as small panels; ``px_per_cm`` adds a 1 cm bar.
+    horizontal), drawn as small panels; ``px_per_cm`` adds a 1 cm bar. A grasp whose ``rejected``
+    entry is True (its P(success) below the quality floor) is drawn faded with a dashed closing line
+    and a cross at its center, and its legend entry dashed.
     """
     plt = _pyplot()
     from matplotlib import patheffects
@@ -551,6 +554,7 @@ def planned_grasps(
     openings = np.array([np.linalg.norm(j[1] - j[0]) for j in jaws])
     fingers = np.asarray(finger_px, dtype=float) if finger_px is not None else np.maximum(0.5 * openings, 4.0)
     colors = [GRASP_COLORS[i % len(GRASP_COLORS)] for i in range(n)]
+    refused = [bool(r) for r in rejected] if rejected is not None else [False] * n
     (u0, v0, u1, v1), mask = _grasp_region(depth, jaws, [0.5 * f + 2 for f in fingers])
     region = depth[v0:v1, u0:u1]
     fitted = depth[mask] if mask.sum() >= 10 else region
@@ -584,13 +588,18 @@ def planned_grasps(
         axis = (jaw[1] - jaw[0]) / max(openings[rank], 1e-9)
         across = np.array([-axis[1], axis[0]]) * 0.5 * fingers[rank]
         z = 3 + n - rank
-        ax.plot(jaw[:, 0], jaw[:, 1], "-", color=color, lw=2.0 if rank else 2.6, path_effects=halo, zorder=z)
+        style, alpha = ("--", 0.55) if refused[rank] else ("-", 1.0)
+        ax.plot(*jaw.T, style, color=color, lw=2.0 if rank else 2.6, alpha=alpha, path_effects=halo, zorder=z)
         points = [np.linspace(jaw[0], jaw[1], 9)]
         for p in jaw:
             finger = np.stack([p - across, p + across])
-            ax.plot(*finger.T, "-", color=color, lw=5.0 if rank else 6.0, solid_capstyle="butt", path_effects=white)
+            width = 5.0 if rank else 6.0
+            ax.plot(*finger.T, "-", color=color, lw=width, alpha=alpha, solid_capstyle="butt", path_effects=white)
             ax.lines[-1].set_zorder(z)
             points.append(np.linspace(p - across, p + across, 5))
+        if refused[rank]:
+            center = jaw.mean(axis=0)
+            ax.plot(*center, "x", color=color, ms=14, mew=3.5, path_effects=white, zorder=z + 0.5)
         own.insert(0, np.concatenate(points))
     if n:
         size = u1 - u0
@@ -643,7 +652,10 @@ def planned_grasps(
     legend = fig.add_subplot(side[1])
     legend.axis("off")
     if n:
-        handles = [Line2D([], [], color=c, marker="o", lw=3, markersize=10, markeredgecolor="white") for c in colors]
+        handles = [
+            Line2D([], [], color=c, ls="--" if r else "-", marker="x" if r else "o", lw=3, markersize=10, mew=2.5)
+            for c, r in zip(colors, refused, strict=True)
+        ]
         legend.legend(handles, list(labels), loc="center", fontsize=10, frameon=False, title="grasps, best first")
     else:
         legend.text(0.5, 0.5, "no grasp found", ha="center", va="center", fontsize=11)

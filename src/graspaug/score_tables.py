@@ -124,3 +124,8 @@ def score_summary(train: pd.DataFrame) -> dict:
         "rarity_train_max": round(float(train.rarity.max()), 4),
         "rarity_graspness_spearman": _rounded(train[["rarity", "graspness"]].corr(method="spearman").iloc[0, 1]),
     }
+
+
+def score_headline(summary: dict) -> dict:
+    """The stage's metrics from its :func:`score_summary`: train ``shapes`` scored and their mean ``graspness``."""
+    return {"shapes": summary["n_train"], "graspness": summary["graspness_train_mean"]}

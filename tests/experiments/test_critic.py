@@ -8,12 +8,14 @@ from graspaug.experiments.critic import (
     contrast_text,
     example_rows,
     finite_or_none,
+    interpolant_contrast,
     interpolate,
     outlier_columns,
     outlier_contrast,
     outlier_lines,
     outlier_table,
     random_pairs,
+    study_headline,
     study_metrics,
     summarize,
 )
@@ -110,3 +112,20 @@ def test_example_rows_one_row_per_pair_and_model():
     assert len(rows) == 6 and len(rows[0]) == len(col_labels) == 7
     assert row_labels[:3] == ["pair 1 AE", "pair 1 AE + extra epochs", "pair 1 AE-Critic"]
     assert col_labels[0] == "α=0.00" and col_labels[-1] == "α=1.00"
+
+
+def test_the_headline_averages_the_interpolants_per_pair_and_leaves_reconstructions_out():
+    """α = 0 (a reconstruction) differs by 5 points, the interpolants by 1 and 3: the headline is 2, exactly;
+    an empty grid drops that α of its pair only."""
+    rng = np.random.default_rng(3)
+    keys = ["0.00", "0.25", "0.50"]
+    control = rng.exponential(3.0, (8, 3))
+    critic = control + np.array([5.0, 1.0, 3.0])
+    boot = PairBootstrap(8, 200, rng)
+    c = interpolant_contrast(critic, control, keys, boot)
+    assert c["mean"] == pytest.approx(2.0) and c["ci_low"] == pytest.approx(2.0) and c["ci_high"] == pytest.approx(2.0)
+    critic[0, 2] = np.nan  # pair 0 keeps α = 0.25 alone: 1.0
+    assert interpolant_contrast(critic, control, keys, boot)["mean"] == pytest.approx((7 * 2.0 + 1.0) / 8)
+    pct = {"ae": control, "ae_extra": control, "ae_critic": control + np.array([5.0, 1.0, 3.0])}
+    study = study_metrics(pct, boot, keys, {"auc": 0.6}, 200)
+    assert study_headline(study) == {"mean": 2.0, "lo": 2.0, "hi": 2.0, "auc": 0.6}

@@ -2,7 +2,7 @@
 
 import torch
 
-from graspaug.experiments.networks import initial_weights, seed_members, stream_seeds, weights_digest
+from graspaug.experiments.networks import initial_weights, seed_headline, seed_members, stream_seeds, weights_digest
 from graspaug.nets.settings import GQCNNConfig
 
 
@@ -68,3 +68,13 @@ def test_a_seeds_lines_timing_and_split_files(tmp_path):
     assert np.load(tmp_path / "test_rows.npy").tolist() == [0, 1, 2]
     assert np.load(tmp_path / "val_rows.npy").tolist() == [0, 1]
     assert json.loads((tmp_path / "split.json").read_text())["base"] == {"2": ["s0", "s1"]}
+
+
+def test_a_seeds_metrics_are_the_mean_aps_of_its_networks():
+    row = {"test_roc_auc": 0.9, "datapoints": 10, "steps": 5, "best_step": {"m0": 5, "m1": 3}}
+    table = {
+        "targeted": {"50": {"0": {**row, "val_ap": 0.4, "test_ap": 0.5}, "1": {**row, "val_ap": None, "test_ap": 0.6}}},
+        "ceiling": {"all": {"-": {**row, "val_ap": 0.6, "test_ap": 0.7}}},
+    }
+    assert seed_headline(table) == {"test_ap": 0.6, "val_ap": 0.5}  # a network without a value is left out
+    assert seed_headline({}) == {"test_ap": None, "val_ap": None}

@@ -4,7 +4,14 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from graspaug.experiments.sim_report import calibration, compare, rate_summary, report_text, trial_contrast
+from graspaug.experiments.sim_report import (
+    calibration,
+    compare,
+    rate_summary,
+    report_text,
+    sim_headline,
+    trial_contrast,
+)
 
 
 def trials_table(outcomes: dict[tuple[str, int, str], list[bool]]) -> pd.DataFrame:
@@ -100,6 +107,9 @@ def test_contrast_interval_excludes_zero_for_a_clear_effect_and_report_says_so()
     assert "`network_vs_antipodal` excludes zero: before succeeds more often than antipodal" in text
     assert "`after_vs_before` excludes zero: after succeeds less often than before" in text
     assert "| o11 | test_shape | 3 | 0.00 | n/a |" in text  # no labels for o10, o11
+    headline = sim_headline(metrics)  # the metrics files: one per contrast, its mean and bootstrap interval
+    assert list(headline) == ["after_vs_before", "network_vs_antipodal"]
+    assert headline["network_vs_antipodal"] == {"mean": round(c["mean"], 5), "lo": c["ci_low"], "hi": c["ci_high"]}
 
 
 def test_calibration_correlates_sim_success_with_graspness():

@@ -76,3 +76,10 @@ def test_paired_test_counts_discordant_attempts():
     assert result["only_before"] == 4 and result["only_after"] == 1
     assert result["p_value"] == pytest.approx(0.375)  # two-sided binomial, 1 of 5 at 0.5
     assert mcnemar_test(before, before)["p_value"] == 1.0
+
+
+def test_a_contrasts_headline_is_its_mean_and_interval_ends_rounded():
+    from graspaug.experiments.stats import headline
+
+    c = {"mean": 0.0123456, "ci_low": -0.001, "ci_high": None, "n_seeds": 4, "per_seed": [0.1, 0.2]}
+    assert headline(c) == {"mean": 0.01235, "lo": -0.001, "hi": None}

@@ -1,6 +1,6 @@
 import pandas as pd
 
-from graspaug.grasping.labelled import grasps_summary
+from graspaug.grasping.labelled import grasps_headline, grasps_summary
 
 
 def test_summary_counts_shapes_without_grasps_and_shares():
@@ -18,6 +18,7 @@ def test_summary_counts_shapes_without_grasps_and_shares():
         "eps_mean_median": 0.002,
         "nominal_force_closure_share": 0.75,
     }
+    assert grasps_headline(summary) == {"shapes": 3, "positive": 0.5}
 
 
 def test_summary_of_a_corpus_without_grasps_has_no_shares():

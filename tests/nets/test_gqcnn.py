@@ -77,3 +77,30 @@ def test_an_ensemble_averages_its_members_and_survives_a_checkpoint(tmp_path):
     assert type(read_gqcnn(tmp_path / "single.pt")[0]) is GQCNN
     with pytest.raises(ValueError, match="one config"):
         GQCNNEnsemble([GQCNN(config), GQCNN(GQCNNConfig(filters=8, fc=8, pose_fc=4))])
+
+
+@pytest.mark.parametrize("image_input", ["depth_minus_gripper", "depth"])
+def test_a_stack_computes_what_each_member_computes_and_gives_their_weights_back(image_input):
+    from graspaug.nets.gqcnn import GQCNNStack
+
+    config = GQCNNConfig(filters=4, fc=8, pose_fc=4, image_input=image_input)
+    torch.manual_seed(0)
+    members = [GQCNN(config) for _ in range(3)]
+    for m, net in enumerate(members):
+        net.set_normalization(0.6 + 0.01 * m, 0.02, 0.62, 0.03 + 0.01 * m)
+    images, z = torch.rand(3, 5, 1, 32, 32) * 0.05 + 0.6, torch.rand(3, 5) * 0.05 + 0.6
+    stack = GQCNNStack(members)
+    each = torch.stack([net(images[m], z[m]) for m, net in enumerate(members)])
+    torch.testing.assert_close(stack(images, z), each, rtol=1e-4, atol=1e-5)
+    (stack(images, z)[1].sum()).backward()  # member 1's loss moves member 1's filters only
+    c = config.filters
+    grad = stack.conv1_2_weight.grad
+    assert grad[c : 2 * c].abs().sum() > 0 and grad[:c].abs().sum() == 0 and grad[2 * c :].abs().sum() == 0
+    with torch.no_grad():
+        stack.fc5_bias[2] += 1.0
+    copies = [GQCNN(config) for _ in range(3)]
+    stack.unstack(copies)
+    torch.testing.assert_close(copies[2].fc5.bias, members[2].fc5.bias + 1.0)
+    torch.testing.assert_close(copies[0](images[0], z[0]), members[0](images[0], z[0]))
+    with pytest.raises(ValueError, match="one config"):
+        GQCNNStack([GQCNN(config), GQCNN(GQCNNConfig(filters=8, fc=8, pose_fc=4))])

@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import torch
+import trimesh
 from PIL import Image
 from typer.testing import CliRunner
 
@@ -19,7 +20,14 @@ from graspaug.geometry.prepare import SurfaceSettings, prepare_shape
 from graspaug.grasping.antipodal import force_closure
 from graspaug.grasping.contacts import close_fingers
 from graspaug.grasping.gripper import ParallelJawGripper
-from graspaug.io.checkpoints import gqcnn_card, read_gqcnn, save_gqcnn
+from graspaug.io.checkpoints import (
+    finish_gqcnn_card,
+    gqcnn_card,
+    operating_point,
+    read_gqcnn,
+    save_gqcnn,
+    training_range,
+)
 from graspaug.io.sources import pybullet_sources
 from graspaug.nets.gqcnn import GQCNN
 from graspaug.nets.settings import GQCNNConfig
@@ -65,8 +73,6 @@ def model_path(tmp_path_factory):
         "validation": {"ap": None},
         "test": {"ap": None},
     }
-    from graspaug.io.checkpoints import finish_gqcnn_card
-
     save_gqcnn(path, GQCNN(GQCNNConfig(image_input="depth")), summary, finish_gqcnn_card(card, summary))
     return path
 
@@ -285,6 +291,7 @@ def test_each_refusal_names_its_culprit(scene, model_path, tmp_path):
         (good_image, missing_model, [], "no such file", "modle.pt"),
         (good_image, str(tmp_path / "empty.pt"), [], "the file is empty", "empty.pt"),
         (good_image, str(tmp_path / "junk.pt"), [], "not a readable PyTorch checkpoint", "junk.pt"),
+        (good_image, good_model, ["--min-quality", "1.5"], "--min-quality must lie in [0, 1]", "--min-quality"),
     ]
     runner = CliRunner()
     for image, model, flags, text, culprit in cases:
@@ -385,3 +392,84 @@ def test_the_picture_enlarges_the_object(scene, model_path, tmp_path):
         assert np.all((jaw >= [u0 + 10, v0 + 10]) & (jaw < [u1 - 10, v1 - 10]))
     planned_grasps(depth, jaws, [f"#{i + 1}" for i in range(3)], tmp_path / "grasp.png", "grasps")
     assert Image.open(tmp_path / "grasp.png").size[0] > 600
+
+
+@pytest.fixture(scope="module")
+def carded_model(scene, model_path, tmp_path_factory):
+    """The untrained GQ-CNN of ``model_path`` with a card of format /2: the operating point of a validation
+    set whose successes the network scored 0.9 and above (so its floor is 0.9, above anything this untrained
+    network gives), and the training range of the crops of its own top 5 grasps on rnd_000 (2.3-2.5 cm
+    above the table, gripper depths 0.688-0.693 m)."""
+    planner = load_planner(model_path)
+    depth = depth_of(scene)
+    grasps = planner.plan(depth, K, 0, top=5)
+    crops, _ = planner.network_crops(depth, K, grasps)
+    net, card = read_gqcnn(model_path)
+    summary = {"pool": "targeted", "base_size": 50, "ratio": 0.0, "seed": 0, "train": {}, "validation": {}, "test": {}}
+    point = operating_point([0, 0, 1, 1], [0.1, 0.2, 0.9, 0.95])
+    carded = finish_gqcnn_card(card, summary, point, training_range(crops, np.array([g.depth for g in grasps])))
+    path = tmp_path_factory.mktemp("carded") / "model.pt"
+    save_gqcnn(path, net, summary, carded)
+    return path
+
+
+@pytest.fixture(scope="module")
+def tall_depth():
+    """A standing bottle (a cylinder 6 cm across, 19 cm tall) seen from 0.7 m straight above: depth (480, 640) m."""
+    bottle = trimesh.creation.cylinder(radius=0.03, height=0.19)
+    bottle.apply_translation([0.0, 0.0, 0.095])
+    return render_depth(bottle, look_at(np.array([0.0, 0.0, 0.7]), np.zeros(3)), Intrinsics())
+
+
+def _plan(image: Path, model: Path, out: Path, *flags: str):
+    return CliRunner().invoke(
+        app, ["plan", str(image), "--model", str(model), "--fx", "525", *flags, "--out", str(out)]
+    )
+
+
+def test_min_quality_on_a_flat_table(carded_model, tmp_path):
+    """An empty table: no grasp, so nothing clears any floor: exit code 1 and grasp.json says so."""
+    np.save(tmp_path / "flat.npy", np.full((480, 640), 0.7))
+    for flags, floor in (((), 0.9), (("--min-quality", "0.2"), 0.2)):
+        result = _plan(tmp_path / "flat.npy", carded_model, tmp_path / "out", *flags)
+        assert result.exit_code == 1 and "no grasp" in result.output and "warning" not in result.output, result.output
+        planned = json.loads((tmp_path / "out/grasp.json").read_text())
+        assert planned["accepted"] is False and planned["grasps"] == [] and planned["warnings"] == []
+        assert planned["quality_floor"]["value"] == pytest.approx(floor)
+
+
+def test_a_tall_object_is_warned_of_and_its_grasp_rejected_below_the_floor(
+    tall_depth, carded_model, model_path, tmp_path
+):
+    """A 19 cm bottle: warnings name the training range and the measured height; the card's floor (0.9)
+    rejects the best grasp (exit code 1, written and drawn as rejected), --min-quality 0 accepts it."""
+    np.save(tmp_path / "tall.npy", tall_depth)
+    result = _plan(tmp_path / "tall.npy", carded_model, tmp_path / "floor")
+    lines = result.output.strip().splitlines()
+    warnings = [line for line in lines if line.startswith("warning: ")]
+    assert result.exit_code == 1, result.output
+    assert any("19.0 cm above the table" in w and "training crops: 2.3-2.5 cm" in w for w in warnings), warnings
+    assert any("gripper depth is 0.5" in w and "0.688-0.693 m" in w for w in warnings), warnings
+    rejected = [line for line in lines if line.startswith("rejected: ")]
+    assert len(rejected) == 1 and "below the floor 0.900" in rejected[0], result.output
+    assert "the model card's validation operating point, max F1 1.00 on 4 validation grasps" in rejected[0]
+    planned = json.loads((tmp_path / "floor/grasp.json").read_text())
+    assert planned["accepted"] is False and planned["grasps"][0]["accepted"] is False
+    assert planned["grasps"][0]["quality"] < 0.9 and planned["quality_floor"]["value"] == pytest.approx(0.9)
+    assert len(planned["warnings"]) == 2 and Image.open(tmp_path / "floor/grasp.png").size[0] > 100
+    accepted = _plan(tmp_path / "tall.npy", carded_model, tmp_path / "off", "--min-quality", "0")
+    assert accepted.exit_code == 0 and "19.0 cm above the table" in accepted.output, accepted.output
+    assert json.loads((tmp_path / "off/grasp.json").read_text())["accepted"] is True
+    # a card without an operating point or a training range (format /1): the default floor, said so; no range
+    old = _plan(tmp_path / "tall.npy", model_path, tmp_path / "old")
+    assert old.exit_code == 0 and "warning" not in old.output, old.output
+    assert "quality floor 0.100: the default 0.1: the model card records no validation operating point" in old.output
+
+
+def test_an_object_inside_the_training_range_gives_no_warning(scene, carded_model, tmp_path):
+    np.save(tmp_path / "depth.npy", depth_of(scene))
+    result = _plan(tmp_path / "depth.npy", carded_model, tmp_path / "out", "--min-quality", "0.5")
+    assert result.exit_code == 0 and "warning" not in result.output, result.output
+    assert "quality floor 0.500: --min-quality" in result.output
+    planned = json.loads((tmp_path / "out/grasp.json").read_text())
+    assert planned["accepted"] is True and planned["grasps"][0]["accepted"] is True and planned["warnings"] == []

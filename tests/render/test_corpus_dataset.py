@@ -3,7 +3,13 @@
 import numpy as np
 import pandas as pd
 
-from graspaug.render.corpus_dataset import datapoints_table, example_crops, render_summary, with_pool_columns
+from graspaug.render.corpus_dataset import (
+    datapoints_table,
+    example_crops,
+    render_headline,
+    render_summary,
+    with_pool_columns,
+)
 
 
 def index_parts():
@@ -49,6 +55,7 @@ def test_summary_and_examples():
         "train": {"datapoints": 8, "positives": 3, "shapes": 2},
     }
     assert summary["rays_per_datapoint"] == 10.0
+    assert render_headline(summary) == {"shapes": 3, "datapoints": 12, "positive": round(4 / 12, 4)}
     chosen, titles, jaws = example_crops(index, 6, 0, 3)
     labels = index.label.to_numpy()[chosen]
     assert len(chosen) == 6 and labels[:3].all() and not labels[3:].any()  # positives first, each group sorted

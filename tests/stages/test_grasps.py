@@ -41,8 +41,10 @@ def test_grasps_stage_writes_labelled_grasps_and_explains_empty_shapes(tmp_path,
     assert table.width.between(0.02 - 1e-9, 0.03).all()
     assert (table.success == (table.eps_mean > 0.002)).all()
     assert (table.eps_mean >= 0).all() and (table.eps_std >= 0).all()
-    summary = json.loads((tmp_path / "metrics/grasps/original.json").read_text())
+    summary = json.loads((tmp_path / "reports/grasps/original.json").read_text())
     assert summary["n_grasps"] == 12 and summary["shapes_without_grasps"] == 1
+    metrics = json.loads((tmp_path / "metrics/grasps/original.json").read_text())
+    assert metrics == {"shapes": 2, "positive": summary["success_share"]}  # the headline only
 
     first = table.copy()
     assert run_stage(tmp_path, "grasps", {**params, "n_jobs": 2}).exit_code == 0

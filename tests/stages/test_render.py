@@ -61,9 +61,15 @@ def test_render_writes_shards_index_metrics_and_a_dexnet_export(tmp_path, monkey
     np.testing.assert_allclose(data.read("eps"), index.eps, rtol=1e-6)
     rows = np.array([len(data) - 1, 0, 3])
     np.testing.assert_array_equal(data.images(rows), images[rows])  # reads across shards, in order
-    summary = json.loads((tmp_path / "metrics/render/original.json").read_text())
+    summary = json.loads((tmp_path / "reports/render/original/summary.json").read_text())
     assert summary["n_datapoints"] == len(data) and summary["shapes_rendered"] + summary["shapes_skipped"] == 3
     assert summary["positive_share"] == round(float(index.label.mean()), 4)
+    metrics = json.loads((tmp_path / "metrics/render/original.json").read_text())
+    assert metrics == {
+        "shapes": summary["shapes_rendered"],
+        "datapoints": len(data),
+        "positive": summary["positive_share"],
+    }
     assert (tmp_path / "reports/render/original/examples.png").stat().st_size > 10_000
 
     # same params, same dataset

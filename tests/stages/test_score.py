@@ -5,7 +5,14 @@ import pandas as pd
 import pytest
 
 from graspaug.errors import DataError
-from graspaug.score_tables import example_shapes, histogram_bars, histogram_table, score_summary, shape_scores
+from graspaug.score_tables import (
+    example_shapes,
+    histogram_bars,
+    histogram_table,
+    score_headline,
+    score_summary,
+    shape_scores,
+)
 from graspaug.scores import rarity
 
 
@@ -49,6 +56,7 @@ def test_histogram_bars_and_summary():
     summary = score_summary(scores[scores.split == "train"])
     assert summary["n_train"] == 8 and summary["train_shapes_without_success"] == 6
     assert summary["graspness_train_mean"] == round(1.5 / 8, 4)
+    assert score_headline(summary) == {"shapes": 8, "graspness": round(1.5 / 8, 4)}
 
 
 def test_empty_grasp_picture_is_still_a_picture(tmp_path):

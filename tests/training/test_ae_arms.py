@@ -4,7 +4,7 @@ import math
 import torch
 
 from graspaug.nets.ae_critic import AEConfig, AutoEncoder, Critic
-from graspaug.training.ae_arms import ArmTrainer, rounded_summary
+from graspaug.training.ae_arms import ArmTrainer, rounded_summary, summary_headline
 
 CPU = torch.device("cpu")
 
@@ -35,3 +35,9 @@ def test_rounded_summary_is_json_without_nan():
     out = rounded_summary({"n": 3, "iou": 0.1234567, "empty": float("nan")})
     assert out == {"n": 3.0, "iou": 0.12346, "empty": None}
     assert json.loads(json.dumps(out)) == out and not any(isinstance(v, float) and math.isnan(v) for v in out.values())
+
+
+def test_the_headline_is_the_test_iou_of_each_arm_and_the_critics_auc():
+    summary = {"n_train": 8.0, "ae_iou_test": 0.8, "ae_iou_train": 0.81, "ae_extra_iou_test": 0.85}
+    summary |= {"ae_critic_iou_test": 0.84, "ae_critic_iou_train": 0.9, "critic_auc": None}
+    assert summary_headline(summary) == {"iou_ae": 0.8, "iou_extra": 0.85, "iou_critic": 0.84, "auc": None}

@@ -27,7 +27,7 @@ import pandas as pd
 from sklearn.metrics import average_precision_score
 
 from graspaug.errors import DataError
-from graspaug.experiments.stats import ObjectBootstrap, percentile_interval, t_interval
+from graspaug.experiments.stats import ObjectBootstrap, headline, percentile_interval, t_interval
 from graspaug.experiments.variants import network_variant, seed_variants
 from graspaug.io.tables import read_table
 
@@ -310,9 +310,9 @@ def ratio_curves(table: pd.DataFrame) -> pd.DataFrame:
 
 
 def ap_metrics(contrasts: dict, table: pd.DataFrame, chosen: dict[int, float], positive_share: float, seeds) -> dict:
-    """The experiment's metrics: the contrasts (:func:`evaluate_contrasts`), test / validation /
-    per-object AP per pool, base size and ratio (of the :func:`network_table`; None where not
-    finite), the ratio chosen on validation AP per base size, the test set's positive share."""
+    """The experiment's report (its metrics: :func:`ap_headline`): the contrasts (:func:`evaluate_contrasts`),
+    test / validation / per-object AP per pool, base size and ratio (of the :func:`network_table`; None where
+    not finite), the ratio chosen on validation AP per base size, the test set's positive share."""
     columns = ["test_ap", "test_ap_ci", "per_object_ap", "val_ap"]
 
     def value(v):
@@ -335,6 +335,12 @@ def ap_metrics(contrasts: dict, table: pd.DataFrame, chosen: dict[int, float], p
         "test_positive_share": round(positive_share, 5),
         "seeds": seeds,
     }
+
+
+def ap_headline(report: dict) -> dict[str, dict]:
+    """The experiment's metrics from its :func:`ap_metrics` report: per declared contrast its mean and
+    95% t-interval over seeds (:func:`~graspaug.experiments.stats.headline`), one metrics file each."""
+    return {name: headline(c) for name, c in report["contrasts"].items()}
 
 
 def gain_sentences(

@@ -13,7 +13,7 @@ import numpy as np
 import pandas as pd
 import torch
 
-from graspaug.experiments.stats import PairBootstrap, mean_interval, paired_contrast
+from graspaug.experiments.stats import PairBootstrap, headline, mean_interval, paired_contrast
 from graspaug.geometry.clusters import largest_cluster, outlier_percentage
 from graspaug.nets.ae_critic import AutoEncoder
 from graspaug.training.autoencoder import decode, encode
@@ -71,6 +71,21 @@ def outlier_contrast(
     return [paired_contrast(pct_a[:, i], pct_b[:, i], boot, level) for i in range(pct_a.shape[1])]
 
 
+def interpolant_contrast(
+    pct_a: np.ndarray, pct_b: np.ndarray, keys: list[str], boot: PairBootstrap, level: float = 0.95
+) -> dict[str, float | None]:
+    """The study's headline: per pair, the mean over the interpolants (α > 0 of ``keys``; every α if
+    none) of ``pct_a − pct_b`` (both (P, A) outlier %, the same pairs; an empty grid left out), then
+    its mean over pairs with the bootstrap interval (percentage points)."""
+    columns = [i for i, k in enumerate(keys) if float(k) > 0] or list(range(len(keys)))
+    diff = pct_a[:, columns] - pct_b[:, columns]  # (P, A')
+    finite = np.isfinite(diff)
+    counts = finite.sum(axis=1)
+    sums = np.where(finite, diff, 0.0).sum(axis=1)
+    per_pair = np.divide(sums, counts, out=np.full(len(diff), np.nan), where=counts > 0)  # (P,)
+    return mean_interval(per_pair, boot, level)
+
+
 def outlier_columns(summary: dict[str, dict[str, dict]], alphas, keys: list[str]) -> dict[str, list]:
     """The outlier table, one row per α (``alphas``, named ``keys`` in ``summary``) and one column per
     model and interval end: ``alpha``, ``<model>``, …, ``<model>_low``, ``<model>_high``, …
@@ -125,7 +140,7 @@ def finite_or_none(values: dict[str, float]) -> dict[str, float | None]:
 def study_metrics(
     pct: dict[str, np.ndarray], boot: PairBootstrap, keys: list[str], critic: dict, n_bootstrap: int
 ) -> dict:
-    """The critic study's metrics (``metrics/critic_eval.json``).
+    """The critic study's results, every model and α (the stage's report; its metrics: :func:`study_headline`).
 
     Parameters
     ----------
@@ -141,7 +156,8 @@ def study_metrics(
     dict — ``n_pairs``, ``n_decoded_per_model``, ``n_bootstrap``, ``critic_auc``, ``critic``,
     ``outlier_pct`` (model → α key → mean %), ``outlier_pct_ci`` (model → α key →
     :func:`~graspaug.experiments.stats.mean_interval` dict), ``contrast`` (:data:`CONTRASTS` name → α key →
-    :func:`~graspaug.experiments.stats.paired_contrast` dict, percentage points) and ``empty_grids`` (model → count).
+    :func:`~graspaug.experiments.stats.paired_contrast` dict, percentage points), ``critic_vs_control_interpolants``
+    (:func:`interpolant_contrast` of the AE-Critic against the control) and ``empty_grids`` (model → count).
     """
     summary = {name: dict(zip(keys, summarize(pct[name], boot))) for name in pct}
     contrast = {c: dict(zip(keys, outlier_contrast(pct[a], pct[b], boot))) for c, (a, b) in CONTRASTS.items()}
@@ -154,8 +170,16 @@ def study_metrics(
         "outlier_pct": {name: {k: v["mean"] for k, v in summary[name].items()} for name in pct},
         "outlier_pct_ci": summary,
         "contrast": contrast,
+        "critic_vs_control_interpolants": interpolant_contrast(pct["ae_critic"], pct["ae_extra"], keys, boot),
         "empty_grids": {name: int(np.isnan(pct[name]).sum()) for name in pct},
     }
+
+
+def study_headline(study: dict) -> dict[str, float | None]:
+    """The stage's metrics from :func:`study_metrics`: the AE-Critic − control outlier difference over the
+    interpolants (``mean``, 95% interval ``lo``, ``hi``; percentage points) and the critic's held-out ROC ``auc``."""
+    auc = study["critic_auc"]
+    return {**headline(study["critic_vs_control_interpolants"]), "auc": None if auc is None else round(auc, 5)}
 
 
 def outlier_lines(wide: pd.DataFrame) -> tuple[dict[str, np.ndarray], dict[str, tuple[np.ndarray, np.ndarray]]]:

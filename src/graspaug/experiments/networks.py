@@ -27,10 +27,10 @@ from tqdm import tqdm
 from graspaug.device import has_native_bfloat16
 from graspaug.errors import DataError
 from graspaug.experiments.variants import Variant
-from graspaug.io.checkpoints import finish_gqcnn_card, gqcnn_card, save_gqcnn
-from graspaug.nets.gqcnn import GQCNN, GQCNNEnsemble
+from graspaug.io.checkpoints import finish_gqcnn_card, gqcnn_card, operating_point, save_gqcnn, training_range
+from graspaug.nets.gqcnn import GQCNN, GQCNNEnsemble, GQCNNStack
 from graspaug.nets.settings import GQCNNConfig
-from graspaug.training.gqcnn import GraspArrays, classification_metrics, predict, train_gqcnn
+from graspaug.training.gqcnn import GraspArrays, classification_metrics, predict_members, train_members
 from graspaug.training.gqcnn_data import (
     Corpora,
     ExperimentSplit,
@@ -114,30 +114,21 @@ def train_network(job: NetworkJob, val: GraspArrays | None = None, test: GraspAr
     train, info = training_set(job.variant, job.split, job.corpora)
     val = val if val is not None else shapes_datapoints(job.corpora.original, job.split.validation)[0]
     test = test if test is not None else test_set(job.corpora.original)[0]
-    members, fits, val_ps, test_ps, history = [], [], [], [], []
-    for m, (init, noise_seed) in enumerate(zip(job.inits, job.noise_seeds, strict=True)):
-        net = GQCNN(job.net)
+    members = [GQCNN(job.net) for _ in job.inits]
+    for net, init in zip(members, job.inits, strict=True):
         net.load_state_dict(init)
-        gen = torch.Generator().manual_seed(noise_seed)
-        member = {"member": m} if len(job.inits) > 1 else {}  # history.csv names members only in an ensemble
-        fit = train_gqcnn(
-            net,
-            train,
-            val,
-            job.train,
-            device,
-            gen,
-            on_log=lambda step, metrics, member=member: history.append({**member, "step": step, **metrics}),
-            progress=False,
-        )
-        val_ps.append(
-            fit["val_predictions"]
-            if fit["val_predictions"] is not None
-            else predict(net, val, device, job.train.eval_batch)
-        )  # the kept weights
-        test_ps.append(predict(net, test, device, job.train.eval_batch))
-        members.append(net)
-        fits.append(fit)
+    gens = [torch.Generator().manual_seed(noise_seed) for noise_seed in job.noise_seeds]
+    history = []
+
+    def log(m: int, step: int, metrics: dict) -> None:  # history.csv names members only in an ensemble
+        history.append({**({"member": m} if len(members) > 1 else {}), "step": step, **metrics})
+
+    fits = train_members(members, train, val, job.train, device, gens, on_log=log, progress=False)
+    kept = GQCNNStack(members)  # the kept weights, every member in one pass
+    val_ps = [f["val_predictions"] for f in fits]
+    if any(p is None for p in val_ps):
+        val_ps = list(predict_members(kept, val, device, job.train.eval_batch))
+    test_ps = list(predict_members(kept, test, device, job.train.eval_batch))
     single = len(members) == 1
     net = members[0] if single else GQCNNEnsemble(members)
     val_p, test_p = np.mean(val_ps, axis=0, dtype=np.float32), np.mean(test_ps, axis=0, dtype=np.float32)
@@ -164,7 +155,11 @@ def train_network(job: NetworkJob, val: GraspArrays | None = None, test: GraspAr
     }
     folder = network_dir(job.out_dir, job.variant)
     folder.mkdir(parents=True, exist_ok=True)
-    save_gqcnn(folder / "model.pt", net, summary, finish_gqcnn_card(job.card, summary))
+    # the card's quality floor comes from the validation predictions alone, its data range from the training crops
+    card = finish_gqcnn_card(
+        job.card, summary, operating_point(val.labels, val_p), training_range(train.images, train.z)
+    )
+    save_gqcnn(folder / "model.pt", net, summary, card)
     np.save(folder / "test_predictions.npy", test_p)
     np.save(folder / "val_predictions.npy", val_p)
     if not single:
@@ -172,18 +167,19 @@ def train_network(job: NetworkJob, val: GraspArrays | None = None, test: GraspAr
         np.save(folder / "val_predictions_members.npy", np.stack(val_ps))
     pd.DataFrame(history).to_csv(folder / "history.csv", index=False)
     (folder / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
-    seconds = sum(f["train_seconds"] for f in fits)
+    seconds = fits[0]["train_seconds"]  # the members trained together
     return {
         **summary,
         "train_seconds": seconds,
-        "samples_per_second": len(fits) * fits[0]["steps"] * min(job.train.batch_size, len(train)) / seconds,
+        "samples_per_second": fits[0]["samples_per_second"],  # every member's samples
     }
 
 
 def seed_card(render, grasps, global_seed: int) -> dict:
     """The model card's data part of every network (:func:`graspaug.io.checkpoints.gqcnn_card`) from the
-    ``render`` params (crop, intrinsics, viewpoints), the ``grasps`` params (gripper, label threshold) and
-    the global seed."""
+    ``render`` params (crop, intrinsics, viewpoints: the camera distance range the planner warns outside of),
+    the ``grasps`` params (gripper, label threshold) and the global seed. :func:`train_network` adds each
+    network's training set, AP, validation operating point and training data range."""
     return gqcnn_card(render.crop, render.intrinsics, render.viewpoints, grasps.gripper, grasps.threshold, global_seed)
 
 
@@ -207,8 +203,8 @@ def _by_member(value):
 
 
 def seed_table(summaries: list[dict]) -> dict:
-    """The seed's metrics file: pool → base size → ratio → validation / test AP and ROC AUC, steps,
-    the kept step (per member of an ensemble: ``{"m0": …}``)."""
+    """The seed's networks (its report): pool → base size → ratio → validation / test AP and ROC AUC,
+    datapoints, steps, the kept step (per member of an ensemble: ``{"m0": …}``)."""
     out: dict = {}
     for s in summaries:
         key = ("ceiling", "all", "-") if s["pool"] == "ceiling" else (s["pool"], str(s["base_size"]), f"{s['ratio']:g}")
@@ -221,6 +217,18 @@ def seed_table(summaries: list[dict]) -> dict:
             "best_step": _by_member(s["train"]["best_step"]),
         }
     return out
+
+
+def seed_headline(table: dict) -> dict[str, float | None]:
+    """The seed's metrics from its :func:`seed_table`: ``test_ap`` and ``val_ap``, each the mean over the
+    seed's networks (those with a value), rounded to 5 decimals; None without any."""
+    rows = [row for by_base in table.values() for by_ratio in by_base.values() for row in by_ratio.values()]
+
+    def mean(key: str) -> float | None:
+        values = [row[key] for row in rows if row[key] is not None]
+        return round(float(np.mean(values)), 5) if values else None
+
+    return {"test_ap": mean("test_ap"), "val_ap": mean("val_ap")}
 
 
 def read_history(seed_dir: Path, variants: list[Variant]) -> pd.DataFrame:
@@ -242,7 +250,8 @@ def seed_plan(variants: list[Variant], members: int, n_validation: int, val_rows
     (``n_validation``) and datapoints (``val_rows`` (N,)), the test datapoints (``test_rows`` (M,))
     and the torch ``device``."""
     return (
-        "%d networks of %d member(s); validation %d shapes (%d datapoints), test %d datapoints; one at a time on %s"
+        "%d networks of %d member(s) (a network's members at once, the networks one after another); "
+        "validation %d shapes (%d datapoints), test %d datapoints; on %s"
         % (len(variants), members, n_validation, len(val_rows), len(test_rows), device)
     )
 

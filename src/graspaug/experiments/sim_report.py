@@ -16,7 +16,14 @@ import numpy as np
 import pandas as pd
 
 from graspaug.errors import DataError
-from graspaug.experiments.stats import ObjectBootstrap, mcnemar_test, paired_contrast, t_interval, wilson_interval
+from graspaug.experiments.stats import (
+    ObjectBootstrap,
+    headline,
+    mcnemar_test,
+    paired_contrast,
+    t_interval,
+    wilson_interval,
+)
 
 #: The contrasts of the sim metrics: name → (arm, reference arm); success(arm) − success(reference).
 CONTRASTS = {
@@ -156,8 +163,8 @@ def trial_setup(
 
 
 def summarize(trials: pd.DataFrame, objects: Sequence, chosen: dict, setup: dict, n_boot: int, seed: int) -> dict:
-    """The experiment's metrics: setup, per-arm rates (Wilson), the contrasts (paired, bootstrap
-    over objects), before vs after per training seed, per-object rates. ``objects``: the
+    """The experiment's report (its metrics: :func:`sim_headline`): setup, per-arm rates (Wilson), the
+    contrasts (paired, bootstrap over objects), before vs after per training seed, per-object rates. ``objects``: the
     :class:`~graspaug.experiments.sim.PreparedObject` of the trials; ``chosen``: arm → (pool, ratio)."""
     model_seeds = setup["model_seeds"]
     metrics = {
@@ -185,6 +192,12 @@ def summarize(trials: pd.DataFrame, objects: Sequence, chosen: dict, setup: dict
             **rates,
         }
     return metrics
+
+
+def sim_headline(summary: dict) -> dict[str, dict]:
+    """The experiment's metrics from its :func:`summarize` report: per contrast the mean paired success
+    difference and its 95% bootstrap interval over objects (:func:`~graspaug.experiments.stats.headline`)."""
+    return {name: headline(c) for name, c in summary["contrasts"].items()}
 
 
 def objects_table(objects: Sequence) -> pd.DataFrame:

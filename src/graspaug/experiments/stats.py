@@ -143,6 +143,14 @@ def paired_contrast(
     return mean_interval(a - b, boot, level)
 
 
+def headline(contrast: dict) -> dict[str, float | None]:
+    """A contrast as a metrics file holds it: ``mean`` and its interval ends ``lo``, ``hi`` (from ``ci_low``,
+    ``ci_high``), rounded to 5 decimals; None stays None. The same three keys in every metrics file, so
+    ``dvc metrics show`` lines every experiment's contrasts up in three columns."""
+    keys = {"mean": "mean", "lo": "ci_low", "hi": "ci_high"}
+    return {k: None if contrast.get(v) is None else round(float(contrast[v]), 5) for k, v in keys.items()}
+
+
 def wilson_interval(successes: int, attempts: int, confidence: float = 0.95) -> tuple[float, float]:
     """Wilson score interval of a success rate (scipy); (0, 1) when there were no attempts."""
     if attempts == 0:

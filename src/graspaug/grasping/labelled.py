@@ -74,3 +74,9 @@ def grasps_summary(table: pd.DataFrame, shape_ids: list[str]) -> dict[str, float
         "eps_mean_median": round(float(table.eps_mean.median()), 6) if len(table) else None,
         "nominal_force_closure_share": round(float((table.eps > 0).mean()), 4) if len(table) else None,
     }
+
+
+def grasps_headline(summary: dict) -> dict[str, float | int | None]:
+    """The stage's metrics from its :func:`grasps_summary`: ``shapes`` of the corpus and the share of
+    grasps labelled positive (``positive``, robust ε above the threshold)."""
+    return {"shapes": summary["n_shapes"], "positive": summary["success_share"]}

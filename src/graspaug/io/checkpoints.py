@@ -12,6 +12,7 @@ import os
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import torch
 
 from graspaug.errors import CheckpointMismatch
@@ -71,7 +72,8 @@ def load_autoencoder(path: str | os.PathLike, expected: AEConfig) -> tuple[AutoE
     return ae, critic, state["train_params"]
 
 
-GQCNN_CARD_FORMAT = "graspaug.gqcnn-card/1"
+#: /2 adds ``operating_point`` and ``training_range`` (:func:`finish_gqcnn_card`); a /1 card reads with both None.
+GQCNN_CARD_FORMAT = "graspaug.gqcnn-card/2"
 
 
 def gqcnn_card(crop, intrinsics, viewpoints, gripper, label_threshold: float, global_seed: int) -> dict[str, Any]:
@@ -94,10 +96,18 @@ def gqcnn_card(crop, intrinsics, viewpoints, gripper, label_threshold: float, gl
     }
 
 
-def finish_gqcnn_card(card: dict[str, Any] | None, summary: dict[str, Any]) -> dict[str, Any] | None:
+def finish_gqcnn_card(
+    card: dict[str, Any] | None,
+    summary: dict[str, Any],
+    operating_point: dict[str, Any] | None = None,
+    training_range: dict[str, Any] | None = None,
+) -> dict[str, Any] | None:
     """``card`` plus the training set (pool, base size, ratio, seed, datapoints, steps, kept step, members, and
     ``gqcnn.train.precision`` as ``precision``: None for a summary written before it was recorded) and the
-    validation / test AP of ``summary`` (a network's ``summary.json``); None stays None."""
+    validation / test AP of ``summary`` (a network's ``summary.json``), the validation ``operating_point``
+    (:func:`operating_point`: a threshold on P(success) chosen on validation predictions)
+    and the ``training_range`` of its training data (:func:`training_range`: gripper
+    depths and object heights, m); either None where not computed. None stays None."""
     if card is None:
         return None
     train = summary["train"]
@@ -116,6 +126,86 @@ def finish_gqcnn_card(card: dict[str, Any] | None, summary: dict[str, Any]) -> d
         },
         "validation_ap": summary["validation"].get("ap"),
         "test_ap": summary["test"].get("ap"),
+        "operating_point": None if operating_point is None else dict(operating_point),
+        "training_range": None if training_range is None else dict(training_range),
+    }
+
+
+def operating_point(labels: np.ndarray, probability: np.ndarray) -> dict[str, Any] | None:
+    """The validation operating point: the threshold t on P(success) that maximises F1 when a grasp
+    with P >= t is predicted to succeed, on a network's *validation* predictions (never test data).
+
+    F1 weighs precision and recall of the successes alone, so the many easy failures of a grasp
+    dataset (positives are a minority) do not pull the threshold down; below t the network, at its
+    best validation trade-off, calls a grasp a failure. Ties go to the lowest threshold (the most
+    permissive floor). Candidate thresholds are the distinct predicted probabilities.
+
+    Parameters
+    ----------
+    labels : (N,) int — 1 = the validation grasp succeeded, 0 = it failed
+    probability : (N,) float — the network's P(success) of each validation grasp
+
+    Returns
+    -------
+    ``{"rule": "max_f1", "threshold", "f1", "precision", "recall", "positive_share", "datapoints"}``
+    (threshold in [0, 1]), or None when the labels hold one class only (no trade-off to choose).
+    """
+    labels = np.asarray(labels).astype(int).ravel()
+    probability = np.asarray(probability, dtype=np.float64).ravel()
+    if labels.shape != probability.shape:
+        raise ValueError(f"operating_point: {len(labels)} labels but {len(probability)} probabilities")
+    if not np.all(np.isfinite(probability)):
+        raise ValueError("operating_point: the probabilities hold NaN or inf")
+    positives = int(labels.sum())
+    if positives == 0 or positives == len(labels):
+        return None
+    order = np.argsort(-probability, kind="stable")
+    p, y = probability[order], labels[order]
+    last = np.r_[p[1:] != p[:-1], True]  # the last row of each run of equal scores: threshold p keeps rows up to it
+    predicted = np.arange(1, len(p) + 1)[last]
+    hits = np.cumsum(y)[last]
+    f1 = 2 * hits / (predicted + positives)
+    best = int(np.flatnonzero(f1 == f1.max())[-1])  # the lowest threshold among ties (scores run high to low)
+    return {
+        "rule": "max_f1",
+        "threshold": float(p[last][best]),
+        "f1": float(f1[best]),
+        "precision": float(hits[best] / predicted[best]),
+        "recall": float(hits[best] / positives),
+        "positive_share": float(positives / len(labels)),
+        "datapoints": int(len(labels)),
+    }
+
+
+def training_range(images: np.ndarray, z: np.ndarray) -> dict[str, Any]:
+    """The range of what a network was trained on, from its training datapoints.
+
+    Parameters
+    ----------
+    images : (N, S, S) float — the training depth crops, m (the camera's depth of each crop pixel)
+    z : (N,) float — the training gripper depths, m (camera z of each grasp center)
+
+    Returns
+    -------
+    ``{"gripper_depth": [min, max], "object_height": [min, max], "datapoints": N}`` in m. A crop's object
+    height is its depth relief, the deepest pixel (the table) minus the nearest (the object's top): the
+    height above the table of what the network saw beside the grasp. It is a lower bound where a crop
+    shows no table, so the largest over the training set is a lower bound of the tallest training object
+    (the corpus objects, scaled for the gripper, fit the 96 px crop; its table pixels are at most a
+    centimetre deeper at a 5° tilt). Empty data gives None ranges.
+    """
+    images = np.asarray(images)
+    z = np.asarray(z, dtype=np.float64).ravel()
+    if len(images) != len(z):
+        raise ValueError(f"training_range: {len(images)} crops but {len(z)} gripper depths")
+    if len(z) == 0:
+        return {"gripper_depth": None, "object_height": None, "datapoints": 0}
+    flat = images.reshape(len(images), -1)
+    relief = flat.max(axis=1).astype(np.float64) - flat.min(axis=1)
+    return {
+        "gripper_depth": [round(float(z.min()), 5), round(float(z.max()), 5)],
+        "object_height": [round(float(relief.min()), 5), round(float(relief.max()), 5)],
+        "datapoints": int(len(z)),
     }
 
 

@@ -32,3 +32,13 @@ def write_json(obj: object, path: str | os.PathLike) -> None:
 
     with atomic_path(path) as tmp:
         tmp.write_text(json.dumps(obj, indent=2) + "\n")
+
+
+def write_json_files(records: dict[str, object], folder: str | os.PathLike) -> None:
+    """Write each of ``records`` (name → object) as ``<name>.json`` in ``folder``, replacing the whole
+    folder at once (no file of an earlier run stays), e.g. one metrics file per contrast."""
+    import json
+
+    with atomic_path(folder, directory=True) as tmp:
+        for name, obj in records.items():
+            (tmp / f"{name}.json").write_text(json.dumps(obj, indent=2) + "\n")

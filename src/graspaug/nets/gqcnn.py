@@ -36,12 +36,14 @@ class LocalResponseNorm(nn.Module):
         super().__init__()
         self.size, self.alpha, self.beta, self.k = size, alpha, beta, k
 
-    def forward(self, x: torch.Tensor) -> torch.Tensor:
-        channels = x.shape[1]
+    def forward(self, x: torch.Tensor, groups: int = 1) -> torch.Tensor:
+        """``x`` (N, G·C, H, W): the norm over the C channels of each of ``groups`` groups apart
+        (the members of a :class:`GQCNNStack`)."""
+        channels = x.shape[1] // groups
         offset = torch.arange(channels, device=x.device)
         diff = offset[None, :] - offset[:, None]  # input channel - output channel
         band = ((diff >= -(self.size // 2)) & (diff <= (self.size - 1) // 2)).to(x.dtype)
-        window = F.conv2d(x * x, band.view(channels, channels, 1, 1))
+        window = F.conv2d(x * x, band.repeat(groups, 1).view(groups * channels, channels, 1, 1), groups=groups)
         return x * torch.exp(torch.log(self.k + self.alpha / self.size * window) * -self.beta)
 
 
@@ -106,6 +108,92 @@ class GQCNN(nn.Module):
 
     def describe(self) -> dict:
         return {**asdict(self.config), "parameters": sum(p.numel() for p in self.parameters())}
+
+
+_CONVS = ("conv1_1", "conv1_2", "conv2_1", "conv2_2")
+_LINEARS = ("fc3", "pc1", "fc4_image", "fc5")  # and fc4_pose, which has no bias
+_NORMALIZATION = ("image_mean", "image_std", "z_mean", "z_std")
+
+
+class GQCNNStack(nn.Module):
+    """K GQ-CNNs of one config as one model, to train them at once: member k takes its own
+    batch, crops (K, N, 1, S, S) and gripper depths (K, N), m → logits (K, N, 2), and computes
+    what its :class:`GQCNN` computes (a test checks it). Every parameter is stacked along the
+    members: a conv layer's filters are one grouped convolution (member k's are output channels
+    k·C … (k+1)·C − 1), a fully connected layer's weights (K, in, out) one batched matrix
+    product. One member is its own GQCNN, unstacked. :meth:`unstack` writes the weights back
+    into the members."""
+
+    def __init__(self, members: list[GQCNN]) -> None:
+        super().__init__()
+        if not members or any(m.config != members[0].config for m in members):
+            raise ValueError("a stack needs at least one member and one config for all")
+        self.k, self.config, self.lrn = len(members), members[0].config, members[0].lrn
+        if self.k == 1:
+            self.single = members[0]
+            return
+        stack = lambda tensors: nn.Parameter(torch.stack([t.detach() for t in tensors]))  # noqa: E731
+        for name in _CONVS:
+            layers = [getattr(m, name) for m in members]
+            self.register_parameter(f"{name}_weight", nn.Parameter(torch.cat([c.weight.detach() for c in layers])))
+            self.register_parameter(f"{name}_bias", nn.Parameter(torch.cat([c.bias.detach() for c in layers])))
+        for name in _LINEARS:
+            layers = [getattr(m, name) for m in members]
+            self.register_parameter(f"{name}_weight", stack(c.weight.t() for c in layers))
+            self.register_parameter(f"{name}_bias", stack(c.bias.unsqueeze(0) for c in layers))
+        self.fc4_pose_weight = stack(m.fc4_pose.weight.t() for m in members)
+        for name in _NORMALIZATION:
+            self.register_buffer(name, torch.stack([getattr(m, name) for m in members]).clone())
+
+    def conv(self, x: torch.Tensor, name: str) -> torch.Tensor:
+        """ReLU of conv layer ``name`` of every member: (N, K·C_in, H, W) → (N, K·C, H, W)."""
+        weight, bias = getattr(self, f"{name}_weight"), getattr(self, f"{name}_bias")
+        return F.relu(F.conv2d(x, weight, bias, padding="same", groups=self.k))
+
+    def forward(self, images: torch.Tensor, z: torch.Tensor) -> torch.Tensor:
+        """Logits (K, N, 2) for crops (K, N, 1, S, S) and gripper depths (K, N), meters."""
+        if self.k == 1:
+            return self.single(images[0], z[0]).unsqueeze(0)
+        k, n = z.shape
+        x = (
+            images[:, :, 0] - z[..., None, None]
+            if self.config.image_input == "depth_minus_gripper"
+            else images[:, :, 0]
+        )
+        x = (x - self.image_mean.view(k, 1, 1, 1)) / self.image_std.view(k, 1, 1, 1)
+        x = x.transpose(0, 1).contiguous(memory_format=torch.channels_last)  # (N, K, S, S): member k is channel k
+        x = self.lrn(self.conv(self.conv(x, "conv1_1"), "conv1_2"), groups=k)
+        x = F.max_pool2d(x, 2)
+        x = self.lrn(self.conv(self.conv(x, "conv2_1"), "conv2_2"), groups=k)
+        if self.config.pool_after_conv2:
+            x = F.max_pool2d(x, 2)
+        x = x.reshape(n, k, -1).transpose(0, 1)  # (K, N, C·h·w), each member's features in (C, h, w) order
+        x = F.relu(torch.baddbmm(self.fc3_bias, x, self.fc3_weight))
+        p = ((z - self.z_mean.view(k, 1)) / self.z_std.view(k, 1)).unsqueeze(-1)
+        p = F.relu(torch.baddbmm(self.pc1_bias, p, self.pc1_weight))
+        x = F.relu(torch.baddbmm(self.fc4_image_bias, x, self.fc4_image_weight) + torch.bmm(p, self.fc4_pose_weight))
+        return torch.baddbmm(self.fc5_bias, x, self.fc5_weight)
+
+    def member_state(self, k: int) -> dict[str, torch.Tensor]:
+        """Member ``k``'s weights and normalization as a :class:`GQCNN` state dict (copies)."""
+        if self.k == 1:
+            return {name: t.detach().clone() for name, t in self.single.state_dict().items()}
+        c = self.config.filters
+        state = {}
+        for name in _CONVS:
+            state[f"{name}.weight"] = getattr(self, f"{name}_weight")[k * c : (k + 1) * c]
+            state[f"{name}.bias"] = getattr(self, f"{name}_bias")[k * c : (k + 1) * c]
+        for name in _LINEARS:
+            state[f"{name}.weight"] = getattr(self, f"{name}_weight")[k].t()
+            state[f"{name}.bias"] = getattr(self, f"{name}_bias")[k, 0]
+        state["fc4_pose.weight"] = self.fc4_pose_weight[k].t()
+        state.update({name: getattr(self, name)[k] for name in _NORMALIZATION})
+        return {name: t.detach().clone().contiguous() for name, t in state.items()}
+
+    def unstack(self, members: list[GQCNN]) -> None:
+        """Write every member's current weights into ``members`` (K GQCNNs of this config)."""
+        for k, member in enumerate(members):
+            member.load_state_dict(self.member_state(k))
 
 
 class GQCNNEnsemble(nn.Module):

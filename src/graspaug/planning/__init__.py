@@ -22,12 +22,19 @@ up-sampled by more than :data:`MAX_UPSAMPLING` nor seen from a distance more tha
 one-line :class:`PlanningError`. The camera should look (nearly) straight down, as in training
 (tilt 0-5°).
 
+The card also holds the network's validation operating point (a threshold on P(success)) and the
+range of its training data: :mod:`graspaug.planning.limits` gives the floor below which a planned
+grasp is rejected (``quality_floor``) and the lines that say where an image lies outside the training
+data (``range_warnings``: camera distance, object height above the table, gripper depth). It is not
+re-exported here, so the simulated robot, which imports this package, does not depend on it.
+
 Modules: :mod:`~graspaug.planning.settings` (sampler and cross-entropy settings, plain data),
 :mod:`~graspaug.planning.grasps` (image grasps, jaw endpoints, Dex-Net's feature vector),
 :mod:`~graspaug.planning.sampler` (antipodal pairs on depth edges), :mod:`~graspaug.planning.policies`
 (the cross-entropy and random policies), :mod:`~graspaug.planning.card` (the model card),
 :mod:`~graspaug.planning.camera` (intrinsics, depth checks, resampling to the training camera),
 :mod:`~graspaug.planning.inputs` (depth images and intrinsics from files),
+:mod:`~graspaug.planning.limits` (the quality floor and the out-of-range warnings),
 :mod:`~graspaug.planning.planner` (the planner) and :mod:`~graspaug.planning.export` (TorchScript
 export). The names below load their module (and torch) on first use, so that importing the
 settings stays light.

@@ -24,7 +24,12 @@ class ModelCard:
     the hand (m); ``label_threshold`` the robust ε above which a training grasp counted as a
     success; ``training_set`` its pool, base size, ratio, seed, size, members and training
     precision (None where not recorded); ``validation_ap`` / ``test_ap`` its Average Precision.
-    ``assumed`` is True for a checkpoint without a card (written before cards existed): the
+    ``operating_point`` (:func:`~graspaug.io.checkpoints.operating_point`) is the threshold on
+    P(success) chosen on the validation predictions, the planner's default quality floor;
+    ``training_range`` (:func:`~graspaug.io.checkpoints.training_range`) the gripper depths (m) and
+    object heights above the table (m) of the training crops. Both are None on cards written before
+    they were recorded (format ``graspaug.gqcnn-card/1``). ``assumed`` is True for a checkpoint
+    without a card (written before cards existed): the
     defaults are then assumed.
     """
 
@@ -38,6 +43,8 @@ class ModelCard:
     training_set: dict = field(default_factory=dict)
     validation_ap: float | None = None
     test_ap: float | None = None
+    operating_point: dict | None = None
+    training_range: dict | None = None
     image_input: str = "depth"
     graspaug_version: str | None = None
     global_seed: int | None = None

@@ -135,6 +135,16 @@ def render_summary(
     }
 
 
+def render_headline(summary: dict) -> dict:
+    """The stage's metrics from its :func:`render_summary`: ``shapes`` rendered, ``datapoints`` and the
+    share of datapoints labelled positive (``positive``)."""
+    return {
+        "shapes": summary["shapes_rendered"],
+        "datapoints": summary["n_datapoints"],
+        "positive": summary["positive_share"],
+    }
+
+
 def example_crops(
     index: pd.DataFrame, n_examples: int, seed: int, factor: int
 ) -> tuple[np.ndarray, list[str], np.ndarray]:

@@ -1,12 +1,11 @@
 """Stage ``critic_eval``: the paper's critic study (Section IV-B), with a control and intervals.
 
-Random pairs of train shapes are interpolated at each α by three models on the same pairs:
-the AE (phase 1), the control (phase 2 with λ = 0) and the AE-Critic. Every decoded grid is
-clustered with DBSCAN; voxels outside its largest cluster are outliers. Outputs:
-``metrics/critic_eval.json`` (per model and α the mean outlier % with a bootstrap 95% interval
-over pairs; paired contrasts; the critic's AUC on held-out shapes),
-``reports/critic_eval/outliers.{csv,png}`` and ``reports/critic_eval/interpolations.png``
-(the paper's Fig. 5: AE / control / AE-Critic rows per pair, main part green, outliers red).
+Random pairs of train shapes are interpolated at each α by three models on the same pairs: the AE (phase 1),
+the control (phase 2 with λ = 0) and the AE-Critic. Every decoded grid is clustered with DBSCAN; voxels outside
+its largest cluster are outliers. Outputs: ``metrics/critic_eval.json`` (AE-Critic − control over the
+interpolants with its interval, the critic's AUC), ``reports/critic_eval/study.json`` (per model and α the mean
+outlier % with a bootstrap 95% interval over pairs; paired contrasts; the critic's AUC on held-out shapes),
+``outliers.{csv,png}`` and ``interpolations.png`` (Fig. 5: AE / control / AE-Critic rows per pair) beside it.
 """
 
 from __future__ import annotations
@@ -26,6 +25,7 @@ from graspaug.experiments.critic import (
     outlier_columns,
     outlier_lines,
     random_pairs,
+    study_headline,
     study_metrics,
 )
 from graspaug.experiments.stats import PairBootstrap
@@ -39,6 +39,7 @@ from graspaug.paths import (
     AE_EXTRA_MODEL,
     AE_MODEL,
     CRITIC_EVAL_METRICS,
+    CRITIC_EVAL_STUDY,
     INTERPOLATIONS_PNG,
     OUTLIERS_CSV,
     OUTLIERS_PNG,
@@ -80,7 +81,8 @@ def run(params: Params) -> None:
             critic = finite_or_none(critic_separation(ae, model_critic, grids["test"], device))
 
     metrics = study_metrics(pct, boot, keys, critic, cfg.n_bootstrap)
-    write_json(metrics, CRITIC_EVAL_METRICS)
+    write_json(metrics, CRITIC_EVAL_STUDY)
+    write_json(study_headline(metrics), CRITIC_EVAL_METRICS)
     # one row per α, one column per model (and its interval), so `dvc plots` draws one line per model
     wide = pd.DataFrame(outlier_columns(metrics["outlier_pct_ci"], cfg.alphas, keys))
     write_csv(wide, OUTLIERS_CSV)
@@ -92,9 +94,5 @@ def run(params: Params) -> None:
         INTERPOLATIONS_PNG,
         "Interpolations per pair: AE, AE + extra epochs (λ = 0), AE-Critic; main part green, outliers red",
     )
-    log.info(
-        "critic_eval: critic AUC %s; AE-Critic − control outlier %% at α %s: %s",
-        critic["auc"],
-        keys,
-        contrast_text(metrics["contrast"]["critic_vs_control"], keys),
-    )
+    text = contrast_text(metrics["contrast"]["critic_vs_control"], keys)
+    log.info("critic_eval: critic AUC %s; AE-Critic − control outlier %% at α %s: %s", critic["auc"], keys, text)

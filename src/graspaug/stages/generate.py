@@ -8,9 +8,9 @@ argues against). Each pool holds ``ceil(max ratio × B)`` kept shapes in order: 
 ``round(R × B)`` are the augmentation set of ratio R. A degenerate decode is rejected with its
 reason and replaced by the next candidate.
 
-Outputs, in ``data/generated/<B>/``: ``meshes/<shape_id>.obj``, ``index.parquet`` (one row
-per kept shape), ``rejects.parquet``, ``base.parquet`` (the base set with its scores); plus
-``metrics/generate/<B>.json`` and ``reports/generate/<B>/{pairs,tsne}.png``.
+Outputs, in ``data/generated/<B>/``: ``meshes/<shape_id>.obj``, ``index.parquet`` (one row per kept shape),
+``rejects.parquet``, ``base.parquet`` (the base set with its scores); ``metrics/generate/<B>.json`` (shapes
+kept, kept share); ``reports/generate/<B>/{summary.json,pairs.png,tsne.png}`` (summary: every pool count).
 """
 
 from __future__ import annotations
@@ -19,6 +19,7 @@ import logging
 import time
 
 from graspaug.device import resolve_device
+from graspaug.generation import generate_headline
 from graspaug.generation_meshes import base_ids, base_set, generate_pools, mesh_batches, tsne_groups
 from graspaug.io.atomic import atomic_path
 from graspaug.io.checkpoints import load_autoencoder
@@ -39,6 +40,7 @@ from graspaug.paths import (
     VOXELS,
     generate_metrics,
     generate_reports,
+    generate_summary,
     generated_dir,
     timing_file,
 )
@@ -81,7 +83,8 @@ def run(params: Params, base_size: int) -> None:
 
     for message in out.warnings:
         log.warning("generate %d: %s", base_size, message)
-    write_json(out.summary, generate_metrics(base_size))
+    write_json(out.summary, generate_summary(base_size))
+    write_json(generate_headline(out.summary), generate_metrics(base_size))
     seconds = round(time.perf_counter() - start, 1)
     write_json({"seconds": seconds}, timing_file("generate", str(base_size)))
     targeted, randoms = out.summary["targeted"], out.summary["random"]

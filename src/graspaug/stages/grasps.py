@@ -5,7 +5,8 @@ Outputs: ``data/grasps/<corpus>.parquet``, one row per grasp: ``shape_id``, ``gr
 ``center_{x,y,z}``, ``axis_{x,y,z}`` (unit, jaw 1 → jaw 2), contacts ``p1_*``, ``p2_*`` with
 outward normals ``n1_*``, ``n2_*`` (m, in the shape's normalized frame), ``width`` (m),
 ``eps`` (ε of the grasp as sampled), ``eps_mean`` / ``eps_std`` (robust ε over perturbations),
-``success`` (``eps_mean > threshold``); and ``metrics/grasps/<corpus>.json``.
+``success`` (``eps_mean > threshold``); ``metrics/grasps/<corpus>.json`` (shapes, positive share) and
+``reports/grasps/<corpus>.json`` (every count and share).
 """
 
 from __future__ import annotations
@@ -15,12 +16,12 @@ import time
 
 import pandas as pd
 
-from graspaug.grasping.labelled import grasps_of_shape, grasps_summary
+from graspaug.grasping.labelled import grasps_headline, grasps_of_shape, grasps_summary
 from graspaug.io.meshes import mesh_path
 from graspaug.io.tables import read_table, write_json, write_table
 from graspaug.params.base import params_model
 from graspaug.params.grasps import GraspsParams
-from graspaug.paths import grasps_metrics, grasps_table, timing_file
+from graspaug.paths import grasps_metrics, grasps_report, grasps_table, timing_file
 from graspaug.stages import corpus_paths
 
 log = logging.getLogger(__name__)
@@ -48,7 +49,8 @@ def run(params: Params, corpus: str = "original") -> None:
 
     seconds = time.perf_counter() - start
     summary = grasps_summary(table, shape_ids)
-    write_json(summary, grasps_metrics(corpus))
+    write_json(summary, grasps_report(corpus))
+    write_json(grasps_headline(summary), grasps_metrics(corpus))
     write_json({"seconds": round(seconds, 1)}, timing_file("grasps", corpus))
     log.info(
         "grasps (%s): %d grasps on %d shapes (%d without), %.1f%% successful, in %.1f s",

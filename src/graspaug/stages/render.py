@@ -13,8 +13,8 @@ one row per datapoint: ``shard``, ``row``, ``shape_id``, ``origin``, ``split``, 
 ``camera_tilt`` (deg), ``center_u`` / ``center_v`` (px in the full image), ``angle`` (rad, jaw
 axis in the image), ``z`` (m, gripper depth), ``width_px`` (open jaws in image px),
 ``collision_free``, ``eps`` (robust ε), ``success`` (ε > threshold of the grasps stage),
-``label`` (= collision_free and success); ``metrics/render/<corpus>.json``;
-``reports/render/<corpus>/examples.png``.
+``label`` (= collision_free and success); ``metrics/render/<corpus>.json`` (shapes, datapoints, positive
+share); ``reports/render/<corpus>/summary.json`` (every count and share) and ``examples.png``.
 """
 
 from __future__ import annotations
@@ -32,12 +32,13 @@ from graspaug.io.tables import read_table, write_json
 from graspaug.params.base import params_model
 from graspaug.params.grasps import GraspsParams
 from graspaug.params.render import RenderParams
-from graspaug.paths import gqcnn_dir, grasps_table, render_examples, render_metrics, timing_file
+from graspaug.paths import gqcnn_dir, grasps_table, render_examples, render_metrics, render_report, timing_file
 from graspaug.render.corpus_dataset import (
     datapoints_table,
     dataset_info,
     example_crops,
     render_corpus,
+    render_headline,
     render_summary,
     with_pool_columns,
 )
@@ -71,7 +72,8 @@ def run(params: Params, corpus: str = "original") -> None:
 
     seconds = time.perf_counter() - start
     summary = render_summary(len(shapes), parts, skipped, index, n_rays, n_poses)
-    write_json(summary, render_metrics(corpus))
+    write_json(summary, render_report(corpus))
+    write_json(render_headline(summary), render_metrics(corpus))
     write_json(
         {"seconds": round(seconds, 1), "datapoints_per_second": round(len(index) / seconds, 1)},
         timing_file("render", corpus),

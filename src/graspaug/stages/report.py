@@ -1,14 +1,13 @@
 """Stage ``report``: the paper's GQ-CNN experiment in one table, declared contrasts with
 intervals, three figures and plain words.
 
-Reads every network of every seed (``models/gqcnn/s<seed>/``). Writes ``metrics/ap.json``
-(``contrasts``: per declared contrast ``mean``, ``ci_low``/``ci_high`` (95% t over seeds),
-``n_seeds``, ``sd``, ``boot_low``/``boot_high`` (95% bootstrap over test objects); ``networks``:
-test / validation / per-object AP per pool, base size, ratio; ``chosen_ratio`` per base size,
-picked on validation AP), ``reports/gqcnn/ap_table.csv`` and, in ``reports/gqcnn/``:
-``report.md``, ``ap_vs_ratio.png`` (Fig. 7), ``improvement_by_score.png`` (Fig. 8: per-object AP
-change of the chosen ratio over 1:0 at the largest base size, by rarity and graspness interval)
-and ``tsne_graspness.png`` (Fig. 1).
+Reads every network of every seed (``models/gqcnn/s<seed>/``). Writes ``metrics/ap/<contrast>.json`` (``mean``,
+``lo``, ``hi``: 95% t over seeds) and, in ``reports/gqcnn/``: ``ap.json`` (``contrasts``: per declared contrast
+``mean``, ``ci_low``/``ci_high``, ``n_seeds``, ``sd``, ``boot_low``/``boot_high`` (95% bootstrap over test objects);
+``networks``: test / validation / per-object AP per pool, base size, ratio; ``chosen_ratio`` per base size, picked
+on validation AP), ``ap_table.csv``, ``report.md``, ``ap_vs_ratio.png`` (Fig. 7), ``improvement_by_score.png``
+(Fig. 8: per-object AP change of the chosen ratio over 1:0 at the largest base size, by rarity and graspness
+interval) and ``tsne_graspness.png`` (Fig. 1).
 """
 
 from __future__ import annotations
@@ -16,6 +15,7 @@ from __future__ import annotations
 import logging
 
 from graspaug.experiments.ap import (
+    ap_headline,
     ap_metrics,
     evaluate_networks,
     gain_sentences,
@@ -27,7 +27,7 @@ from graspaug.experiments.ap import (
 )
 from graspaug.experiments.ap_figures import draw_ap_vs_ratio, draw_improvement, draw_latent_map, draw_pr_roc
 from graspaug.io.atomic import atomic_path
-from graspaug.io.tables import read_table, write_csv, write_json
+from graspaug.io.tables import read_table, write_csv, write_json, write_json_files
 from graspaug.params.base import params_model
 from graspaug.params.embed import EmbedParams
 from graspaug.params.generate import GenerateParams
@@ -35,6 +35,7 @@ from graspaug.params.gqcnn import GQCNNParams
 from graspaug.params.score import ScoreParams
 from graspaug.paths import (
     AP_METRICS,
+    AP_REPORT,
     LATENTS,
     REPORT_DIR,
     SCORES,
@@ -84,7 +85,9 @@ def run(params: Params) -> None:
     draw_latent_map(latents, scores, augmentation, generated_graspness, base, perplexity, params.seed, tsne)
 
     positive_share = float(labels.mean())
-    write_json(ap_metrics(results, table, chosen, positive_share, seeds), AP_METRICS)
+    ap_report = ap_metrics(results, table, chosen, positive_share, seeds)
+    write_json(ap_report, AP_REPORT)
+    write_json_files(ap_headline(ap_report), AP_METRICS)
     words = training_words(cfg.train, cfg.members)
     with atomic_path(REPORT_DIR / "report.md") as tmp:
         tmp.write_text(report_markdown(table, results, chosen, extras, seeds, positive_share, words))

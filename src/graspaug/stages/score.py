@@ -6,7 +6,8 @@ split. Graspness is the share of a shape's sampled grasps whose robust ε exceed
 threshold (0 for a shape without grasps).
 
 Outputs: ``data/scores.parquet`` (``shape_id``, ``split``, ``rarity``, ``graspness``,
-``n_grasps``, ``n_success``), ``metrics/score.json``, and in ``reports/score/``: graspness and
+``n_grasps``, ``n_success``), ``metrics/score.json`` (train shapes, mean graspness), and in ``reports/score/``:
+``summary.json`` (every figure of the train split), graspness and
 rarity histograms of the train split (CSV + PNG; the graspness one is the paper's Fig. 4) and
 ``grasp_examples.png`` (low / middle / high graspness shapes with their grasps).
 """
@@ -28,6 +29,7 @@ from graspaug.paths import (
     RARITY_HIST_CSV,
     RARITY_HIST_PNG,
     SCORE_METRICS,
+    SCORE_SUMMARY,
     SCORES,
     SHAPES_DIR,
     SHAPES_TABLE,
@@ -39,6 +41,7 @@ from graspaug.score_tables import (
     grasp_examples,
     histogram_bars,
     histogram_table,
+    score_headline,
     score_summary,
     shape_scores,
 )
@@ -72,7 +75,8 @@ def run(params: Params) -> None:
     pictures = grasp_examples(meshes, grasps, scores, picks)
     grasps_on_shapes(*pictures, GRASP_EXAMPLES_PNG, vmax=2 * threshold, threshold=threshold)
     summary = score_summary(train)
-    write_json(summary, SCORE_METRICS)
+    write_json(summary, SCORE_SUMMARY)
+    write_json(score_headline(summary), SCORE_METRICS)
     log.info(
         "score: %d shapes; train graspness mean %.3f, rarity median %.3f",
         len(scores),

@@ -1,19 +1,17 @@
 """Stage ``sim``: simulated Panda pick-and-place trials with the GQ-CNN before and after augmentation.
 
-Arms (:mod:`graspaug.experiments.sim`): ``before`` = the targeted network of base size
-``sim.base_size`` at ratio 0, ``after`` = the same base size at the ratio chosen on validation AP
-(``metrics/ap.json``), ``real`` = the ``real`` pool's network there (when trained), each once per
-training seed of ``gqcnn.seeds``, and ``antipodal`` = a random antipodal grasp without a network.
-Every object (the everyday objects of ``sim.objects``, ``sim.n_test_objects`` held-out test
-shapes and the meshes of ``sim.objects_path``), with mass and friction drawn per object, is
-dropped ``sim.attempts`` times from seeded poses, the same for every arm; the planner sees the
+Arms (:mod:`graspaug.experiments.sim`): ``before`` = the targeted network of base size ``sim.base_size`` at ratio 0,
+``after`` = the same base size at the ratio chosen on validation AP (``reports/gqcnn/ap.json``), ``real`` = the
+``real`` pool's network there (when trained), each once per training seed of ``gqcnn.seeds``, and ``antipodal`` =
+a random antipodal grasp without a network. Every object (the everyday objects of ``sim.objects``,
+``sim.n_test_objects`` held-out test shapes and the meshes of ``sim.objects_path``), with mass and friction drawn
+per object, is dropped ``sim.attempts`` times from seeded poses, the same for every arm; the planner sees the
 D435-like noisy depth image and the Panda tries to put the object in the bin.
 
-Writes ``metrics/sim.json`` (per-arm rates with 95 % Wilson intervals; ``contrasts``: paired differences with a
-bootstrap interval over objects; per training seed and per object; the calibration's Spearman correlation) and
-``reports/sim/`` (``report.md``, ``trials.csv`` one row per attempt, ``success.csv``/``success.png`` per object,
-``objects.csv``, ``calibration.csv``, ``timing.json``, ``trials/<arm>-<object>.png`` depth image with the grasp
-and pick frames).
+Writes ``metrics/sim/<contrast>.json`` (``mean``, ``lo``, ``hi``: the paired difference, bootstrap over objects) and
+``reports/sim/`` (``summary.json``: per-arm rates with 95 % Wilson intervals, the contrasts in full, per training
+seed and per object, the calibration; ``report.md``, ``trials.csv`` one row per attempt, ``success.{csv,png}``
+per object, ``objects.csv``, ``calibration.csv``, ``timing.json``, ``trials/<arm>-<object>.png``).
 """
 
 from __future__ import annotations
@@ -32,9 +30,16 @@ from graspaug.experiments.sim import (
     trials_table,
 )
 from graspaug.experiments.sim_outputs import write_trials_report
-from graspaug.experiments.sim_report import calibration, outcome_words, planning_timing, summarize, trial_setup
+from graspaug.experiments.sim_report import (
+    calibration,
+    outcome_words,
+    planning_timing,
+    sim_headline,
+    summarize,
+    trial_setup,
+)
 from graspaug.io.atomic import atomic_path
-from graspaug.io.tables import read_table, write_json
+from graspaug.io.tables import read_table, write_json, write_json_files
 from graspaug.params.base import params_model
 from graspaug.params.generate import GenerateParams
 from graspaug.params.gqcnn import GQCNNParams
@@ -42,7 +47,7 @@ from graspaug.params.grasps import GraspsParams
 from graspaug.params.ingest import IngestParams
 from graspaug.params.render import RenderParams
 from graspaug.params.sim import SimParams
-from graspaug.paths import AP_METRICS, SCORES, SHAPES_DIR, SHAPES_TABLE, SIM_METRICS, SIM_REPORT_DIR, gqcnn_seed_dir
+from graspaug.paths import AP_REPORT, SCORES, SHAPES_DIR, SHAPES_TABLE, SIM_METRICS, SIM_REPORT_DIR, gqcnn_seed_dir
 from graspaug.stages import StageError
 
 log = logging.getLogger(__name__)
@@ -62,11 +67,11 @@ Params = params_model(
 def run(params: Params) -> None:
     start = time.perf_counter()
     cfg, model_seeds = params.sim, list(params.gqcnn.seeds)
-    if not AP_METRICS.exists():
-        raise StageError(f"{AP_METRICS} is missing: run `dvc repro report` first")
-    best, from_report = after_ratio(json.loads(AP_METRICS.read_text()), cfg.base_size, params.generate.ratios)
+    if not AP_REPORT.exists():
+        raise StageError(f"{AP_REPORT} is missing: run `dvc repro report` first")
+    best, from_report = after_ratio(json.loads(AP_REPORT.read_text()), cfg.base_size, params.generate.ratios)
     if not from_report:
-        log.warning(NO_AP, AP_METRICS, cfg.base_size, best)
+        log.warning(NO_AP, AP_REPORT, cfg.base_size, best)
     seed_dirs = {seed: gqcnn_seed_dir(seed) for seed in model_seeds}
     chosen = arms(best, cfg.base_size, seed_dirs)
     # an empty or unreadable sim.objects_path: a DataError, which the CLI prints in one line
@@ -90,5 +95,6 @@ def run(params: Params) -> None:
         )
         timing["stage_seconds"] = round(time.perf_counter() - start, 1)
         write_json(timing, out / "timing.json")
-    write_json(metrics, SIM_METRICS)
+        write_json(metrics, out / "summary.json")
+    write_json_files(sim_headline(metrics), SIM_METRICS)
     log.info("sim: %s; %.0f s", outcome_words(metrics, timing), time.perf_counter() - start)

@@ -2,7 +2,8 @@
 the AE-Critic and its control (λ = 0: the same epochs, learning rate and batches, no critic).
 
 Outputs: ``models/ae.pt``, ``models/ae_extra.pt`` (control), ``models/ae_critic.pt``, DVCLive
-logs in ``metrics/train_ae/{ae,ae_extra,ae_critic}/``, summary ``metrics/train_ae.json``.
+logs in ``metrics/train_ae/{ae,ae_extra,ae_critic}/``, the headline ``metrics/train_ae.json`` (test IoU per arm, the
+critic's AUC), every figure in ``reports/train_ae/summary.json``.
 """
 
 from __future__ import annotations
@@ -27,12 +28,13 @@ from graspaug.paths import (
     AE_MODEL,
     SHAPES_TABLE,
     TRAIN_AE_LIVE,
+    TRAIN_AE_REPORT,
     TRAIN_AE_SUMMARY,
     VOXELS,
     timing_file,
 )
 from graspaug.stages import StageError
-from graspaug.training.ae_arms import ArmTrainer, rounded_summary
+from graspaug.training.ae_arms import ArmTrainer, rounded_summary, summary_headline
 from graspaug.training.autoencoder import critic_separation, grids_by_split, train_ae_critic, train_autoencoder
 
 log = logging.getLogger(__name__)
@@ -78,7 +80,8 @@ def run(params: Params) -> None:
     summary["critic_auc"] = critic_separation(ae, critic, test, device)["auc"]
 
     timing["train_s"] = time.perf_counter() - start
-    write_json(rounded_summary(summary), TRAIN_AE_SUMMARY)
+    write_json(rounded_summary(summary), TRAIN_AE_REPORT)
+    write_json(summary_headline(rounded_summary(summary)), TRAIN_AE_SUMMARY)
     write_json({k: round(v, 2) for k, v in timing.items()}, timing_file("train_ae"))
     log.info(
         "train_ae: test IoU AE %.3f, control %.3f, AE-Critic %.3f; critic AUC %.3f; %.0f s",

@@ -1,17 +1,13 @@
 """Stage ``train_gqcnn``: every GQ-CNN of one training seed, as a paired set.
 
-Networks (``graspaug.experiments.variants.seed_variants``): targeted at every base size ×
-ratio of ``generate``; random and real at every nonzero ratio of ``gqcnn.augment_base_sizes``;
-the ceiling. All start from the seed's initial weights and noise stream and are validated on
-the same ``gqcnn.val_shapes`` train shapes (``graspaug.training.gqcnn_data``); each keeps the
-weights of its best validation AP. With ``gqcnn.members`` > 1 each network is an ensemble of
-that many members, member m starting from the same weights in every variant. Networks train one
-after another with every thread. Test set: every test-split datapoint of ``data/gqcnn/original``.
+Networks (``experiments.variants.seed_variants``): targeted at every base size × ratio of ``generate``; random and
+real at every nonzero ratio of ``gqcnn.augment_base_sizes``; the ceiling. All start from the seed's initial weights
+and noise stream, are validated on the same ``gqcnn.val_shapes`` train shapes and keep the weights of their best
+validation AP (``gqcnn.members`` > 1: ensembles); tested on every test datapoint of ``data/gqcnn/original``.
 
-Outputs: ``models/gqcnn/s<seed>/`` (one folder per network, ``test_rows.npy``,
-``val_rows.npy``, ``split.json``), ``metrics/gqcnn/s<seed>.json`` (validation and test AP per
-network), ``reports/gqcnn/validation/s<seed>.{png,csv}`` (validation AP vs step of every
-network) and ``reports/timing/train_gqcnn/s<seed>.json``.
+Outputs: ``models/gqcnn/s<seed>/`` (one folder per network, ``test_rows.npy``, ``val_rows.npy``, ``split.json``),
+``metrics/gqcnn/s<seed>.json`` (test and validation AP, means over the networks), ``reports/gqcnn/networks/
+s<seed>.json`` (AP per network), ``reports/gqcnn/validation/s<seed>.{png,csv}`` (validation AP vs step).
 """
 
 from __future__ import annotations
@@ -27,6 +23,7 @@ from graspaug.experiments.networks import (
     result_lines,
     save_seed_split,
     seed_card,
+    seed_headline,
     seed_members,
     seed_plan,
     seed_table,
@@ -41,7 +38,16 @@ from graspaug.params.generate import GenerateParams
 from graspaug.params.gqcnn import GQCNNParams
 from graspaug.params.grasps import GraspsParams
 from graspaug.params.render import RenderParams
-from graspaug.paths import SHAPES_TABLE, gqcnn_dir, gqcnn_seed_dir, gqcnn_seed_metrics, gqcnn_val_curves, timing_file
+from graspaug.paths import (
+    SHAPES_TABLE,
+    gqcnn_dir,
+    gqcnn_seed_dir,
+    gqcnn_seed_metrics,
+    gqcnn_seed_networks,
+    gqcnn_val_curves,
+    timing_file,
+)
+from graspaug.plots import validation_curves
 from graspaug.stages import StageError
 from graspaug.training.gqcnn_data import Corpora, load_split, shapes_datapoints, test_set
 
@@ -57,8 +63,6 @@ Params = params_model(
 
 
 def run(params: Params, seed: int) -> None:
-    from graspaug.plots import validation_curves
-
     cfg, gen = params.gqcnn, params.generate
     if seed not in cfg.seeds:
         raise StageError(f"seed {seed} is not in gqcnn.seeds {list(cfg.seeds)}")
@@ -75,8 +79,7 @@ def run(params: Params, seed: int) -> None:
     log.info("train_gqcnn seed %d: %s", seed, plan)
     if (warning := precision_warning(cfg.train.precision, device)) is not None:
         log.warning("%s", warning)
-    # one network at a time with every thread: two 1-thread workers were slower on 2 cores
-    # (docs/results.md#benchmarks)
+    # one network at a time with every thread: two 1-thread workers were slower on 2 cores (docs/results.md#benchmarks)
     with atomic_path(gqcnn_seed_dir(seed), directory=True) as folder:
         card = seed_card(params.render, params.grasps, params.seed)
         jobs = [
@@ -87,10 +90,10 @@ def run(params: Params, seed: int) -> None:
         save_seed_split(folder, split, test_rows, val_rows)
         history = read_history(folder, variants)
     write_csv(history, gqcnn_val_curves(seed).with_suffix(".csv"))
-    validation_curves(
-        history, gqcnn_val_curves(seed), f"Validation AP of every network of seed {seed} (dots: the kept weights)"
-    )
-    write_json({"seed": seed, "networks": seed_table(results)}, gqcnn_seed_metrics(seed))
+    title = f"Validation AP of every network of seed {seed} (dots: the kept weights)"
+    validation_curves(history, gqcnn_val_curves(seed), title)
+    write_json({"seed": seed, "networks": seed_table(results)}, gqcnn_seed_networks(seed))
+    write_json(seed_headline(seed_table(results)), gqcnn_seed_metrics(seed))
     write_json(seed_timing(results, time.perf_counter() - start), timing_file("train_gqcnn", f"s{seed}"))
     for line in result_lines(results):
         log.info("train_gqcnn seed %d %s", seed, line)

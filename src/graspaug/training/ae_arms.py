@@ -88,3 +88,10 @@ class ArmTrainer:
 def rounded_summary(summary: dict[str, float]) -> dict[str, float | None]:
     """``summary`` rounded to 5 decimals as floats, NaN (e.g. the IoU of an empty test split; not JSON) as None."""
     return {k: round(float(v), 5) if math.isfinite(v) else None for k, v in summary.items()}
+
+
+def summary_headline(summary: dict[str, float | None]) -> dict[str, float | None]:
+    """The stage's metrics from its :func:`rounded_summary`: the test IoU of each arm (``iou_ae``,
+    ``iou_extra``: the λ = 0 control, ``iou_critic``) and the critic's held-out ROC AUC (``auc``)."""
+    arms = {"iou_ae": "ae", "iou_extra": "ae_extra", "iou_critic": "ae_critic"}
+    return {**{key: summary.get(f"{arm}_iou_test") for key, arm in arms.items()}, "auc": summary.get("critic_auc")}

@@ -9,7 +9,6 @@ with the best validation AP kept: every variant is trained to about the same con
 
 from __future__ import annotations
 
-import copy
 import math
 import time
 from collections.abc import Callable
@@ -22,7 +21,7 @@ from sklearn.metrics import accuracy_score, average_precision_score, roc_auc_sco
 from torch.optim.swa_utils import AveragedModel, get_ema_multi_avg_fn
 from tqdm import tqdm
 
-from graspaug.nets.gqcnn import GQCNN
+from graspaug.nets.gqcnn import GQCNN, GQCNNStack
 from graspaug.training.settings import NoiseSettings, TrainSettings
 
 
@@ -39,6 +38,7 @@ class GraspArrays:
 
 
 LogCallback = Callable[[int, dict[str, float]], None]
+MemberLogCallback = Callable[[int, int, dict[str, float]], None]
 
 
 def normalization(net: GQCNN, train: GraspArrays) -> tuple[float, float, float, float]:
@@ -75,19 +75,32 @@ def augment(
     return images, z
 
 
+def _batches(data: GraspArrays, device: torch.device, batch: int):
+    """``data`` in batches of ``batch``: crops (B, 1, S, S) channels-last and gripper depths (B,) on ``device``."""
+    for start in range(0, len(data), batch):
+        images = torch.from_numpy(np.ascontiguousarray(data.images[start : start + batch])).unsqueeze(1)
+        z = torch.from_numpy(np.ascontiguousarray(data.z[start : start + batch], dtype=np.float32))
+        yield start, images.to(device, memory_format=torch.channels_last), z.to(device)
+
+
 def predict(net: GQCNN, data: GraspArrays, device: torch.device, batch: int = 128) -> np.ndarray:
     """P(success) (N,) float32 for every datapoint."""
     net.eval()
     out = np.empty(len(data), dtype=np.float32)
     with torch.inference_mode():
-        for start in range(0, len(data), batch):
-            images = (
-                torch.from_numpy(np.ascontiguousarray(data.images[start : start + batch]))
-                .unsqueeze(1)
-                .to(device, memory_format=torch.channels_last)
-            )
-            z = torch.from_numpy(np.ascontiguousarray(data.z[start : start + batch], dtype=np.float32)).to(device)
+        for start, images, z in _batches(data, device, batch):
             out[start : start + batch] = net.success_probability(images, z).cpu().numpy()
+    return out
+
+
+def predict_members(stack: GQCNNStack, data: GraspArrays, device: torch.device, batch: int = 128) -> np.ndarray:
+    """P(success) (K, N) float32 of every member of ``stack`` for every datapoint, in one pass."""
+    stack.eval()
+    out = np.empty((stack.k, len(data)), dtype=np.float32)
+    with torch.inference_mode():
+        for start, images, z in _batches(data, device, batch):
+            logits = stack(images.expand(stack.k, *images.shape), z.expand(stack.k, *z.shape))
+            out[:, start : start + batch] = torch.softmax(logits, dim=-1)[..., 1].cpu().numpy()
     return out
 
 
@@ -120,91 +133,126 @@ def train_gqcnn(
     on_log: LogCallback | None = None,
     progress: bool = True,
 ) -> dict:
-    """Train ``net`` for ``settings.steps_for(len(train))`` SGD steps on batches drawn epoch by
-    epoch from ``train`` (softmax cross-entropy), evaluating validation AP ``settings.evals``
-    times; ``net`` ends with the weights of the best evaluation (the last ones without ``val``).
+    """Train one network: :func:`train_members` with one member."""
+    log = None if on_log is None else lambda member, step, metrics: on_log(step, metrics)
+    return train_members([net], train, val, settings, device, [gen], log, progress)[0]
+
+
+def train_members(
+    nets: list[GQCNN],
+    train: GraspArrays,
+    val: GraspArrays | None,
+    settings: TrainSettings,
+    device: torch.device,
+    gens: list[torch.Generator],
+    on_log: MemberLogCallback | None = None,
+    progress: bool = True,
+) -> list[dict]:
+    """Train the K networks ``nets`` (one config) at once, as one :class:`GQCNNStack`, for
+    ``settings.steps_for(len(train))`` SGD steps each, on batches drawn epoch by epoch from
+    ``train`` (softmax cross-entropy), evaluating validation AP ``settings.evals`` times. Member
+    k draws its batch order and noise from ``gens[k]`` alone and its gradient is that of its own
+    loss, so it is trained as it would be alone (up to float rounding; a test checks it). Each
+    net ends with the weights of its best evaluation (the last ones without ``val``).
     With ``settings.precision = "bfloat16"`` the training steps' forward and backward run in
     bfloat16 mixed precision (``torch.autocast``); the weights, the optimizer, the loss and every
     evaluation stay float32. With ``settings.ema_decay > 0`` the evaluated and kept weights are
     an exponential moving average of the trained ones (``torch.optim.swa_utils.AveragedModel``),
     updated every step.
-    ``on_log(step, metrics)`` gets the mean loss and train accuracy since the last evaluation,
-    the learning rate and the validation AP / accuracy. Returns the steps, the best step, its
-    validation AP and predictions (N_val,) (None without ``val``), and throughput."""
+    ``on_log(member, step, metrics)`` gets each member's mean loss and train accuracy since the
+    last evaluation, the learning rate and the validation AP / accuracy. Returns per member the
+    steps, the best step, its validation AP and predictions (N_val,) (None without ``val``), and
+    throughput (the samples of every member)."""
     if len(train) < 2:
         raise ValueError(f"need at least 2 training datapoints, got {len(train)}")
-    net.set_normalization(*normalization(net, train))
-    net.to(device, memory_format=torch.channels_last)  # measured ~1.3× faster on the CPU at these widths
+    if len(gens) != len(nets):
+        raise ValueError(f"one generator per member: {len(nets)} members, {len(gens)} generators")
+    stats = normalization(nets[0], train)
+    for net in nets:
+        net.set_normalization(*stats)
+    stack = GQCNNStack(nets).to(device, memory_format=torch.channels_last)  # ~1.3× faster on the CPU at these widths
     # the weights that are evaluated and kept: an exponential moving average of the trained ones, or those themselves
     averaged = (
-        AveragedModel(net, multi_avg_fn=get_ema_multi_avg_fn(settings.ema_decay), use_buffers=True)
+        AveragedModel(stack, multi_avg_fn=get_ema_multi_avg_fn(settings.ema_decay), use_buffers=True)
         if settings.ema_decay > 0
         else None
     )
-    evaluated = averaged.module if averaged is not None else net
-    steps = settings.steps_for(len(train))
+    evaluated = averaged.module if averaged is not None else stack
+    steps, k = settings.steps_for(len(train)), len(nets)
     opt = torch.optim.SGD(
-        net.parameters(), lr=settings.lr, momentum=settings.momentum, weight_decay=settings.weight_decay
+        stack.parameters(), lr=settings.lr, momentum=settings.momentum, weight_decay=settings.weight_decay
     )
     schedule = torch.optim.lr_scheduler.LambdaLR(opt, lambda step: cosine_lr(step, steps, settings.final_lr))
     eval_at = {int(round(steps * (i + 1) / settings.evals)) for i in range(settings.evals)}
     images = torch.from_numpy(np.ascontiguousarray(train.images)).unsqueeze(1)
     z = torch.from_numpy(np.ascontiguousarray(train.z, dtype=np.float32))
     labels = torch.from_numpy(np.asarray(train.labels, dtype=np.int64))
-    order, cursor = torch.randperm(len(train), generator=gen), 0
+    orders, cursors = [torch.randperm(len(train), generator=gen) for gen in gens], [0] * k
     batch_size = min(settings.batch_size, len(train))
-    best = {"step": steps, "val_ap": float("nan"), "state": None}
-    loss_sum, correct, seen, start = 0.0, 0, 0, time.perf_counter()
+    best = [{"step": steps, "val_ap": float("nan"), "state": None} for _ in nets]
+    loss_sum, correct, seen, start = torch.zeros(k), torch.zeros(k), 0, time.perf_counter()
     for step in tqdm(range(1, steps + 1), desc="train GQ-CNN", unit="step", disable=not progress):
-        if cursor + batch_size > len(order):
-            order, cursor = torch.randperm(len(train), generator=gen), 0
-        idx = order[cursor : cursor + batch_size]
-        cursor += batch_size
-        net.train()
-        batch, depth = augment(images[idx], z[idx], settings.noise, gen)
+        crops, depths, targets = [], [], []
+        for m, gen in enumerate(gens):  # each member's batch and noise from its own generator
+            if cursors[m] + batch_size > len(orders[m]):
+                orders[m], cursors[m] = torch.randperm(len(train), generator=gen), 0
+            idx = orders[m][cursors[m] : cursors[m] + batch_size]
+            cursors[m] += batch_size
+            batch, depth = augment(images[idx], z[idx], settings.noise, gen)
+            crops.append(batch)
+            depths.append(depth)
+            targets.append(labels[idx])
+        stack.train()
         with torch.autocast(device.type, dtype=torch.bfloat16, enabled=settings.precision == "bfloat16"):
-            logits = net(batch.to(device, memory_format=torch.channels_last), depth.to(device)).float()
-        target = labels[idx].to(device)
-        loss = F.cross_entropy(logits, target)
+            logits = stack(torch.stack(crops).to(device), torch.stack(depths).to(device)).float()  # (K, B, 2)
+        target = torch.stack(targets).to(device)
+        losses = torch.stack([F.cross_entropy(logits[m], target[m]) for m in range(k)])
         opt.zero_grad(set_to_none=True)
-        loss.backward()
+        losses.sum().backward()  # member m's gradient is that of its own loss
         opt.step()
         if averaged is not None:
-            averaged.update_parameters(net)
+            averaged.update_parameters(stack)
         lr_used = schedule.get_last_lr()[0]
         schedule.step()
-        loss_sum += loss.item() * len(idx)
-        correct += int((logits.argmax(1) == target).sum())
-        seen += len(idx)
+        loss_sum += losses.detach().cpu() * batch_size
+        correct += (logits.argmax(2) == target).sum(1).cpu()
+        seen += batch_size
         if step in eval_at:
-            metrics = {"loss": loss_sum / seen, "train_accuracy": correct / seen, "lr": lr_used}
-            if val is not None and len(val):
-                probability = predict(evaluated, val, device, settings.eval_batch)
-                scores = classification_metrics(val.labels, probability)
-                ap = scores["ap"] if scores["ap"] is not None else float("nan")
-                metrics.update(val_accuracy=scores["accuracy"], val_ap=ap)
-                if best["state"] is None or (
-                    math.isfinite(ap) and not ap <= best["val_ap"]
-                ):  # ties keep the earlier; a NaN is replaced
-                    best = {
-                        "step": step,
-                        "val_ap": ap,
-                        "state": copy.deepcopy(evaluated.state_dict()),
-                        "val_predictions": probability,
-                    }
-            if on_log is not None:
-                on_log(step, metrics)
-            loss_sum, correct, seen = 0.0, 0, 0
+            probabilities = (
+                predict_members(evaluated, val, device, settings.eval_batch) if val is not None and len(val) else None
+            )
+            for m in range(k):
+                metrics = {"loss": float(loss_sum[m]) / seen, "train_accuracy": float(correct[m]) / seen, "lr": lr_used}
+                if probabilities is not None:
+                    scores = classification_metrics(val.labels, probabilities[m])
+                    ap = scores["ap"] if scores["ap"] is not None else float("nan")
+                    metrics.update(val_accuracy=scores["accuracy"], val_ap=ap)
+                    if best[m]["state"] is None or (
+                        math.isfinite(ap) and not ap <= best[m]["val_ap"]
+                    ):  # ties keep the earlier; a NaN is replaced
+                        best[m] = {
+                            "step": step,
+                            "val_ap": ap,
+                            "state": evaluated.member_state(m),
+                            "val_predictions": probabilities[m],
+                        }
+                if on_log is not None:
+                    on_log(m, step, metrics)
+            loss_sum, correct, seen = torch.zeros(k), torch.zeros(k), 0
     seconds = time.perf_counter() - start
-    if best["state"] is not None:
-        net.load_state_dict(best["state"])
-    elif averaged is not None:
-        net.load_state_dict(evaluated.state_dict())
-    return {
-        "steps": steps,
-        "best_step": best["step"],
-        "best_val_ap": best["val_ap"],
-        "val_predictions": best.get("val_predictions"),
-        "train_seconds": seconds,
-        "samples_per_second": steps * batch_size / seconds,
-    }
+    for m, net in enumerate(nets):
+        if best[m]["state"] is not None:
+            net.load_state_dict(best[m]["state"])
+        else:
+            net.load_state_dict(evaluated.member_state(m))
+    return [
+        {
+            "steps": steps,
+            "best_step": b["step"],
+            "best_val_ap": b["val_ap"],
+            "val_predictions": b.get("val_predictions"),
+            "train_seconds": seconds,
+            "samples_per_second": k * steps * batch_size / seconds,
+        }
+        for b in best
+    ]
