@@ -177,6 +177,9 @@ def operating_point(labels: np.ndarray, probability: np.ndarray) -> dict[str, An
     }
 
 
+RANGE_SHARE = 0.95  # the share of a network's training datapoints its card's ranges cover (the central part)
+
+
 def training_range(images: np.ndarray, z: np.ndarray) -> dict[str, Any]:
     """The range of what a network was trained on, from its training datapoints.
 
@@ -187,12 +190,13 @@ def training_range(images: np.ndarray, z: np.ndarray) -> dict[str, Any]:
 
     Returns
     -------
-    ``{"gripper_depth": [min, max], "object_height": [min, max], "datapoints": N}`` in m. A crop's object
-    height is its depth relief, the deepest pixel (the table) minus the nearest (the object's top): the
-    height above the table of what the network saw beside the grasp. It is a lower bound where a crop
-    shows no table, so the largest over the training set is a lower bound of the tallest training object
-    (the corpus objects, scaled for the gripper, fit the 96 px crop; its table pixels are at most a
-    centimetre deeper at a 5° tilt). Empty data gives None ranges.
+    ``{"gripper_depth": [low, high], "object_height": [low, high], "share": 0.95, "datapoints": N}`` in m:
+    the central ``share`` of the training datapoints (2.5th to 97.5th percentile), not the extremes, which
+    a few tall stable poses decide (the default corpus's train crops: relief 2.1 cm at the 2.5th
+    percentile, 6.0 cm median, 8.5 cm at the 97.5th, 34 cm largest). A crop's object height is its
+    depth relief, the deepest pixel (the table) minus the nearest (the object's top): the height above
+    the table of what the network saw beside the grasp; a lower bound where a crop shows no table (its
+    table pixels are at most a centimetre deeper at a 5° tilt). Empty data gives None ranges.
     """
     images = np.asarray(images)
     z = np.asarray(z, dtype=np.float64).ravel()
@@ -202,9 +206,15 @@ def training_range(images: np.ndarray, z: np.ndarray) -> dict[str, Any]:
         return {"gripper_depth": None, "object_height": None, "datapoints": 0}
     flat = images.reshape(len(images), -1)
     relief = flat.max(axis=1).astype(np.float64) - flat.min(axis=1)
+    tail = 50 * (1 - RANGE_SHARE)  # percent below and above the range
+
+    def central(values: np.ndarray) -> list[float]:
+        return [round(float(v), 5) for v in np.percentile(values, [tail, 100 - tail])]
+
     return {
-        "gripper_depth": [round(float(z.min()), 5), round(float(z.max()), 5)],
-        "object_height": [round(float(relief.min()), 5), round(float(relief.max()), 5)],
+        "gripper_depth": central(z),
+        "object_height": central(relief),
+        "share": RANGE_SHARE,
         "datapoints": int(len(z)),
     }
 

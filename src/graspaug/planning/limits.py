@@ -130,10 +130,10 @@ def range_warnings(
     - the camera distance (m; ``camera_distance``, default the image's median depth, as the planner
       takes it) outside the card's ``camera_distance`` (the rendered viewpoints, ± :data:`DISTANCE_TOLERANCE`);
     - the object under the best grasp (the first of ``grasps``; without one, the highest point)
-      taller above the table (:func:`object_height`) than the tallest object of the training crops
-      (``training_range.object_height``, + :data:`HEIGHT_TOLERANCE`);
+      taller above the table (:func:`object_height`) than the central share (95%) of the training crops
+      show (``training_range.object_height``, + :data:`HEIGHT_TOLERANCE`);
     - the best grasp's gripper depth, on the training camera the planner resamples to, outside the
-      training gripper depths (``training_range.gripper_depth``).
+      central share of the training gripper depths (``training_range.gripper_depth``).
     """
     intrinsics = intrinsics_for(np.shape(depth), intrinsics)
     warnings = []
@@ -147,6 +147,7 @@ def range_warnings(
             f"{low:g}-{high:g} m; the image is resampled to {target:g} m"
         )
     trained = card.training_range or {}
+    share = f"{trained['share']:.0%} of " if trained.get("share") else ""  # cards before the share: the extremes
     heights = trained.get("object_height")
     if heights:
         best = grasps[0].jaw_pixels if grasps else None
@@ -154,17 +155,17 @@ def range_warnings(
         if height > heights[1] + HEIGHT_TOLERANCE:
             where = "the object under the best grasp" if grasps else "the highest object"
             warnings.append(
-                f"{where} stands {100 * height:.1f} cm above the table, taller than any training object "
-                f"(training crops: {100 * heights[0]:.1f}-{100 * heights[1]:.1f} cm above the table): "
-                "the network has not seen such a scene"
+                f"{where} stands {100 * height:.1f} cm above the table, taller than the objects of {share}the "
+                f"training crops ({100 * heights[0]:.1f}-{100 * heights[1]:.1f} cm above the table): "
+                "the network has seen few such scenes or none"
             )
     depths = trained.get("gripper_depth")
     if depths and grasps:
         virtual = grasps[0].depth + camera_adapter(card, intrinsics, distance).shift
         if not (depths[0] <= virtual <= depths[1]):
             warnings.append(
-                f"the best grasp's gripper depth is {virtual:.3f} m on the training camera, outside the training "
-                f"gripper depths {depths[0]:.3f}-{depths[1]:.3f} m"
+                f"the best grasp's gripper depth is {virtual:.3f} m on the training camera, outside {share}the "
+                f"training gripper depths ({depths[0]:.3f}-{depths[1]:.3f} m)"
             )
     return warnings
 
