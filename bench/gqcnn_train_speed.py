@@ -1,15 +1,15 @@
 """GQ-CNN training throughput on the CPU: the loop as it was when the speed work began
 (``_gqcnn_reference.py``: batch 64, contiguous layout, the LRN power as ``pow``, glibc's default
-allocator settings) against the current one (``graspaug.training.gqcnn.train_gqcnn`` as the
-``train_gqcnn`` stage runs it: batch 128, channels-last, ``graspaug.device.keep_freed_memory``)
-in each of its two precisions (``gqcnn.train.precision``: float32, and bfloat16 mixed
-precision), on the same rendered datapoints, the same network (default ``gqcnn.net``), the same
-number of SGD steps and torch's default threads.
+allocator settings) against the current one-network loop (``graspaug.training.gqcnn.train_gqcnn``:
+batch 128, channels-last, ``graspaug.device.keep_freed_memory``) in each of its two precisions
+(``gqcnn.train.precision``: float32, and bfloat16 mixed precision), on the same rendered
+datapoints, the same network (default ``gqcnn.net``), the same number of SGD steps and torch's
+default threads.
 
-Each measurement runs in a fresh process (the allocator setting is process-wide), and the three
-loops take turns over ``--rounds`` rounds (each round starts with another), so a machine that
-speeds up or slows down during the run shifts all; the ratios printed are the medians of the
-rounds' ratios. Needs ``data/gqcnn/original`` (``dvc repro render@original`` with the default
+Each measurement runs in a fresh process (the allocator setting is process-wide), and the four
+loops and the peak measurement take turns over ``--rounds`` rounds (each round starts with
+another), so a machine that speeds up or slows down during the run shifts all; the ratios printed
+are the medians of the rounds' ratios. Needs ``data/gqcnn/original`` (``dvc repro render@original`` with the default
 params).
 
 The limit: the network's arithmetic per training sample (forward and backward, counted from the
@@ -88,7 +88,8 @@ def measure_peak(n: int = 2048, reps: int = 10) -> dict:
 
 
 def measure(which: str, steps: int, datapoints: int, members: int) -> dict:
-    """Train one network for ``steps`` steps in this process; samples/s and page faults per step."""
+    """Train one network (``members`` at once for the ``members`` loop) for ``steps`` steps in this process;
+    samples/s and page faults per step."""
     import resource
     from types import SimpleNamespace
 
@@ -226,11 +227,12 @@ def main() -> None:
         ref = got["reference"]
         line = (
             f"round {r + 1}: peak {peaks[-1] / 1e9:.0f} GFLOP/s; reference (batch 64, {ref['threads']} threads) "
-            f"{ref['samples_per_second']:6.0f} samples/s"
+            f"{ref['samples_per_second']:6.0f} samples/s ({ref['faults_per_step']:.0f} page faults/step)"
         )
         for which in loops:
             speed = got[which]["samples_per_second"]
-            line += f"; {which} {speed:6.0f} ({speed / ref['samples_per_second']:.2f}x)"
+            faults = got[which]["faults_per_step"]
+            line += f"; {which} {speed:6.0f} ({speed / ref['samples_per_second']:.2f}x, {faults:.0f} faults/step)"
         print(line, flush=True)
     peak = float(np.median(peaks))
     print(f"peak float32: median {peak / 1e9:.0f} GFLOP/s over {args.rounds} rounds")

@@ -13,7 +13,8 @@ against its members' mean. Run where ``dvc repro train_gqcnn`` has run with thes
 
     python studies/gqcnn_members.py [--members 4] [--out studies/out/members]
 
-Members M … K−1 cost (K−M) / M times ``train_gqcnn``'s time (one network at a time, every thread).
+Members M … K−1 cost about (K−M) / M times ``train_gqcnn``'s time (the stage trains a network's
+members at once, this study its extra members at once, one network at a time, every thread).
 """
 
 from __future__ import annotations
@@ -44,7 +45,7 @@ from graspaug.paths import SHAPES_TABLE, gqcnn_dir, gqcnn_seed_dir
 from graspaug.training.gqcnn_data import Corpora, load_split, shapes_datapoints, test_set
 
 
-def train_members(params, split, variants, val, test, members: int, out: Path, corpora: Corpora) -> None:
+def train_extra_members(params, split, variants, val, test, members: int, out: Path, corpora: Corpora) -> None:
     """Members ``gqcnn.members`` … ``members``−1 of every network (``variants``) of every seed, one
     at a time (skipping those on disk); ``val`` / ``test``: the experiment's datapoints, read from ``corpora``."""
     cfg = params.gqcnn
@@ -98,7 +99,7 @@ def main() -> None:
     split = load_split(corpora.original, read_table(SHAPES_TABLE), list(gen.base_sizes), cfg.val_shapes, params.seed)
     variants = seed_variants(gen.base_sizes, gen.ratios, cfg.augment_base_sizes, cfg.ceiling)
     val, test = shapes_datapoints(corpora.original, split.validation)[0], test_set(corpora.original)[0]  # read once
-    train_members(params, split, variants, val, test, args.members, args.out, corpora)
+    train_extra_members(params, split, variants, val, test, args.members, args.out, corpora)
     val_labels, test_labels = val.labels, test.labels
     rows = []
     for seed in cfg.seeds:

@@ -1,12 +1,20 @@
-"""The torch device the ``device`` param names."""
+"""The torch device the ``device`` param names, and the process's memory allocator (glibc).
+
+torch is imported inside the functions that need it: per-shape worker processes import this module
+for :func:`release_freed_memory` alone."""
 
 from __future__ import annotations
 
-import torch
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    import torch
 
 
 def resolve_device(device: str) -> torch.device:
     """``auto`` → CUDA when present, else CPU; ``cuda`` without a CUDA device is an error."""
+    import torch
+
     if device == "auto":
         return torch.device("cuda" if torch.cuda.is_available() else "cpu")
     if device == "cuda" and not torch.cuda.is_available():
@@ -15,6 +23,20 @@ def resolve_device(device: str) -> torch.device:
 
 
 _HEAP_KEPT = 1 << 30  # bytes
+
+
+def _glibc(name: str):
+    """The glibc function ``name`` (ctypes), or None where there is none (macOS, musl)."""
+    import ctypes
+    import ctypes.util
+    import sys
+
+    if not sys.platform.startswith("linux"):
+        return None
+    try:
+        return getattr(ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6"), name)
+    except (OSError, AttributeError):
+        return None
 
 
 def keep_freed_memory() -> bool:
@@ -26,16 +48,8 @@ def keep_freed_memory() -> bool:
     Raising the mmap and trim thresholds to 1 GiB (``mallopt``) keeps those pages, as jemalloc
     or tcmalloc would. Process-wide and idempotent; returns False where there is no glibc
     (macOS, musl), which changes nothing there."""
-    import ctypes
-    import ctypes.util
-    import sys
-
-    if not sys.platform.startswith("linux"):
-        return False
-    try:
-        libc = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6")
-        mallopt = libc.mallopt
-    except (OSError, AttributeError):
+    mallopt = _glibc("mallopt")
+    if mallopt is None:
         return False
     m_trim_threshold, m_mmap_threshold = -1, -3  # glibc's malloc.h
     mmap_set = mallopt(m_mmap_threshold, _HEAP_KEPT) or mallopt(
@@ -44,10 +58,24 @@ def keep_freed_memory() -> bool:
     return bool(mmap_set) and bool(mallopt(m_trim_threshold, _HEAP_KEPT))
 
 
+def release_freed_memory() -> bool:
+    """Hand the memory this process has freed back to the operating system (glibc's ``malloc_trim``);
+    False where there is no glibc. A per-shape worker process calls it after each shape
+    (:mod:`graspaug.parallel`): glibc keeps what a large mesh or scene freed, so a worker's resident
+    size would grow from shape to shape."""
+    malloc_trim = _glibc("malloc_trim")
+    if malloc_trim is None:
+        return False
+    malloc_trim(0)
+    return True
+
+
 def has_native_bfloat16(device: torch.device) -> bool:
     """Whether ``device`` computes bfloat16 convolutions and matrix products in hardware (a
     CUDA GPU that supports it; a CPU with AVX512-BF16 or AMX, as oneDNN reports); elsewhere
     ``torch.autocast`` emulates bfloat16, slower than float32."""
+    import torch
+
     if device.type == "cuda":
         return torch.cuda.is_bf16_supported()
     return (

@@ -19,6 +19,8 @@ from typing import Any, TypeVar
 from joblib import Parallel, delayed, parallel_config
 from tqdm import tqdm
 
+from graspaug.device import release_freed_memory
+
 T = TypeVar("T")
 
 
@@ -55,25 +57,6 @@ def _in_folder(folder: str, fn: Callable[..., T], item: Any) -> T:
     return fn(item)
 
 
-def release_freed_memory() -> bool:
-    """Hand the memory this process has freed back to the operating system (glibc's
-    ``malloc_trim``); False where there is no glibc. A worker process calls it after each shape:
-    glibc keeps what a large mesh or scene freed, the worker's resident size then grows from shape
-    to shape, and joblib's loky executor, which restarts a worker grown 300 MB past its size after
-    its first task (its guard against memory leaks), would restart healthy workers with a warning."""
-    import ctypes
-    import ctypes.util
-    import sys
-
-    if not sys.platform.startswith("linux"):
-        return False
-    try:
-        ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6").malloc_trim(0)
-    except (OSError, AttributeError):
-        return False
-    return True
-
-
 _LEAK_GUARD = 2 << 30  # bytes
 
 
@@ -90,8 +73,9 @@ def _relax_leak_guard() -> None:
 
 
 def _trimmed(fn: Callable[..., T], item: Any) -> T:
-    """``fn(item)`` in a worker process, then :func:`release_freed_memory`; the worker's leak guard
-    relaxed (:func:`_relax_leak_guard`)."""
+    """``fn(item)`` in a worker process, then :func:`graspaug.device.release_freed_memory` (glibc keeps what a
+    large mesh or scene freed; joblib's loky executor restarts a worker grown 300 MB past its size after its
+    first task, with a warning); the worker's leak guard relaxed (:func:`_relax_leak_guard`)."""
     _relax_leak_guard()
     try:
         return fn(item)

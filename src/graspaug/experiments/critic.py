@@ -74,10 +74,10 @@ def outlier_contrast(
 def interpolant_contrast(
     pct_a: np.ndarray, pct_b: np.ndarray, keys: list[str], boot: PairBootstrap, level: float = 0.95
 ) -> dict[str, float | None]:
-    """The study's headline: per pair, the mean over the interpolants (α > 0 of ``keys``; every α if
-    none) of ``pct_a − pct_b`` (both (P, A) outlier %, the same pairs; an empty grid left out), then
+    """The study's headline: per pair, the mean over the interpolants (0 < α < 1 of ``keys``; every α
+    if none) of ``pct_a − pct_b`` (both (P, A) outlier %, the same pairs; an empty grid left out), then
     its mean over pairs with the bootstrap interval (percentage points)."""
-    columns = [i for i, k in enumerate(keys) if float(k) > 0] or list(range(len(keys)))
+    columns = [i for i, k in enumerate(keys) if 0 < float(k) < 1] or list(range(len(keys)))
     diff = pct_a[:, columns] - pct_b[:, columns]  # (P, A')
     finite = np.isfinite(diff)
     counts = finite.sum(axis=1)

@@ -124,7 +124,7 @@ def train_network(job: NetworkJob, val: GraspArrays | None = None, test: GraspAr
         history.append({**({"member": m} if len(members) > 1 else {}), "step": step, **metrics})
 
     fits = train_members(members, train, val, job.train, device, gens, on_log=log, progress=False)
-    kept = GQCNNStack(members)  # the kept weights, every member in one pass
+    kept = GQCNNStack(members).to(device, memory_format=torch.channels_last)  # the kept weights, one pass
     val_ps = [f["val_predictions"] for f in fits]
     if any(p is None for p in val_ps):
         val_ps = list(predict_members(kept, val, device, job.train.eval_batch))

@@ -121,8 +121,8 @@ class GQCNNStack(nn.Module):
     what its :class:`GQCNN` computes (a test checks it). Every parameter is stacked along the
     members: a conv layer's filters are one grouped convolution (member k's are output channels
     k·C … (k+1)·C − 1), a fully connected layer's weights (K, in, out) one batched matrix
-    product. One member is its own GQCNN, unstacked. :meth:`unstack` writes the weights back
-    into the members."""
+    product. One member is its own GQCNN, unstacked. :meth:`member_state` gives a member's weights
+    back as a GQCNN state dict."""
 
     def __init__(self, members: list[GQCNN]) -> None:
         super().__init__()
@@ -189,11 +189,6 @@ class GQCNNStack(nn.Module):
         state["fc4_pose.weight"] = self.fc4_pose_weight[k].t()
         state.update({name: getattr(self, name)[k] for name in _NORMALIZATION})
         return {name: t.detach().clone().contiguous() for name, t in state.items()}
-
-    def unstack(self, members: list[GQCNN]) -> None:
-        """Write every member's current weights into ``members`` (K GQCNNs of this config)."""
-        for k, member in enumerate(members):
-            member.load_state_dict(self.member_state(k))
 
 
 class GQCNNEnsemble(nn.Module):

@@ -92,8 +92,8 @@ def run(params: Params, seed: int) -> None:
     write_csv(history, gqcnn_val_curves(seed).with_suffix(".csv"))
     title = f"Validation AP of every network of seed {seed} (dots: the kept weights)"
     validation_curves(history, gqcnn_val_curves(seed), title)
-    write_json({"seed": seed, "networks": seed_table(results)}, gqcnn_seed_networks(seed))
-    write_json(seed_headline(seed_table(results)), gqcnn_seed_metrics(seed))
+    write_json({"seed": seed, "networks": (table := seed_table(results))}, gqcnn_seed_networks(seed))
+    write_json(seed_headline(table), gqcnn_seed_metrics(seed))
     write_json(seed_timing(results, time.perf_counter() - start), timing_file("train_gqcnn", f"s{seed}"))
     for line in result_lines(results):
         log.info("train_gqcnn seed %d %s", seed, line)

@@ -1,8 +1,9 @@
 """Training and evaluating a GQ-CNN by Dex-Net 2.0's recipe.
 
 Datapoints travel as :class:`GraspArrays`: depth crops (N, S, S) float32 (m), gripper depths
-(N,) (m), labels (N,) 0/1. Every random choice (batch order, noise, symmetrization) comes from
-one ``torch.Generator``. The budget rule is a number of passes over each network's own
+(N,) (m), labels (N,) 0/1. Every random choice of a network (batch order, noise,
+symmetrization) comes from its own ``torch.Generator``, also when several train at once
+(:func:`train_members`). The budget rule is a number of passes over each network's own
 training set (with a step cap), the learning rate annealed along a cosine, and the weights
 with the best validation AP kept: every variant is trained to about the same convergence.
 """
@@ -206,6 +207,7 @@ def train_members(
         with torch.autocast(device.type, dtype=torch.bfloat16, enabled=settings.precision == "bfloat16"):
             logits = stack(torch.stack(crops).to(device), torch.stack(depths).to(device)).float()  # (K, B, 2)
         target = torch.stack(targets).to(device)
+        # one call per member: a single member's loss is then computed exactly as before the stack
         losses = torch.stack([F.cross_entropy(logits[m], target[m]) for m in range(k)])
         opt.zero_grad(set_to_none=True)
         losses.sum().backward()  # member m's gradient is that of its own loss
