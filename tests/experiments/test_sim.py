@@ -20,9 +20,12 @@ def seed_dirs_with(tmp_path, networks: list[str], seeds=(0, 1)) -> dict:
 def test_arms_pair_before_and_after_and_add_real_only_when_every_seed_has_it(tmp_path):
     dirs = seed_dirs_with(tmp_path, ["targeted/50-0", "targeted/50-1.5"])
     assert model_path(dirs[0], 50, 0.0, "real") == dirs[0] / "targeted/50-0/model.pt"  # ratio 0 is the targeted network
-    assert arms(1.5, 50, dirs) == {"before": ("targeted", 0.0), "after": ("targeted", 1.5), "antipodal": (None, None)}
-    seed_dirs_with(tmp_path, ["real/50-1.5"])
-    assert arms(1.5, 50, dirs)["real"] == ("real", 1.5)
+    expected = {"before": ("targeted", 0.0, 50), "after": ("targeted", 1.5, 50), "antipodal": (None, None, None)}
+    assert arms(1.5, 50, dirs, (50, 200)) == expected  # no B = 200 network: no positive control arm
+    seed_dirs_with(tmp_path, ["real/50-1.5", "targeted/200-0"])
+    chosen = arms(1.5, 50, dirs, (50, 100, 200))
+    assert chosen["real"] == ("real", 1.5, 50) and "more_real" not in chosen  # the next larger B is 100
+    assert arms(1.5, 50, dirs, (50, 200))["more_real"] == ("targeted", 0.0, 200)
     with pytest.raises(DataError, match=r"s0/targeted/50-2/model.pt is missing"):
         arms(2.0, 50, dirs)
 
@@ -73,7 +76,7 @@ def test_the_plan_line_counts_objects_arms_and_seeds():
 
     from graspaug.experiments.sim import trials_plan
 
-    chosen = {"before": ("targeted", 0.0), "after": ("targeted", 1.5), "antipodal": (None, None)}
+    chosen = {"before": ("targeted", 0.0, 50), "after": ("targeted", 1.5, 50), "antipodal": (None, None, None)}
     objects = [SimpleNamespace(name="a"), SimpleNamespace(name="b")]
     assert trials_plan(objects, chosen, 3, 2, {"x.obj": "empty"}) == (
         "2 objects × 3 attempts; arms before, after, antipodal × 2 training seeds (after = ratio 1.5); 1 skipped meshes"

@@ -39,19 +39,19 @@ def test_antipodal_pairs_with_every_training_seed():
     c = trial_contrast(trials, "before", "antipodal", n_boot=200)
     # each antipodal drop counts once, against the network's outcomes averaged over the seeds (1 and 0.5)
     assert c["n_trials"] == 2 and c["n_objects"] == 1 and c["mean"] == 0.75
-    assert c["mcnemar_p"] is None and c["only_before"] is None  # McNemar needs 0/1 pairs
+    assert c["only_before"] is None and "mcnemar_p" not in c  # a drop of the antipodal arm counts once
     assert c["n_seeds"] == 2 and c["per_seed"] == {"0": 1.0, "1": 0.5}
     assert c["t_ci_low"] < 0.75 < c["t_ci_high"]  # t(0.975, 1) = 12.7 × 0.25 / √2 on each side
 
 
-def test_contrast_between_network_arms_keeps_mcnemar_and_gives_a_t_interval_over_seeds():
+def test_contrast_between_network_arms_counts_discordant_picks_and_gives_a_t_interval_over_seeds():
     outcomes = {}
     for seed, gain in ((0, 1), (1, 2), (2, 1)):  # after wins `gain` more of 4 drops per object than before
         for k in range(5):
             outcomes[("before", seed, f"o{k}")] = [False] * gain + [True] * (4 - gain)
             outcomes[("after", seed, f"o{k}")] = [True] * 4
     c = trial_contrast(trials_table(outcomes), "after", "before", n_boot=200)
-    assert c["n_trials"] == 60 and c["only_after"] == 20 and c["only_before"] == 0 and c["mcnemar_p"] < 1e-5
+    assert c["n_trials"] == 60 and c["only_after"] == 20 and c["only_before"] == 0 and "mcnemar_p" not in c
     assert c["per_seed"] == {"0": 0.25, "1": 0.5, "2": 0.25} and c["mean"] == pytest.approx(1 / 3, abs=1e-4)
     half = 4.302653 * np.std([0.25, 0.5, 0.25], ddof=1) / np.sqrt(3)
     assert c["t_ci_low"] == pytest.approx(1 / 3 - half, abs=1e-4) and c["t_ci_high"] == pytest.approx(
@@ -69,7 +69,7 @@ def test_contrast_interval_excludes_zero_for_a_clear_effect_and_report_says_so()
     trials = trials_table(outcomes)
     c = trial_contrast(trials, "before", "antipodal", n_boot=1000)
     assert c["ci_low"] > 0 and c["mean"] == pytest.approx(np.mean([1, 1, 2 / 3]) - 1 / 12, abs=1e-4)
-    chosen = {"before": ("targeted", 0.0), "after": ("targeted", 1.0), "antipodal": (None, None)}
+    chosen = {"before": ("targeted", 0.0, 50), "after": ("targeted", 1.0, 50), "antipodal": (None, None, None)}
     metrics = {
         "setup": {
             "camera_height": 0.65,
@@ -80,8 +80,8 @@ def test_contrast_interval_excludes_zero_for_a_clear_effect_and_report_says_so()
             "base_size": 50,
         },
         "arms": {
-            arm: {"pool": pool, "ratio": ratio, **rate_summary(trials.success[trials.arm == arm])}
-            for arm, (pool, ratio) in chosen.items()
+            arm: {"pool": pool, "ratio": ratio, "base_size": b, **rate_summary(trials.success[trials.arm == arm])}
+            for arm, (pool, ratio, b) in chosen.items()
         },
         "contrasts": {
             "after_vs_before": trial_contrast(trials, "after", "before", n_boot=1000),
@@ -133,3 +133,17 @@ def test_the_outcome_line_gives_rates_contrasts_and_planning_time():
     assert outcome_words(metrics, timing) == (
         "before 3/4, after 4/4; after_vs_before +0.25 [-0.12, +0.50]; planning 0.012 s per grasp (max 0.000)"
     )
+
+
+def test_the_report_reads_augmentation_only_when_the_positive_control_shows():
+    from graspaug.experiments.sim_report import control_words
+
+    shows = {"real_data": {"mean": 0.08, "ci_low": 0.02, "ci_high": 0.14}}
+    fails = {"real_data": {"mean": -0.02, "ci_low": -0.09, "ci_high": 0.05}}
+    assert control_words(shows).startswith("The positive control shows") and "test of augmentation" in control_words(
+        shows
+    )
+    assert control_words(fails).startswith("The positive control does not show") and "measures the cell" in (
+        control_words(fails)
+    )
+    assert control_words({}).startswith("No positive control")

@@ -8,7 +8,6 @@ from sklearn.metrics import average_precision_score
 
 from graspaug.experiments.stats import (
     ObjectBootstrap,
-    mcnemar_test,
     percentile_interval,
     t_interval,
     weighted_average_precision,
@@ -67,15 +66,6 @@ def test_wilson_interval_known_values():
     low, high = wilson_interval(10, 10)
     assert high == pytest.approx(1.0) and low == pytest.approx(0.7225, abs=1e-4)
     assert wilson_interval(0, 0) == (0.0, 1.0)
-
-
-def test_paired_test_counts_discordant_attempts():
-    before = np.array([1, 1, 1, 0, 0, 1, 1, 1], bool)
-    after = np.array([1, 0, 0, 0, 1, 1, 0, 0], bool)
-    result = mcnemar_test(before, after)
-    assert result["only_before"] == 4 and result["only_after"] == 1
-    assert result["p_value"] == pytest.approx(0.375)  # two-sided binomial, 1 of 5 at 0.5
-    assert mcnemar_test(before, before)["p_value"] == 1.0
 
 
 def test_a_contrasts_headline_is_its_mean_and_interval_ends_rounded():

@@ -4,8 +4,10 @@ and their physics, one object's attempts in one arm, and the trials table.
 Every arm sees the same seeded drops, sensor noise and planner seeds (paired). Arms: ``before``
 = the targeted network of base size B at ratio 0, ``after`` = the same B at the ratio chosen on
 validation AP (by the GQ-CNN experiment's report), ``real`` = the ``real`` pool's network at that
-B and ratio (when it was trained), each once per training seed, and ``antipodal`` = a random
-antipodal seed grasp without a network (once: it has no training seed). The numbers and the
+B and ratio (when it was trained), ``more_real`` = the network of the next larger base size at
+ratio 0 (more real shapes, no augmentation: the cell's positive control for training data, when
+trained), each once per training seed, and ``antipodal`` = a random antipodal seed grasp without a
+network (once: it has no training seed). The numbers and the
 report's text are :mod:`graspaug.experiments.sim_report`.
 """
 
@@ -60,26 +62,35 @@ def model_path(seed_dir: Path, base_size: int, ratio: float, pool: str = "target
     return Path(seed_dir) / network_variant(pool, base_size, ratio).name / "model.pt"
 
 
+#: What an arm plans with: (pool, ratio, base size) of its network, or (None, None, None) without one.
+ArmNetwork = tuple[str | None, float | None, int | None]
+
+
 def arms(
-    best_ratio: float, base_size: int, seed_dirs: Mapping[int, Path]
-) -> dict[str, tuple[str | None, float | None]]:
-    """Arm → (pool, ratio): ``before`` (targeted, 0), ``after`` (targeted, ``best_ratio``: the
-    ratio chosen on validation AP for ``base_size``), ``real`` (real, that ratio) when its network
-    exists for every training seed, ``antipodal`` (None, None). ``seed_dirs``: training seed →
-    the folder of its networks; a missing ``before`` or ``after`` network is a :class:`DataError`."""
+    best_ratio: float, base_size: int, seed_dirs: Mapping[int, Path], base_sizes: Sequence[int] = ()
+) -> dict[str, ArmNetwork]:
+    """Arm → (pool, ratio, base size): ``before`` (targeted, 0, B), ``after`` (targeted, ``best_ratio``:
+    the ratio chosen on validation AP for B = ``base_size``), ``real`` (real, that ratio, B) and
+    ``more_real`` (targeted, 0, the smallest of ``base_sizes`` above B: more real shapes, the cell's
+    positive control) when their networks exist for every training seed, ``antipodal`` (None, None, None).
+    ``seed_dirs``: training seed → the folder of its networks; a missing ``before`` or ``after`` network
+    is a :class:`DataError`."""
     best = float(best_ratio)
-    chosen: dict[str, tuple[str | None, float | None]] = {"before": ("targeted", 0.0), "after": ("targeted", best)}
+    chosen: dict[str, ArmNetwork] = {"before": ("targeted", 0.0, base_size), "after": ("targeted", best, base_size)}
     for seed_dir in seed_dirs.values():
-        for pool, ratio in chosen.values():
-            if not model_path(seed_dir, base_size, ratio, pool).exists():
-                raise DataError(
-                    f"{model_path(seed_dir, base_size, ratio, pool)} is missing: run `dvc repro train_gqcnn` first"
-                )
-    if best > 0 and all(model_path(seed_dir, base_size, best, "real").exists() for seed_dir in seed_dirs.values()):
-        chosen["real"] = ("real", best)
-    else:
-        log.info("sim: no `real` network at B = %d, ratio %g for every training seed: no real arm", base_size, best)
-    chosen["antipodal"] = (None, None)
+        for pool, ratio, b in chosen.values():
+            if not model_path(seed_dir, b, ratio, pool).exists():
+                raise DataError(f"{model_path(seed_dir, b, ratio, pool)} is missing: run `dvc repro train_gqcnn` first")
+    optional = {"real": ("real", best, base_size)} if best > 0 else {}
+    larger = [b for b in base_sizes if b > base_size]
+    if larger:
+        optional["more_real"] = ("targeted", 0.0, min(larger))
+    for arm, (pool, ratio, b) in optional.items():
+        if all(model_path(seed_dir, b, ratio, pool).exists() for seed_dir in seed_dirs.values()):
+            chosen[arm] = (pool, ratio, b)
+        else:
+            log.info("sim: no %s network at B = %d, ratio %g for every training seed: no %s arm", pool, b, ratio, arm)
+    chosen["antipodal"] = (None, None, None)
     return chosen
 
 
@@ -186,8 +197,7 @@ def trial_objects(
 
 def object_jobs(
     objects: Sequence[PreparedObject],
-    chosen: dict,
-    base_size: int,
+    chosen: dict[str, ArmNetwork],
     seed_dirs: Mapping[int, Path],
     attempts: int,
     seed: int,
@@ -202,7 +212,7 @@ def object_jobs(
         drops = tuple(int(shape_rng(seed, obj.name, f"sim-drop-{a}").integers(2**31 - 1)) for a in range(attempts))
         plans = tuple(int(shape_rng(seed, obj.name, f"sim-plan-{a}").integers(2**31 - 1)) for a in range(attempts))
         record = index < n_pictures
-        for arm, (pool, ratio) in chosen.items():
+        for arm, (pool, ratio, base_size) in chosen.items():
             if pool is None:
                 jobs.append(ObjectJob(arm, -1, None, obj.name, obj.kind, obj.body, drops, plans, record))
                 continue
@@ -314,7 +324,7 @@ def run_object(
 
 def trials_plan(objects: Sequence, chosen: dict, attempts: int, n_seeds: int, skipped: dict[str, str]) -> str:
     """One line on what :func:`run_trials` will run: objects × attempts, the arms (``chosen``: arm →
-    (pool, ratio)) × training seeds, the ``after`` ratio and the count of skipped user meshes."""
+    (pool, ratio, base size)) × training seeds, the ``after`` ratio and the count of skipped user meshes."""
     return "%d objects × %d attempts; arms %s × %d training seeds (after = ratio %g); %d skipped meshes" % (
         len(objects),
         attempts,
@@ -346,11 +356,11 @@ def run_trials(jobs: Sequence[ObjectJob], sim, crop, workers) -> list[dict]:
     return [row for rows in parallel_map(work, jobs, workers, "sim") for row in rows]
 
 
-def trials_table(rows: list[dict], chosen: dict[str, tuple[str | None, float | None]]) -> pd.DataFrame:
+def trials_table(rows: list[dict], chosen: dict[str, ArmNetwork]) -> pd.DataFrame:
     """The trials table: a row per attempt (:func:`run_object`'s rows without the pictures) and
-    the ``ratio`` of its arm (``chosen``: arm → (pool, ratio))."""
+    the ``ratio`` of its arm (``chosen``: arm → (pool, ratio, base size))."""
     trials = pd.DataFrame([{k: v for k, v in row.items() if not k.startswith("_")} for row in rows])
-    trials["ratio"] = trials.arm.map({arm: ratio for arm, (_, ratio) in chosen.items()})
+    trials["ratio"] = trials.arm.map({arm: network[1] for arm, network in chosen.items()})
     return trials
 
 

@@ -9,8 +9,8 @@
 * :func:`weighted_average_precision`: Average Precision as sklearn's (step-wise, no
   interpolation): the mean over positives of the precision at their rank, with datapoint
   weights for the bootstrap;
-* :func:`wilson_interval` (a success rate) and :func:`mcnemar_test` (two planners on the same
-  attempts).
+* :func:`wilson_interval` (a success rate). No McNemar test: the robot trials' picks cluster by
+  object and training seed, so they are compared with the object bootstrap and the t-interval.
 """
 
 from __future__ import annotations
@@ -157,15 +157,3 @@ def wilson_interval(successes: int, attempts: int, confidence: float = 0.95) -> 
         return 0.0, 1.0
     ci = binomtest(int(successes), int(attempts)).proportion_ci(confidence_level=confidence, method="wilson")
     return float(ci.low), float(ci.high)
-
-
-def mcnemar_test(before: np.ndarray, after: np.ndarray) -> dict[str, float | int]:
-    """Exact McNemar test of two planners on the same attempts: ``before``, ``after`` (N,) bool
-    outcomes of the same drops. Counts the discordant attempts and gives the two-sided p-value
-    of "neither planner wins the discordant attempts more often"."""
-    before, after = np.asarray(before, dtype=bool), np.asarray(after, dtype=bool)
-    only_before = int(np.sum(before & ~after))
-    only_after = int(np.sum(after & ~before))
-    n = only_before + only_after
-    p = 1.0 if n == 0 else float(binomtest(only_after, n, 0.5).pvalue)
-    return {"only_before": only_before, "only_after": only_after, "p_value": p}

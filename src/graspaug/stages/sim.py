@@ -1,12 +1,11 @@
 """Stage ``sim``: simulated Panda pick-and-place trials with the GQ-CNN before and after augmentation.
 
-Arms (:mod:`graspaug.experiments.sim`): ``before`` = the targeted network of base size ``sim.base_size`` at ratio 0,
-``after`` = the same base size at the ratio chosen on validation AP (``reports/gqcnn/ap.json``), ``real`` = the
-``real`` pool's network there (when trained), each once per training seed of ``gqcnn.seeds``, and ``antipodal`` =
-a random antipodal grasp without a network. Every object (the everyday objects of ``sim.objects``,
-``sim.n_test_objects`` held-out test shapes and the meshes of ``sim.objects_path``), with mass and friction drawn
-per object, is dropped ``sim.attempts`` times from seeded poses, the same for every arm; the planner sees the
-D435-like noisy depth image and the Panda tries to put the object in the bin.
+Arms (:mod:`graspaug.experiments.sim`): ``before`` (B = ``sim.base_size``, ratio 0), ``after`` (the ratio chosen on
+validation AP, ``reports/gqcnn/ap.json``), ``real`` (the ``real`` pool there), ``more_real`` (the next larger B at
+ratio 0: the positive control), each per training seed, and ``antipodal`` (no network). Every object (the everyday
+objects of ``sim.objects``, ``sim.n_test_objects`` held-out test shapes, the meshes of ``sim.objects_path``), with
+mass and friction drawn per object, is dropped ``sim.attempts`` times from seeded poses, the same for every arm;
+the planner sees the D435-like noisy depth image and the Panda tries to put the object in the bin.
 
 Writes ``metrics/sim/<contrast>.json`` (``mean``, ``lo``, ``hi``: the paired difference, bootstrap over objects) and
 ``reports/sim/`` (``summary.json``: per-arm rates with 95 % Wilson intervals, the contrasts in full, per training
@@ -73,12 +72,12 @@ def run(params: Params) -> None:
     if not from_report:
         log.warning(NO_AP, AP_REPORT, cfg.base_size, best)
     seed_dirs = {seed: gqcnn_seed_dir(seed) for seed in model_seeds}
-    chosen = arms(best, cfg.base_size, seed_dirs)
+    chosen = arms(best, cfg.base_size, seed_dirs, params.generate.base_sizes)
     # an empty or unreadable sim.objects_path: a DataError, which the CLI prints in one line
     objects, skipped = trial_objects(
         cfg, read_table(SHAPES_TABLE), SHAPES_DIR, params.ingest, params.seed, params.workers
     )
-    jobs = object_jobs(objects, chosen, cfg.base_size, seed_dirs, cfg.attempts, params.seed, cfg.n_pictures)
+    jobs = object_jobs(objects, chosen, seed_dirs, cfg.attempts, params.seed, cfg.n_pictures)
     log.info("sim: %s", trials_plan(objects, chosen, cfg.attempts, len(model_seeds), skipped))
     rows = run_trials(jobs, cfg, params.render.crop, params.workers)
     trials = trials_table(rows, chosen)
