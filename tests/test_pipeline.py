@@ -416,6 +416,39 @@ def test_dvc_repro_sim(tiny_repo, tmp_path):
     assert "Running stage" not in again.stdout
 
 
+def test_dvc_repro_grasp_calibration(tiny_repo):
+    """The tiny profile's 6 labelled test grasps executed in the cell: one row each, from the rendered test split,
+    with an outcome; the headline files hold the summary's figures."""
+    import json
+
+    work, env = tiny_repo
+    run(["dvc", "repro", "grasp_calibration"], work, env)
+    out = work / "reports/grasp_calibration"
+    grasps = pd.read_csv(out / "grasps.csv")
+    index = pd.read_parquet(work / "data/gqcnn/original/index.parquet")
+    test = index[index.split == "test"].set_index(["shape_id", "pose_id", "grasp_id"])
+    assert len(grasps) == 6 and grasps.set_index(["shape_id", "pose_id", "grasp_id"]).index.isin(test.index).all()
+    from graspaug.sim.trials import OUTCOMES
+
+    assert set(grasps.outcome) <= set(OUTCOMES) and (grasps.executed_success == (grasps.outcome == "success")).all()
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["n_grasps"] == 6 and summary["n_positive"] == int(grasps.label.sum())
+    for name in (
+        "success_positive",
+        "success_negative",
+        "auc_eps",
+        "auc_eps_collision_free",
+        "auc_quality",
+        "auc_label",
+    ):
+        headline = json.loads((work / f"metrics/grasp_calibration/{name}.json").read_text())
+        assert set(headline) == {"mean", "lo", "hi"}
+        assert headline["mean"] == (None if summary[name]["mean"] is None else round(summary[name]["mean"], 5))
+    assert (out / "calibration.png").stat().st_size > 0 and len(pd.read_csv(out / "by_eps.csv")) > 0
+    again = run(["dvc", "repro", "grasp_calibration"], work, env)
+    assert "Running stage" not in again.stdout
+
+
 def test_metrics_hold_few_scalars_and_fit_a_terminal(tiny_repo):
     """Every metrics file of the finished tiny run holds numbers, strings, booleans or None (dicts of them), no
     lists; `dvc metrics show` prints one table whose columns are the union of every file's keys: its rows stay
@@ -616,7 +649,8 @@ def test_killed_stage_leaves_no_output_and_repro_completes(tiny_repo):
 
 
 def test_editing_a_sim_setting_reruns_only_sim(tiny_repo):
-    """Exact code deps: a sim-only module's edit (a settings description) changes the `sim` stage alone."""
+    """Exact code deps: a cell-only module's edit (a settings description) changes the stages that run the robot
+    cell (`sim`, `grasp_calibration`) alone."""
     import json
 
     work, env = tiny_repo
@@ -630,5 +664,5 @@ def test_editing_a_sim_setting_reruns_only_sim(tiny_repo):
         changed = json.loads(run(["dvc", "status", "--json"], work, env).stdout)
     finally:
         settings.write_text(original)
-    assert set(changed) == {"sim"}, f"changed stages: {sorted(changed)}"
+    assert set(changed) == {"sim", "grasp_calibration"}, f"changed stages: {sorted(changed)}"
     assert json.loads(run(["dvc", "status", "--json"], work, env).stdout) == {}

@@ -284,6 +284,19 @@ stage_command(
     "sim",
 )
 
+stage_command(
+    "grasp-calibration",
+    "Do the robot cell's outcomes follow the grasp labels? `sim.calibration_grasps` labelled datapoints of the "
+    "rendered test split (half positive, spread over the test shapes) are executed in the `sim` stage's cell: each "
+    "shape rests on the table in its datapoint's stable pose and the Panda executes that grasp from above, lifts and "
+    "carries the object to the bin.\n\nWrites `metrics/grasp_calibration/<figure>.json` (success_positive, "
+    "success_negative, auc_eps, auc_eps_collision_free, auc_quality, auc_label: mean, lo, hi, bootstrap over "
+    "shapes) and "
+    "`reports/grasp_calibration/` (`summary.json` with outcome counts per label, `grasps.csv` one row per executed "
+    "grasp, `by_eps.csv` and `calibration.png`: success per robust-ε bin, ROC curves).\n\n{params}",
+    "sim",
+)
+
 
 @app.command(
     name="plan",

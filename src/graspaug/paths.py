@@ -142,6 +142,8 @@ AP_REPORT = REPORT_DIR / "ap.json"  # contrasts, networks, chosen ratios (sim re
 # sim
 SIM_METRICS = Path("metrics/sim")  # one file per contrast
 SIM_REPORT_DIR = Path("reports/sim")
+CALIBRATION_METRICS = Path("metrics/grasp_calibration")  # one file per figure: mean, lo, hi
+CALIBRATION_REPORT_DIR = Path("reports/grasp_calibration")
 
 
 def timing_file(stage: str, item: str | None = None) -> Path:

@@ -732,3 +732,44 @@ def precision_recall_roc(
         ax.legend(fontsize=8)
     fig.suptitle(title)
     _save(fig, path)
+
+
+def label_calibration(by_eps: pd.DataFrame, grasps: pd.DataFrame, path: str | os.PathLike, title: str) -> None:
+    """Do executed grasps follow their labels? Left: success rate per robust-ε bin (``by_eps``:
+    ``collision_free``, ``eps_mid``, ``rate``, ``lo``, ``hi``), one line for grasps labelled
+    collision-free and one for colliding ones. Right: ROC curves of
+    the robust ε and of the label against the executed outcome (``grasps``: ``eps``, ``label``,
+    ``executed_success``), AUC in the legend."""
+    from sklearn.metrics import roc_auc_score, roc_curve
+
+    plt = _pyplot()
+    fig, (rates, roc) = plt.subplots(1, 2, figsize=(11, 4.5))
+    for free, group in by_eps.groupby("collision_free"):
+        group = group.sort_values("eps_mid")
+        rate = group.rate.to_numpy(float)
+        rates.errorbar(
+            group.eps_mid * 1000,
+            rate,
+            yerr=[rate - group.lo.to_numpy(float), group.hi.to_numpy(float) - rate],
+            marker="o",
+            capsize=3,
+            label="labelled collision-free approach" if free else "labelled colliding approach",
+        )
+    rates.set_xlabel("robust ε (×1000), median of the bin")
+    rates.set_ylabel("executed success rate (95% Wilson)")
+    rates.set_ylim(0, 1.02)
+    y = grasps.executed_success.to_numpy(bool)
+    if 0 < y.sum() < len(y):
+        for name, score in (("robust ε", grasps.eps), ("label", grasps.label.astype(float))):
+            fpr, tpr, _ = roc_curve(y, score)
+            roc.plot(fpr, tpr, label=f"{name} (AUC {roc_auc_score(y, score):.3f})")
+    else:
+        roc.text(0.5, 0.5, "one outcome only: no curve", ha="center", va="center")
+    roc.plot([0, 1], [0, 1], color="gray", ls=":", label="chance")
+    roc.set_xlabel("false positive rate")
+    roc.set_ylabel("true positive rate")
+    for ax in (rates, roc):
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8)
+    fig.suptitle(title)
+    _save(fig, path)

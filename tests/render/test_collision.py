@@ -52,6 +52,22 @@ def test_the_palm_hits_a_tall_object_grasped_low():
     assert free(mesh, pose, [0.0, 0.0, 0.1])
 
 
+def test_the_palm_keeps_its_clearance_above_the_object():
+    """A 5 cm box grasped 1.5 cm below its top: the palm (3.9 cm behind the center) ends 2.4 cm above it. Grasped
+    3.8 cm below its top the palm ends 1 mm above it: free without a clearance, not with 2 mm."""
+    mesh, pose = resting((0.04, 0.04, 0.05))
+    axis = ALONG_X
+
+    def free_with(clearance, center):
+        checker = CollisionChecker(mesh, HAND, 0.1, palm_clearance=clearance)
+        return bool(checker.collision_free(np.array([center]), axis, approach_directions(axis), pose=pose)[0])
+
+    assert free_with(0.0, [0, 0, 0.035]) and free_with(0.002, [0, 0, 0.035])
+    assert free_with(0.0, [0, 0, 0.012]) and not free_with(0.002, [0, 0, 0.012])
+    with pytest.raises(ValueError, match="palm_clearance"):
+        CollisionChecker(mesh, HAND, 0.1, palm_clearance=-0.001)
+
+
 def test_placing_by_pose_equals_moving_the_mesh(random_object):
     rng = np.random.default_rng(0)
     axes = rng.normal(size=(60, 3))

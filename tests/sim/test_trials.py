@@ -60,6 +60,19 @@ def test_scripted_top_down_cube_grasp_lands_in_bin(cube):
     assert 0.0 < result.grasp_center[2] < 0.05  # the cube rests on the table, its center ~2 cm up
 
 
+def test_the_hand_errs_by_a_seeded_offset(cube):
+    """With an execution error the hand misses the planned center by an offset drawn from the drop seed (the
+    planned center is what the trial reports); a 10 cm SD puts the jaws far off the cube, which is then not
+    lifted or hit, while the same grasp without the error lands it in the bin (above)."""
+    sloppy = TrialSettings(position_error=0.1, angle_error=0.2)
+    result = run_trial(cube, drop_seed=3, scripted=top_down_across, settings=sloppy)
+    again = run_trial(cube, drop_seed=3, scripted=top_down_across, settings=sloppy)
+    exact = run_trial(cube, drop_seed=3, scripted=top_down_across)
+    assert exact.hand_error == (0.0, 0.0, 0.0) and result.hand_error == again.hand_error
+    assert np.hypot(*result.hand_error[:2]) > 0.05  # this seed's draw: beyond the cube's half width
+    assert result.grasp_center == exact.grasp_center and result.outcome in ("not_lifted", "collision")
+
+
 def test_a_blocked_approach_is_a_collision(cube):
     """A plate 10 cm above the table over the drop area: the hand hits it on the way to the cube
     (the same grasp without the plate lands the cube in the bin, above)."""

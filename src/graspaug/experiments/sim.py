@@ -26,6 +26,7 @@ import pandas as pd
 from graspaug.errors import DataError
 from graspaug.experiments.variants import network_variant
 from graspaug.rng import shape_rng
+from graspaug.sim.objects import PreparedObject, prepare_objects
 
 log = logging.getLogger(__name__)
 
@@ -43,17 +44,6 @@ class ObjectJob:
     drop_seeds: tuple[int, ...]
     plan_seeds: tuple[int, ...]
     record: bool
-
-
-@dataclass(frozen=True)
-class PreparedObject:
-    """An object of the trials: its name, kind, physics body, extents (3,) m and drawn density (kg/m³)."""
-
-    name: str
-    kind: str
-    body: object  # graspaug.sim.objects.SimObject
-    extents: tuple[float, float, float]
-    density: float
 
 
 def model_path(seed_dir: Path, base_size: int, ratio: float, pool: str = "targeted") -> Path:
@@ -126,57 +116,6 @@ def test_shape_ids(shapes: pd.DataFrame, n: int, seed: int) -> list[str]:
         raise DataError(f"sim.n_test_objects = {n} but the test split has {len(test)} shapes")
     chosen = shape_rng(seed, "sim", "test-objects").choice(len(test), size=n, replace=False)
     return [test[i] for i in sorted(chosen)]
-
-
-def _prepare_one(item: tuple, physics, seed: int, vhacd_resolution: int, cache: Path) -> PreparedObject:
-    from graspaug.sim.objects import draw_physics, mesh_volume, prepare_object
-
-    name, kind, mesh = item
-    drawn = draw_physics(mesh_volume(mesh), physics, shape_rng(seed, name, "sim-physics"))
-    body = prepare_object(
-        name,
-        mesh,
-        cache,
-        drawn["mass"],
-        drawn["lateral_friction"],
-        vhacd_resolution,
-        drawn["spinning_friction"],
-        drawn["rolling_friction"],
-    )
-    return PreparedObject(name, kind, body, tuple(float(x) for x in mesh.extents), drawn["density"])
-
-
-def prepare_objects(
-    everyday: Sequence[str],
-    test_shapes: Sequence[str],
-    shapes_dir: Path,
-    physics,
-    seed: int,
-    vhacd_resolution: int,
-    user_meshes: Sequence[tuple[str, object]] = (),
-    cache_dir: Path | None = None,
-    workers=1,
-) -> list[PreparedObject]:
-    """Every object of the trials (everyday, test shapes read from the mesh folder ``shapes_dir``,
-    the user's meshes), decompositions cached (computed on ``workers``, a process count or
-    :class:`graspaug.parallel.Workers`), with mass and friction drawn per object from ``physics``
-    (``sim.physics``) and the global ``seed`` (the same for every arm)."""
-    from graspaug.io.meshes import mesh_path, read_mesh
-    from graspaug.parallel import parallel_map
-    from graspaug.sim.objects import default_cache_dir, everyday_mesh
-
-    cache = default_cache_dir() if cache_dir is None else Path(cache_dir)
-    meshes = [(name, "everyday", everyday_mesh(name)) for name in everyday]
-    meshes += [(shape_id, "test_shape", read_mesh(mesh_path(shapes_dir, shape_id))) for shape_id in test_shapes]
-    meshes += [(name, "user", mesh) for name, mesh in user_meshes]
-    names = [name for name, _, _ in meshes]
-    if len(set(names)) != len(names):
-        raise DataError(
-            f"sim: two objects share a name: {sorted({n for n in names if names.count(n) > 1})} "
-            "(rename the user's mesh files)"
-        )
-    work = functools.partial(_prepare_one, physics=physics, seed=seed, vhacd_resolution=vhacd_resolution, cache=cache)
-    return parallel_map(work, meshes, workers, "sim objects")
 
 
 def trial_objects(

@@ -25,17 +25,22 @@ def approach_directions(axes: np.ndarray, down: np.ndarray = np.array([0.0, 0.0,
     return approach / np.linalg.norm(approach, axis=1, keepdims=True)
 
 
-def swept_gripper_boxes(gripper: ParallelJawGripper, approach_distance: float) -> tuple[np.ndarray, np.ndarray]:
+def swept_gripper_boxes(
+    gripper: ParallelJawGripper, approach_distance: float, clearance: float = 0.0
+) -> tuple[np.ndarray, np.ndarray]:
     """Centers (3, 3) and full extents (3, 3) in the grasp frame of the left finger, right finger
-    and palm, fingers open to ``gripper.max_width``, each stretched back along the approach."""
+    and palm, fingers open to ``gripper.max_width``, each stretched back along the approach; the
+    palm's face toward the grasp comes ``clearance`` m closer (the gap the palm must keep above the
+    object)."""
     g = gripper
     tip = g.fingertip_offset
     finger_x = g.max_width / 2 + g.finger_thickness / 2
     finger_z = tip - (g.finger_length + approach_distance) / 2
-    palm_z = -g.palm_offset - (g.palm_size[2] + approach_distance) / 2
+    palm_depth = g.palm_size[2] + approach_distance + clearance
+    palm_z = -g.palm_offset + clearance - palm_depth / 2
     centers = np.array([[-finger_x, 0.0, finger_z], [finger_x, 0.0, finger_z], [0.0, 0.0, palm_z]])
     finger = [g.finger_thickness, g.finger_width, g.finger_length + approach_distance]
-    palm = [g.palm_size[0], g.palm_size[1], g.palm_size[2] + approach_distance]
+    palm = [g.palm_size[0], g.palm_size[1], palm_depth]
     return centers, np.array([finger, finger, palm])
 
 
@@ -43,14 +48,21 @@ class CollisionChecker:
     """Approach collisions of ``gripper`` with one object resting on the table.
 
     ``mesh``: the object (m) in its own frame; each query says where it rests on the table
-    (the plane z = 0), so the collision structure is built once for all its poses.
+    (the plane z = 0), so the collision structure is built once for all its poses. With
+    ``palm_clearance`` (m) the palm must also stay that far from the object at the grasp.
     """
 
-    def __init__(self, mesh: trimesh.Trimesh, gripper: ParallelJawGripper, approach_distance: float = 0.1) -> None:
-        if approach_distance < 0:
-            raise ValueError(f"approach_distance must be >= 0, got {approach_distance}")
+    def __init__(
+        self,
+        mesh: trimesh.Trimesh,
+        gripper: ParallelJawGripper,
+        approach_distance: float = 0.1,
+        palm_clearance: float = 0.0,
+    ) -> None:
+        if approach_distance < 0 or palm_clearance < 0:
+            raise ValueError(f"approach_distance and palm_clearance must be >= 0, got {approach_distance, palm_clearance}")
         self.object = fcl.CollisionObject(mesh_to_BVH(mesh), fcl.Transform())
-        self.box_centers, self.box_extents = swept_gripper_boxes(gripper, approach_distance)
+        self.box_centers, self.box_extents = swept_gripper_boxes(gripper, approach_distance, palm_clearance)
         self.boxes = [fcl.Box(*extents) for extents in self.box_extents]
 
     def collision_free(

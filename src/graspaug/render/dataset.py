@@ -167,7 +167,7 @@ def render_shape(
     and unit jaw ``axes`` (N, 3) in that frame: a crop, image geometry and approach collision
     check for every grasp of every scene of :func:`plan_scenes`."""
     scenes, n_poses = plan_scenes(mesh, centers, axes, gripper.max_width, settings, rng)
-    checker = CollisionChecker(mesh, gripper, settings.approach_distance) if scenes else None
+    checker = CollisionChecker(mesh, gripper, settings.approach_distance, settings.palm_clearance) if scenes else None
     images, rows, n_rays = [], {name: [] for name in COLUMNS}, 0
     for scene in scenes:
         crops, rays = crops_by_ray_casting(

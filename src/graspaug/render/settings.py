@@ -97,7 +97,8 @@ class RenderSettings:
     ``max_poses`` most probable stable poses with probability >= ``min_pose_probability``;
     ``images_per_pose`` random camera views of each; in each view every grasp whose jaw axis is
     within ``axis_tolerance_deg`` of parallel to the table (at most ``max_grasps_per_image``,
-    a seeded random subset; 0: all), approached from above over ``approach_distance`` (m).
+    a seeded random subset; 0: all), approached from above over ``approach_distance`` (m), the
+    palm keeping ``palm_clearance`` (m) above the object.
     """
 
     max_poses: int = Field(5, ge=1, description="Most probable stable resting poses rendered per shape.")
@@ -122,6 +123,12 @@ class RenderSettings:
     )
     approach_distance: float = Field(
         0.1, ge=0, description="Length of the straight approach from above checked for gripper collisions (m)."
+    )
+    palm_clearance: float = Field(
+        0.002,
+        ge=0,
+        description="Gap the palm must keep from the object at the grasp for the approach to count as collision "
+        "free (m; 0: the palm may end touching the object's top).",
     )
     viewpoints: ViewpointRanges = Field(
         default_factory=ViewpointRanges, description="Dex-Net 2.0's random camera placement."

@@ -1,6 +1,7 @@
 """Objects for the simulated trials: the everyday objects of ``pybullet_data``, held-out test
 shapes and the meshes of a user's folder, as meshes in meters with a cached convex
-decomposition for collisions, and each object's mass and friction drawn from a seed.
+decomposition for collisions, and each object's mass and friction drawn from a seed
+(:func:`prepare_objects`: the same body for a name and seed in every stage that picks it).
 
 Every object is a visual mesh (what the camera sees) plus its convex decomposition by pybullet's
 V-HACD (what collides); the decomposition is cached per mesh under the cache folder, keyed by the
@@ -10,10 +11,12 @@ SHA-256 of the mesh file and the V-HACD resolution, so it runs once per machine.
 from __future__ import annotations
 
 import contextlib
+import functools
 import hashlib
 import logging
 import os
 import tempfile
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -22,6 +25,8 @@ import pybullet
 import pybullet_data
 import trimesh
 
+from graspaug.errors import DataError
+from graspaug.rng import shape_rng
 from graspaug.sim.catalog import EVERYDAY_OBJECTS
 from graspaug.sim.settings import ObjectPhysics
 
@@ -154,6 +159,12 @@ def folder_meshes(
     return meshes, skipped
 
 
+def body_origin(mesh: trimesh.Trimesh) -> np.ndarray:
+    """Where a simulated object's body frame sits in its mesh's frame (3,) m: the center of mass of a
+    closed volume, else the bounding-box center (several pybullet_data meshes are open)."""
+    return np.asarray(mesh.center_mass if mesh.is_volume else mesh.bounds.mean(axis=0), dtype=float)
+
+
 def prepare_object(
     name: str,
     mesh: trimesh.Trimesh,
@@ -165,11 +176,10 @@ def prepare_object(
     rolling_friction: float = 0.0,
 ) -> SimObject:
     """Write ``mesh`` (m) to the cache as ``<name>-<sha256>.obj``, decompose it, and return the
-    :class:`SimObject` for the trials. The mesh is centered on its center of mass when it is a
-    closed volume, else on its bounding-box center (several pybullet_data meshes are open); the
-    body's center of mass is that origin."""
+    :class:`SimObject` for the trials. The mesh is moved so that :func:`body_origin` is its
+    origin; the body's center of mass is that origin."""
     mesh = mesh.copy()
-    mesh.apply_translation(-mesh.center_mass if mesh.is_volume else -mesh.bounds.mean(axis=0))
+    mesh.apply_translation(-body_origin(mesh))
     cache_dir = Path(cache_dir)
     cache_dir.mkdir(parents=True, exist_ok=True)
     data = trimesh.exchange.obj.export_obj(mesh, include_normals=False, include_texture=False)
@@ -188,3 +198,62 @@ def prepare_object(
         spinning_friction=spinning_friction,
         rolling_friction=rolling_friction,
     )
+
+
+@dataclass(frozen=True)
+class PreparedObject:
+    """An object of the trials: its name, kind, physics body, extents (3,) m and drawn density (kg/m³)."""
+
+    name: str
+    kind: str
+    body: SimObject
+    extents: tuple[float, float, float]
+    density: float
+
+
+def _prepare_one(item: tuple, physics, seed: int, vhacd_resolution: int, cache: Path) -> PreparedObject:
+    name, kind, mesh = item
+    drawn = draw_physics(mesh_volume(mesh), physics, shape_rng(seed, name, "sim-physics"))
+    body = prepare_object(
+        name,
+        mesh,
+        cache,
+        drawn["mass"],
+        drawn["lateral_friction"],
+        vhacd_resolution,
+        drawn["spinning_friction"],
+        drawn["rolling_friction"],
+    )
+    return PreparedObject(name, kind, body, tuple(float(x) for x in mesh.extents), drawn["density"])
+
+
+def prepare_objects(
+    everyday: Sequence[str],
+    test_shapes: Sequence[str],
+    shapes_dir: Path,
+    physics,
+    seed: int,
+    vhacd_resolution: int,
+    user_meshes: Sequence[tuple[str, object]] = (),
+    cache_dir: Path | None = None,
+    workers=1,
+) -> list[PreparedObject]:
+    """Every object of the trials (everyday, test shapes read from the mesh folder ``shapes_dir``,
+    the user's meshes), decompositions cached (computed on ``workers``, a process count or
+    :class:`graspaug.parallel.Workers`), with mass and friction drawn per object from ``physics``
+    (``sim.physics``) and the global ``seed`` (the same for every arm)."""
+    from graspaug.io.meshes import mesh_path, read_mesh
+    from graspaug.parallel import parallel_map
+
+    cache = default_cache_dir() if cache_dir is None else Path(cache_dir)
+    meshes = [(name, "everyday", everyday_mesh(name)) for name in everyday]
+    meshes += [(shape_id, "test_shape", read_mesh(mesh_path(shapes_dir, shape_id))) for shape_id in test_shapes]
+    meshes += [(name, "user", mesh) for name, mesh in user_meshes]
+    names = [name for name, _, _ in meshes]
+    if len(set(names)) != len(names):
+        raise DataError(
+            f"sim: two objects share a name: {sorted({n for n in names if names.count(n) > 1})} "
+            "(rename the user's mesh files)"
+        )
+    work = functools.partial(_prepare_one, physics=physics, seed=seed, vhacd_resolution=vhacd_resolution, cache=cache)
+    return parallel_map(work, meshes, workers, "sim objects")

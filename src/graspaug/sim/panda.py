@@ -50,7 +50,7 @@ class Panda:
             [0, 0, 0],
             physicsClientId=client,
         )
-        pybullet.changeConstraint(gear, gearRatio=-1, erp=0.1, maxForce=50, physicsClientId=client)
+        pybullet.changeConstraint(gear, gearRatio=-1, erp=0.1, maxForce=hand.centering_force, physicsClientId=client)
         for link in FINGER_JOINTS:
             pybullet.changeDynamics(
                 self.body,

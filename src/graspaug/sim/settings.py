@@ -70,6 +70,11 @@ class HandSettings:
         "0.0033 = (2/3)·5 mm, a uniformly pressed contact disc of 5 mm radius (a rubber pad on a rigid "
         "object).",
     )
+    centering_force: float = Field(
+        50.0,
+        gt=0,
+        description="Force limit of the gear that keeps the two fingers symmetric about the grasp center (N).",
+    )
     speed: float = Field(0.25, gt=0, description="Cartesian speed of the grasp center on the way down and up (m/s).")
     transit_speed: float = Field(
         0.5, gt=0, description="Cartesian speed from the rest pose to the pre-grasp pose (m/s)."
@@ -96,6 +101,15 @@ class TrialSettings:
     carry_height: float = Field(0.25, gt=0, description="Grasp center above the bin floor when released (m).")
     carry_speed: float = Field(0.5, gt=0, description="Carrying speed (m/s).")
     release_time: float = Field(1.0, gt=0, description="Wait after opening, before the bin check (s).")
+    position_error: float = Field(
+        0.0,
+        ge=0,
+        description="SD of the error with which the hand reaches a grasp, along each table axis x, y (m): camera-robot "
+        "calibration and control error, drawn per attempt from its drop seed (0: the hand goes where the grasp is).",
+    )
+    angle_error: float = Field(
+        0.0, ge=0, description="SD of the error of the jaw angle about the vertical (rad), drawn as position_error."
+    )
     collision_force: float = Field(
         10.0,
         gt=0,

@@ -46,6 +46,7 @@ class TrialResult:
     planning_time: float | None = None  # s
     candidates: int = 0
     contact_force: float = 0.0  # largest contact force (N) of the robot before the fingers closed
+    hand_error: tuple[float, float, float] = (0.0, 0.0, 0.0)  # where the hand went off the grasp: x, y (m), angle (rad)
     depth: np.ndarray | None = None
     frames: list[tuple[str, np.ndarray]] = field(default_factory=list)
 
@@ -93,19 +94,26 @@ def run_trial(
     sensor: DepthNoise = DepthNoise(),
     record: bool = False,
     obstacles: tuple[Obstacle, ...] = (),
+    placement: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> TrialResult:
     """Drop ``obj`` at the pose drawn from ``drop_seed``, then pick it with ``planner``'s grasp
     on the ``sensor``'s depth image (or the ``scripted`` one: the object's resting position (3,) m
     and quaternion (x, y, z, w) → table-frame grasp center (3,) m and jaw angle rad) and carry
-    it to the bin. ``obstacles`` are static boxes added once the object rests."""
+    it to the bin. ``obstacles`` are static boxes added once the object rests. With ``placement``
+    (position (3,) m, quaternion (x, y, z, w) of the object's body) the object is put there and
+    left to settle instead of dropped (a stable pose on the table, as the rendered datasets have it)."""
     rng = np.random.default_rng(drop_seed)
     with PickScene(layout, hand) as scene:
-        xy = rng.uniform(-settings.drop_offset, settings.drop_offset, size=2)
-        orientation = random_orientation(rng)
-        scene.add_object(obj, [xy[0], xy[1], 1.0], orientation)  # high up to measure its extent in that orientation
-        low, _ = scene.object_bounds()
-        drop = np.array([xy[0], xy[1], 1.0 - low[2] + settings.drop_clearance])
-        scene.move_object(drop, orientation)
+        if placement is None:
+            xy = rng.uniform(-settings.drop_offset, settings.drop_offset, size=2)
+            orientation = random_orientation(rng)
+            scene.add_object(obj, [xy[0], xy[1], 1.0], orientation)  # high up to measure its extent in that pose
+            low, _ = scene.object_bounds()
+            drop = np.array([xy[0], xy[1], 1.0 - low[2] + settings.drop_clearance])
+            scene.move_object(drop, orientation)
+        else:
+            drop = np.asarray(placement[0], dtype=float)
+            scene.add_object(obj, drop, placement[1])
         scene.settle(settings.settle_time)
         for half_extents, position in obstacles:
             scene.add_box(half_extents, position)
@@ -140,6 +148,11 @@ def run_trial(
             center, jaw_angle = scripted(*scene.object_pose())
             center, jaw_angle = np.asarray(center, dtype=float), float(jaw_angle)
         result.grasp_center, result.jaw_angle = tuple(float(x) for x in center), jaw_angle
+        if settings.position_error > 0 or settings.angle_error > 0:  # where the hand really goes
+            error = np.random.default_rng([drop_seed, 2]).normal(size=3)
+            error *= [settings.position_error, settings.position_error, settings.angle_error]
+            result.hand_error = tuple(float(e) for e in error)
+            center, jaw_angle = center + [error[0], error[1], 0.0], jaw_angle + float(error[2])
         start_height = scene.object_pose()[0][2]
 
         robot = scene.robot
