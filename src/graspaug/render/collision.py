@@ -60,7 +60,9 @@ class CollisionChecker:
         palm_clearance: float = 0.0,
     ) -> None:
         if approach_distance < 0 or palm_clearance < 0:
-            raise ValueError(f"approach_distance and palm_clearance must be >= 0, got {approach_distance, palm_clearance}")
+            raise ValueError(
+                f"approach_distance and palm_clearance must be >= 0, got {approach_distance} and {palm_clearance}"
+            )
         self.object = fcl.CollisionObject(mesh_to_BVH(mesh), fcl.Transform())
         self.box_centers, self.box_extents = swept_gripper_boxes(gripper, approach_distance, palm_clearance)
         self.boxes = [fcl.Box(*extents) for extents in self.box_extents]
