@@ -13,6 +13,7 @@ from graspaug.experiments.grasp_calibration import (
     placement,
     run_shape,
     summarize,
+    summary_line,
 )
 from graspaug.render.stable_poses import stable_poses
 from graspaug.sim.objects import body_origin, everyday_mesh
@@ -123,3 +124,5 @@ def test_summary_of_a_hand_made_table():
     assert s["outcomes"]["positive"]["success"] == 3 and s["outcomes"]["negative"]["collision"] == 2
     one_outcome = summarize(table.assign(executed_success=True), n_bootstrap=50, seed=0)
     assert one_outcome["auc_eps"] == {"mean": None, "lo": None, "hi": None}
+    assert "ROC AUC of robust eps n/a" in summary_line(one_outcome)
+    assert "success 0.750 [" in summary_line(s) and "8 grasps on 4 shapes" in summary_line(s)

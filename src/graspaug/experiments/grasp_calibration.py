@@ -262,3 +262,18 @@ def headline(summary: dict) -> dict[str, dict]:
     """The metrics files: name → {mean, lo, hi} for the success rates per label and the ROC AUCs."""
     names = ("success_positive", "success_negative", "auc_eps", "auc_eps_collision_free", "auc_quality", "auc_label")
     return {name: {k: None if v is None else round(float(v), 5) for k, v in summary[name].items()} for name in names}
+
+
+def summary_line(summary: dict) -> str:
+    """One line of a :func:`summarize` result: success per label and the ROC AUCs of ε and of Dex-Net's score,
+    each with its interval ("n/a" where one outcome is missing)."""
+
+    def figure(name: str) -> str:
+        f = summary[name]
+        return "n/a" if f["mean"] is None else f"{f['mean']:.3f} [{f['lo']:.3f}, {f['hi']:.3f}]"
+
+    return (
+        f"{summary['n_grasps']} grasps on {summary['n_shapes']} shapes; success {figure('success_positive')} of "
+        f"positives, {figure('success_negative')} of negatives; ROC AUC of robust eps {figure('auc_eps')}, of eps "
+        f"with colliding grasps at 0 {figure('auc_quality')}"
+    )

@@ -22,6 +22,7 @@ from graspaug.experiments.grasp_calibration import (
     shape_jobs,
     success_by_eps,
     summarize,
+    summary_line,
 )
 from graspaug.io.atomic import atomic_path
 from graspaug.io.meshes import mesh_path, read_mesh
@@ -69,14 +70,4 @@ def run(params: Params) -> None:
         title = f"{len(table)} labelled test grasps executed in the cell"
         label_calibration(by_eps, table, out / "calibration.png", title)
     write_json_files(headline(summary), CALIBRATION_METRICS)
-    p, n, auc = summary["success_positive"], summary["success_negative"], summary["auc_eps"]
-    log.info(
-        "grasp_calibration: success %.3f of positives, %.3f of negatives; ROC AUC of robust eps %.3f [%.3f, %.3f]; "
-        "%.0f s",
-        p["mean"],
-        n["mean"],
-        auc["mean"],
-        auc["lo"],
-        auc["hi"],
-        summary["seconds"],
-    )
+    log.info("grasp_calibration: %s; %.0f s", summary_line(summary), summary["seconds"])
