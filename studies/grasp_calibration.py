@@ -17,12 +17,11 @@ run (it reads ``data/gqcnn/original/index.parquet``, ``data/grasps/original.parq
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import json
 import time
 from pathlib import Path
 
-import yaml
+from _cell import with_changes
 
 from graspaug.config import Params
 from graspaug.experiments.grasp_calibration import choose_grasps, run_calibration, shape_jobs, summarize
@@ -30,16 +29,6 @@ from graspaug.io.meshes import mesh_path, read_mesh
 from graspaug.io.tables import read_table
 from graspaug.paths import SHAPES_DIR, gqcnn_dir, grasps_table
 from graspaug.sim.objects import prepare_objects
-
-
-def with_changes(sim, changes: list[str]):
-    """``sim`` (SimParams) with ``section.key=value`` changes (values in YAML)."""
-    sections: dict[str, dict] = {}
-    for change in changes:
-        key, value = change.split("=", 1)
-        section, name = key.split(".", 1)
-        sections.setdefault(section, {})[name] = yaml.safe_load(value)
-    return dataclasses.replace(sim, **{s: dataclasses.replace(getattr(sim, s), **v) for s, v in sections.items()})
 
 
 def main() -> None:

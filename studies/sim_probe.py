@@ -20,14 +20,13 @@ the missing networks are trained there first with the default ``gqcnn`` params, 
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import functools
 import json
 import time
 from pathlib import Path
 
 import pandas as pd
-import yaml
+from _cell import with_changes
 
 from graspaug.config import Params
 from graspaug.experiments.sim import object_jobs, prepare_objects, run_object, test_shape_ids
@@ -83,16 +82,6 @@ def train_before(models: Path, seeds: list[int], base_size: int, params: Params)
         print(f"# trained s{seed} targeted {base_size}-0: validation AP {result['validation']['ap']:.4f}", flush=True)
 
 
-def with_changes(sim, changes: list[str]):
-    """``sim`` (SimParams) with ``section.key=value`` changes (values in YAML)."""
-    sections: dict[str, dict] = {}
-    for change in changes:
-        key, value = change.split("=", 1)
-        section, name = key.split(".", 1)
-        sections.setdefault(section, {})[name] = yaml.safe_load(value)
-    return dataclasses.replace(sim, **{s: dataclasses.replace(getattr(sim, s), **v) for s, v in sections.items()})
-
-
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2, 3])
@@ -114,9 +103,9 @@ def main() -> None:
     objects = prepare_objects(
         sim.objects, tests, SHAPES_DIR, sim.physics, params.seed, sim.vhacd_resolution, workers=args.workers
     )
-    arms = {"before": ("targeted", 0.0), "antipodal": (None, None)}
+    arms = {"before": ("targeted", 0.0, args.base_size), "antipodal": (None, None, None)}
     seed_dirs = {s: args.models / f"s{s}" for s in args.seeds}
-    jobs = object_jobs(objects, arms, args.base_size, seed_dirs, attempts, params.seed, 0)
+    jobs = object_jobs(objects, arms, seed_dirs, attempts, params.seed, 0)
     start = time.perf_counter()
     work = functools.partial(
         run_object,
