@@ -30,9 +30,9 @@ def choose_grasps(index: pd.DataFrame, n: int, seed: int) -> pd.DataFrame:
     """``n`` datapoints of the test split of the rendered dataset's ``index`` (one row per
     datapoint: ``shape_id``, ``split``, ``label``, …), half labelled positive and half negative
     (negatives fill in for missing positives; fewer than ``n`` only when the split has fewer),
-    spread over as many shapes as possible: within a label,
-    every shape gives its first (seeded random) datapoint before any gives a second. Sorted by
-    shape. Raises ValueError when the test split is empty."""
+    spread over as many shapes as possible: within a label, every shape gives its first (seeded
+    random) datapoint before any gives a second. Sorted by shape. Raises ValueError when the
+    test split is empty."""
     test = index[index.split == "test"]
     if test.empty:
         raise ValueError("the rendered dataset has no test-split datapoints to execute")
@@ -50,9 +50,9 @@ def choose_grasps(index: pd.DataFrame, n: int, seed: int) -> pd.DataFrame:
 
 @dataclass(frozen=True)
 class ShapeGrasps:
-    """One shape's grasps to execute: ``pose`` (4, 4) puts the shape's mesh (own frame) at rest
-    on the table z = 0 per grasp (G, 4, 4); ``centers`` / ``axes`` (G, 3) are the grasps in the
-    mesh's frame; ``rows`` the datapoints' index rows."""
+    """One shape's G grasps to execute: ``poses`` (G, 4, 4), each putting the shape's mesh (own
+    frame) at rest on the table z = 0 in that grasp's stable pose; ``centers`` / ``axes`` (G, 3)
+    are the grasps in the mesh's frame; ``rows`` the datapoints' index rows."""
 
     shape_id: str
     sim_object: object  # graspaug.sim.objects.SimObject
