@@ -26,8 +26,15 @@ from graspaug.experiments.fidelity import distribution_distances, surface_cloud
 from graspaug.generation import ratio_count
 from graspaug.io.meshes import mesh_path, read_mesh
 from graspaug.io.tables import read_table
-from graspaug.paths import SCORES, SHAPES_DIR, generated_index, generated_meshes, gqcnn_dir, gqcnn_seed_dir
-from graspaug.paths import grasps_table
+from graspaug.paths import (
+    SCORES,
+    SHAPES_DIR,
+    generated_index,
+    generated_meshes,
+    gqcnn_dir,
+    gqcnn_seed_dir,
+    grasps_table,
+)
 from graspaug.rng import shape_rng
 
 

@@ -3,6 +3,7 @@
 from dataclasses import dataclass
 
 import numpy as np
+import pandas as pd
 import pytest
 
 from graspaug.generation import (
@@ -68,19 +69,42 @@ def test_targeted_candidates_interleave_groups_and_weights():
     graspable = np.array([3, 2, 1, 0, 0, 0.0])  # top half: 0, 1, 2
     cands = targeted_candidates(z, rare, graspable, 50, 1, 0, [0.5, 0.3])
     by = [(c.selected_by, c.a, c.b, c.alpha) for c in cands]
-    assert by == [
+    assert by == [  # weights cycle along each group's pairs, shifted by one each round
         ("rarity", 3, 4, 0.5),
         ("graspness", 0, 1, 0.5),
-        ("rarity", 5, 4, 0.5),
-        ("graspness", 2, 1, 0.5),
-        ("rarity", 3, 4, 0.3),
-        ("graspness", 0, 1, 0.3),
         ("rarity", 5, 4, 0.3),
         ("graspness", 2, 1, 0.3),
+        ("rarity", 3, 4, 0.3),
+        ("graspness", 0, 1, 0.3),
+        ("rarity", 5, 4, 0.5),
+        ("graspness", 2, 1, 0.5),
     ]
     # a shape in both groups: its pairs are not generated twice
     both = targeted_candidates(z, rare, rare, 50, 1, 0, [0.5])
     assert [(c.selected_by, c.a, c.b) for c in both] == [("rarity", 3, 4), ("rarity", 5, 4)]
+
+
+def test_targeted_and_random_pools_use_each_weight_equally_often():
+    """The two streams share one weight schedule: in every prefix each weight of ``alphas`` comes up as often as
+    the others, within one (per group for the targeted stream, so within two in all)."""
+    from collections import Counter
+
+    rng = np.random.default_rng(3)
+    z, rare, grasp = rng.normal(size=(40, 4)), rng.random(40), rng.random(40)
+    alphas = [0.5, 0.3]
+    targeted = TargetedStream(z, rare, grasp, 75, 2, 3, alphas)
+    random = RandomStream(40, alphas, np.random.default_rng(0))
+    for n in (10, 25, 50):
+        for stream, slack in ((targeted, 2), (random, 1)):
+            counts = Counter(c.alpha for c in stream.take(0, n))
+            assert set(counts) == set(alphas) and max(counts.values()) - min(counts.values()) <= slack, (n, counts)
+
+
+def test_a_pools_makeup_counts_parents_and_weights():
+    from graspaug.generation import pool_makeup
+
+    rows = pd.DataFrame({"parent_a": ["s1", "s1", "s2"], "parent_b": ["s2", "s3", "s3"], "alpha": [0.5, 0.3, 0.5]})
+    assert pool_makeup(rows) == {"distinct_parents": 3, "alphas": {"0.3": 1, "0.5": 2}}
 
 
 def test_random_stream_is_seeded_distinct_and_finite():

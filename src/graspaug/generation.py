@@ -103,13 +103,21 @@ def targeted_candidates(
 ) -> list[Candidate]:
     """Candidates from the shapes above the ``percentile`` in rarity (one group) and in
     graspness (another), each paired with its N-th to (N+K)-th nearest neighbours of its group
-    in latent space. The two groups' lists (each: every pair at the first α, then every pair at
-    the next α, …) are interleaved one by one; a pair and weight already taken is skipped."""
+    in latent space. Each group's list holds every pair once per round, the weights cycling
+    through ``alphas`` along the pairs and shifted by one each round (the random pool's schedule,
+    so both pools use each weight equally often); the two lists are interleaved one by one; a
+    pair and weight already taken is skipped."""
     lists = []
     for name, scores in (("rarity", rarity), ("graspness", graspness)):
         group = above_percentile(scores, percentile)
         pairs = [(int(group[i]), int(group[j])) for i, j in neighbour_pairs(z[group], first, extra)]
-        lists.append([Candidate(a, b, float(alpha), name) for alpha in alphas for a, b in pairs])
+        lists.append(
+            [
+                Candidate(a, b, float(alphas[(k + round_) % len(alphas)]), name)
+                for round_ in range(len(alphas))
+                for k, (a, b) in enumerate(pairs)
+            ]
+        )
     out: list[Candidate] = []
     seen: set[tuple[frozenset[int], float]] = set()
     for k in range(max(len(lst) for lst in lists)):
@@ -314,6 +322,7 @@ def pool_summary(
             "kept": len(kept_t),
             "tried": len(kept_t) + len(rejected_t),
             "kept_share": round(kept_share["targeted"], 4),
+            **pool_makeup(index[index.pool == "targeted"]),
             "by_rarity": int((index.selected_by == "rarity").sum()),
             "by_graspness": int((index.selected_by == "graspness").sum()),
             "k_used": targeted.extra,
@@ -325,11 +334,20 @@ def pool_summary(
             "kept": len(kept_r),
             "tried": len(kept_r) + len(rejected_r),
             "kept_share": round(kept_share["random"], 4),
+            **pool_makeup(index[index.pool == "random"]),
         },
         "rejects": {str(k): int(v) for k, v in reasons.value_counts().sort_index().items()},
         "kept_watertight_one_piece_share": round(float((index.watertight & index.one_piece).mean()), 4),
     }
     return summary, kept_share
+
+
+def pool_makeup(rows) -> dict:
+    """What a pool's kept shapes (their ``index.parquet`` rows: ``parent_a``, ``parent_b``, ``alpha``) are
+    made of: ``distinct_parents`` (base shapes that parent at least one) and ``alphas`` (weight → shapes)."""
+    parents = set(rows.parent_a) | set(rows.parent_b)
+    counts = rows.alpha.value_counts().sort_index()
+    return {"distinct_parents": len(parents), "alphas": {f"{a:g}": int(n) for a, n in counts.items()}}
 
 
 def generate_headline(summary: dict) -> dict[str, float | int]:

@@ -46,7 +46,8 @@ def test_a_pool_of_the_reference_shapes_is_indistinguishable_and_boxes_are_not()
     reference = [surface_cloud(m, 256, rng) for m in spheres]
     again = [surface_cloud(m, 256, rng) for m in spheres]  # the same shapes, other points
     same = distribution_distances(again, reference)
-    assert same["coverage"] == 1.0 and same["mmd"] < 0.002
+    # each shape's nearest is its twin in the other set; MMD is the sampling noise of 256 points (a few mm)
+    assert same["coverage"] == 1.0 and same["one_nna"] == 0.0 and same["mmd"] < 0.005
     boxes = [surface_cloud(trimesh.creation.box((0.1, 0.01, 0.01 * k)), 256, rng) for k in (1, 2, 3, 4)]
     other = distribution_distances(boxes, reference)
-    assert other["one_nna"] == 1.0 and other["mmd"] > 5 * same["mmd"]
+    assert other["one_nna"] == 1.0 and other["coverage"] < 0.5 and other["mmd"] > 3 * same["mmd"]
