@@ -25,10 +25,8 @@ from _cell import with_changes
 
 from graspaug.config import Params
 from graspaug.experiments.grasp_calibration import choose_grasps, run_calibration, shape_jobs, summarize
-from graspaug.io.meshes import mesh_path, read_mesh
 from graspaug.io.tables import read_table
 from graspaug.paths import SHAPES_DIR, gqcnn_dir, grasps_table
-from graspaug.sim.objects import prepare_objects
 
 
 def main() -> None:
@@ -42,12 +40,7 @@ def main() -> None:
     sim = with_changes(params.sim, args.changes)
     start = time.perf_counter()
     chosen = choose_grasps(read_table(gqcnn_dir("original") / "index.parquet"), args.n, params.seed)
-    ids = sorted(chosen.shape_id.unique())
-    meshes = {shape_id: read_mesh(mesh_path(SHAPES_DIR, shape_id)) for shape_id in ids}
-    objects = prepare_objects((), ids, SHAPES_DIR, sim.physics, params.seed, sim.vhacd_resolution, workers=args.workers)
-    jobs = shape_jobs(
-        chosen, read_table(grasps_table("original")), meshes, {o.name: o.body for o in objects}, params.seed
-    )
+    jobs = shape_jobs(chosen, read_table(grasps_table("original")), SHAPES_DIR, sim, params.seed, args.workers)
     prepared = time.perf_counter() - start
     table = run_calibration(jobs, sim, args.workers)
     seconds = time.perf_counter() - start

@@ -129,14 +129,21 @@ def run_shape(job: ShapeGrasps, layout, hand, trial_settings) -> list[dict]:
     return rows
 
 
-def shape_jobs(chosen: pd.DataFrame, grasps: pd.DataFrame, meshes, objects, seed: int) -> list[ShapeGrasps]:
+def shape_jobs(chosen: pd.DataFrame, grasps: pd.DataFrame, shapes_dir, sim, seed: int, workers=1) -> list[ShapeGrasps]:
     """A job per shape of ``chosen`` (:func:`choose_grasps`): ``grasps`` the grasps table
-    (``grasp_id``, ``center_*``, ``axis_*`` per shape, mesh frame), ``meshes`` shape id →
-    trimesh, ``objects`` shape id → SimObject; trial seeds from the global ``seed``, the shape
-    and the datapoint. Stable poses are recomputed from the mesh, as the render stage numbered them."""
+    (``grasp_id``, ``center_*``, ``axis_*`` per shape, mesh frame); the meshes are read from the
+    folder ``shapes_dir`` and made into bodies as the ``sim`` stage makes them (``sim``: the
+    ``sim`` params section; decompositions on ``workers``); trial seeds from the global ``seed``,
+    the shape and the datapoint. Stable poses are recomputed from the mesh, as the render stage
+    numbered them."""
+    from graspaug.io.meshes import mesh_path, read_mesh
     from graspaug.render.stable_poses import stable_poses
-    from graspaug.sim.objects import body_origin
+    from graspaug.sim.objects import body_origin, prepare_objects
 
+    ids = sorted(chosen.shape_id.unique())
+    meshes = {shape_id: read_mesh(mesh_path(shapes_dir, shape_id)) for shape_id in ids}
+    prepared = prepare_objects((), ids, shapes_dir, sim.physics, seed, sim.vhacd_resolution, workers=workers)
+    objects = {o.name: o.body for o in prepared}
     by_id = grasps.set_index(["shape_id", "grasp_id"])
     jobs = []
     for shape_id, rows in chosen.groupby("shape_id", sort=True):

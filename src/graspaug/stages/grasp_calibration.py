@@ -25,13 +25,11 @@ from graspaug.experiments.grasp_calibration import (
     summary_line,
 )
 from graspaug.io.atomic import atomic_path
-from graspaug.io.meshes import mesh_path, read_mesh
 from graspaug.io.tables import read_table, write_csv, write_json, write_json_files
 from graspaug.params.base import params_model
 from graspaug.params.sim import SimParams
 from graspaug.paths import CALIBRATION_METRICS, CALIBRATION_REPORT_DIR, SHAPES_DIR, gqcnn_dir, grasps_table
 from graspaug.plots import label_calibration
-from graspaug.sim.objects import prepare_objects
 from graspaug.stages import StageError
 
 log = logging.getLogger(__name__)
@@ -46,18 +44,12 @@ def run(params: Params) -> None:
         chosen = choose_grasps(read_table(gqcnn_dir("original") / "index.parquet"), cfg.calibration_grasps, params.seed)
     except ValueError as exc:
         raise StageError(f"grasp_calibration: {exc}") from None
-    ids = sorted(chosen.shape_id.unique())
-    meshes = {shape_id: read_mesh(mesh_path(SHAPES_DIR, shape_id)) for shape_id in ids}
-    objects = prepare_objects(
-        (), ids, SHAPES_DIR, cfg.physics, params.seed, cfg.vhacd_resolution, workers=params.workers
-    )
-    bodies = {o.name: o.body for o in objects}
-    jobs = shape_jobs(chosen, read_table(grasps_table("original")), meshes, bodies, params.seed)
+    jobs = shape_jobs(chosen, read_table(grasps_table("original")), SHAPES_DIR, cfg, params.seed, params.workers)
     log.info(
         "grasp_calibration: %d labelled grasps (%d positive) on %d test shapes",
         len(chosen),
         chosen.label.sum(),
-        len(ids),
+        len(jobs),
     )
     table = run_calibration(jobs, cfg, params.workers)
     summary = summarize(table, cfg.n_bootstrap, params.seed)
