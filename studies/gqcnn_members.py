@@ -97,7 +97,7 @@ def main() -> None:
         parser.error(f"--members {args.members} is below gqcnn.members ({cfg.members}) of params.yaml")
     corpora = Corpora(gqcnn_dir("original"), {b: gqcnn_dir(f"gen_{b}") for b in cfg.augment_base_sizes})
     split = load_split(corpora.original, read_table(SHAPES_TABLE), list(gen.base_sizes), cfg.val_shapes, params.seed)
-    variants = seed_variants(gen.base_sizes, gen.ratios, cfg.augment_base_sizes, cfg.ceiling)
+    variants = seed_variants(gen.base_sizes, gen.ratios, cfg.augment_base_sizes, cfg.ceiling, cfg.pools)
     val, test = shapes_datapoints(corpora.original, split.validation)[0], test_set(corpora.original)[0]  # read once
     train_extra_members(params, split, variants, val, test, args.members, args.out, corpora)
     val_labels, test_labels = val.labels, test.labels
@@ -128,7 +128,7 @@ def main() -> None:
         runs = table[table.members == k]
         chosen = choose_ratios(runs, cfg.augment_base_sizes)
         ap = runs.set_index(["pool", "base_size", "ratio", "seed"]).test_ap
-        for c in declared_contrasts(gen.base_sizes, gen.ratios, cfg.augment_base_sizes, chosen):
+        for c in declared_contrasts(gen.base_sizes, gen.ratios, cfg.augment_base_sizes, chosen, cfg.pools):
             per_seed = [sum(w * ap[(*key, s)] for w, key in c.terms) for s in cfg.seeds]
             print(f"k = {k}  {c.name:30s} {fmt(t_interval(per_seed)):32s} SD {np.std(per_seed, ddof=1):.4f}")
     print("\nnetwork test AP by k: ensemble mean over seeds (SD over seeds); the k-th member alone (mean over seeds)")

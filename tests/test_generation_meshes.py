@@ -7,7 +7,7 @@ import trimesh
 
 from graspaug.errors import DataError
 from graspaug.generation import Decoded, pool_size
-from graspaug.generation_meshes import REJECT_COLUMNS, BaseSet, base_ids, generate_pools, tsne_groups
+from graspaug.generation_meshes import REJECT_COLUMNS, BaseSet, ReconSource, base_ids, generate_pools, tsne_groups
 from graspaug.params.generate import GenerateParams
 from graspaug.scores import rarity
 
@@ -59,3 +59,59 @@ def test_generate_pools_reports_an_exhausted_pool():
     base, cfg = make_base(3), GenerateParams(base_sizes=(3,), ratios=(1.0, 2.0), alphas=(0.5,))
     with pytest.raises(DataError, match=r"generate 3, \w+ pool: only"):
         generate_pools(base, cfg, 0, lambda batch: [Decoded(c, None, None, "bad") for c in batch], k=2)
+
+
+def test_the_recon_pool_reconstructs_the_real_pool_in_order_and_skips_a_failed_decode():
+    base, cfg = make_base(), GenerateParams(base_sizes=(10,), ratios=(0.0, 0.5), n_examples=2)
+    real = make_base(8, seed=1)
+    real = BaseSet(np.array([f"real{i}" for i in range(8)]), real.z, real.rarity, real.graspness, real.pitch)
+
+    def second_fails(batch):
+        return [
+            Decoded(c, np.zeros(1, np.uint8), None, "tiny") if c.a == 1 else Decoded(c, None, BOX, None) for c in batch
+        ]
+
+    out = generate_pools(base, cfg, 0, some_rejected, 3, ("targeted", "recon"), ReconSource(real, second_fails))
+    recon = out.index[out.index.pool == "recon"]
+    assert list(out.index.pool.unique()) == ["targeted", "recon"]  # random was not asked for
+    assert list(recon.parent_a) == list(recon.parent_b) == ["real0", "real2", "real3", "real4", "real5"]
+    assert (recon.alpha == 0).all() and (recon.selected_by == "recon").all()
+    assert list(recon.shape_id) == [f"gen_10_c{k:04d}" for k in range(5)]
+    np.testing.assert_array_equal(np.stack(recon.z.to_numpy()), real.z[[0, 2, 3, 4, 5]])
+    assert out.summary["recon"]["tried"] == 6 and out.summary["recon"]["distinct_parents"] == 5
+    assert list(out.rejects.parent_a[out.rejects.pool == "recon"]) == ["real1"]
+    with pytest.raises(DataError, match="the recon pool needs the real pool's shapes"):
+        generate_pools(base, cfg, 0, some_rejected, 3, ("targeted", "recon"))
+
+
+def test_a_recon_shape_is_the_autoencoders_reconstruction_meshed_at_its_own_scale():
+    """The recon pool's grid of a shape is decode(encode(its voxels)), cleaned as every decode is."""
+    import torch
+
+    from graspaug.generation import ReconStream
+    from graspaug.generation_meshes import mesh_batches
+    from graspaug.geometry.from_voxels import clean_occupancy
+    from graspaug.geometry.settings import DecodeSettings
+    from graspaug.nets.ae_critic import AEConfig, AutoEncoder
+    from graspaug.training.autoencoder import decode, encode
+
+    torch.manual_seed(0)
+    ae = AutoEncoder(AEConfig(resolution=16, z_dim=8, base_width=4, top_width=16))
+    with torch.no_grad():  # untrained: a bias that leaves most of the grid occupied, varying with the latent
+        ae.decoder.net[-1].bias.fill_(1.0)
+    grids = torch.zeros(3, 1, 16, 16, 16)
+    grids[:, :, 4:12, 5:11, 6:10] = 1
+    z = encode(ae, grids, torch.device("cpu"))
+    pitch = np.array([0.002, 0.003, 0.004])
+    real = BaseSet(np.array(["a", "b", "c"]), z, np.zeros(3), np.zeros(3), pitch)
+    settings = DecodeSettings(threshold=0.5, min_voxels=1, min_main_share=0.01, smoothing_iterations=0)
+    run_batch = mesh_batches(ae, torch.device("cpu"), real, settings, 1, "test")
+    decoded = run_batch(ReconStream(3).take(0, 3))
+    probability = decode(ae, z, torch.device("cpu"))
+    for k, d in enumerate(decoded):
+        grid = clean_occupancy(probability[k], 0.5, settings.opening, 1, 0.01)
+        np.testing.assert_array_equal(d.packed_grid, np.packbits(grid.occupancy))
+        assert d.mesh is not None and d.reason is None  # meshed at its own pitch: extent in voxels × pitch
+        filled = np.argwhere(grid.occupancy)
+        voxels_across = filled.max(0) - filled.min(0) + 1
+        np.testing.assert_allclose(np.sort(d.mesh.extents), np.sort(voxels_across * pitch[k]), rtol=0.2)

@@ -139,12 +139,18 @@ def test_dvc_repro_score(tiny_repo):
     assert "positive" in shown.stdout and "graspness" in shown.stdout
 
 
+def summary_rejects(work, base_size: int, pool: str) -> int:
+    rejects = pd.read_parquet(work / f"data/generated/{base_size}/rejects.parquet")
+    return int((rejects.pool == pool).sum())
+
+
 def test_dvc_repro_generate_and_its_grasps(tiny_repo):
     import json
 
     import trimesh
 
     from graspaug.generation import draw_base_sets
+    from graspaug.training.gqcnn_data import load_split
 
     work, env = tiny_repo
     run(["dvc", "repro", "grasps_generated"], work, env)
@@ -157,22 +163,29 @@ def test_dvc_repro_generate_and_its_grasps(tiny_repo):
     assert set(drawn[4]) < set(base[6].shape_id) <= set(shapes.shape_id[shapes.split == "train"])
     for b in (6,):
         index = pd.read_parquet(work / f"data/generated/{b}/index.parquet")
-        for pool in ("targeted", "random"):
+        for pool in ("targeted", "random", "recon"):
             part = index[index.pool == pool]
             assert list(part.order) == list(range(b))  # max ratio 1 -> B shapes, in order
-        assert set(index.parent_a) | set(index.parent_b) <= set(base[b].shape_id)
+        mixed = index[index.pool != "recon"]
+        assert set(mixed.parent_a) | set(mixed.parent_b) <= set(base[b].shape_id)
+        # recon: the real pool's shapes in the experiment's order, each decoded alone (a failed decode is skipped)
+        recon = index[index.pool == "recon"]
+        real_pool = load_split(work / "data/gqcnn/original", shapes, [4, 6], 2, 0).real_pool
+        assert (recon.parent_a == recon.parent_b).all() and (recon.alpha == 0).all()
+        assert list(recon.parent_a) == [s for s in real_pool if s in set(recon.parent_a)]
+        assert real_pool.index(recon.parent_a.iloc[-1]) < b + summary_rejects(work, b, "recon")
         pairs = index.apply(lambda r: (r.pool, frozenset((r.parent_a, r.parent_b)), r.alpha), axis=1)
         assert pairs.is_unique  # no shape generated twice
         assert index.alpha.between(0, 0.5).all() and index.watertight.all()
-        assert set(index.selected_by) <= {"rarity", "graspness", "random"}
+        assert set(index.selected_by) <= {"rarity", "graspness", "random", "recon"}
         for shape_id in index.shape_id[:3]:
             mesh = trimesh.load(work / f"data/generated/{b}/meshes/{shape_id}.obj", force="mesh")
             assert mesh.is_watertight
         summary = json.loads((work / f"reports/generate/{b}/summary.json").read_text())
-        assert summary["targeted"]["kept"] == summary["random"]["kept"] == b
-        assert json.loads((work / f"metrics/generate/{b}.json").read_text())["shapes"] == 2 * b
+        assert summary["targeted"]["kept"] == summary["random"]["kept"] == summary["recon"]["kept"] == b
+        assert json.loads((work / f"metrics/generate/{b}.json").read_text())["shapes"] == 3 * b
         rejects = pd.read_parquet(work / f"data/generated/{b}/rejects.parquet")
-        assert summary["targeted"]["tried"] + summary["random"]["tried"] == 2 * b + len(rejects)
+        assert sum(summary[p]["tried"] for p in ("targeted", "random", "recon")) == 3 * b + len(rejects)
         assert sum(summary["rejects"].values()) == len(rejects)
         grasps = pd.read_parquet(work / f"data/grasps/gen_{b}.parquet")
         assert set(grasps.shape_id) <= set(index.shape_id)
@@ -209,7 +222,7 @@ def test_dvc_repro_render(tiny_repo):
             generated = pd.read_parquet(work / f"data/generated/{corpus[4:]}/index.parquet")
             assert set(index.shape_id) <= set(generated.shape_id) and (index.base_size == int(corpus[4:])).all()
             assert (
-                set(index.pool) <= {"targeted", "random"}
+                set(index.pool) <= {"targeted", "random", "recon"}
                 and index.order.notna().all()
                 and (index.split == "train").all()
             )
@@ -225,14 +238,14 @@ def test_dvc_repro_gqcnn_matrix_and_report(tiny_repo):
     run(["dvc", "repro", "report"], work, env)
     names = (
         ["targeted/4-0"]
-        + [f"{p}/6-{r:g}" for p in ("targeted", "random", "real") for r in (0.5, 1.0)]
+        + [f"{p}/6-{r:g}" for p in ("targeted", "random", "real", "recon") for r in (0.5, 1.0)]
         + ["targeted/6-0", "ceiling"]
     )
     digests, validation = {}, {}
     for seed in (0, 1):
         assert set(json.loads((work / f"metrics/gqcnn/s{seed}.json").read_text())) == {"test_ap", "val_ap"}
         metrics = json.loads((work / f"reports/gqcnn/networks/s{seed}.json").read_text())["networks"]
-        assert set(metrics) == {"targeted", "random", "real", "ceiling"} and set(metrics["targeted"]["6"]) == {
+        assert set(metrics) == {"targeted", "random", "real", "recon", "ceiling"} and set(metrics["targeted"]["6"]) == {
             "0",
             "0.5",
             "1",
@@ -277,6 +290,8 @@ def test_dvc_repro_gqcnn_matrix_and_report(tiny_repo):
     assert len(validation[0] | validation[1]) == 1
     real = json.loads((work / "models/gqcnn/s0/real/6-1/summary.json").read_text())["train"]
     assert real["original_shapes"] == 12 and real["generated_shapes_asked"] == 0
+    recon = json.loads((work / "models/gqcnn/s0/recon/6-1/summary.json").read_text())["train"]
+    assert recon["original_shapes"] == recon["generated_shapes_asked"] == 6 and 1 <= recon["generated_shapes"] <= 6
     targeted = json.loads((work / "models/gqcnn/s0/targeted/6-1/summary.json").read_text())["train"]
     assert (
         targeted["generated_shapes_asked"] == 6
@@ -292,6 +307,8 @@ def test_dvc_repro_gqcnn_matrix_and_report(tiny_repo):
         "targeted_vs_none@6",
         "targeted_vs_random@6",
         "targeted_vs_real@6",
+        "recon_vs_real@6",
+        "targeted_vs_recon@6",
     }
     assert ("targeted_vs_none_chosen@6" in ap["contrasts"]) == ("6" in ap["chosen_ratio"])
     for c in ap["contrasts"].values():
@@ -554,7 +571,7 @@ def test_every_declared_plot_renders(tiny_repo):
         for file, column in series:
             assert any(draws(d, file, column) for d in datapoints), f"{name!r} does not draw {column} of {file}"
         if "ap_table.csv" in series[0][0]:  # long format: one line per pool
-            assert {d["pool"] for d in datapoints} >= {"targeted", "random", "real"}, name
+            assert {d["pool"] for d in datapoints} >= {"targeted", "random", "real", "recon"}, name
 
     run(["dvc", "plots", "show"], work, env)
     page = (work / "dvc_plots/index.html").read_text()

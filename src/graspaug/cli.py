@@ -162,11 +162,13 @@ stage_command(
     help="Generate new shapes for one base set of B train shapes (paper Section III-C): pair its rare shapes, and "
     "separately its graspable ones, with their N-th to (N+K)-th nearest neighbours in latent space, decode the "
     "interpolated latents with the AE-Critic and mesh them (fill, opening, marching cubes, Humphrey smoothing); also a "
-    "random-pair pool of the same size as the baseline. Each pool holds max(ratios) × B shapes in order: the first "
+    "random-pair pool of the same size as the baseline, and the recon pool: the real pool's shapes (as the GQ-CNN "
+    "experiment orders them, from the rendered corpus) decoded from their own latents, the same way (gqcnn.pools says "
+    "which pools). Each pool holds max(ratios) × B shapes in order: the first "
     "round(R × B) are the set for ratio R.\n\nWrites `data/generated/<B>/` (`meshes/*.obj`, `index.parquet`, "
     "`rejects.parquet`, `base.parquet`), `metrics/generate/<B>.json` and "
     "`reports/generate/<B>/{summary.json,pairs.png,tsne.png}`.\n\n{params}\n\nAlso `score.k` (rarity on the base "
-    "set), `seed`, `device`, `n_jobs`.",
+    "set), `gqcnn.pools`, `gqcnn.val_shapes` (the real pool), `seed`, `device`, `n_jobs`.",
     cls=_with_params("generate", "generate"),
 )
 def generate_command(
@@ -259,12 +261,15 @@ stage_command(
     "The paper's GQ-CNN experiment in one place: test AP of every network of every seed (pooled and per test object, "
     "with validation AP), contrasts declared before any network is read (real_data: the positive control; "
     "targeted_vs_none, at the mean over ratios and at the ratio chosen on validation; targeted_vs_random; "
-    "targeted_vs_real), each with a 95% t-interval over seeds and a 95% bootstrap interval over test objects, AP vs "
+    "targeted_vs_real; recon_vs_real: what decoding costs a real shape; targeted_vs_recon: what interpolation and "
+    "selection add to a decoded shape; each pool contrast only when both pools are in gqcnn.pools), each with a "
+    "95% t-interval over seeds and a 95% bootstrap interval over test objects, AP vs "
     "ratio (Fig. 7), the per-object AP change of the validation-chosen ratio by rarity and graspness (Fig. 8), a t-SNE "
     "of original and generated latents by graspness (Fig. 1), and the verdicts in words.\n\nWrites "
     "`metrics/ap/<contrast>.json` (mean, lo, hi), `reports/gqcnn/{ap.json,report.md,ap_table.csv,ap_vs_ratio.png,"
     "improvement_by_score.png,tsne_graspness.png}`.\n\nReads "
-    "params `generate.base_sizes`, `generate.ratios`, `gqcnn.seeds`, `gqcnn.augment_base_sizes`, `gqcnn.ceiling`, "
+    "params `generate.base_sizes`, `generate.ratios`, `gqcnn.seeds`, `gqcnn.augment_base_sizes`, `gqcnn.pools`, "
+    "`gqcnn.ceiling`, "
     "`gqcnn.val_shapes`, `score.k`, `embed.perplexity`, `seed`.",
 )
 

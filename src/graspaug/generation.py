@@ -216,6 +216,15 @@ class RandomStream(CandidateStream):
             )
 
 
+class ReconStream(CandidateStream):
+    """The ``recon`` pool's stream: shape k of a list of real shapes reconstructed alone
+    (parents k and k, weight 0), in the list's order, so a rejected decode is replaced by the next shape."""
+
+    def __init__(self, n_shapes: int) -> None:
+        super().__init__()
+        self._append([Candidate(k, k, 0.0, "recon") for k in range(n_shapes)])
+
+
 class HasReason(Protocol):
     reason: str | None
 
@@ -258,23 +267,31 @@ class Decoded:
     reason: str | None
 
 
+ID_LETTERS = {"targeted": "t", "random": "r", "recon": "c", "blend": "b"}  # gen_<B>_<letter><order>
+
+
 def pool_tables(
-    base: np.ndarray, z: np.ndarray, pools: dict[str, tuple[list[Decoded], list[Decoded]]], base_size: int
+    sources: dict[str, tuple[np.ndarray, np.ndarray]],
+    pools: dict[str, tuple[list[Decoded], list[Decoded]]],
+    base_size: int,
 ) -> tuple[list[dict], list[dict]]:
-    """Rows of ``index.parquet`` (one per kept shape, in pool order) and of ``rejects.parquet``
-    for the pools (name → (kept, rejected)) of base set ``base`` (shape ids) with latents ``z`` (B, d)."""
+    """Rows of ``index.parquet`` (one per kept shape, pools in the order of ``pools``, each in pool
+    order) and of ``rejects.parquet`` for the pools (name → (kept, rejected)) of base size
+    ``base_size``; ``sources``: pool name → (shape ids (P,), latents (P, d)) its candidates' parent
+    indices point into (the base set; the real pool for ``recon``)."""
     rows, rejects = [], []
     for pool, (kept, rejected) in pools.items():
+        ids, z = sources[pool]
         for order, d in enumerate(kept):
             c, m = d.candidate, d.mesh
             rows.append(
                 {
-                    "shape_id": f"gen_{base_size}_{pool[0]}{order:04d}",
+                    "shape_id": f"gen_{base_size}_{ID_LETTERS[pool]}{order:04d}",
                     "base_size": base_size,
                     "pool": pool,
                     "order": order,
-                    "parent_a": base[c.a],
-                    "parent_b": base[c.b],
+                    "parent_a": ids[c.a],
+                    "parent_b": ids[c.b],
                     "alpha": c.alpha,
                     "selected_by": c.selected_by,
                     "z": ((1 - c.alpha) * z[c.a] + c.alpha * z[c.b]).astype(np.float32),
@@ -290,12 +307,11 @@ def pool_tables(
                     "origin": "generated",
                 }
             )
-    for pool, (_, rejected) in pools.items():
         rejects += [
             {
                 "pool": pool,
-                "parent_a": base[d.candidate.a],
-                "parent_b": base[d.candidate.b],
+                "parent_a": ids[d.candidate.a],
+                "parent_b": ids[d.candidate.b],
                 "alpha": d.candidate.alpha,
                 "selected_by": d.candidate.selected_by,
                 "reason": d.reason,
@@ -309,36 +325,31 @@ def pool_summary(
     base_size: int, needed: int, pools: dict, targeted: TargetedStream, index, reject_rows: list[dict]
 ) -> tuple[dict, dict[str, float]]:
     """The ``generate`` stage's metrics for the pools (name → (kept, rejected) Decoded lists), and
-    each pool's share of usable decodes."""
+    each pool's share of usable decodes. Every pool gets ``kept``, ``tried``, ``kept_share`` and
+    its :func:`pool_makeup`; the targeted pool also how its stream was widened."""
     import pandas as pd
 
     reasons = pd.Series([r["reason"].split(":")[0] for r in reject_rows], dtype=object)
-    kept_share = {name: len(kept) / (len(kept) + len(rejected)) for name, (kept, rejected) in pools.items()}
-    (kept_t, rejected_t), (kept_r, rejected_r) = pools["targeted"], pools["random"]
-    summary = {
-        "base_size": base_size,
-        "pool_size": needed,
-        "targeted": {
-            "kept": len(kept_t),
-            "tried": len(kept_t) + len(rejected_t),
-            "kept_share": round(kept_share["targeted"], 4),
-            **pool_makeup(index[index.pool == "targeted"]),
-            "by_rarity": int((index.selected_by == "rarity").sum()),
-            "by_graspness": int((index.selected_by == "graspness").sum()),
-            "k_used": targeted.extra,
-            "alphas_used": targeted.alphas,
-            "percentile_used": targeted.percentile,
-            "widening": targeted.notes,
-        },
-        "random": {
-            "kept": len(kept_r),
-            "tried": len(kept_r) + len(rejected_r),
-            "kept_share": round(kept_share["random"], 4),
-            **pool_makeup(index[index.pool == "random"]),
-        },
-        "rejects": {str(k): int(v) for k, v in reasons.value_counts().sort_index().items()},
-        "kept_watertight_one_piece_share": round(float((index.watertight & index.one_piece).mean()), 4),
+    kept_share = {name: len(kept) / max(1, len(kept) + len(rejected)) for name, (kept, rejected) in pools.items()}
+    summary: dict = {"base_size": base_size, "pool_size": needed}
+    for name, (kept, rejected) in pools.items():
+        summary[name] = {
+            "kept": len(kept),
+            "tried": len(kept) + len(rejected),
+            "kept_share": round(kept_share[name], 4),
+            **pool_makeup(index[index.pool == name]),
+        }
+    targeted_rows = index[index.pool == "targeted"]
+    summary["targeted"] |= {
+        "by_rarity": int((targeted_rows.selected_by == "rarity").sum()),
+        "by_graspness": int((targeted_rows.selected_by == "graspness").sum()),
+        "k_used": targeted.extra,
+        "alphas_used": targeted.alphas,
+        "percentile_used": targeted.percentile,
+        "widening": targeted.notes,
     }
+    summary["rejects"] = {str(k): int(v) for k, v in reasons.value_counts().sort_index().items()}
+    summary["kept_watertight_one_piece_share"] = round(float((index.watertight & index.one_piece).mean()), 4)
     return summary, kept_share
 
 
@@ -351,10 +362,10 @@ def pool_makeup(rows) -> dict:
 
 
 def generate_headline(summary: dict) -> dict[str, float | int]:
-    """The stage's metrics from its :func:`pool_summary`: generated ``shapes`` kept (both pools) and the
+    """The stage's metrics from its :func:`pool_summary`: generated ``shapes`` kept (every pool) and the
     share of decoded shapes kept (``kept``)."""
-    kept = summary["targeted"]["kept"] + summary["random"]["kept"]
-    tried = summary["targeted"]["tried"] + summary["random"]["tried"]
+    pools = [v for v in summary.values() if isinstance(v, dict) and "tried" in v]
+    kept, tried = sum(p["kept"] for p in pools), sum(p["tried"] for p in pools)
     return {"shapes": kept, "kept": round(kept / tried, 4) if tried else None}
 
 

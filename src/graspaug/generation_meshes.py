@@ -21,6 +21,7 @@ from graspaug.generation import (
     Decoded,
     PoolExhausted,
     RandomStream,
+    ReconStream,
     TargetedStream,
     base_scores_table,
     draw_base_sets,
@@ -108,30 +109,55 @@ def mesh_batches(
 
 
 Pools = dict[str, tuple[list[Decoded], list[Decoded]]]
+GENERATED_POOLS = ("targeted", "random", "recon")  # the pools generate can make, in index order
+
+
+@dataclass(frozen=True)
+class ReconSource:
+    """What the ``recon`` pool reconstructs: ``shapes``, the real pool's shapes in its order (a
+    :class:`BaseSet`: ids, latents, pitches), and ``run_batch``, :func:`mesh_batches` over them."""
+
+    shapes: BaseSet
+    run_batch: Callable[[list[Candidate]], list[Decoded]]
 
 
 def fill_pools(
-    base: BaseSet, cfg: GenerateParams, seed: int, run_batch: Callable[[list[Candidate]], list[Decoded]]
+    base: BaseSet,
+    cfg: GenerateParams,
+    seed: int,
+    run_batch: Callable[[list[Candidate]], list[Decoded]],
+    pools: Sequence[str] = ("targeted", "random"),
+    recon: ReconSource | None = None,
 ) -> tuple[Pools, TargetedStream, int]:
-    """Fill the targeted pool, then the random one (seeded by ``[seed, BASE_SEED, B]``), each to
-    ``pool_size(cfg.ratios, B)`` kept shapes with ``run_batch`` (:func:`mesh_batches`).
+    """Fill each of ``pools`` (of :data:`GENERATED_POOLS`; the targeted one always) to
+    ``pool_size(cfg.ratios, B)`` kept shapes: ``targeted`` and ``random`` (seeded by
+    ``[seed, BASE_SEED, B]``) with ``run_batch`` (:func:`mesh_batches` over the base set),
+    ``recon`` from ``recon`` (the real pool's shapes, each decoded from its own latent).
 
-    Returns (pools: name → (kept, rejected) Decoded lists, the targeted stream as widened, shapes
-    per pool); a :class:`graspaug.errors.DataError` if a pool's candidates run out first.
+    Returns (pools: name → (kept, rejected) Decoded lists, in :data:`GENERATED_POOLS` order, the
+    targeted stream as widened, shapes per pool); a :class:`graspaug.errors.DataError` if a pool's
+    candidates run out first, or ``recon`` is asked for without its source.
     """
     base_size = len(base.ids)
     needed = pool_size(cfg.ratios, base_size)
     targeted_stream = TargetedStream(
         base.z, base.rarity, base.graspness, cfg.percentile, cfg.first_neighbour, cfg.extra_neighbours, cfg.alphas
     )
-    random_stream = RandomStream(base_size, cfg.alphas, np.random.default_rng([seed, BASE_SEED, base_size]))
-    pools = {}
-    for name, stream in (("targeted", targeted_stream), ("random", random_stream)):
+    if "recon" in pools and recon is None:
+        raise DataError(f"generate {base_size}: the recon pool needs the real pool's shapes")
+    streams = {
+        "targeted": (targeted_stream, run_batch),
+        "random": (RandomStream(base_size, cfg.alphas, np.random.default_rng([seed, BASE_SEED, base_size])), run_batch),
+        "recon": (ReconStream(len(recon.shapes.ids)), recon.run_batch) if recon else None,
+    }
+    out = {}
+    for name in (p for p in GENERATED_POOLS if p == "targeted" or p in pools):
+        stream, runner = streams[name]
         try:
-            pools[name] = fill_pool(stream, needed, run_batch)
+            out[name] = fill_pool(stream, needed, runner)
         except PoolExhausted as exc:
             raise DataError(f"generate {base_size}, {name} pool: {exc}") from None
-    return pools, targeted_stream, needed
+    return out, targeted_stream, needed
 
 
 @dataclass(frozen=True)
@@ -162,13 +188,22 @@ class GeneratedSet:
 
 
 def generated_set(
-    base: BaseSet, pools: Pools, targeted: TargetedStream, needed: int, k: int, n_examples: int
+    base: BaseSet,
+    pools: Pools,
+    targeted: TargetedStream,
+    needed: int,
+    k: int,
+    n_examples: int,
+    recon_shapes: BaseSet | None = None,
 ) -> GeneratedSet:
     """The :class:`GeneratedSet` of ``pools`` (:func:`fill_pools`: the pools, the targeted stream
     and the shapes per pool) for ``base``; ``k``: the rarity's neighbours; ``n_examples``: targeted
-    decodes to picture."""
+    decodes to picture; ``recon_shapes``: the shapes the recon pool reconstructs."""
     base_size = len(base.ids)
-    rows, reject_rows = pool_tables(base.ids, base.z, pools, base_size)
+    sources = {name: (base.ids, base.z) for name in pools}
+    if recon_shapes is not None:
+        sources["recon"] = (recon_shapes.ids, recon_shapes.z)
+    rows, reject_rows = pool_tables(sources, pools, base_size)
     index = pd.DataFrame(rows)
     index["rarity_vs_base"] = rarity(base.z, k, query=np.stack(index.z.to_numpy()))
     base_table = base_scores_table(base.ids, base.rarity, base.graspness, targeted.percentile)
@@ -177,7 +212,7 @@ def generated_set(
         index,
         pd.DataFrame(reject_rows, columns=REJECT_COLUMNS),
         base_table,
-        pools["targeted"][0] + pools["random"][0],
+        [d for kept, _ in pools.values() for d in kept],
         summary,
         kept_share,
         example_decodes(pools, n_examples),
@@ -191,16 +226,22 @@ def generated_set(
 
 
 def generate_pools(
-    base: BaseSet, cfg: GenerateParams, seed: int, run_batch: Callable[[list[Candidate]], list[Decoded]], k: int
+    base: BaseSet,
+    cfg: GenerateParams,
+    seed: int,
+    run_batch: Callable[[list[Candidate]], list[Decoded]],
+    k: int,
+    pools: Sequence[str] = ("targeted", "random"),
+    recon: ReconSource | None = None,
 ) -> GeneratedSet:
     """:func:`fill_pools` then :func:`generated_set` (``k``: the rarity's neighbours)."""
-    pools, targeted, needed = fill_pools(base, cfg, seed, run_batch)
-    return generated_set(base, pools, targeted, needed, k, cfg.n_examples)
+    filled, targeted, needed = fill_pools(base, cfg, seed, run_batch, pools, recon)
+    return generated_set(base, filled, targeted, needed, k, cfg.n_examples, recon.shapes if recon else None)
 
 
 def example_decodes(pools: Pools, n_examples: int) -> list[Decoded]:
     """The decodes to picture: the targeted pool's first ``n_examples`` kept, then the random pool's first 2."""
-    return pools["targeted"][0][:n_examples] + pools["random"][0][:2]
+    return pools["targeted"][0][:n_examples] + pools.get("random", ([], []))[0][:2]
 
 
 def tsne_groups(base: BaseSet, index: pd.DataFrame, perplexity: float, seed: int) -> tuple[np.ndarray, list[str]]:

@@ -192,7 +192,7 @@ def crop_grid(
 
 def ap_vs_ratio(table: pd.DataFrame, path: str | os.PathLike, title: str) -> None:
     """The paper's Fig. 7: test AP against the augmentation ratio, one panel per base size, one
-    line per pool (targeted solid, random dashed, real dotted), each starting from the base
+    line per pool (targeted solid, random dashed, real dotted, recon dash-dotted), each starting from the base
     set alone at ratio 0, with 95% t-interval error bars; the ceiling (every train shape) as a
     grey band. ``table``: :func:`graspaug.experiments.ap.network_table` (columns ``pool``,
     ``base_size``, ``ratio``, ``test_ap``, ``test_ap_ci``)."""
@@ -202,7 +202,12 @@ def ap_vs_ratio(table: pd.DataFrame, path: str | os.PathLike, title: str) -> Non
     fig, axes = plt.subplots(
         1, max(len(bases), 1), figsize=(3.6 * max(len(bases), 1) + 0.8, 3.8), sharey=True, squeeze=False
     )
-    styles = {"targeted": ("-", "tab:blue"), "random": ("--", "tab:orange"), "real": (":", "tab:green")}
+    styles = {
+        "targeted": ("-", "tab:blue"),
+        "random": ("--", "tab:orange"),
+        "real": (":", "tab:green"),
+        "recon": ("-.", "tab:purple"),
+    }
     ceiling = table[table.pool == "ceiling"]
     for ax, base in zip(axes[0], bases):
         rows = networks[networks.base_size == base]
@@ -254,7 +259,7 @@ def validation_curves(history, path: str | os.PathLike, title: str) -> None:
     plt = _pyplot()
     fig, ax = plt.subplots(figsize=(7.2, 4.6))
     for name, rows in history.groupby("network", sort=True):
-        style = "--" if name.startswith("random") else (":" if name.startswith("real") else "-")
+        style = {"random": "--", "real": ":", "recon": "-."}.get(name.split("/")[0], "-")
         (line,) = ax.plot(rows.step, rows.val_ap, linestyle=style, linewidth=1.2, label=name)
         if rows.val_ap.notna().any():
             best = rows.loc[rows.val_ap.idxmax()]

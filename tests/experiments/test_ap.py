@@ -19,7 +19,18 @@ def test_the_declared_contrasts():
         "targeted_vs_none_chosen@50",
         "targeted_vs_random@50",
         "targeted_vs_real@50",
+        "recon_vs_real@50",
+        "targeted_vs_recon@50",
     ]
+    three_pools = declared_contrasts([50, 200], [0.0, 1.0], [50], {}, ("targeted", "random", "real"))
+    assert [c.name for c in three_pools][-2:] == ["targeted_vs_random@50", "targeted_vs_real@50"]
+    decoding = {k: w for w, k in declared_contrasts([50, 200], [0.0, 0.5, 1.0], [50], {})[-2].terms}
+    assert decoding == {
+        ("recon", 50, 0.5): 0.5,
+        ("recon", 50, 1.0): 0.5,
+        ("real", 50, 0.5): -0.5,
+        ("real", 50, 1.0): -0.5,
+    }
     contrasts = {c.name: c for c in declared_contrasts([50, 200], [0.0, 0.5, 1.0], [50], {50: 0.5})}
     assert dict((k, w) for w, k in contrasts["real_data"].terms) == {
         ("targeted", 200, 0.0): 1.0,
@@ -34,8 +45,10 @@ def test_the_declared_contrasts():
         "targeted/50-1",
         "random/50-1",
         "real/50-1",
+        "recon/50-1",
         "ceiling",
     ]
+    assert "recon/50-1" not in [v.name for v in seed_variants([50], [0.0, 1.0], [50], False, ("targeted", "real"))]
 
 
 def test_gain_sentences_give_shares_and_call_a_gap_within_the_ceilings_interval_no_gap():
@@ -124,14 +137,15 @@ def test_evaluate_networks_is_the_report_chain_step_by_step(tmp_path):
     import pandas as pd
 
     generate = SimpleNamespace(base_sizes=[10, 20], ratios=[0.0, 1.0])
-    gqcnn = SimpleNamespace(augment_base_sizes=[10], ceiling=True, val_shapes=1)
-    variants = seed_variants(generate.base_sizes, generate.ratios, gqcnn.augment_base_sizes, gqcnn.ceiling)
+    gqcnn = SimpleNamespace(augment_base_sizes=[10], ceiling=True, val_shapes=1, pools=("targeted", "recon", "real"))
+    variants = seed_variants(generate.base_sizes, generate.ratios, gqcnn.augment_base_sizes, gqcnn.ceiling, gqcnn.pools)
     seed_dirs, index = _seed_folders(tmp_path, variants)
     ev = ap.evaluate_networks(seed_dirs, tmp_path / "original", generate, gqcnn, seed=5, n_resamples=50)
 
     runs = collect(seed_dirs, variants)
     chosen = ap.choose_ratios(runs, gqcnn.augment_base_sizes)
-    contrasts = declared_contrasts(generate.base_sizes, generate.ratios, gqcnn.augment_base_sizes, chosen)
+    contrasts = declared_contrasts(generate.base_sizes, generate.ratios, gqcnn.augment_base_sizes, chosen, gqcnn.pools)
+    assert [c.name for c in contrasts][-3:] == ["targeted_vs_real@10", "recon_vs_real@10", "targeted_vs_recon@10"]
     rows = ap.test_rows(seed_dirs[0])
     labels, object_ids = index.label.to_numpy()[rows], index.shape_id.to_numpy()[rows]
     results = ap.evaluate_contrasts(contrasts, runs, seed_dirs, labels, object_ids, n_resamples=50, seed=5)

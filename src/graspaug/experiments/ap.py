@@ -12,7 +12,10 @@ network is read:
   shapes must help);
 * ``targeted_vs_none@B``: mean over R > 0 of AP(targeted, B, R) − AP(B, 1:0);
 * ``targeted_vs_none_chosen@B``: the same at the ratio chosen on mean validation AP;
-* ``targeted_vs_random@B``, ``targeted_vs_real@B``: mean over R > 0 at equal counts.
+* ``<a>_vs_<b>@B`` for the pool pairs of :data:`PAIRS` whose pools are trained: mean over R > 0 of
+  AP(a, B, R) − AP(b, B, R), equal shape counts (``targeted_vs_random``, ``targeted_vs_real``,
+  ``recon_vs_real``: what decoding alone costs, ``targeted_vs_recon``: what interpolation and
+  selection add to a decoded shape).
 """
 
 from __future__ import annotations
@@ -27,11 +30,18 @@ import pandas as pd
 from sklearn.metrics import average_precision_score
 
 from graspaug.errors import DataError
+from graspaug.experiments.settings import POOLS
 from graspaug.experiments.stats import ObjectBootstrap, headline, percentile_interval, t_interval
 from graspaug.experiments.variants import network_variant, seed_variants
 from graspaug.io.tables import read_table
 
 Key = tuple[str, int, float]  # (pool, base size, ratio); ratio 0 of any pool is ("targeted", B, 0.0)
+PAIRS = {  # pool a vs pool b at equal shape counts: what the difference measures
+    ("targeted", "random"): "what selecting rare and graspable neighbours adds over random pairs",
+    ("targeted", "real"): "generated vs as many more real shapes",
+    ("recon", "real"): "what decoding and meshing cost a real shape",
+    ("targeted", "recon"): "what interpolation and selection add to a decoded shape",
+}
 
 
 def _key(pool: str, base: int, ratio: float) -> Key:
@@ -48,8 +58,9 @@ class Contrast:
     chosen_on_validation: bool = field(default=False)
 
 
-def declared_contrasts(base_sizes, ratios, augment_base_sizes, chosen: dict[int, float]) -> list[Contrast]:
-    """The experiment's contrasts (module docstring); ``chosen``: base size → ratio chosen on validation."""
+def declared_contrasts(base_sizes, ratios, augment_base_sizes, chosen: dict[int, float], pools=POOLS) -> list[Contrast]:
+    """The experiment's contrasts (module docstring); ``chosen``: base size → ratio chosen on
+    validation; ``pools``: the pools trained (``gqcnn.pools``)."""
     out, nonzero = [], [float(r) for r in ratios if r > 0]
     small, large = min(base_sizes), max(base_sizes)
     if large > small:
@@ -80,20 +91,15 @@ def declared_contrasts(base_sizes, ratios, augment_base_sizes, chosen: dict[int,
                 )
             )
     for b in augment_base_sizes:
-        for other in ("random", "real"):
-            if nonzero:
+        for one, other in PAIRS:
+            if nonzero and one in pools and other in pools:
                 terms = tuple(
                     t
                     for r in nonzero
-                    for t in ((1 / len(nonzero), _key("targeted", b, r)), (-1 / len(nonzero), _key(other, b, r)))
+                    for t in ((1 / len(nonzero), _key(one, b, r)), (-1 / len(nonzero), _key(other, b, r)))
                 )
-                out.append(
-                    Contrast(
-                        f"targeted_vs_{other}@{b}",
-                        terms,
-                        f"targeted vs {other} shapes at B = {b}, equal counts, mean over ratios",
-                    )
-                )
+                words = f"{one} vs {other} shapes at B = {b}, equal counts, mean over ratios: {PAIRS[one, other]}"
+                out.append(Contrast(f"{one}_vs_{other}@{b}", terms, words))
     return out
 
 
@@ -189,10 +195,10 @@ def evaluate_networks(
     global ``seed``) on the test datapoints of the first seed in the original corpus's dataset
     folder ``original`` (its ``index.parquet``), and tabulate AP and per-object AP per network."""
     base_sizes, ratios, augment_base_sizes = generate.base_sizes, generate.ratios, gqcnn.augment_base_sizes
-    variants = seed_variants(base_sizes, ratios, augment_base_sizes, gqcnn.ceiling)
+    variants = seed_variants(base_sizes, ratios, augment_base_sizes, gqcnn.ceiling, gqcnn.pools)
     runs = collect(seed_dirs, variants)
     chosen = choose_ratios(runs, augment_base_sizes)
-    contrasts = declared_contrasts(base_sizes, ratios, augment_base_sizes, chosen)
+    contrasts = declared_contrasts(base_sizes, ratios, augment_base_sizes, chosen, gqcnn.pools)
     index = read_table(Path(original) / "index.parquet")
     labels, object_ids = test_labels(index, seed_dirs[next(iter(seed_dirs))])
     results = evaluate_contrasts(contrasts, runs, seed_dirs, labels, object_ids, n_resamples=n_resamples, seed=seed)

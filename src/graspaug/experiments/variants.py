@@ -1,21 +1,22 @@
 """The networks of the GQ-CNN experiment, by name: a :class:`Variant` is (pool, base size B,
 ratio R), and its name is its folder in its training seed's folder (plain data, no I/O).
 
-Pools: ``targeted`` / ``random`` (generated shapes), ``real`` (more real train shapes) and the
-``ceiling`` (every train shape outside validation; no base size or ratio). Ratio 0 of any pool
-but the ceiling is the base set alone: the ``targeted`` network (:func:`network_variant`).
+Pools: ``targeted`` / ``random`` (interpolants), ``recon`` (the real pool's shapes decoded by the
+AutoEncoder alone), ``real`` (more real train shapes) and the ``ceiling`` (every train shape
+outside validation; no base size or ratio). Ratio 0 of any pool but the ceiling is the base set
+alone: the ``targeted`` network (:func:`network_variant`).
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
-POOLS = ("targeted", "random", "real")
+from graspaug.experiments.settings import POOLS
 
 
 @dataclass(frozen=True, order=True)
 class Variant:
-    """One network of a seed: ``pool`` (targeted, random, real or ceiling), base size, ratio."""
+    """One network of a seed: ``pool`` (one of :data:`POOLS`, or ceiling), base size, ratio."""
 
     pool: str
     base_size: int = 0
@@ -33,15 +34,9 @@ def network_variant(pool: str, base_size: int, ratio: float) -> Variant:
     return Variant("targeted" if pool != "ceiling" and float(ratio) == 0.0 else pool, base_size, ratio)
 
 
-def seed_variants(base_sizes, ratios, augment_base_sizes, ceiling: bool) -> list[Variant]:
-    """Every network of a seed: 1:0 at every base size; targeted, random and real at every
-    nonzero ratio of ``augment_base_sizes``; the ceiling."""
+def seed_variants(base_sizes, ratios, augment_base_sizes, ceiling: bool, pools=POOLS) -> list[Variant]:
+    """Every network of a seed: 1:0 at every base size; each of ``pools`` (in :data:`POOLS` order)
+    at every nonzero ratio of ``augment_base_sizes``; the ceiling."""
     out = [Variant("targeted", b, 0.0) for b in base_sizes]
-    out += [
-        Variant(p, b, float(r))
-        for p in ("targeted", "random", "real")
-        for b in augment_base_sizes
-        for r in ratios
-        if r > 0
-    ]
+    out += [Variant(p, b, float(r)) for p in POOLS if p in pools for b in augment_base_sizes for r in ratios if r > 0]
     return out + ([Variant("ceiling")] if ceiling else [])

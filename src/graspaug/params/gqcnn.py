@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from graspaug.experiments.settings import POOLS
 from graspaug.nets.settings import GQCNNConfig
 from graspaug.settings import Field, settings
 from graspaug.training.settings import TrainSettings
@@ -44,8 +45,15 @@ class GQCNNParams:
         description="Also train one network per seed on every train shape outside validation (how much of the gap "
         "augmentation closes; study and paper profiles: on).",
     )
+    pools: tuple[str, ...] = Field(
+        ("targeted", "random", "real", "recon"),
+        description="Pools that get augmented networks at every nonzero ratio of augment_base_sizes: `targeted` "
+        "(interpolants of rare and graspable neighbours), `random` (interpolants of random pairs), `real` (more real "
+        "train shapes, the positive control), `recon` (the real pool's shapes passed through the AutoEncoder alone: "
+        "what decoding and meshing cost); `generate` makes the generated ones. `targeted` is always trained.",
+    )
     members: int = Field(
-        3,
+        2,
         ge=1,
         le=64,
         description="GQ-CNNs trained per network, each from its own initial weights and noise stream (member m of "
@@ -55,5 +63,10 @@ class GQCNNParams:
     )
 
     def __post_init__(self) -> None:
+        unknown = sorted(set(self.pools) - set(POOLS))
+        if unknown or "targeted" not in self.pools or len(set(self.pools)) != len(self.pools):
+            raise ValueError(
+                f"gqcnn.pools: distinct names of {list(POOLS)}, targeted among them; got {list(self.pools)}"
+            )
         if not self.seeds or len(set(self.seeds)) != len(self.seeds) or min(self.seeds) < 0:
             raise ValueError(f"gqcnn.seeds: must be distinct seeds >= 0; got {list(self.seeds)}")

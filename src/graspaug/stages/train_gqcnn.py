@@ -1,9 +1,9 @@
 """Stage ``train_gqcnn``: every GQ-CNN of one training seed, as a paired set.
 
-Networks (``experiments.variants.seed_variants``): targeted at every base size × ratio of ``generate``; random and
-real at every nonzero ratio of ``gqcnn.augment_base_sizes``; the ceiling. All start from the seed's initial weights
-and noise stream, are validated on the same ``gqcnn.val_shapes`` train shapes and keep the weights of their best
-validation AP (``gqcnn.members`` > 1: ensembles); tested on every test datapoint of ``data/gqcnn/original``.
+Networks (``experiments.variants.seed_variants``): targeted at every base size × ratio of ``generate``; the other
+``gqcnn.pools`` at every nonzero ratio of ``gqcnn.augment_base_sizes``; the ceiling. All start from the seed's
+initial weights and noise stream, are validated on the same ``gqcnn.val_shapes`` train shapes and keep the weights
+of their best validation AP (``gqcnn.members`` > 1: ensembles); tested on every test datapoint of the corpus.
 
 Outputs: ``models/gqcnn/s<seed>/`` (one folder per network, ``test_rows.npy``, ``val_rows.npy``, ``split.json``),
 ``metrics/gqcnn/s<seed>.json`` (test and validation AP, means over the networks), ``reports/gqcnn/networks/
@@ -70,7 +70,7 @@ def run(params: Params, seed: int) -> None:
     corpora = Corpora(gqcnn_dir("original"), {b: gqcnn_dir(f"gen_{b}") for b in cfg.augment_base_sizes})
     # too few shapes for the validation set: a DataError, which the CLI prints in one line
     split = load_split(corpora.original, read_table(SHAPES_TABLE), list(gen.base_sizes), cfg.val_shapes, params.seed)
-    variants = seed_variants(gen.base_sizes, gen.ratios, cfg.augment_base_sizes, cfg.ceiling)
+    variants = seed_variants(gen.base_sizes, gen.ratios, cfg.augment_base_sizes, cfg.ceiling, cfg.pools)
     device = resolve_device(params.device)
     inits, noise_seeds = seed_members(cfg.net, params.seed, seed, cfg.members)
     val, val_rows = shapes_datapoints(corpora.original, split.validation)

@@ -1,0 +1,8 @@
+"""The experiment's plain data: the pools whose networks it can train (params read them)."""
+
+from __future__ import annotations
+
+POOLS = ("targeted", "random", "real", "recon")
+"""Pools of augmented networks, in report order: ``targeted`` / ``random`` (interpolants of the
+base set's rare-and-graspable neighbours / of random pairs), ``real`` (more real train shapes, the
+positive control) and ``recon`` (the real pool's shapes decoded from their own latents)."""
