@@ -1,10 +1,11 @@
 """How faithful are the generated pools, before any training? (issue #33, item 3) One table per run.
 
-For base size B of a finished default run, per pool (the ``targeted`` and ``random`` generated
-shapes, and the ``real`` pool's first B shapes of training seed 0's split, the control): shapes,
-distinct parents and α counts (generated pools), graspness (share of sampled grasps with robust ε
-above the threshold) against the mean of each shape's two parents, the share of positive rendered
-datapoints, datapoints per shape, median sorted extents, and coverage / MMD / 1-NN accuracy on the
+For base size B of a finished default run, per pool (every generated pool: ``targeted``,
+``random``, ``recon``, ``blend`` as ``gqcnn.pools`` made them, and the ``real`` pool's first B
+shapes of training seed 0's split, the control): shapes, distinct parents and α counts (generated
+pools), graspness (share of sampled grasps with robust ε above the threshold) against the mean of
+each shape's two parents, the share of positive rendered datapoints, datapoints per shape, median
+sorted extents, and coverage / MMD / 1-NN accuracy on the
 Chamfer distance against as many held-out real shapes (a seeded draw from the test split; Chamfer
 on ``--points`` surface points per shape, :mod:`graspaug.experiments.fidelity`). Prints one JSON
 line per pool. Run it in a project where ``render_generated@B`` and ``train_gqcnn@0`` have run:
@@ -47,7 +48,7 @@ def main() -> None:
     start = time.perf_counter()
     generated = read_table(generated_index(b))
     split = json.loads((gqcnn_seed_dir(0) / "split.json").read_text())
-    pools = {p: list(generated.shape_id[generated.pool == p]) for p in ("targeted", "random")}
+    pools = {p: list(generated.shape_id[generated.pool == p]) for p in generated.pool.unique()}  # every generated one
     pools["real"] = list(split["real_pool"][: ratio_count(1.0, b)])
     scores = read_table(SCORES).set_index("shape_id").graspness
     gen_grasps = read_table(grasps_table(f"gen_{b}")).groupby("shape_id").success.mean()

@@ -96,7 +96,9 @@ def main() -> None:
     if args.members < cfg.members:
         parser.error(f"--members {args.members} is below gqcnn.members ({cfg.members}) of params.yaml")
     corpora = Corpora(gqcnn_dir("original"), {b: gqcnn_dir(f"gen_{b}") for b in cfg.augment_base_sizes})
-    split = load_split(corpora.original, read_table(SHAPES_TABLE), list(gen.base_sizes), cfg.val_shapes, params.seed)
+    split = load_split(
+        corpora.original, read_table(SHAPES_TABLE), list(gen.base_sizes), cfg.val_shapes, params.data_seed
+    )
     variants = seed_variants(gen.base_sizes, gen.ratios, cfg.augment_base_sizes, cfg.ceiling, cfg.pools)
     val, test = shapes_datapoints(corpora.original, split.validation)[0], test_set(corpora.original)[0]  # read once
     train_extra_members(params, split, variants, val, test, args.members, args.out, corpora)

@@ -66,7 +66,7 @@ def main() -> None:
     cfg = params.gqcnn
     corpora = Corpora(gqcnn_dir("original"))
     split = load_split(
-        corpora.original, read_table(SHAPES_TABLE), list(params.generate.base_sizes), cfg.val_shapes, params.seed
+        corpora.original, read_table(SHAPES_TABLE), list(params.generate.base_sizes), cfg.val_shapes, params.data_seed
     )
     val, _ = shapes_datapoints(corpora.original, split.validation)
     sets = {b: training_set(Variant("targeted", b, 0.0), split, corpora)[0] for b in args.base_sizes}

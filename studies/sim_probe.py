@@ -49,7 +49,7 @@ def train_before(models: Path, seeds: list[int], base_size: int, params: Params)
     cfg = params.gqcnn
     corpora = Corpora(gqcnn_dir("original"))
     split = load_split(
-        corpora.original, read_table(SHAPES_TABLE), list(params.generate.base_sizes), cfg.val_shapes, params.seed
+        corpora.original, read_table(SHAPES_TABLE), list(params.generate.base_sizes), cfg.val_shapes, params.data_seed
     )
     val, _ = shapes_datapoints(corpora.original, split.validation)
     test, _ = test_set(corpora.original)

@@ -115,3 +115,43 @@ def test_a_recon_shape_is_the_autoencoders_reconstruction_meshed_at_its_own_scal
         filled = np.argwhere(grid.occupancy)
         voxels_across = filled.max(0) - filled.min(0) + 1
         np.testing.assert_allclose(np.sort(d.mesh.extents), np.sort(voxels_across * pitch[k]), rtol=0.2)
+
+
+def test_the_blend_pool_takes_the_targeted_pools_pairs_and_weights_and_replaces_a_failure():
+    base, cfg = make_base(), GenerateParams(base_sizes=(10,), ratios=(0.0, 1.0))
+
+    def first_fails(batch):  # the blend of the targeted pool's first kept pair fails
+        first = out_targeted[0]
+        return [
+            Decoded(c, np.zeros(0, np.uint8), None if c == first else BOX, "empty" if c == first else None)
+            for c in batch
+        ]
+
+    plain = generate_pools(base, cfg, 0, some_rejected, 3, ("targeted",))
+    out_targeted = [d.candidate for d in plain.kept]
+    out = generate_pools(base, cfg, 0, some_rejected, 3, ("targeted", "blend"), blend=first_fails)
+    targeted, blend = (out.index[out.index.pool == p] for p in ("targeted", "blend"))
+    key = lambda rows: list(zip(rows.parent_a, rows.parent_b, rows.alpha))  # noqa: E731
+    assert key(blend)[: len(blend) - 1] == key(targeted)[1:]  # the same pairs and weights, in order
+    assert key(blend)[-1] not in key(targeted)  # the failure replaced by the targeted stream's next candidate
+    assert list(blend.shape_id) == [f"gen_10_b{k:04d}" for k in range(len(blend))]
+    assert (
+        len(blend) == len(targeted) == out.summary["blend"]["kept"] and out.summary["blend"]["tried"] == len(blend) + 1
+    )
+    with pytest.raises(DataError, match="the blend pool needs the base set's meshes"):
+        generate_pools(base, cfg, 0, some_rejected, 3, ("targeted", "blend"))
+
+
+def test_blend_batches_mix_the_parents_meshes_at_each_weight():
+    from graspaug.generation import Candidate
+    from graspaug.generation_meshes import blend_batches
+    from graspaug.geometry.voxelize import fit_grid, iou, voxelize_solid
+
+    meshes = [trimesh.creation.capsule(height=0.03, radius=0.01), trimesh.creation.icosphere(radius=0.02)]
+    run_batch = blend_batches(meshes, 96, 3, 1, "test")  # the default: the ingest surface resolution
+    ends = run_batch([Candidate(0, 1, 0.0, "rarity"), Candidate(0, 1, 1.0, "rarity"), Candidate(0, 1, 0.5, "rarity")])
+    for d, parent in zip(ends[:2], meshes):  # voxel IoU in the parent's 32³ grid, the child placed as it
+        grid, child = fit_grid(parent.bounds, 32, 1), d.mesh.vertices + parent.bounds.mean(0) - d.mesh.bounds.mean(0)
+        grids = [voxelize_solid(v, m.faces, grid) for v, m in ((child, d.mesh), (parent.vertices, parent))]
+        assert d.reason is None and iou(*grids) >= 0.95
+    assert ends[2].reason is None and ends[2].mesh.is_watertight

@@ -163,10 +163,10 @@ def test_dvc_repro_generate_and_its_grasps(tiny_repo):
     assert set(drawn[4]) < set(base[6].shape_id) <= set(shapes.shape_id[shapes.split == "train"])
     for b in (6,):
         index = pd.read_parquet(work / f"data/generated/{b}/index.parquet")
-        for pool in ("targeted", "random", "recon"):
+        for pool in ("targeted", "random", "recon", "blend"):  # the tiny profile asks for every pool
             part = index[index.pool == pool]
             assert list(part.order) == list(range(b))  # max ratio 1 -> B shapes, in order
-        mixed = index[index.pool != "recon"]
+        mixed = index[index.pool != "recon"]  # blend: the targeted pairs with no network
         assert set(mixed.parent_a) | set(mixed.parent_b) <= set(base[b].shape_id)
         # recon: the real pool's shapes in the experiment's order, each decoded alone (a failed decode is skipped)
         recon = index[index.pool == "recon"]
@@ -182,10 +182,16 @@ def test_dvc_repro_generate_and_its_grasps(tiny_repo):
             mesh = trimesh.load(work / f"data/generated/{b}/meshes/{shape_id}.obj", force="mesh")
             assert mesh.is_watertight
         summary = json.loads((work / f"reports/generate/{b}/summary.json").read_text())
-        assert summary["targeted"]["kept"] == summary["random"]["kept"] == summary["recon"]["kept"] == b
-        assert json.loads((work / f"metrics/generate/{b}.json").read_text())["shapes"] == 3 * b
+        pools = ("targeted", "random", "recon", "blend")
+        assert [summary[p]["kept"] for p in pools] == [b] * 4
+        assert json.loads((work / f"metrics/generate/{b}.json").read_text())["shapes"] == 4 * b
         rejects = pd.read_parquet(work / f"data/generated/{b}/rejects.parquet")
-        assert sum(summary[p]["tried"] for p in ("targeted", "random", "recon")) == 3 * b + len(rejects)
+        assert sum(summary[p]["tried"] for p in pools) == 4 * b + len(rejects)
+        blend, targeted = (index[index.pool == p] for p in ("blend", "targeted"))
+        shared = set(zip(blend.parent_a, blend.parent_b, blend.alpha)) & set(
+            zip(targeted.parent_a, targeted.parent_b, targeted.alpha)
+        )
+        assert len(shared) >= b - summary_rejects(work, b, "blend")  # the targeted pairs and weights
         assert sum(summary["rejects"].values()) == len(rejects)
         grasps = pd.read_parquet(work / f"data/grasps/gen_{b}.parquet")
         assert set(grasps.shape_id) <= set(index.shape_id)
@@ -222,7 +228,7 @@ def test_dvc_repro_render(tiny_repo):
             generated = pd.read_parquet(work / f"data/generated/{corpus[4:]}/index.parquet")
             assert set(index.shape_id) <= set(generated.shape_id) and (index.base_size == int(corpus[4:])).all()
             assert (
-                set(index.pool) <= {"targeted", "random", "recon"}
+                set(index.pool) <= {"targeted", "random", "recon", "blend"}
                 and index.order.notna().all()
                 and (index.split == "train").all()
             )
@@ -238,14 +244,16 @@ def test_dvc_repro_gqcnn_matrix_and_report(tiny_repo):
     run(["dvc", "repro", "report"], work, env)
     names = (
         ["targeted/4-0"]
-        + [f"{p}/6-{r:g}" for p in ("targeted", "random", "real", "recon") for r in (0.5, 1.0)]
+        + [f"{p}/6-{r:g}" for p in ("targeted", "random", "real", "recon", "blend") for r in (0.5, 1.0)]
         + ["targeted/6-0", "ceiling"]
     )
     digests, validation = {}, {}
     for seed in (0, 1):
         assert set(json.loads((work / f"metrics/gqcnn/s{seed}.json").read_text())) == {"test_ap", "val_ap"}
         metrics = json.loads((work / f"reports/gqcnn/networks/s{seed}.json").read_text())["networks"]
-        assert set(metrics) == {"targeted", "random", "real", "recon", "ceiling"} and set(metrics["targeted"]["6"]) == {
+        assert set(metrics) == {"targeted", "random", "real", "recon", "blend", "ceiling"} and set(
+            metrics["targeted"]["6"]
+        ) == {
             "0",
             "0.5",
             "1",
@@ -302,13 +310,17 @@ def test_dvc_repro_gqcnn_matrix_and_report(tiny_repo):
     report = (work / "reports/gqcnn/report.md").read_text()
     # one metrics file per declared contrast: its mean and t-interval ends
     assert {p.stem for p in (work / "metrics/ap").glob("*.json")} == set(ap["contrasts"])
-    assert set(ap["contrasts"]) - {"targeted_vs_none_chosen@6"} == {
+    matched = {n for n in ap["contrasts"] if n.endswith("_vs_real_datapoints@6")}  # where the real curve reaches
+    assert matched <= {f"{p}_vs_real_datapoints@6" for p in ("targeted", "random", "recon", "blend")}
+    assert set(ap["contrasts"]) - {"targeted_vs_none_chosen@6"} - matched == {
         "real_data",
         "targeted_vs_none@6",
         "targeted_vs_random@6",
         "targeted_vs_real@6",
         "recon_vs_real@6",
         "targeted_vs_recon@6",
+        "blend_vs_recon@6",
+        "targeted_vs_blend@6",
     }
     assert ("targeted_vs_none_chosen@6" in ap["contrasts"]) == ("6" in ap["chosen_ratio"])
     for c in ap["contrasts"].values():

@@ -168,7 +168,8 @@ stage_command(
     "round(R × B) are the set for ratio R.\n\nWrites `data/generated/<B>/` (`meshes/*.obj`, `index.parquet`, "
     "`rejects.parquet`, `base.parquet`), `metrics/generate/<B>.json` and "
     "`reports/generate/<B>/{summary.json,pairs.png,tsne.png}`.\n\n{params}\n\nAlso `score.k` (rarity on the base "
-    "set), `gqcnn.pools`, `gqcnn.val_shapes` (the real pool), `seed`, `device`, `n_jobs`.",
+    "set), `gqcnn.pools`, `gqcnn.val_shapes` (the real pool), `data_seed` (base sets, real pool, random pairs), "
+    "`seed`, `device`, `n_jobs`.",
     cls=_with_params("generate", "generate"),
 )
 def generate_command(
@@ -235,8 +236,9 @@ def export_dexnet_command(
     name="train-gqcnn",
     help="Train every GQ-CNN (Dex-Net 2.0) of one training seed as a paired set (paper Section IV-C): `targeted` at "
     "every base size B × ratio R of `generate` (the B base shapes' rendered grasps + those of the first round(R × B) "
-    "shapes of B's targeted pool), `random` (random-pair interpolants) and `real` (round(R × B) more real train "
-    "shapes) at every nonzero ratio of `gqcnn.augment_base_sizes`, and the `ceiling` (every train shape outside "
+    "shapes of B's targeted pool), the other `gqcnn.pools` (`random`: random-pair interpolants, `real`: round(R × B) "
+    "more real train shapes, `recon`: the real pool decoded by the AutoEncoder, `blend`: the targeted pairs with no "
+    "network) at every nonzero ratio of `gqcnn.augment_base_sizes`, and the `ceiling` (every train shape outside "
     "validation). Every network of the seed starts from the same weights and noise stream and is validated on the same "
     "`gqcnn.val_shapes` train shapes; it trains `gqcnn.train.epochs` passes over its own set (within min/max steps), "
     "the learning rate annealed along a cosine, and keeps the weights with the best validation AP. With "
@@ -245,7 +247,8 @@ def export_dexnet_command(
     "grasp of the original corpus.\n\nWrites `models/gqcnn/s<seed>/<pool>/<B>-<R>/` (model.pt, predictions, "
     "history.csv), `metrics/gqcnn/s<seed>.json` (mean test and validation AP), `reports/gqcnn/networks/s<seed>.json` "
     "(AP per network) and "
-    "`reports/gqcnn/validation/s<seed>.png` (validation AP vs step).\n\n{params}\n\nAlso `seed`, `device`, `n_jobs`.",
+    "`reports/gqcnn/validation/s<seed>.png` (validation AP vs step).\n\n{params}\n\nAlso `data_seed` (base sets, "
+    "validation shapes, real pool), `seed`, `device`, `n_jobs`.",
     cls=_with_params("train_gqcnn", "gqcnn"),
 )
 def train_gqcnn_command(

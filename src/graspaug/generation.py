@@ -225,6 +225,25 @@ class ReconStream(CandidateStream):
         self._append([Candidate(k, k, 0.0, "recon") for k in range(n_shapes)])
 
 
+class FollowStream(CandidateStream):
+    """Another pool's candidates for a control pool (the ``blend`` pool follows the targeted one):
+    ``first`` (that pool's kept candidates, in order: the same pairs and weights) then the rest of
+    its ``stream`` in order, so a failure here is replaced by that pool's next candidate."""
+
+    def __init__(self, first: Sequence[Candidate], stream: CandidateStream) -> None:
+        super().__init__()
+        self.stream, self._read = stream, 0
+        self._append(list(first))
+
+    def _grow(self, count: int) -> None:
+        while len(self.items) < count:
+            batch = self.stream.take(self._read, count - len(self.items))
+            if not batch:
+                return
+            self._read += len(batch)
+            self._append(batch)
+
+
 class HasReason(Protocol):
     reason: str | None
 

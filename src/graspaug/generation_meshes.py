@@ -19,6 +19,7 @@ from graspaug.generation import (
     BASE_SEED,
     Candidate,
     Decoded,
+    FollowStream,
     PoolExhausted,
     RandomStream,
     ReconStream,
@@ -109,7 +110,7 @@ def mesh_batches(
 
 
 Pools = dict[str, tuple[list[Decoded], list[Decoded]]]
-GENERATED_POOLS = ("targeted", "random", "recon")  # the pools generate can make, in index order
+GENERATED_POOLS = ("targeted", "random", "recon", "blend")  # the pools generate can make, in index order
 
 
 @dataclass(frozen=True)
@@ -121,6 +122,24 @@ class ReconSource:
     run_batch: Callable[[list[Candidate]], list[Decoded]]
 
 
+def blend_batches(
+    meshes: Sequence, resolution: int, margin: int, workers: int, label: str
+) -> Callable[[list[Candidate]], list[Decoded]]:
+    """A batch runner for :func:`graspaug.generation.fill_pool` that makes each candidate with no
+    network: :func:`graspaug.geometry.blend.blend_solids` of its parents among ``meshes`` (the
+    base set's meshes, m, in base-set order) at its weight, on ``resolution``-cell grids with
+    ``margin`` empty cells, on ``workers`` processes. Its grids are not kept (an empty array)."""
+    from graspaug.geometry.blend import blend_solids
+    from graspaug.parallel import parallel_map
+
+    def run_batch(candidates: list[Candidate]) -> list[Decoded]:
+        jobs = [(meshes[c.a], meshes[c.b], c.alpha) for c in candidates]
+        out = parallel_map(lambda job: blend_solids(*job, resolution, margin), jobs, workers, label)
+        return [Decoded(c, np.zeros(0, np.uint8), mesh, reason) for c, (mesh, reason) in zip(candidates, out)]
+
+    return run_batch
+
+
 def fill_pools(
     base: BaseSet,
     cfg: GenerateParams,
@@ -128,11 +147,14 @@ def fill_pools(
     run_batch: Callable[[list[Candidate]], list[Decoded]],
     pools: Sequence[str] = ("targeted", "random"),
     recon: ReconSource | None = None,
+    blend: Callable[[list[Candidate]], list[Decoded]] | None = None,
 ) -> tuple[Pools, TargetedStream, int]:
     """Fill each of ``pools`` (of :data:`GENERATED_POOLS`; the targeted one always) to
     ``pool_size(cfg.ratios, B)`` kept shapes: ``targeted`` and ``random`` (seeded by
     ``[seed, BASE_SEED, B]``) with ``run_batch`` (:func:`mesh_batches` over the base set),
-    ``recon`` from ``recon`` (the real pool's shapes, each decoded from its own latent).
+    ``recon`` from ``recon`` (the real pool's shapes, each decoded from its own latent),
+    ``blend`` with the runner ``blend`` (:func:`blend_batches`) on the targeted pool's candidates
+    (its kept ones first: the same pairs and weights).
 
     Returns (pools: name → (kept, rejected) Decoded lists, in :data:`GENERATED_POOLS` order, the
     targeted stream as widened, shapes per pool); a :class:`graspaug.errors.DataError` if a pool's
@@ -145,6 +167,8 @@ def fill_pools(
     )
     if "recon" in pools and recon is None:
         raise DataError(f"generate {base_size}: the recon pool needs the real pool's shapes")
+    if "blend" in pools and blend is None:
+        raise DataError(f"generate {base_size}: the blend pool needs the base set's meshes")
     streams = {
         "targeted": (targeted_stream, run_batch),
         "random": (RandomStream(base_size, cfg.alphas, np.random.default_rng([seed, BASE_SEED, base_size])), run_batch),
@@ -152,6 +176,8 @@ def fill_pools(
     }
     out = {}
     for name in (p for p in GENERATED_POOLS if p == "targeted" or p in pools):
+        if name == "blend":
+            streams[name] = (FollowStream([d.candidate for d in out["targeted"][0]], targeted_stream), blend)
         stream, runner = streams[name]
         try:
             out[name] = fill_pool(stream, needed, runner)
@@ -233,9 +259,10 @@ def generate_pools(
     k: int,
     pools: Sequence[str] = ("targeted", "random"),
     recon: ReconSource | None = None,
+    blend: Callable[[list[Candidate]], list[Decoded]] | None = None,
 ) -> GeneratedSet:
     """:func:`fill_pools` then :func:`generated_set` (``k``: the rarity's neighbours)."""
-    filled, targeted, needed = fill_pools(base, cfg, seed, run_batch, pools, recon)
+    filled, targeted, needed = fill_pools(base, cfg, seed, run_batch, pools, recon, blend)
     return generated_set(base, filled, targeted, needed, k, cfg.n_examples, recon.shapes if recon else None)
 
 

@@ -8,6 +8,7 @@ import pytest
 from graspaug.errors import DataError
 from graspaug.experiments import ap
 from graspaug.experiments.ap import collect, declared_contrasts
+from graspaug.experiments.settings import POOLS
 from graspaug.experiments.variants import seed_variants
 
 
@@ -21,10 +22,12 @@ def test_the_declared_contrasts():
         "targeted_vs_real@50",
         "recon_vs_real@50",
         "targeted_vs_recon@50",
+        "blend_vs_recon@50",
+        "targeted_vs_blend@50",
     ]
     three_pools = declared_contrasts([50, 200], [0.0, 1.0], [50], {}, ("targeted", "random", "real"))
     assert [c.name for c in three_pools][-2:] == ["targeted_vs_random@50", "targeted_vs_real@50"]
-    decoding = {k: w for w, k in declared_contrasts([50, 200], [0.0, 0.5, 1.0], [50], {})[-2].terms}
+    decoding = {k: w for w, k in declared_contrasts([50, 200], [0.0, 0.5, 1.0], [50], {})[-4].terms}
     assert decoding == {
         ("recon", 50, 0.5): 0.5,
         ("recon", 50, 1.0): 0.5,
@@ -46,6 +49,7 @@ def test_the_declared_contrasts():
         "random/50-1",
         "real/50-1",
         "recon/50-1",
+        "blend/50-1",
         "ceiling",
     ]
     assert "recon/50-1" not in [v.name for v in seed_variants([50], [0.0, 1.0], [50], False, ("targeted", "real"))]
@@ -55,6 +59,7 @@ def test_gain_sentences_give_shares_and_call_a_gap_within_the_ceilings_interval_
     import pandas as pd
 
     from graspaug.experiments.ap import gain_sentences
+    from graspaug.experiments.stats import fieller_interval
 
     table = pd.DataFrame(
         [
@@ -66,9 +71,16 @@ def test_gain_sentences_give_shares_and_call_a_gap_within_the_ceilings_interval_
         ],
         columns=["pool", "base_size", "ratio", "test_ap", "test_ap_ci"],
     )
-    results = {"targeted_vs_none@50": {"mean": 0.02}, "targeted_vs_real@50": {"mean": -0.06}}  # real shapes: +0.08
+    results = {  # real shapes: +0.08, seed by seed +0.07, +0.09, +0.08, +0.08
+        "targeted_vs_none@50": {"mean": 0.02, "per_seed": [0.01, 0.03, 0.02, 0.02]},
+        "targeted_vs_real@50": {"mean": -0.06, "per_seed": [-0.06, -0.06, -0.06, -0.06]},
+    }
     lines = gain_sentences(results, table, {50: 1.0, 200: 1.0}, [50], ceiling_shapes=600)
     assert "give 25% of the gain of the same number of real shapes" in lines[0]
+    share = fieller_interval(np.array([0.01, 0.03, 0.02, 0.02]), np.array([0.07, 0.09, 0.08, 0.08]))
+    assert f"95% Fieller interval over seeds [{share['ci_low']:.0%}, {share['ci_high']:.0%}]" in lines[0]
+    noisy = {**results, "targeted_vs_real@50": {"mean": -0.01, "per_seed": [-0.1, 0.1, -0.06, 0.02]}}
+    assert "Fieller interval is unbounded" in gain_sentences(noisy, table, {}, [50], ceiling_shapes=None)[0]
     assert "1:1 closes 20% of the gap" in lines[1]  # (0.42 - 0.40) / (0.50 - 0.40)
     assert "no gap for augmentation to close" in lines[2] and "closes" not in lines[2]  # 0.005 < ±0.01: not "100%"
     assert gain_sentences(results, table, {50: 1.0}, [50], ceiling_shapes=None) == lines[:1]
@@ -81,7 +93,8 @@ def test_networks_are_read_from_the_seed_folders_given(tmp_path):
     seed_dirs = {3: tmp_path / "s3"}
     folder = seed_dirs[3] / "targeted" / "50-0"
     folder.mkdir(parents=True)
-    (folder / "summary.json").write_text(json.dumps({"validation": {"ap": 0.5}, "test": {"ap": 0.4, "roc_auc": 0.7}}))
+    summary = {"validation": {"ap": 0.5}, "test": {"ap": 0.4, "roc_auc": 0.7}, "train": {"datapoints": 3550}}
+    (folder / "summary.json").write_text(json.dumps(summary))
     np.save(folder / "test_predictions.npy", np.array([0.1, 0.9], dtype=np.float32))
     runs = collect(seed_dirs, variants)
     assert runs.to_dict("records") == [
@@ -93,6 +106,7 @@ def test_networks_are_read_from_the_seed_folders_given(tmp_path):
             "val_ap": 0.5,
             "test_ap": 0.4,
             "test_roc_auc": 0.7,
+            "train_datapoints": 3550,
         }
     ]
     # ratio 0 of any pool is the targeted network
@@ -182,3 +196,29 @@ def test_the_pr_roc_figure_draws_the_compared_networks(tmp_path):
     labels = index.label.to_numpy()[ap.test_rows(seed_dirs[0])]
     draw_pr_roc(labels, seed_dirs[0], 0, 10, 1.0, False, tmp_path / "pr_roc.png")
     assert (tmp_path / "pr_roc.png").stat().st_size > 0
+
+
+def test_datapoint_matched_contrasts_interpolate_the_real_shape_curve_in_datapoints():
+    import pandas as pd
+
+    from graspaug.experiments.ap import datapoint_matched_contrasts
+
+    rows = [  # (pool, B, R, training datapoints): real shapes at 3,000 / 6,000 / 12,000 datapoints
+        ("targeted", 50, 0.0, 3000),
+        ("targeted", 200, 0.0, 12000),
+        ("real", 50, 1.0, 6000),
+        ("targeted", 50, 1.0, 4500),  # halfway between B = 50 alone and 1:1 real
+        ("recon", 50, 1.0, 9000),  # halfway between 1:1 real and B = 200
+        ("random", 50, 1.0, 2000),  # below the curve: no contrast
+    ]
+    runs = pd.DataFrame(rows, columns=["pool", "base_size", "ratio", "train_datapoints"]).assign(seed=0)
+    out = {c.name: c for c in datapoint_matched_contrasts(runs, [50, 200], [0.0, 1.0], [50], POOLS)}
+    assert set(out) == {"targeted_vs_real_datapoints@50", "recon_vs_real_datapoints@50"}
+    weights = lambda c: {k: w for w, k in c.terms if w}  # noqa: E731
+    assert weights(out["targeted_vs_real_datapoints@50"]) == pytest.approx(
+        {("targeted", 50, 1.0): 1.0, ("targeted", 50, 0.0): -0.5, ("real", 50, 1.0): -0.5}
+    )
+    assert weights(out["recon_vs_real_datapoints@50"]) == pytest.approx(
+        {("recon", 50, 1.0): 1.0, ("real", 50, 1.0): -0.5, ("targeted", 200, 0.0): -0.5}
+    )
+    assert datapoint_matched_contrasts(runs, [50, 200], [0.0, 1.0], [50], ("targeted", "recon")) == []  # no real pool

@@ -73,3 +73,44 @@ def test_a_contrasts_headline_is_its_mean_and_interval_ends_rounded():
 
     c = {"mean": 0.0123456, "ci_low": -0.001, "ci_high": None, "n_seeds": 4, "per_seed": [0.1, 0.2]}
     assert headline(c) == {"mean": 0.01235, "lo": -0.001, "hi": None}
+
+
+def test_the_nested_interval_covers_each_source_of_variance_on_hand_made_tables():
+    from graspaug.experiments.stats import nested_interval, percentile_interval
+
+    rng = np.random.default_rng(0)
+    flat = nested_interval(np.full((3, 4), 0.02), np.full((3, 4, 500), 0.02), rng)
+    assert flat == pytest.approx({"mean": 0.02, "ci_low": 0.02, "ci_high": 0.02, "n_draws": 3, "n_seeds": 4})
+    # draws alone vary: the bootstrap of the mean of 60 draw effects, SE = SD / sqrt(60)
+    effects = rng.normal(0.1, 0.05, size=60)
+    full = np.repeat(effects[:, None], 4, axis=1)
+    out = nested_interval(full, np.repeat(full[:, :, None], 4000, axis=2), np.random.default_rng(1))
+    se = effects.std() / np.sqrt(60)
+    assert out["mean"] == pytest.approx(effects.mean())
+    assert out["ci_low"] == pytest.approx(effects.mean() - 1.96 * se, abs=0.25 * se)
+    assert out["ci_high"] == pytest.approx(effects.mean() + 1.96 * se, abs=0.25 * se)
+    # test objects alone vary (the same object resample in every cell): the object bootstrap's interval
+    objects = rng.normal(0.0, 0.01, size=3000)
+    alone = nested_interval(np.zeros((3, 4)), np.broadcast_to(objects, (3, 4, 3000)), np.random.default_rng(2))
+    assert (alone["ci_low"], alone["ci_high"]) == pytest.approx(percentile_interval(objects))
+    # seeds on top of objects: wider than objects alone
+    seeds = rng.normal(0.0, 0.02, size=(3, 4))
+    both = nested_interval(seeds, seeds[:, :, None] + objects, np.random.default_rng(3))
+    assert both["ci_high"] - both["ci_low"] > alone["ci_high"] - alone["ci_low"]
+
+
+def test_the_fieller_interval_inverts_the_t_test_of_the_paired_difference():
+    from scipy import stats
+
+    from graspaug.experiments.stats import fieller_interval
+
+    gain, real_gain = np.array([0.010, 0.020, 0.015, 0.012]), np.array([0.040, 0.035, 0.045, 0.041])
+    out = fieller_interval(gain, real_gain)
+    assert out["bounded"] and out["ci_low"] < out["ratio"] < out["ci_high"]
+    assert out["ratio"] == pytest.approx(gain.mean() / real_gain.mean())
+    critical = stats.t.ppf(0.975, 3)
+    for theta in (out["ci_low"], out["ci_high"]):  # at either end x - θ y is exactly on the edge of significance
+        d = gain - theta * real_gain
+        assert abs(d.mean() / (d.std(ddof=1) / 2)) == pytest.approx(critical)
+    noisy = fieller_interval(gain, np.array([0.03, -0.02, 0.01, -0.015]))  # the real gain is not clearly nonzero
+    assert not noisy["bounded"] and noisy["ci_low"] is None and noisy["ci_high"] is None

@@ -45,3 +45,24 @@ def test_split_ids_are_plain_data_by_role():
         "real_pool": split.real_pool,
         "base": {"10": split.base[10], "20": split.base[20]},
     }
+
+
+def test_a_new_data_seed_redraws_base_sets_validation_and_real_pool_but_not_the_test_split(tmp_path, repo_root):
+    import pandas as pd
+    import yaml
+
+    from graspaug.training.gqcnn_data import load_split
+
+    shapes = pd.DataFrame({"shape_id": TRAIN + ["tst_0", "tst_1"], "split": ["train"] * 60 + ["test"] * 2})
+    (tmp_path / "original").mkdir()
+    shapes.assign(label=0).to_parquet(tmp_path / "original" / "index.parquet", index=False)
+    draws = [load_split(tmp_path / "original", shapes, [10, 20], 8, data_seed) for data_seed in (0, 1)]
+    assert draws[0] == load_split(tmp_path / "original", shapes, [10, 20], 8, 0)  # the data seed alone decides
+    for role in ("validation", "real_pool"):
+        assert getattr(draws[0], role) != getattr(draws[1], role), role
+    assert draws[0].base[20] != draws[1].base[20] and all(set(d.base[10]) < set(d.base[20]) for d in draws)
+    assert all(not {"tst_0", "tst_1"} & (set(d.ceiling) | set(d.real_pool)) for d in draws)
+    # the test split is ingest's, drawn from `seed`: only the stages that draw the experiment's data read data_seed
+    stages = yaml.safe_load((repo_root / "dvc.yaml").read_text())["stages"]
+    readers = {name for name, stage in stages.items() if "data_seed" in (stage.get("do") or stage).get("params", [])}
+    assert readers == {"generate", "train_gqcnn"}

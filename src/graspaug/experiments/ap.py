@@ -15,7 +15,13 @@ network is read:
 * ``<a>_vs_<b>@B`` for the pool pairs of :data:`PAIRS` whose pools are trained: mean over R > 0 of
   AP(a, B, R) − AP(b, B, R), equal shape counts (``targeted_vs_random``, ``targeted_vs_real``,
   ``recon_vs_real``: what decoding alone costs, ``targeted_vs_recon``: what interpolation and
-  selection add to a decoded shape).
+  selection add to a decoded shape, ``blend_vs_recon``, ``targeted_vs_blend``: what the latent
+  space adds over mixing the same parents' signed distance fields);
+* ``<pool>_vs_real_datapoints@B``: the same pools against real shapes at as many training
+  datapoints (:func:`datapoint_matched_contrasts`), since a generated shape yields fewer.
+
+The share of the real-shape gain that targeted shapes give has a Fieller interval over seeds
+(:func:`gain_sentences`).
 """
 
 from __future__ import annotations
@@ -31,7 +37,7 @@ from sklearn.metrics import average_precision_score
 
 from graspaug.errors import DataError
 from graspaug.experiments.settings import POOLS
-from graspaug.experiments.stats import ObjectBootstrap, headline, percentile_interval, t_interval
+from graspaug.experiments.stats import ObjectBootstrap, fieller_interval, headline, percentile_interval, t_interval
 from graspaug.experiments.variants import network_variant, seed_variants
 from graspaug.io.tables import read_table
 
@@ -41,6 +47,8 @@ PAIRS = {  # pool a vs pool b at equal shape counts: what the difference measure
     ("targeted", "real"): "generated vs as many more real shapes",
     ("recon", "real"): "what decoding and meshing cost a real shape",
     ("targeted", "recon"): "what interpolation and selection add to a decoded shape",
+    ("blend", "recon"): "interpolants made with no network vs decoded real shapes",
+    ("targeted", "blend"): "what the learned latent space adds over geometric interpolation of the same pairs",
 }
 
 
@@ -103,13 +111,52 @@ def declared_contrasts(base_sizes, ratios, augment_base_sizes, chosen: dict[int,
     return out
 
 
+def datapoint_matched_contrasts(runs: pd.DataFrame, base_sizes, ratios, augment_base_sizes, pools) -> list[Contrast]:
+    """Per augmented base size B and pool (but ``real``): ``<pool>_vs_real_datapoints@B``, the pool's
+    AP minus the AP that real shapes give at as many training datapoints, mean over ratios R > 0.
+    The real-shape curve is AP against training datapoints through the real-shape networks (1:0 at
+    every base size, ``real`` at B and every R), linear between neighbouring points; the weights
+    come from the datapoint counts (the same in every seed: they are design, not outcome). A
+    network outside the curve's range, or without a count (``runs.train_datapoints``), gives no
+    contrast. So a pool is not penalised for yielding fewer datapoints per shape."""
+    counts = runs.groupby(["pool", "base_size", "ratio"]).train_datapoints.first()
+    nonzero, out = [float(r) for r in ratios if r > 0], []
+    for b in augment_base_sizes:
+        curve = [("targeted", int(x), 0.0) for x in base_sizes] + [("real", int(b), r) for r in nonzero]
+        points = sorted((float(counts[k]), k) for k in curve if k in counts and pd.notna(counts[k]))
+        if len(points) < 2 or "real" not in pools:
+            continue
+        xs = np.array([x for x, _ in points])
+        for pool in (p for p in pools if p != "real"):
+            terms: list[tuple[float, Key]] = []
+            for r in nonzero:
+                key = (pool, int(b), r)
+                x = counts.get(key)
+                if x is None or pd.isna(x) or not xs[0] <= x <= xs[-1]:
+                    terms = []
+                    break
+                hi = min(int(np.searchsorted(xs, x, side="left")), len(xs) - 1)
+                lo = max(hi - 1, 0)
+                share = 0.0 if xs[hi] == xs[lo] else (x - xs[lo]) / (xs[hi] - xs[lo])
+                n = len(nonzero)
+                terms += [(1 / n, key), (-(1 - share) / n, points[lo][1]), (-share / n, points[hi][1])]
+            if terms:
+                words = (
+                    f"{pool} at B = {b} vs real shapes giving as many training datapoints (the real-shape networks' AP "
+                    "interpolated in datapoints), mean over ratios"
+                )
+                out.append(Contrast(f"{pool}_vs_real_datapoints@{b}", tuple(terms), words))
+    return out
+
+
 def network_folder(seed_dir: Path, key: Key) -> Path:
     """The folder of network ``key`` (pool, B, R) in its seed's folder ``seed_dir``."""
     return Path(seed_dir) / network_variant(*key).name
 
 
 def collect(seed_dirs: Mapping[int, Path], variants) -> pd.DataFrame:
-    """One row per network and seed: pool, base_size, ratio, seed, val_ap, test_ap, test_roc_auc.
+    """One row per network and seed: pool, base_size, ratio, seed, val_ap, test_ap, test_roc_auc,
+    train_datapoints (None when its summary does not say).
     ``seed_dirs``: training seed → the folder of its networks (the seeds in this order)."""
     rows = []
     for seed, seed_dir in seed_dirs.items():
@@ -127,6 +174,7 @@ def collect(seed_dirs: Mapping[int, Path], variants) -> pd.DataFrame:
                     "val_ap": s["validation"]["ap"],
                     "test_ap": s["test"]["ap"],
                     "test_roc_auc": s["test"]["roc_auc"],
+                    "train_datapoints": s.get("train", {}).get("datapoints"),
                 }
             )
     return pd.DataFrame(rows)
@@ -199,6 +247,7 @@ def evaluate_networks(
     runs = collect(seed_dirs, variants)
     chosen = choose_ratios(runs, augment_base_sizes)
     contrasts = declared_contrasts(base_sizes, ratios, augment_base_sizes, chosen, gqcnn.pools)
+    contrasts += datapoint_matched_contrasts(runs, base_sizes, ratios, augment_base_sizes, gqcnn.pools)
     index = read_table(Path(original) / "index.parquet")
     labels, object_ids = test_labels(index, seed_dirs[next(iter(seed_dirs))])
     results = evaluate_contrasts(contrasts, runs, seed_dirs, labels, object_ids, n_resamples=n_resamples, seed=seed)
@@ -356,7 +405,8 @@ def gain_sentences(
     a share of the same number of real shapes' gain (mean over ratios), and, with the ceiling
     (``ceiling_shapes`` train shapes; None without it), the share of the gap from 1:0 to the
     ceiling that the chosen ratio closes. A gap within the ceiling's 95% t half-width is
-    reported as no gap rather than as a share of noise. Ratios of means: no intervals."""
+    reported as no gap rather than as a share of noise. The share of the real-shape gain has a Fieller
+    interval over seeds (:func:`~graspaug.experiments.stats.fieller_interval`); the ceiling's share none."""
     out = []
     for b in augment_base_sizes:
         t, r = results.get(f"targeted_vs_none@{b}"), results.get(f"targeted_vs_real@{b}")
@@ -364,10 +414,18 @@ def gain_sentences(
             t["mean"] - r["mean"] if t and r and None not in (t["mean"], r["mean"]) else 0.0
         )  # mean over R of AP(real, B, R) - AP(B, 1:0)
         if real_gain:
+            gain = np.array([np.nan if v is None else v for v in t["per_seed"]], dtype=float)
+            real = gain - np.array([np.nan if v is None else v for v in r["per_seed"]], dtype=float)
+            ok = np.isfinite(gain) & np.isfinite(real)
+            share = fieller_interval(gain[ok], real[ok])
+            interval = (
+                f"95% Fieller interval over seeds [{share['ci_low']:.0%}, {share['ci_high']:.0%}]"
+                if share["bounded"]
+                else "the real-shape gain is not clearly nonzero over seeds, so its Fieller interval is unbounded"
+            )
             out.append(
                 f"At B = {b}, generated shapes give {t['mean'] / real_gain:.0%} of the gain of the same number of "
-                "real shapes "
-                f"({t['mean']:+.4f} vs {real_gain:+.4f} AP, mean over ratios; a ratio of means, no interval)."
+                f"real shapes ({t['mean']:+.4f} vs {real_gain:+.4f} AP, mean over ratios; {interval})."
             )
     nets = table.set_index(["pool", "base_size", "ratio"])
     if ceiling_shapes is None or ("ceiling", 0, 0.0) not in nets.index:

@@ -84,3 +84,17 @@ class DecodeSettings:
         description="A decode whose largest piece holds less than this share of its voxels is rejected (in pieces).",
     )
     smoothing_iterations: int = Field(10, ge=0, description="Humphrey smoothing iterations on the marching-cubes mesh.")
+
+
+@settings
+class BlendSettings:
+    """Two parents' signed distance fields → their weighted blend (params section ``generate.blend``)."""
+
+    resolution: int = Field(
+        96, ge=16, le=256, description="Cells per side of each parent's grid (the default ingest surface resolution)."
+    )
+    margin: int = Field(
+        3,
+        ge=1,
+        description="Empty cells around each parent along its largest extent (one voxel of a 32³ grid at 96 cells).",
+    )

@@ -91,8 +91,16 @@ class BaseParams(BaseModel):
     seed: int = Field(
         0,
         ge=0,
-        description="Seeds every random choice: the split, network initialisation and batches, critic-study pairs, "
-        "t-SNE, grasp sampling and perturbations.",
+        description="Seeds every random choice that data_seed does not: the train/test split, network initialisation "
+        "and batches, critic-study pairs, t-SNE, grasp sampling and perturbations, the robot cell.",
+    )
+    data_seed: int = Field(
+        0,
+        ge=0,
+        description="Seeds the draws of the GQ-CNN experiment's data, apart from the training seeds: the base sets, "
+        "the validation shapes and the real pool's order, and the random pool's pairs (so every generated pool). The "
+        "test split, the AutoEncoder and the grasp labels stay on `seed`. Cross it with gqcnn.seeds to cover data "
+        "draws: `dvc exp run -S data_seed=1`.",
     )
     device: Literal["auto", "cpu", "cuda"] = Field(
         "auto", description="Torch device: `auto` (CUDA when present), `cpu` or `cuda`."

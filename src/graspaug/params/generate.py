@@ -6,7 +6,7 @@ from typing import Any
 
 from pydantic import model_validator
 
-from graspaug.geometry.settings import DecodeSettings
+from graspaug.geometry.settings import BlendSettings, DecodeSettings
 from graspaug.settings import Field, settings
 
 
@@ -59,6 +59,10 @@ class GenerateParams:
     )
     n_examples: int = Field(6, ge=1, description="Parent pairs drawn with their child in the picture.")
     decode: DecodeSettings = Field(default_factory=DecodeSettings, description="Decoded grid → mesh.")
+    blend: BlendSettings = Field(
+        default_factory=BlendSettings,
+        description="The blend pool (gqcnn.pools): the targeted pool's pairs interpolated with no network.",
+    )
 
     @model_validator(mode="before")
     @classmethod

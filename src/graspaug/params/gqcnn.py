@@ -50,7 +50,9 @@ class GQCNNParams:
         description="Pools that get augmented networks at every nonzero ratio of augment_base_sizes: `targeted` "
         "(interpolants of rare and graspable neighbours), `random` (interpolants of random pairs), `real` (more real "
         "train shapes, the positive control), `recon` (the real pool's shapes passed through the AutoEncoder alone: "
-        "what decoding and meshing cost); `generate` makes the generated ones. `targeted` is always trained.",
+        "what decoding and meshing cost), `blend` (the targeted pool's pairs and weights interpolated with no "
+        "network, by mixing the parents' signed distance fields); `generate` makes the generated ones. `targeted` is "
+        "always trained.",
     )
     members: int = Field(
         2,

@@ -1,17 +1,12 @@
 """Stage ``generate``: for one base set of B train shapes (``generate@50`` …), pools of new shapes.
 
-The targeted pool pairs the base set's rare shapes, and separately its graspable ones, with their
-N-th … (N+K)-th latent neighbours, decodes ``(1 - α) z_a + α z_b`` with the AE-Critic and meshes
-it (paper Section III-C); the random pool does the same for random pairs; the recon pool decodes
-the real pool's shapes (the GQ-CNN experiment's order) from their own latents. ``gqcnn.pools``
-says which are made. Each pool holds ``ceil(max ratio × B)`` kept shapes: the first
-``round(R × B)`` are ratio R's set; a degenerate decode is rejected with its reason and replaced
-by the next candidate.
-
-Outputs, in ``data/generated/<B>/``: ``meshes/<shape_id>.obj``, ``index.parquet`` (one row per kept shape),
-``rejects.parquet``, ``base.parquet`` (the base set with its scores); ``metrics/generate/<B>.json`` (shapes
-kept, kept share); ``reports/generate/<B>/{summary.json,pairs.png,tsne.png}`` (summary: every pool count).
-"""
+Targeted: the base set's rare, and separately graspable, shapes with their N-th … (N+K)-th latent
+neighbours, ``(1 - α) z_a + α z_b`` decoded by the AE-Critic and meshed (paper Section III-C);
+random: random pairs; recon: the real pool's shapes (the GQ-CNN experiment's order) from their own
+latents; blend: the targeted pairs with no network. ``gqcnn.pools`` says which; each holds
+``ceil(max ratio × B)`` kept shapes, the first ``round(R × B)`` ratio R's set; a failed shape is
+replaced by the next candidate. Writes ``data/generated/<B>/`` (``meshes/``, ``index``, ``rejects``
+and ``base.parquet``), ``metrics/generate/<B>.json``, ``reports/generate/<B>/`` (summary, pictures)."""
 
 from __future__ import annotations
 
@@ -29,13 +24,14 @@ from graspaug.generation_meshes import (
     ReconSource,
     base_ids,
     base_set,
+    blend_batches,
     generate_pools,
     mesh_batches,
     tsne_groups,
 )
 from graspaug.io.atomic import atomic_path
 from graspaug.io.checkpoints import load_autoencoder
-from graspaug.io.meshes import mesh_path, write_obj
+from graspaug.io.meshes import mesh_path, read_mesh, write_obj
 from graspaug.io.tables import read_table, write_json, write_table
 from graspaug.io.voxels import read_voxels
 from graspaug.params.ae import AEParams
@@ -64,19 +60,22 @@ def run(params: Params, base_size: int) -> None:
     cfg = params.generate
     shapes, latents, scores = (read_table(path) for path in (paths.SHAPES_TABLE, paths.LATENTS, paths.SCORES))
     voxels = read_voxels(paths.VOXELS)
-    ids = base_ids(shapes, cfg.base_sizes, base_size, params.seed)
+    ids = base_ids(shapes, cfg.base_sizes, base_size, params.data_seed)
     base = base_set(ids, latents, scores, voxels, params.score.k)
 
     ae, _, _ = load_autoencoder(paths.AE_CRITIC_MODEL, params.ae.net)
     meshes = partial(mesh_batches, ae, resolve_device(params.device), settings=cfg.decode, workers=params.workers)
     gq = params.gqcnn
-    pools, recon = [p for p in GENERATED_POOLS if p in gq.pools], None
+    pools, recon, blend = [p for p in GENERATED_POOLS if p in gq.pools], None, None
     if "recon" in pools:  # the real pool as the GQ-CNN experiment draws it
-        split = load_split(paths.gqcnn_dir("original"), shapes, list(cfg.base_sizes), gq.val_shapes, params.seed)
+        split = load_split(paths.gqcnn_dir("original"), shapes, list(cfg.base_sizes), gq.val_shapes, params.data_seed)
         real = base_set(np.array(split.real_pool), latents, scores, voxels, params.score.k)
         recon = ReconSource(real, meshes(real, label=f"generate {base_size} recon"))
+    if "blend" in pools:  # the base shapes' own surfaces
+        solids = [read_mesh(mesh_path(paths.SHAPES_DIR, s)) for s in ids]
+        blend = blend_batches(solids, cfg.blend.resolution, cfg.blend.margin, params.workers, f"blend {base_size}")
     run_batch = meshes(base, label=f"generate {base_size}")
-    out = generate_pools(base, cfg, params.seed, run_batch, params.score.k, pools, recon)
+    out = generate_pools(base, cfg, params.data_seed, run_batch, params.score.k, pools, recon, blend)
     for level, message in [(logging.INFO, n) for n in out.notes] + [(logging.WARNING, w) for w in out.warnings]:
         log.log(level, "generate %d: %s", base_size, message)
 

@@ -68,8 +68,8 @@ def run(params: Params, seed: int) -> None:
         raise StageError(f"seed {seed} is not in gqcnn.seeds {list(cfg.seeds)}")
     start = time.perf_counter()
     corpora = Corpora(gqcnn_dir("original"), {b: gqcnn_dir(f"gen_{b}") for b in cfg.augment_base_sizes})
-    # too few shapes for the validation set: a DataError, which the CLI prints in one line
-    split = load_split(corpora.original, read_table(SHAPES_TABLE), list(gen.base_sizes), cfg.val_shapes, params.seed)
+    shapes = read_table(SHAPES_TABLE)  # too few for the validation set: a DataError, printed in one line
+    split = load_split(corpora.original, shapes, list(gen.base_sizes), cfg.val_shapes, params.data_seed)
     variants = seed_variants(gen.base_sizes, gen.ratios, cfg.augment_base_sizes, cfg.ceiling, cfg.pools)
     device = resolve_device(params.device)
     inits, noise_seeds = seed_members(cfg.net, params.seed, seed, cfg.members)

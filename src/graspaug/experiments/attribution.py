@@ -1,0 +1,171 @@
+"""Why generated shapes help or not: the GQ-CNN experiment's contrasts over several draws of the
+data (``data_seed``) crossed with the paired training seeds, each with one interval that covers
+draws, seeds and test objects (:func:`graspaug.experiments.stats.nested_interval`), and the
+decomposition of the gap between generated and real shapes into steps:
+
+    real ─(recon_vs_real: what the decoder loses)→ recon ─(blend_vs_recon)→ blend
+         ─(targeted_vs_blend: what the learned latent space adds over geometric interpolation)→ targeted
+    targeted_vs_random: what the selection by rarity and graspness adds
+
+A draw is one experiment (its networks by training seed); every draw is tested on the same test
+datapoints (the test split is drawn from ``seed``, not ``data_seed``), so one resample of the test
+objects serves every draw, seed and network.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from graspaug.errors import DataError
+from graspaug.experiments.ap import (
+    Contrast,
+    collect,
+    datapoint_matched_contrasts,
+    declared_contrasts,
+    test_predictions,
+)
+from graspaug.experiments.stats import (
+    ObjectBootstrap,
+    nested_indices,
+    nested_interval,
+    nested_means,
+    percentile_interval,
+)
+from graspaug.experiments.variants import seed_variants
+
+STEPS = ("recon_vs_real", "blend_vs_recon", "targeted_vs_blend", "targeted_vs_random")
+
+
+def draw_contrasts(runs: pd.DataFrame, generate, gqcnn) -> list[Contrast]:
+    """The contrasts of one draw (``runs``: :func:`graspaug.experiments.ap.collect`): the declared
+    ones without the validation-chosen ratio (it may differ between draws), and the
+    datapoint-matched ones (their weights come from the draw's own datapoint counts)."""
+    base_sizes, ratios, augment = generate.base_sizes, generate.ratios, gqcnn.augment_base_sizes
+    return declared_contrasts(base_sizes, ratios, augment, {}, gqcnn.pools) + datapoint_matched_contrasts(
+        runs, base_sizes, ratios, augment, gqcnn.pools
+    )
+
+
+def combine_draws(
+    draws: Mapping[int, Mapping[int, Path]],
+    labels: np.ndarray,
+    object_ids: np.ndarray,
+    generate,
+    gqcnn,
+    n_resamples: int,
+    seed: int,
+) -> dict:
+    """Every contrast over all draws and seeds.
+
+    Parameters
+    ----------
+    draws : data seed → (training seed → the folder of that seed's networks); every draw has the
+        same training seeds
+    labels, object_ids : (N,) — the test datapoints' labels and objects, in the order of every
+        network's ``test_predictions.npy``
+    generate, gqcnn : the params sections the draws were run with (only ``data_seed`` differs)
+    n_resamples : int — resamples of the test objects and of the nested bootstrap
+    seed : int — seeds both
+
+    Returns
+    -------
+    dict — ``contrasts``: name → ``mean``, ``ci_low``, ``ci_high`` (:func:`nested_interval`),
+    ``n_draws``, ``n_seeds``, ``per_draw`` (mean over seeds per draw), ``meaning``; ``share``: the
+    share of the real-shape gain that targeted shapes give per augmented base size (ratio of the
+    nested means, its percentile interval); ``draws``, ``seeds``
+    """
+    seeds = sorted({s for d in draws.values() for s in d})
+    if any(sorted(d) != seeds for d in draws.values()):
+        raise DataError("every draw needs the same training seeds")
+    variants = seed_variants(generate.base_sizes, generate.ratios, gqcnn.augment_base_sizes, False, gqcnn.pools)
+    boot = ObjectBootstrap(object_ids, n_resamples, seed)
+    per_draw: dict[int, tuple[pd.DataFrame, dict[str, Contrast]]] = {}
+    for d, seed_dirs in draws.items():
+        runs = collect(seed_dirs, variants)
+        per_draw[d] = runs, {c.name: c for c in draw_contrasts(runs, generate, gqcnn)}
+    names = [n for n in next(iter(per_draw.values()))[1] if all(n in c for _, c in per_draw.values())]
+    cache: dict = {}
+
+    def boot_ap(d: int, s: int, key) -> np.ndarray:
+        if (d, s, key) not in cache:
+            cache[d, s, key] = boot.average_precision(labels, test_predictions(draws[d][s], key))
+        return cache[d, s, key]
+
+    full, resampled = {}, {}
+    for name in names:
+        f, r = np.zeros((len(draws), len(seeds))), np.zeros((len(draws), len(seeds), n_resamples))
+        for i, (d, (runs, contrasts)) in enumerate(per_draw.items()):
+            ap = runs.set_index(["pool", "base_size", "ratio", "seed"]).test_ap.astype(float)
+            for j, s in enumerate(seeds):
+                f[i, j] = sum(w * ap.get((*k, s), np.nan) for w, k in contrasts[name].terms)
+                r[i, j] = sum(w * boot_ap(d, s, k) for w, k in contrasts[name].terms)
+        full[name], resampled[name] = f, r
+    rng = np.random.default_rng([seed, 0xA77])
+    out = {
+        name: {
+            **nested_interval(full[name], resampled[name], rng),
+            "per_draw": [round(float(v), 5) for v in full[name].mean(axis=1)],
+            "meaning": per_draw[next(iter(per_draw))][1][name].meaning,
+        }
+        for name in names
+    }
+    shares = {}
+    indices = nested_indices(len(draws), len(seeds), n_resamples, rng)
+    for b in gqcnn.augment_base_sizes:
+        gain, versus_real = f"targeted_vs_none@{b}", f"targeted_vs_real@{b}"
+        if gain in full and versus_real in full:
+            x, y = resampled[gain], resampled[gain] - resampled[versus_real]  # y: the real shapes' gain
+            ratio = nested_means(x, indices) / nested_means(y, indices)
+            low, high = percentile_interval(ratio)
+            mean = float(full[gain].mean() / (full[gain] - full[versus_real]).mean())
+            shares[str(b)] = {"share": mean, "ci_low": low, "ci_high": high}
+    return {"contrasts": out, "share": shares, "draws": list(draws), "seeds": seeds}
+
+
+def losing_step(contrasts: Mapping[str, dict], base_size: int) -> str:
+    """One sentence: which step of the decomposition (:data:`STEPS`) at ``base_size`` loses the most
+    of the real-shape gain, if any step's interval lies below zero."""
+    steps = {s: contrasts.get(f"{s}@{base_size}") for s in STEPS}
+    below = {s: c for s, c in steps.items() if c and c["ci_high"] is not None and c["ci_high"] < 0}
+    if not below:
+        shown = [s for s, c in steps.items() if c]
+        return (
+            f"At B = {base_size} no step ({', '.join(shown) or 'none measured'}) loses AP with its interval below zero."
+        )
+    worst = min(below, key=lambda s: below[s]["mean"])
+    c = below[worst]
+    return (
+        f"At B = {base_size} the step that loses most is `{worst}`: {c['mean']:+.4f} AP "
+        f"[{c['ci_low']:+.4f}, {c['ci_high']:+.4f}] over {c['n_draws']} draws × {c['n_seeds']} seeds and the test "
+        "objects."
+    )
+
+
+def decomposition_markdown(result: dict, augment_base_sizes: Sequence[int], command: str) -> str:
+    """The attribution report: every contrast with its interval over draws, seeds and objects, the
+    share of the real-shape gain, and per base size the step that loses it."""
+    lines = [
+        "# Why generated shapes help or not: the gap to real shapes, step by step",
+        "",
+        f"Draws (data_seed) {result['draws']} × training seeds {result['seeds']}; every interval is a 95% "
+        "hierarchical bootstrap over draws, seeds within draws and test objects. Command: `" + command + "`.",
+        "",
+        "| contrast | mean | 95% interval | per draw | meaning |",
+        "|---|---|---|---|---|",
+    ]
+    for name, c in result["contrasts"].items():
+        interval = "-" if c["ci_low"] is None else f"[{c['ci_low']:+.4f}, {c['ci_high']:+.4f}]"
+        per_draw = ", ".join(f"{v:+.4f}" for v in c["per_draw"])
+        lines.append(f"| `{name}` | {c['mean']:+.4f} | {interval} | {per_draw} | {c['meaning']} |")
+    lines += ["", "## What it says", ""]
+    for b, s in result["share"].items():
+        interval = "unbounded" if s["ci_low"] is None else f"[{s['ci_low']:.0%}, {s['ci_high']:.0%}]"
+        lines.append(
+            f"- B = {b}: targeted shapes give {s['share']:.0%} of the real-shape gain, 95% interval {interval}."
+        )
+    lines += [f"- {losing_step(result['contrasts'], b)}" for b in augment_base_sizes]
+    return "\n".join(lines) + "\n"

@@ -1,0 +1,82 @@
+"""Contrasts over data draws × training seeds (graspaug.experiments.attribution) on hand-made networks."""
+
+import json
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+from sklearn.metrics import average_precision_score
+
+from graspaug.errors import DataError
+from graspaug.experiments.attribution import combine_draws, decomposition_markdown, losing_step
+from graspaug.experiments.variants import seed_variants
+
+GENERATE = SimpleNamespace(base_sizes=[10, 20], ratios=[0.0, 1.0])
+GQCNN = SimpleNamespace(augment_base_sizes=[10], pools=("targeted", "random", "real", "recon", "blend"))
+LABELS = (np.arange(60) % 4 == 0).astype(int)
+OBJECTS = np.array([f"o{i % 12}" for i in range(60)])
+DATAPOINTS = {"targeted/10-0": 300, "targeted/20-0": 1200, "real/10-1": 600}  # the real-shape curve
+
+
+def make_draws(tmp_path, draws=(0, 1), seeds=(0, 1)):
+    """Networks whose test predictions are noise around the labels; recon predicts exactly as real."""
+    rng = np.random.default_rng(0)
+    out = {}
+    for d in draws:
+        out[d] = {}
+        for s in seeds:
+            seed_dir = tmp_path / f"draw{d}" / f"s{s}"
+            predictions = {}
+            for v in seed_variants(GENERATE.base_sizes, GENERATE.ratios, GQCNN.augment_base_sizes, False, GQCNN.pools):
+                p = predictions["real/10-1"] if v.name == "recon/10-1" else LABELS + rng.normal(0, 0.8, len(LABELS))
+                predictions[v.name] = p
+                (seed_dir / v.name).mkdir(parents=True)
+                np.save(seed_dir / v.name / "test_predictions.npy", p.astype(np.float32))
+                summary = {
+                    "validation": {"ap": 0.5},
+                    "test": {"ap": average_precision_score(LABELS, p), "roc_auc": 0.5},
+                    "train": {"datapoints": DATAPOINTS.get(v.name, 450)},
+                }
+                (seed_dir / v.name / "summary.json").write_text(json.dumps(summary))
+            out[d][s] = seed_dir
+    return out
+
+
+def test_combine_draws_gives_every_contrast_one_interval_over_draws_seeds_and_objects(tmp_path):
+    draws = make_draws(tmp_path)
+    result = combine_draws(draws, LABELS, OBJECTS, GENERATE, GQCNN, n_resamples=300, seed=0)
+    contrasts = result["contrasts"]
+    assert {"real_data", "recon_vs_real@10", "blend_vs_recon@10", "targeted_vs_blend@10"} <= set(contrasts)
+    assert "targeted_vs_none_chosen@10" not in contrasts  # the chosen ratio may differ between draws
+    assert {"targeted_vs_real_datapoints@10", "recon_vs_real_datapoints@10"} <= set(contrasts)
+    same = contrasts["recon_vs_real@10"]  # recon predicts as real in every draw and seed: exactly zero
+    assert same["mean"] == 0 and same["ci_low"] == same["ci_high"] == 0 and same["per_draw"] == [0, 0]
+    ap = {  # targeted_vs_blend by hand, from the summaries
+        (d, s): json.loads((draws[d][s] / "targeted/10-1/summary.json").read_text())["test"]["ap"]
+        - json.loads((draws[d][s] / "blend/10-1/summary.json").read_text())["test"]["ap"]
+        for d in draws
+        for s in (0, 1)
+    }
+    step = contrasts["targeted_vs_blend@10"]
+    assert step["mean"] == pytest.approx(np.mean(list(ap.values())))
+    assert step["per_draw"] == pytest.approx([(ap[d, 0] + ap[d, 1]) / 2 for d in draws], abs=1e-5)
+    assert step["n_draws"] == 2 and step["n_seeds"] == 2 and step["ci_low"] < step["ci_high"]
+    assert set(result["share"]) == {"10"} and result["draws"] == [0, 1] and result["seeds"] == [0, 1]
+    text = decomposition_markdown(result, [10], "python studies/attribution.py")
+    assert "| `targeted_vs_blend@10` |" in text and "B = 10" in text
+
+
+def test_every_draw_needs_the_same_training_seeds(tmp_path):
+    draws = make_draws(tmp_path, seeds=(0, 1))
+    draws[1] = {0: draws[1][0]}
+    with pytest.raises(DataError, match="the same training seeds"):
+        combine_draws(draws, LABELS, OBJECTS, GENERATE, GQCNN, n_resamples=10, seed=0)
+
+
+def test_the_losing_step_is_the_most_negative_with_its_interval_below_zero():
+    c = {
+        "recon_vs_real@50": {"mean": -0.03, "ci_low": -0.05, "ci_high": -0.01, "n_draws": 3, "n_seeds": 4},
+        "targeted_vs_blend@50": {"mean": -0.05, "ci_low": -0.09, "ci_high": 0.01, "n_draws": 3, "n_seeds": 4},
+    }
+    assert "`recon_vs_real`: -0.0300 AP [-0.0500, -0.0100] over 3 draws × 4 seeds" in losing_step(c, 50)
+    assert losing_step({}, 50).startswith("At B = 50 no step (none measured)")
