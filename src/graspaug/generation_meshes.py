@@ -128,13 +128,17 @@ def blend_batches(
     """A batch runner for :func:`graspaug.generation.fill_pool` that makes each candidate with no
     network: :func:`graspaug.geometry.blend.blend_solids` of its parents among ``meshes`` (the
     base set's meshes, m, in base-set order) at its weight, on ``resolution``-cell grids with
-    ``margin`` empty cells, on ``workers`` processes. Its grids are not kept (an empty array)."""
-    from graspaug.geometry.blend import blend_solids
+    ``margin`` empty cells, on ``workers`` processes; each parent's distance field is computed once
+    per batch. Its grids are not kept (an empty array)."""
+    from graspaug.geometry.blend import blend_fields, signed_distance_grid
     from graspaug.parallel import parallel_map
 
     def run_batch(candidates: list[Candidate]) -> list[Decoded]:
-        jobs = [(meshes[c.a], meshes[c.b], c.alpha) for c in candidates]
-        out = parallel_map(lambda job: blend_solids(*job, resolution, margin), jobs, workers, label)
+        parents = sorted({i for c in candidates for i in (c.a, c.b)})
+        grids = parallel_map(lambda i: signed_distance_grid(meshes[i], resolution, margin), parents, workers, label)
+        field = dict(zip(parents, grids))
+        jobs = [(field[c.a], field[c.b], c.alpha) for c in candidates]
+        out = parallel_map(lambda job: blend_fields(*job), jobs, workers, label)
         return [Decoded(c, np.zeros(0, np.uint8), mesh, reason) for c, (mesh, reason) in zip(candidates, out)]
 
     return run_batch

@@ -60,8 +60,17 @@ def blend_solids(
     (mesh, None), the child's closed surface, meters, centered on its center of mass; or
     (None, reason) when the mixed field has no solid or its surface is not one closed piece.
     """
-    field_a, pitch_a = signed_distance_grid(mesh_a, resolution, margin)
-    field_b, pitch_b = signed_distance_grid(mesh_b, resolution, margin)
+    return blend_fields(
+        signed_distance_grid(mesh_a, resolution, margin), signed_distance_grid(mesh_b, resolution, margin), alpha
+    )
+
+
+def blend_fields(
+    parent_a: tuple[np.ndarray, float], parent_b: tuple[np.ndarray, float], alpha: float
+) -> tuple[trimesh.Trimesh | None, str | None]:
+    """:func:`blend_solids` from the parents' :func:`signed_distance_grid` (field, pitch), each
+    computed once however many pairs a parent is in."""
+    (field_a, pitch_a), (field_b, pitch_b) = parent_a, parent_b
     field = (1 - alpha) * field_a + alpha * field_b
     if not (field < 0).any():
         return None, "empty blend: no cell inside both weighted fields"
