@@ -139,6 +139,35 @@ def test_dvc_repro_score(tiny_repo):
     assert "positive" in shown.stdout and "graspness" in shown.stdout
 
 
+def test_from_failures_generates_from_train_shapes_near_a_users_failure_meshes(tiny_repo, tmp_path):
+    import trimesh
+
+    work, env = tiny_repo
+    run(["dvc", "repro", "score"], work, env)
+    failures = tmp_path / "failures"
+    failures.mkdir()
+    trimesh.creation.box((0.02, 0.05, 0.08)).export(failures / "box.obj")
+    trimesh.creation.capsule(height=0.06, radius=0.015).export(failures / "capsule.stl")
+    (failures / "broken.obj").write_text("not a mesh\n")
+    command = ["graspaug", "from-failures", str(failures), "--count", "3", "--per-failure", "2"]
+    run([*command, "-o", str(tmp_path / "out")], work, env)
+    index = pd.read_csv(tmp_path / "out/index.csv")
+    shapes = pd.read_parquet(work / "data/shapes.parquet")
+    train = set(shapes.shape_id[shapes.split == "train"])
+    # the failure objects are the anchors' seeds, never parents: every parent is a train shape
+    assert len(index) == 3 and set(index.failure) <= {"box", "capsule"}
+    assert set(index.parent_a) | set(index.parent_b) <= train and index.parent_a.nunique() <= 2 * 2
+    assert all((tmp_path / "out/meshes" / f"{s}.obj").stat().st_size > 0 for s in index.shape_id)
+    skipped = pd.read_csv(tmp_path / "out/skipped.csv")
+    assert list(skipped.file) == ["broken.obj"] and skipped.reason.iloc[0]
+    run([*command, "-o", str(tmp_path / "again")], work, env)  # the same shapes for the same params
+    pd.testing.assert_frame_equal(pd.read_csv(tmp_path / "again/index.csv"), index)
+    missing = subprocess.run(
+        [*command[:2], str(tmp_path / "nowhere")], cwd=work, env=env, capture_output=True, text=True
+    )
+    assert missing.returncode == 1 and "the failure folder" in missing.stderr and "nowhere" in missing.stderr
+
+
 def summary_rejects(work, base_size: int, pool: str) -> int:
     rejects = pd.read_parquet(work / f"data/generated/{base_size}/rejects.parquet")
     return int((rejects.pool == pool).sum())
@@ -234,6 +263,28 @@ def test_dvc_repro_render(tiny_repo):
             )
         assert (work / f"reports/render/{corpus}/examples.png").stat().st_size > 0
     again = run(["dvc", "repro", "render", "render_generated"], work, env)
+    assert "Running stage" not in again.stdout
+
+
+def test_dvc_repro_fidelity(tiny_repo):
+    import json
+
+    from graspaug.experiments.fidelity import HEADLINE
+
+    work, env = tiny_repo
+    run(["dvc", "repro", "fidelity"], work, env)
+    pools = ("targeted", "random", "real", "recon", "blend")
+    files = {p.stem: json.loads(p.read_text()) for p in (work / "metrics/fidelity/6").glob("*.json")}
+    assert set(files) == {f"{p}_{f}" for p in pools for f in HEADLINE} - {"real_graspness_kept"}
+    for pool in pools:
+        one_nna = files[f"{pool}_one_nna"]
+        assert 0 <= one_nna["lo"] <= one_nna["mean"] <= one_nna["hi"] <= 1, pool
+        assert files[f"{pool}_datapoints_per_shape"]["mean"] > 0, pool
+    table = pd.read_csv(work / "reports/fidelity/6/fidelity.csv").set_index("pool")
+    assert table.loc["real", "shapes"] == 6 and table.loc["blend", "distinct_parents"] >= 2 and (table.mmd > 0).all()
+    assert "| recon | " in (work / "reports/fidelity/6/fidelity.md").read_text()
+    assert not (work / "metrics/fidelity/4").exists()  # only the augmented base sizes
+    again = run(["dvc", "repro", "fidelity"], work, env)
     assert "Running stage" not in again.stdout
 
 
@@ -336,6 +387,18 @@ def test_dvc_repro_gqcnn_matrix_and_report(tiny_repo):
     )
     for picture in ("ap_vs_ratio", "improvement_by_score", "tsne_graspness"):
         assert (work / f"reports/gqcnn/{picture}.png").stat().st_size > 0
+    # the decomposition real → recon → blend → targeted / random on this run's one draw, its step named in the report
+    steps = json.loads((work / "reports/gqcnn/decomposition.json").read_text())
+    assert steps["draws"] == [0] and steps["seeds"] == [0, 1]
+    step = steps["contrasts"]["blend_vs_recon@6"]
+    assert step["n_draws"] == 1 and step["n_seeds"] == 2
+    assert (
+        step["ci_low"] is None or step["ci_low"] <= step["ci_high"]
+    )  # None: a resample of the few tiny objects lacks a class
+    same = ap["contrasts"]["blend_vs_recon@6"]["mean"]  # None: a network of the few tiny shapes had no test AP
+    assert step["mean"] == pytest.approx(same, abs=1e-4) if same is not None else step["mean"] is None
+    assert "One draw of the data" in (work / "reports/gqcnn/decomposition.md").read_text()
+    assert "At B = 6 " in report
     shown = run(["dvc", "metrics", "show", "--json"], work, env)
     assert "metrics/gqcnn/s1.json" in shown.stdout and "metrics/ap/real_data.json" in shown.stdout
     again = run(["dvc", "repro", "report"], work, env)

@@ -181,6 +181,27 @@ def generate_command(
 
 
 @app.command(
+    name="fidelity",
+    help="How close each pool of one base size B is to real shapes, before any network trains on it: per pool of "
+    "`gqcnn.pools` (the shapes of its 1:1 augmentation set), graspness and the share of the parents' graspness a "
+    "child keeps, the share of positive rendered datapoints, datapoints per shape, median extents, and coverage / MMD "
+    "/ 1-NN accuracy on the Chamfer distance against B held-out real shapes of the test split, each with a 95% "
+    "bootstrap interval over shapes.\n\nWrites `metrics/fidelity/<B>/<pool>_<figure>.json` (mean, lo, hi) and "
+    "`reports/fidelity/<B>/{fidelity.csv,fidelity.md}`.\n\nParams: `gqcnn.pools`, `gqcnn.augment_base_sizes`; "
+    "`generate.base_sizes`, `gqcnn.val_shapes` and `data_seed` (the real pool, drawn as the GQ-CNN experiment draws "
+    "it); `seed` (the reference shapes, the surface points, the resamples).",
+)
+def fidelity_command(
+    base_size: int = typer.Option(
+        ..., "--base-size", "-b", help="The base set size B (one of gqcnn.augment_base_sizes)."
+    ),
+    params: Path = ParamsOption,
+) -> None:
+    stage = _stage("fidelity")
+    _run(lambda p: stage.run(p, base_size), _load(params, stage))
+
+
+@app.command(
     name="render",
     help="Render a Dex-Net 2.0 style grasp image dataset for a corpus: each shape in its most probable stable poses "
     "on a table, random depth-camera views from above, and for every grasp whose jaw axis is near parallel to the "
@@ -438,6 +459,30 @@ def plan_command(
         f"wrote {out / 'grasp.json'} and {out / 'grasp.png'} ({grasps[0].planning_time:.2f} s; quality floor "
         f"{floor.value:.3f}: {floor.source})"
     )
+
+
+@app.command(
+    name="from-failures",
+    help="Generate new training shapes near objects a grasp planner fails on, for a planner trained anywhere. FOLDER "
+    "holds meshes (.obj, .stl, .ply) of the objects it missed; each is closed and scaled as the corpus is, voxelized "
+    "and encoded by this project's AE-Critic. Its `--per-failure` nearest train shapes in latent space become "
+    "anchors, each interpolated with its nearest train shapes (`generate.first_neighbour`, `extra_neighbours`, "
+    "`alphas`), decoded and meshed as `generate` does, until `--count` shapes are kept. A failure object is never a "
+    "parent itself. Needs `train_ae`, `embed` and `score` to have run (`dvc repro score`).\n\nWrites "
+    "`<out>/meshes/failure_<order>.obj` (m), `<out>/index.csv` (per shape: the failure object it serves, anchor "
+    "`parent_a`, neighbour `parent_b`, `alpha`, size), `<out>/rejects.csv` and `<out>/skipped.csv` (files that could "
+    "not be used, and why). Feed the meshes to your own pipeline, or to this one (`data.source: folder`, `data.path`).",
+)
+def from_failures_command(
+    folder: Path = typer.Argument(..., help="Folder of meshes of the objects the planner failed on."),
+    count: int = typer.Option(20, "--count", "-n", help="Shapes to generate."),
+    per_failure: int = typer.Option(3, "--per-failure", help="Train shapes anchored near each failure object."),
+    out: Path = typer.Option(Path("failures_generated"), "--out", "-o", help="Folder to write (replaced whole)."),
+    params: Path = ParamsOption,
+) -> None:
+    import graspaug.stages.from_failures as command
+
+    _run(lambda p: command.run(p, folder, count, per_failure, out), _load(params, command))
 
 
 @app.command(

@@ -72,10 +72,13 @@ def above_percentile(scores: np.ndarray, percentile: float) -> np.ndarray:
     return chosen if len(chosen) else np.array([int(np.argmax(scores))])
 
 
-def neighbour_pairs(z: np.ndarray, first: int, extra: int) -> list[tuple[int, int]]:
-    """Pairs ``(i, j)`` of each point ``i`` with its ``first``-th to ``(first + extra)``-th nearest
-    neighbours ``j`` (Euclidean, 1 = nearest; ranks beyond the other points are skipped), in
-    order of (neighbour rank, i); a pair already met the other way round is dropped."""
+def neighbour_pairs(
+    z: np.ndarray, first: int, extra: int, anchors: Sequence[int] | None = None
+) -> list[tuple[int, int]]:
+    """Pairs ``(i, j)`` of each point ``i`` (every point, or only the ``anchors``, in their order)
+    with its ``first``-th to ``(first + extra)``-th nearest neighbours ``j`` among all points
+    (Euclidean, 1 = nearest; ranks beyond the other points are skipped), in order of (neighbour
+    rank, i); a pair already met the other way round is dropped."""
     n = len(z)
     last = min(first + extra, n - 1)
     if n < 2 or first > last:
@@ -84,7 +87,7 @@ def neighbour_pairs(z: np.ndarray, first: int, extra: int) -> list[tuple[int, in
     seen: set[frozenset[int]] = set()
     pairs = []
     for rank in range(first, last + 1):
-        for i in range(n):
+        for i in range(n) if anchors is None else anchors:
             j = int(idx[i, rank - 1])
             if frozenset((i, j)) not in seen:
                 seen.add(frozenset((i, j)))
@@ -111,13 +114,7 @@ def targeted_candidates(
     for name, scores in (("rarity", rarity), ("graspness", graspness)):
         group = above_percentile(scores, percentile)
         pairs = [(int(group[i]), int(group[j])) for i, j in neighbour_pairs(z[group], first, extra)]
-        lists.append(
-            [
-                Candidate(a, b, float(alphas[(k + round_) % len(alphas)]), name)
-                for round_ in range(len(alphas))
-                for k, (a, b) in enumerate(pairs)
-            ]
-        )
+        lists.append(cycled(pairs, alphas, name))
     out: list[Candidate] = []
     seen: set[tuple[frozenset[int], float]] = set()
     for k in range(max(len(lst) for lst in lists)):
@@ -196,6 +193,45 @@ class TargetedStream(CandidateStream):
                 self.notes.append(
                     f"percentile lowered to {self.percentile:g} ({len(self.items)} candidates, {count} wanted)"
                 )
+            else:
+                return
+            self._refill()
+
+
+def cycled(pairs: Sequence[tuple[int, int]], alphas: Sequence[float], selected_by: str) -> list[Candidate]:
+    """Every pair once per weight round: the weights cycle through ``alphas`` along the pairs,
+    shifted by one each round, so each weight is used equally often (the schedule every pool shares)."""
+    return [
+        Candidate(a, b, float(alphas[(k + round_) % len(alphas)]), selected_by)
+        for round_ in range(len(alphas))
+        for k, (a, b) in enumerate(pairs)
+    ]
+
+
+class FailureStream(CandidateStream):
+    """The lifelong loop's failure-targeted stream: each anchor (a training shape near an object
+    the planner fails on, most failing first) paired with its ``first``-th to ``(first + extra)``-th
+    nearest neighbours in latent space among all ``z``, the weights cycling as every pool's do
+    (:func:`cycled`; α on the neighbour, so below 0.5 a child stays nearer its anchor). When it
+    runs dry it widens, each step noted: the next weight of EXTRA_ALPHAS, then K by one."""
+
+    def __init__(self, z: np.ndarray, anchors: Sequence[int], first: int, extra: int, alphas: Sequence[float]) -> None:
+        super().__init__()
+        self.z, self.anchors, self.first, self.extra, self.alphas = z, list(anchors), first, extra, list(alphas)
+        self._refill()
+
+    def _refill(self) -> None:
+        self._append(cycled(neighbour_pairs(self.z, self.first, self.extra, self.anchors), self.alphas, "failure"))
+
+    def _grow(self, count: int) -> None:
+        while len(self.items) < count:
+            extra_alphas = [a for a in EXTRA_ALPHAS if a not in self.alphas]
+            if extra_alphas:
+                self.alphas.append(extra_alphas[0])
+                self.notes.append(f"alpha {extra_alphas[0]} added ({len(self.items)} candidates, {count} wanted)")
+            elif self.first + self.extra < len(self.z) - 1:
+                self.extra += 1
+                self.notes.append(f"K widened to {self.extra} ({len(self.items)} candidates, {count} wanted)")
             else:
                 return
             self._refill()
@@ -286,7 +322,7 @@ class Decoded:
     reason: str | None
 
 
-ID_LETTERS = {"targeted": "t", "random": "r", "recon": "c", "blend": "b"}  # gen_<B>_<letter><order>
+ID_LETTERS = {"targeted": "t", "random": "r", "recon": "c", "blend": "b", "failure": "f"}  # gen_<B>_<letter><order>
 
 
 def pool_tables(

@@ -19,6 +19,7 @@ from graspaug.generation import (
     BASE_SEED,
     Candidate,
     Decoded,
+    FailureStream,
     FollowStream,
     PoolExhausted,
     RandomStream,
@@ -281,3 +282,43 @@ def tsne_groups(base: BaseSet, index: pd.DataFrame, perplexity: float, seed: int
     xy = tsne_2d(np.concatenate([base.z, np.stack(index.z.to_numpy())]), perplexity, seed)
     groups = ["base"] * len(base.ids) + [f"generated ({s})" for s in index.selected_by]
     return xy, groups
+
+
+def failure_shapes(
+    pool: BaseSet,
+    anchors: Sequence[int],
+    failures: Sequence[str],
+    count: int,
+    cfg: GenerateParams,
+    run_batch: Callable[[list[Candidate]], list[Decoded]],
+) -> tuple[pd.DataFrame, pd.DataFrame, list[Decoded], list[str]]:
+    """``count`` shapes generated from training shapes near objects a planner fails on.
+
+    Parameters
+    ----------
+    pool : the training shapes (a :class:`BaseSet`) the anchors index
+    anchors : indices into ``pool``, most failing first
+        (:func:`graspaug.experiments.lifelong.failure_anchors`)
+    failures : (len(anchors),) — the name of the failure object each anchor is nearest to
+    count : shapes to keep
+    cfg : the ``generate`` params: neighbours (``first_neighbour``, ``extra_neighbours``) and ``alphas``
+    run_batch : :func:`mesh_batches` over ``pool``
+
+    Returns
+    -------
+    (index, rejects, kept, notes) — ``index``: one row per kept shape (``shape_id`` ``failure_<order>``, the
+    columns of :func:`graspaug.generation.pool_tables` with ``parent_a`` the anchor, and ``failure``), ``rejects``
+    (:data:`REJECT_COLUMNS`), the kept decodes (meshes in m) in ``index`` order, and how the stream was widened;
+    a :class:`DataError` if the candidates run out first
+    """
+    stream = FailureStream(pool.z, anchors, cfg.first_neighbour, cfg.extra_neighbours, cfg.alphas)
+    try:
+        kept, rejected = fill_pool(stream, count, run_batch)
+    except PoolExhausted as exc:
+        raise DataError(f"failure pool: {exc}") from None
+    rows, reject_rows = pool_tables({"failure": (pool.ids, pool.z)}, {"failure": (kept, rejected)}, len(pool.ids))
+    index = pd.DataFrame(rows)
+    served = dict(zip(anchors, failures))
+    index["shape_id"] = [f"failure_{order:04d}" for order in index.order]
+    index["failure"] = [served[d.candidate.a] for d in kept]
+    return index, pd.DataFrame(reject_rows, columns=REJECT_COLUMNS), kept, stream.notes

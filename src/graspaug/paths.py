@@ -63,6 +63,14 @@ def generate_summary(base_size: int) -> Path:
 GENERATED_SUFFIX = ".obj"
 
 
+def fidelity_metrics(base_size: int) -> Path:  # one file per pool and headline figure
+    return Path(f"metrics/fidelity/{base_size}")
+
+
+def fidelity_reports(base_size: int) -> Path:
+    return Path(f"reports/fidelity/{base_size}")
+
+
 # grasps (one table per corpus: `dvc.yaml` runs the stage for each)
 def corpus_files(corpus: str) -> tuple[Path, Path, str] | None:
     """(shape table, mesh folder, mesh suffix) of a corpus: ``original`` (ingested shapes) or

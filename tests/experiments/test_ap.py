@@ -167,6 +167,7 @@ def test_evaluate_networks_is_the_report_chain_step_by_step(tmp_path):
     assert ev.chosen == chosen and ev.contrasts == results
     pd.testing.assert_frame_equal(ev.table, ap.network_table(runs, per_object))
     assert ev.by_network.keys() == by_network.keys() and np.array_equal(ev.labels, labels)
+    assert np.array_equal(ev.object_ids, object_ids)
     assert ev.ceiling_shapes == 2 - 1  # the train shapes t0, t1 but one validation shape
 
     predictions = ap.compared_predictions(seed_dirs[0], 10, 1.0, ceiling=True)

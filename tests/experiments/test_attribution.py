@@ -80,3 +80,30 @@ def test_the_losing_step_is_the_most_negative_with_its_interval_below_zero():
     }
     assert "`recon_vs_real`: -0.0300 AP [-0.0500, -0.0100] over 3 draws × 4 seeds" in losing_step(c, 50)
     assert losing_step({}, 50).startswith("At B = 50 no step (none measured)")
+
+
+def test_one_draw_gives_intervals_over_seeds_and_objects_and_says_they_miss_other_draws(tmp_path):
+    """The report stage's decomposition: one run is one draw of the data."""
+    draws = make_draws(tmp_path, draws=(0,), seeds=(0, 1, 2))
+    result = combine_draws(draws, LABELS, OBJECTS, GENERATE, GQCNN, n_resamples=300, seed=0)
+    step = result["contrasts"]["targeted_vs_blend@10"]
+    assert step["n_draws"] == 1 and step["n_seeds"] == 3 and step["ci_low"] < step["mean"] < step["ci_high"]
+    text = decomposition_markdown(result, [10], "dvc repro report")
+    assert "One draw of the data" in text and "does not cover other draws" in text and "Draws (data_seed)" not in text
+    c = {"recon_vs_real@50": {"mean": -0.03, "ci_low": -0.05, "ci_high": -0.01, "n_draws": 1, "n_seeds": 4}}
+    assert "over 4 seeds of one draw and the test objects" in losing_step(c, 50)
+
+
+def test_a_network_without_a_test_ap_gives_no_mean_and_valid_json(tmp_path):
+    """A tiny run's network may have no test AP: the decomposition says so with None, never NaN."""
+    draws = make_draws(tmp_path, draws=(0,), seeds=(0, 1))
+    summary = draws[0][1] / "blend/10-1/summary.json"
+    data = json.loads(summary.read_text())
+    data["test"]["ap"] = None
+    summary.write_text(json.dumps(data))
+    result = combine_draws(draws, LABELS, OBJECTS, GENERATE, GQCNN, n_resamples=50, seed=0)
+    step = result["contrasts"]["blend_vs_recon@10"]
+    assert step["mean"] is None and step["per_draw"] == [None]
+    json.loads(json.dumps(result, allow_nan=False))  # strict JSON
+    text = decomposition_markdown(result, [10], "dvc repro report")
+    assert "| `blend_vs_recon@10` | - |" in text

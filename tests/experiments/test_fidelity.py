@@ -3,14 +3,22 @@
 from __future__ import annotations
 
 import numpy as np
+import pandas as pd
 import pytest
 import trimesh
 
 from graspaug.experiments.fidelity import (
+    FIGURES,
+    HEADLINE,
     chamfer_matrix,
     coverage_mmd,
     distribution_distances,
+    fidelity_headline,
+    fidelity_markdown,
+    fidelity_table,
     one_nn_accuracy,
+    pool_shapes,
+    resampled_distances,
     surface_cloud,
 )
 
@@ -51,3 +59,63 @@ def test_a_pool_of_the_reference_shapes_is_indistinguishable_and_boxes_are_not()
     boxes = [surface_cloud(trimesh.creation.box((0.1, 0.01, 0.01 * k)), 256, rng) for k in (1, 2, 3, 4)]
     other = distribution_distances(boxes, reference)
     assert other["one_nna"] == 1.0 and other["coverage"] < 0.5 and other["mmd"] > 3 * same["mmd"]
+
+
+def _spheres(radii, rng, points=128):
+    return [surface_cloud(trimesh.creation.icosphere(radius=r), points, rng) for r in radii]
+
+
+def test_resampled_distances_at_the_identity_are_the_plain_ones_and_copies_are_not_neighbours():
+    rng = np.random.default_rng(1)
+    pool, reference = _spheres((0.02, 0.03, 0.04), rng), _spheres((0.021, 0.031, 0.041), rng)
+    pp, rr, pr = chamfer_matrix(pool, pool), chamfer_matrix(reference, reference), chamfer_matrix(pool, reference)
+    identity = np.arange(3)
+    assert resampled_distances(pp, rr, pr, identity, identity) == pytest.approx(distribution_distances(pool, reference))
+    # a resample holding one pool shape three times: its copies are not each other's nearest shapes
+    copies = resampled_distances(pp, rr, pr, np.array([0, 0, 0]), identity)
+    assert copies["one_nna"] < 1.0
+    with pytest.raises(ValueError, match="one size"):
+        resampled_distances(pp, rr, pr, identity, identity[:2])
+
+
+def test_pool_shapes_reads_graspness_datapoints_and_the_parents_mix():
+    meshes = {"c0": trimesh.creation.box((0.01, 0.03, 0.02)), "c1": trimesh.creation.icosphere(radius=0.02)}
+    graspness = {"a": 0.4, "b": 0.2, "c0": 0.3}  # c1 had no sampled grasp
+    rendered = pd.DataFrame({"shape_id": ["c0", "c0", "c0", "c1"], "label": [1, 0, 0, 1]})
+    parents = pd.DataFrame(
+        {"shape_id": ["c1", "c0"], "parent_a": ["a", "a"], "parent_b": ["b", "a"], "alpha": [0.25, 0]}
+    )
+    pool = pool_shapes(meshes, graspness, rendered, 64, 0, parents)
+    assert pool.ids == ["c0", "c1"] and pool.graspness.tolist() == [0.3, 0.0]
+    assert pool.parents == pytest.approx([0.4, 0.75 * 0.4 + 0.25 * 0.2])
+    assert pool.datapoints.tolist() == [3, 1] and pool.positives.tolist() == [1, 1]
+    assert pool.extents[0] == pytest.approx([0.01, 0.02, 0.03]) and pool.distinct_parents == 2
+    assert pool.alphas == {"0": 1, "0.25": 1} and len(pool.clouds) == 2 and pool.clouds[0].shape == (64, 3)
+    again = pool_shapes(meshes, graspness, rendered, 64, 0, parents)  # each shape's points: its own seeded stream
+    assert np.array_equal(again.clouds[1], pool.clouds[1])
+    real = pool_shapes(meshes, graspness, rendered, 64, 0)
+    assert np.isnan(real.parents).all() and real.distinct_parents is None and real.alphas == {}
+
+
+def test_fidelity_table_gives_intervals_that_hold_the_values_and_tell_a_far_pool_from_a_near_one():
+    rng = np.random.default_rng(2)
+    radii = np.linspace(0.02, 0.04, 8)
+    reference = _spheres(radii, rng)
+    rendered = pd.DataFrame({"shape_id": [f"s{i}" for i in range(8) for _ in range(i + 1)], "label": 1})
+    near = {f"s{i}": trimesh.creation.icosphere(radius=r + 0.0005) for i, r in enumerate(radii)}
+    far = {f"s{i}": trimesh.creation.box((0.1, 0.01, 0.005 * (i + 1))) for i in range(8)}
+    graspness = {f"s{i}": 0.1 * (i % 3) for i in range(8)}
+    pools = {name: pool_shapes(m, graspness, rendered, 128, 0) for name, m in (("near", near), ("far", far))}
+    table = fidelity_table(pools, reference, 200, np.random.default_rng(0)).set_index("pool")
+    for figure in FIGURES:
+        if figure != "graspness_kept":  # real shapes keep no parents' graspness
+            assert (table[f"{figure}_lo"] <= table[figure] + 1e-12).all() and (
+                table[figure] <= table[f"{figure}_hi"] + 1e-12
+            ).all()
+    assert table.graspness_kept.isna().all() and table.datapoints_per_shape.tolist() == [4.5, 4.5]
+    assert table.loc["near", "one_nna_hi"] < table.loc["far", "one_nna_lo"]
+    assert table.loc["far", "one_nna"] == 1.0 and table.loc["near", "coverage"] > table.loc["far", "coverage"]
+    headline = fidelity_headline(table.reset_index())  # one metrics file per pool and figure; real shapes keep none
+    assert set(headline) == {f"{p}_{f}" for p in ("near", "far") for f in HEADLINE if f != "graspness_kept"}
+    assert headline["far_one_nna"] == {"mean": 1.0, "lo": 1.0, "hi": 1.0}
+    assert "| near | 8 | - |" in fidelity_markdown(table.reset_index(), 8, len(reference))

@@ -230,6 +230,7 @@ class Evaluation:
     table: pd.DataFrame
     by_network: dict[tuple, pd.Series]
     labels: np.ndarray
+    object_ids: np.ndarray
     ceiling_shapes: int
 
 
@@ -253,7 +254,7 @@ def evaluate_networks(
     results = evaluate_contrasts(contrasts, runs, seed_dirs, labels, object_ids, n_resamples=n_resamples, seed=seed)
     per_object, by_network = per_object_aps(seed_dirs, variants, labels, object_ids)
     table = network_table(runs, per_object)
-    return Evaluation(chosen, results, table, by_network, labels, ceiling_shapes(index, gqcnn.val_shapes))
+    return Evaluation(chosen, results, table, by_network, labels, object_ids, ceiling_shapes(index, gqcnn.val_shapes))
 
 
 def per_object_ap(labels: np.ndarray, probability: np.ndarray, shape_ids: np.ndarray) -> pd.Series:

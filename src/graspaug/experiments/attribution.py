@@ -108,7 +108,7 @@ def combine_draws(
     out = {
         name: {
             **nested_interval(full[name], resampled[name], rng),
-            "per_draw": [round(float(v), 5) for v in full[name].mean(axis=1)],
+            "per_draw": [round(float(v), 5) if np.isfinite(v) else None for v in full[name].mean(axis=1)],
             "meaning": per_draw[next(iter(per_draw))][1][name].meaning,
         }
         for name in names
@@ -122,7 +122,7 @@ def combine_draws(
             ratio = nested_means(x, indices) / nested_means(y, indices)
             low, high = percentile_interval(ratio)
             mean = float(full[gain].mean() / (full[gain] - full[versus_real]).mean())
-            shares[str(b)] = {"share": mean, "ci_low": low, "ci_high": high}
+            shares[str(b)] = {"share": mean if np.isfinite(mean) else None, "ci_low": low, "ci_high": high}
     return {"contrasts": out, "share": shares, "draws": list(draws), "seeds": seeds}
 
 
@@ -130,7 +130,9 @@ def losing_step(contrasts: Mapping[str, dict], base_size: int) -> str:
     """One sentence: which step of the decomposition (:data:`STEPS`) at ``base_size`` loses the most
     of the real-shape gain, if any step's interval lies below zero."""
     steps = {s: contrasts.get(f"{s}@{base_size}") for s in STEPS}
-    below = {s: c for s, c in steps.items() if c and c["ci_high"] is not None and c["ci_high"] < 0}
+    below = {
+        s: c for s, c in steps.items() if c and c["mean"] is not None and c["ci_high"] is not None and c["ci_high"] < 0
+    }
     if not below:
         shown = [s for s, c in steps.items() if c]
         return (
@@ -138,34 +140,44 @@ def losing_step(contrasts: Mapping[str, dict], base_size: int) -> str:
         )
     worst = min(below, key=lambda s: below[s]["mean"])
     c = below[worst]
+    over = f"{c['n_draws']} draws × {c['n_seeds']} seeds" if c["n_draws"] > 1 else f"{c['n_seeds']} seeds of one draw"
     return (
         f"At B = {base_size} the step that loses most is `{worst}`: {c['mean']:+.4f} AP "
-        f"[{c['ci_low']:+.4f}, {c['ci_high']:+.4f}] over {c['n_draws']} draws × {c['n_seeds']} seeds and the test "
-        "objects."
+        f"[{c['ci_low']:+.4f}, {c['ci_high']:+.4f}] over {over} and the test objects."
     )
 
 
 def decomposition_markdown(result: dict, augment_base_sizes: Sequence[int], command: str) -> str:
     """The attribution report: every contrast with its interval over draws, seeds and objects, the
     share of the real-shape gain, and per base size the step that loses it."""
+    if len(result["draws"]) > 1:
+        design = (
+            f"Draws (data_seed) {result['draws']} × training seeds {result['seeds']}; every interval is a 95% "
+            "hierarchical bootstrap over draws, seeds within draws and test objects."
+        )
+    else:
+        design = (
+            f"One draw of the data × training seeds {result['seeds']}; every interval is a 95% bootstrap over the "
+            "seeds and the test objects. It does not cover other draws of the base sets, validation shapes and "
+            "pools: `python studies/attribution.py` runs several and gives intervals that do."
+        )
     lines = [
         "# Why generated shapes help or not: the gap to real shapes, step by step",
         "",
-        f"Draws (data_seed) {result['draws']} × training seeds {result['seeds']}; every interval is a 95% "
-        "hierarchical bootstrap over draws, seeds within draws and test objects. Command: `" + command + "`.",
+        design + " Command: `" + command + "`.",
         "",
         "| contrast | mean | 95% interval | per draw | meaning |",
         "|---|---|---|---|---|",
     ]
     for name, c in result["contrasts"].items():
         interval = "-" if c["ci_low"] is None else f"[{c['ci_low']:+.4f}, {c['ci_high']:+.4f}]"
-        per_draw = ", ".join(f"{v:+.4f}" for v in c["per_draw"])
-        lines.append(f"| `{name}` | {c['mean']:+.4f} | {interval} | {per_draw} | {c['meaning']} |")
+        per_draw = ", ".join("-" if v is None else f"{v:+.4f}" for v in c["per_draw"])
+        mean = "-" if c["mean"] is None else f"{c['mean']:+.4f}"
+        lines.append(f"| `{name}` | {mean} | {interval} | {per_draw} | {c['meaning']} |")
     lines += ["", "## What it says", ""]
     for b, s in result["share"].items():
         interval = "unbounded" if s["ci_low"] is None else f"[{s['ci_low']:.0%}, {s['ci_high']:.0%}]"
-        lines.append(
-            f"- B = {b}: targeted shapes give {s['share']:.0%} of the real-shape gain, 95% interval {interval}."
-        )
+        share = "an undefined share" if s["share"] is None else f"{s['share']:.0%}"
+        lines.append(f"- B = {b}: targeted shapes give {share} of the real-shape gain, 95% interval {interval}.")
     lines += [f"- {losing_step(result['contrasts'], b)}" for b in augment_base_sizes]
     return "\n".join(lines) + "\n"

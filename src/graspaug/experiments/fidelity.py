@@ -19,10 +19,17 @@ of the other cloud (m, not squared), the clouds centered on their centroids.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+import json
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
 
 import numpy as np
+import pandas as pd
 from scipy.spatial import cKDTree
+
+from graspaug.errors import DataError
+from graspaug.experiments.stats import percentile_interval
+from graspaug.rng import shape_rng
 
 
 def surface_cloud(mesh, n_points: int, rng: np.random.Generator) -> np.ndarray:
@@ -73,3 +80,198 @@ def distribution_distances(pool: Sequence[np.ndarray], reference: Sequence[np.nd
     coverage, mmd = coverage_mmd(pr)
     one_nna = one_nn_accuracy(chamfer_matrix(pool, pool), chamfer_matrix(reference, reference), pr)
     return {"coverage": coverage, "mmd": mmd, "one_nna": one_nna}
+
+
+@dataclass(frozen=True)
+class PoolShapes:
+    """One pool's shapes, one row each (:func:`pool_shapes`).
+
+    Attributes
+    ----------
+    ids : (n,) shape ids
+    clouds : n arrays (P, 3) m — surface points (:func:`surface_cloud`)
+    extents : (n, 3) m — each shape's bounding-box extents, sorted
+    graspness : (n,) — the share of the shape's sampled grasps with robust ε above the threshold
+    parents : (n,) — the parents' graspness mixed as the child mixes them, (1 − α) g_a + α g_b
+        (NaN for a real shape)
+    datapoints, positives : (n,) int — the shape's rendered datapoints and its positive ones
+    distinct_parents : int or None — parents of the pool's shapes, counted once (None: real shapes)
+    alphas : dict — α → how many shapes (empty for real shapes)
+    """
+
+    ids: list[str]
+    clouds: list[np.ndarray]
+    extents: np.ndarray
+    graspness: np.ndarray
+    parents: np.ndarray
+    datapoints: np.ndarray
+    positives: np.ndarray
+    distinct_parents: int | None = None
+    alphas: dict = field(default_factory=dict)
+
+
+def pool_shapes(
+    meshes: Mapping[str, object],
+    graspness: Mapping[str, float],
+    rendered: pd.DataFrame,
+    n_points: int,
+    seed: int,
+    parents: pd.DataFrame | None = None,
+) -> PoolShapes:
+    """A pool's :class:`PoolShapes` from its meshes.
+
+    Parameters
+    ----------
+    meshes : shape id → trimesh, in pool order
+    graspness : shape id → graspness (a shape missing here had no sampled grasp: 0)
+    rendered : the pool's rendered datapoints (columns ``shape_id``, ``label``)
+    n_points : surface points per shape; each shape's points come from its own stream of ``seed``
+    parents : for generated shapes, their rows of the generated index (``shape_id``, ``parent_a``,
+        ``parent_b``, ``alpha``), the parents' graspness looked up in ``graspness``
+    """
+    ids = list(meshes)
+    counts = rendered.groupby("shape_id").label.agg(["size", "sum"]).reindex(ids, fill_value=0)
+    mixed, distinct, alphas = np.full(len(ids), np.nan), None, {}
+    if parents is not None:
+        p = parents.set_index("shape_id").loc[ids]
+        g_a, g_b = (p[c].map(lambda s: graspness.get(s, 0.0)).to_numpy(float) for c in ("parent_a", "parent_b"))
+        mixed = (1 - p.alpha.to_numpy(float)) * g_a + p.alpha.to_numpy(float) * g_b
+        distinct = len(set(p.parent_a) | set(p.parent_b))
+        alphas = {f"{a:g}": int(n) for a, n in p.alpha.value_counts().sort_index().items()}
+    return PoolShapes(
+        ids=ids,
+        clouds=[surface_cloud(meshes[s], n_points, shape_rng(seed, s, "fidelity")) for s in ids],
+        extents=np.sort([np.asarray(meshes[s].extents, float) for s in ids], axis=1).reshape(-1, 3),
+        graspness=np.array([graspness.get(s, 0.0) for s in ids], float),
+        parents=mixed,
+        datapoints=counts["size"].to_numpy(int),
+        positives=counts["sum"].to_numpy(int),
+        distinct_parents=distinct,
+        alphas=alphas,
+    )
+
+
+def resampled_distances(pp: np.ndarray, rr: np.ndarray, pr: np.ndarray, i: np.ndarray, j: np.ndarray) -> dict:
+    """``coverage``, ``mmd`` (m) and ``one_nna`` of pool shapes ``i`` against reference shapes ``j``
+    (index arrays of one length, drawn with replacement) from the full Chamfer matrices within the
+    pool ``pp``, within the reference ``rr`` and across ``pr``. Copies of one shape are not each
+    other's neighbours: a resample scores as its distinct shapes would, not better."""
+    i, j = np.asarray(i), np.asarray(j)
+    if len(i) != len(j):
+        raise ValueError(f"1-NNA needs sets of one size; got {len(i)} pool and {len(j)} reference shapes")
+    across = pr[np.ix_(i, j)]
+    coverage = float(np.isin(j, j[across.argmin(axis=1)]).mean())
+    within_pool = np.where(i[:, None] == i[None, :], np.inf, pp[np.ix_(i, i)])
+    within_reference = np.where(j[:, None] == j[None, :], np.inf, rr[np.ix_(j, j)])
+    nearest = np.block([[within_pool, across], [across.T, within_reference]]).argmin(axis=1)
+    own = np.r_[np.zeros(len(i), bool), np.ones(len(j), bool)]
+    return {
+        "coverage": coverage,
+        "mmd": float(across.min(axis=0).mean()),
+        "one_nna": float((own[nearest] == own).mean()),
+    }
+
+
+FIGURES = ("graspness", "graspness_kept", "positive_share", "datapoints_per_shape", "coverage", "mmd", "one_nna")
+"""The figures of :func:`fidelity_table`, each with its interval."""
+
+
+def _shape_figures(pool: PoolShapes, i: np.ndarray) -> dict:
+    graspness = float(pool.graspness[i].mean())
+    kept = graspness / float(np.mean(pool.parents[i])) if np.isfinite(pool.parents).all() else np.nan
+    return {
+        "graspness": graspness,
+        "graspness_kept": kept,
+        "positive_share": float(pool.positives[i].sum() / max(pool.datapoints[i].sum(), 1)),
+        "datapoints_per_shape": float(pool.datapoints[i].mean()),
+    }
+
+
+def fidelity_table(
+    pools: Mapping[str, PoolShapes], reference: Sequence[np.ndarray], n_resamples: int, rng: np.random.Generator
+) -> pd.DataFrame:
+    """How close each pool is to real shapes, before any training, with 95% intervals.
+
+    Each pool gets :data:`FIGURES`: its graspness and (generated pools) the share of its parents'
+    graspness it keeps, the share of positive rendered datapoints, datapoints per shape, and
+    coverage / MMD / 1-NNA against the ``reference`` clouds (held-out real shapes) on the first m
+    shapes of each (m: the smaller count). Intervals: percentile bootstrap, ``n_resamples`` times
+    drawing the pool's shapes and (for the distances) m pool and m reference shapes with
+    replacement.
+
+    Returns
+    -------
+    DataFrame — one row per pool: ``pool``, ``shapes``, ``distinct_parents``, ``alphas``, the median
+    sorted extents ``extent_small``/``extent_middle``/``extent_large`` (m), and per figure its value
+    and ``<figure>_lo``/``<figure>_hi``
+    """
+    rr_full = chamfer_matrix(reference, reference)
+    rows = []
+    for name, pool in pools.items():
+        n, m = len(pool.ids), min(len(pool.ids), len(reference))
+        if m < 2:
+            raise DataError(f"fidelity: pool {name!r} has {n} shapes and the reference {len(reference)}; need 2 each")
+        pp, pr = chamfer_matrix(pool.clouds, pool.clouds), chamfer_matrix(pool.clouds, reference)
+        point = _shape_figures(pool, np.arange(n)) | resampled_distances(pp, rr_full, pr, np.arange(m), np.arange(m))
+        samples = []
+        for _ in range(n_resamples):
+            shapes, i, j = rng.integers(0, n, n), rng.integers(0, n, m), rng.integers(0, len(reference), m)
+            samples.append(_shape_figures(pool, shapes) | resampled_distances(pp, rr_full, pr, i, j))
+        row = {"pool": name, "shapes": n, "distinct_parents": pool.distinct_parents, "alphas": json.dumps(pool.alphas)}
+        row |= dict(zip(("extent_small", "extent_middle", "extent_large"), np.median(pool.extents, axis=0).tolist()))
+        for figure in FIGURES:
+            low, high = percentile_interval(np.array([s[figure] for s in samples]))
+            row |= {figure: point[figure], f"{figure}_lo": low, f"{figure}_hi": high}
+        rows.append(row)
+    return pd.DataFrame(rows)
+
+
+HEADLINE = ("graspness_kept", "positive_share", "datapoints_per_shape", "one_nna")
+"""The figures of :func:`fidelity_table` that go to metrics files (the rest: the report's table)."""
+
+
+def fidelity_headline(table: pd.DataFrame) -> dict[str, dict]:
+    """Metrics files from :func:`fidelity_table`: ``<pool>_<figure>`` → ``mean``, ``lo``, ``hi`` (its
+    95% interval) for each figure of :data:`HEADLINE` a pool has (real shapes keep no parents' graspness)."""
+
+    def value(v):
+        return None if v is None or not np.isfinite(v) else round(float(v), 4)
+
+    return {
+        f"{row.pool}_{f}": {"mean": value(row[f]), "lo": value(row[f"{f}_lo"]), "hi": value(row[f"{f}_hi"])}
+        for _, row in table.iterrows()
+        for f in HEADLINE
+        if value(row[f]) is not None
+    }
+
+
+def fidelity_markdown(table: pd.DataFrame, base_size: int, reference_count: int) -> str:
+    """The fidelity table in words and numbers: value [95% interval] per pool and figure."""
+
+    def cell(row, f: str, digits: int) -> str:
+        v, lo, hi = row[f], row[f"{f}_lo"], row[f"{f}_hi"]
+        if v is None or not np.isfinite(v):
+            return "-"
+        return f"{v:.{digits}f} [{lo:.{digits}f}, {hi:.{digits}f}]"
+
+    lines = [
+        f"# Fidelity of the pools at B = {base_size}, before any training",
+        "",
+        f"Each pool against {reference_count} held-out real shapes (test split; Chamfer distance on surface points). "
+        "Intervals: 95% percentile bootstrap over the pool's shapes and the reference shapes. 1-NNA 0.5 is "
+        "indistinguishable from real shapes, 1.0 fully separable; the `real` pool is the control.",
+        "",
+        "| pool | shapes | parents | graspness | kept of parents | positive share | datapoints / shape "
+        "| COV | MMD (mm) | 1-NNA | median extents (cm) |",
+        "|---|---|---|---|---|---|---|---|---|---|---|",
+    ]
+    for _, row in table.iterrows():
+        mmd = "-" if pd.isna(row.mmd) else f"{1e3 * row.mmd:.2f} [{1e3 * row.mmd_lo:.2f}, {1e3 * row.mmd_hi:.2f}]"
+        extents = " / ".join(f"{100 * row[e]:.1f}" for e in ("extent_small", "extent_middle", "extent_large"))
+        parents = "-" if row.distinct_parents is None or pd.isna(row.distinct_parents) else int(row.distinct_parents)
+        lines.append(
+            f"| {row.pool} | {row.shapes} | {parents} | {cell(row, 'graspness', 3)} | {cell(row, 'graspness_kept', 2)} "
+            f"| {cell(row, 'positive_share', 3)} | {cell(row, 'datapoints_per_shape', 1)} | {cell(row, 'coverage', 2)} "
+            f"| {mmd} | {cell(row, 'one_nna', 2)} | {extents} |"
+        )
+    return "\n".join(lines) + "\n"

@@ -7,3 +7,9 @@ POOLS = ("targeted", "random", "real", "recon", "blend")
 base set's rare-and-graspable neighbours / of random pairs), ``real`` (more real train shapes, the
 positive control), ``recon`` (the real pool's shapes decoded from their own latents) and ``blend``
 (the targeted pool's pairs and weights interpolated with no network: mixed signed distance fields)."""
+
+FIDELITY_POINTS = 512
+"""Surface points per shape for the fidelity stage's Chamfer distances."""
+
+FIDELITY_RESAMPLES = 1000
+"""Bootstrap resamples of the fidelity stage's intervals."""

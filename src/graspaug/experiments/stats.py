@@ -195,12 +195,13 @@ def nested_interval(full: np.ndarray, resampled: np.ndarray, rng: np.random.Gene
 
     Returns
     -------
-    dict — ``mean`` (of ``full``), ``ci_low``, ``ci_high``, ``n_draws``, ``n_seeds``
+    dict — ``mean`` (of ``full``; None if a cell is not finite), ``ci_low``, ``ci_high``, ``n_draws``, ``n_seeds``
     """
     full, resampled = np.asarray(full, dtype=float), np.asarray(resampled, dtype=float)
     n_draws, n_seeds, n_resamples = resampled.shape
     low, high = percentile_interval(nested_means(resampled, nested_indices(n_draws, n_seeds, n_resamples, rng)), level)
-    return {"mean": float(full.mean()), "ci_low": low, "ci_high": high, "n_draws": n_draws, "n_seeds": n_seeds}
+    mean = float(full.mean()) if np.isfinite(full).all() else None  # a network without a test AP: no mean
+    return {"mean": mean, "ci_low": low, "ci_high": high, "n_draws": n_draws, "n_seeds": n_seeds}
 
 
 def fieller_interval(x, y, level: float = 0.95) -> dict:

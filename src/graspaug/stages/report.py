@@ -1,13 +1,13 @@
-"""Stage ``report``: the paper's GQ-CNN experiment in one table, declared contrasts with
-intervals, three figures and plain words.
+"""Stage ``report``: the paper's GQ-CNN experiment in one table, declared contrasts with intervals, figures, words.
 
 Reads every network of every seed (``models/gqcnn/s<seed>/``). Writes ``metrics/ap/<contrast>.json`` (``mean``,
-``lo``, ``hi``: 95% t over seeds) and, in ``reports/gqcnn/``: ``ap.json`` (``contrasts``: per declared contrast
-``mean``, ``ci_low``/``ci_high``, ``n_seeds``, ``sd``, ``boot_low``/``boot_high`` (95% bootstrap over test objects);
-``networks``: test / validation / per-object AP per pool, base size, ratio; ``chosen_ratio`` per base size, picked
-on validation AP), ``ap_table.csv``, ``report.md``, ``ap_vs_ratio.png`` (Fig. 7), ``improvement_by_score.png``
-(Fig. 8: per-object AP change of the chosen ratio over 1:0 at the largest base size, by rarity and graspness
-interval) and ``tsne_graspness.png`` (Fig. 1).
+``lo``, ``hi``: 95% t over seeds) and, in ``reports/gqcnn/``: ``ap.json`` (per declared contrast ``mean``,
+``ci_low``/``ci_high``, ``n_seeds``, ``sd``, ``boot_low``/``boot_high`` (95% bootstrap over test objects); test,
+validation and per-object AP per network; ``chosen_ratio`` per base size, picked on validation AP), ``ap_table.csv``,
+``report.md``, ``decomposition.{md,json}`` (the gap to real shapes step by step, real → recon → blend → targeted /
+random, intervals over the seeds and test objects of this run's one draw of the data), ``ap_vs_ratio.png`` (Fig. 7),
+``improvement_by_score.png`` (Fig. 8: per-object AP change of the chosen ratio over 1:0 at the largest base size, by
+rarity and graspness interval) and ``tsne_graspness.png`` (Fig. 1).
 """
 
 from __future__ import annotations
@@ -26,6 +26,7 @@ from graspaug.experiments.ap import (
     verdict,
 )
 from graspaug.experiments.ap_figures import draw_ap_vs_ratio, draw_improvement, draw_latent_map, draw_pr_roc
+from graspaug.experiments.attribution import combine_draws, decomposition_markdown, losing_step
 from graspaug.io.atomic import atomic_path
 from graspaug.io.tables import read_table, write_csv, write_json, write_json_files
 from graspaug.params.base import params_model
@@ -67,7 +68,12 @@ def run(params: Params) -> None:
     write_csv(ratio_curves(table), REPORT_DIR / "ap_vs_ratio.csv")  # the curves of ap_vs_ratio.png, one column each
     extras = gain_sentences(results, table, chosen, cfg.augment_base_sizes, ev.ceiling_shapes if cfg.ceiling else None)
     draw_ap_vs_ratio(table, seeds, REPORT_DIR / "ap_vs_ratio.png")
-
+    # real → recon → blend → targeted / random, step by step, on this run's one draw of the data
+    steps = combine_draws({params.data_seed: seed_dirs}, labels, ev.object_ids, gen, cfg, 1000, params.seed)
+    write_json(steps, REPORT_DIR / "decomposition.json")
+    extras += [losing_step(steps["contrasts"], b) for b in cfg.augment_base_sizes]
+    with atomic_path(REPORT_DIR / "decomposition.md") as tmp:
+        tmp.write_text(decomposition_markdown(steps, cfg.augment_base_sizes, "dvc repro report"))
     # Fig. 8: the largest augmented base size, its ratio chosen on validation against 1:0
     base = max(cfg.augment_base_sizes)
     compare = chosen.get(base, max(gen.ratios))
@@ -83,7 +89,6 @@ def run(params: Params) -> None:
     # Fig. 1: t-SNE of original train and generated latents by graspness
     tsne, perplexity = REPORT_DIR / "tsne_graspness.png", params.embed.perplexity
     draw_latent_map(latents, scores, augmentation, generated_graspness, base, perplexity, params.seed, tsne)
-
     positive_share = float(labels.mean())
     ap_report = ap_metrics(results, table, chosen, positive_share, seeds)
     write_json(ap_report, AP_REPORT)
