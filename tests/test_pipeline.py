@@ -160,6 +160,7 @@ def test_from_failures_generates_from_train_shapes_near_a_users_failure_meshes(t
     assert all((tmp_path / "out/meshes" / f"{s}.obj").stat().st_size > 0 for s in index.shape_id)
     skipped = pd.read_csv(tmp_path / "out/skipped.csv")
     assert list(skipped.file) == ["broken.obj"] and skipped.reason.iloc[0]
+    assert list(pd.read_csv(tmp_path / "out/failures.csv").object) == ["box", "capsule"]
     run([*command, "-o", str(tmp_path / "again")], work, env)  # the same shapes for the same params
     pd.testing.assert_frame_equal(pd.read_csv(tmp_path / "again/index.csv"), index)
     missing = subprocess.run(
@@ -403,6 +404,30 @@ def test_dvc_repro_gqcnn_matrix_and_report(tiny_repo):
     assert "metrics/gqcnn/s1.json" in shown.stdout and "metrics/ap/real_data.json" in shown.stdout
     again = run(["dvc", "repro", "report"], work, env)
     assert "Running stage" not in again.stdout
+
+
+def test_from_failures_of_a_networks_worst_validation_objects(tiny_repo, tmp_path):
+    import json
+
+    work, env = tiny_repo
+    run(["dvc", "repro", "train_gqcnn"], work, env)
+    command = ["graspaug", "from-failures", "--network", "targeted/6-0", "--worst", "2", "--count", "3"]
+    run([*command, "-o", str(tmp_path / "out")], work, env)
+    failures = pd.read_csv(tmp_path / "out/failures.csv")
+    validation = json.loads((work / "models/gqcnn/s0/split.json").read_text())["validation"]
+    # every validation object with datapoints is scored, worst first; the two worst are the failures
+    assert set(failures.object) <= set(validation) and len(failures) >= 2
+    assert failures.log_loss.is_monotonic_decreasing and failures.failure.tolist()[:2] == [True, True]
+    assert not failures.failure.iloc[2:].any()
+    index = pd.read_csv(tmp_path / "out/index.csv")
+    shapes = pd.read_parquet(work / "data/shapes.parquet")
+    train = set(shapes.shape_id[shapes.split == "train"]) - set(validation)  # no validation object is a parent
+    assert len(index) == 3 and set(index.parent_a) | set(index.parent_b) <= train
+    assert set(index.failure) <= set(failures.object[:2])
+    both = subprocess.run(
+        [*command, str(tmp_path)], cwd=work, env=env, capture_output=True, text=True
+    )  # a folder and a network: refused
+    assert both.returncode == 1 and "either a folder" in both.stderr
 
 
 def test_a_one_member_network_is_a_plain_gqcnn(tiny_repo, tmp_path):

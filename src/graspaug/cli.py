@@ -463,18 +463,26 @@ def plan_command(
 
 @app.command(
     name="from-failures",
-    help="Generate new training shapes near objects a grasp planner fails on, for a planner trained anywhere. FOLDER "
-    "holds meshes (.obj, .stl, .ply) of the objects it missed; each is closed and scaled as the corpus is, voxelized "
-    "and encoded by this project's AE-Critic. Its `--per-failure` nearest train shapes in latent space become "
+    help="Generate new training shapes near objects a grasp planner fails on. The failure objects are either FOLDER, "
+    "meshes (.obj, .stl, .ply) of objects a planner trained anywhere missed (each closed and scaled as the corpus is, "
+    "voxelized and encoded by this project's AE-Critic), or with `--network` the `--worst` validation objects of one "
+    "of this project's GQ-CNNs (highest mean log loss of its validation predictions, averaged over `gqcnn.seeds`; the "
+    "test split never chooses). Each failure object's `--per-failure` nearest train shapes in latent space become "
     "anchors, each interpolated with its nearest train shapes (`generate.first_neighbour`, `extra_neighbours`, "
     "`alphas`), decoded and meshed as `generate` does, until `--count` shapes are kept. A failure object is never a "
-    "parent itself. Needs `train_ae`, `embed` and `score` to have run (`dvc repro score`).\n\nWrites "
-    "`<out>/meshes/failure_<order>.obj` (m), `<out>/index.csv` (per shape: the failure object it serves, anchor "
-    "`parent_a`, neighbour `parent_b`, `alpha`, size), `<out>/rejects.csv` and `<out>/skipped.csv` (files that could "
-    "not be used, and why). Feed the meshes to your own pipeline, or to this one (`data.source: folder`, `data.path`).",
+    "parent, and with `--network` no validation object is one either. Needs `dvc repro score` (and `train_gqcnn` for "
+    "`--network`).\n\nWrites `<out>/meshes/failure_<order>.obj` (m), `<out>/index.csv` (per shape: the failure "
+    "object it serves, anchor `parent_a`, neighbour `parent_b`, `alpha`, size), `<out>/failures.csv` (the failure "
+    "objects worst first; with `--network` every validation object's datapoints, log loss and AP), `<out>/rejects.csv` "
+    "and `<out>/skipped.csv` (files that could not be used, and why). Feed the meshes to your own pipeline, or to this "
+    "one (`data.source: folder`, `data.path`).",
 )
 def from_failures_command(
-    folder: Path = typer.Argument(..., help="Folder of meshes of the objects the planner failed on."),
+    folder: Path | None = typer.Argument(None, help="Folder of meshes of the objects the planner failed on."),
+    network: str | None = typer.Option(
+        None, "--network", help="Instead of FOLDER: a network of this project, <pool>/<B>-<R>, e.g. targeted/50-0."
+    ),
+    worst: int = typer.Option(10, "--worst", help="With --network: how many of its worst validation objects."),
     count: int = typer.Option(20, "--count", "-n", help="Shapes to generate."),
     per_failure: int = typer.Option(3, "--per-failure", help="Train shapes anchored near each failure object."),
     out: Path = typer.Option(Path("failures_generated"), "--out", "-o", help="Folder to write (replaced whole)."),
@@ -482,7 +490,7 @@ def from_failures_command(
 ) -> None:
     import graspaug.stages.from_failures as command
 
-    _run(lambda p: command.run(p, folder, count, per_failure, out), _load(params, command))
+    _run(lambda p: command.run(p, folder, network, worst, count, per_failure, out), _load(params, command))
 
 
 @app.command(

@@ -60,3 +60,35 @@ def test_the_failure_stream_pairs_only_anchors_with_their_neighbours_and_shares_
     everything = stream.take(0, 10_000)  # widened to every neighbour and weight, then exhausted
     assert len({(frozenset((c.a, c.b)), c.alpha) for c in everything}) == len(everything)
     assert any(n.startswith("K widened") for n in stream.notes)
+
+
+def _seed_folders(tmp_path, predictions: dict[int, list[float]], rows=(0, 1, 2, 3)):
+    import json
+
+    folders = {}
+    for seed, p in predictions.items():
+        folder = tmp_path / f"s{seed}"
+        (folder / "targeted/6-0").mkdir(parents=True)
+        np.save(folder / "targeted/6-0/val_predictions.npy", np.array(p, np.float32))
+        np.save(folder / "val_rows.npy", np.array(rows))
+        (folder / "split.json").write_text(json.dumps({"validation": ["a", "b", "c"]}))
+        folders[seed] = folder
+    return folders
+
+
+def test_validation_errors_average_the_seeds_predictions_and_rank_worst_first(tmp_path):
+    import pandas as pd
+
+    from graspaug.experiments.lifelong import validation_errors
+
+    index = pd.DataFrame({"shape_id": ["a", "a", "b", "b", "t"], "label": [1, 0, 1, 0, 1]})
+    folders = _seed_folders(tmp_path, {0: [0.9, 0.1, 0.1, 0.9], 1: [0.7, 0.3, 0.3, 0.5]})
+    errors, validation = validation_errors(folders, "targeted/6-0", index)
+    assert list(errors.index) == ["b", "a"] and validation == ["a", "b", "c"]  # b: its labels the wrong way round
+    expected = object_errors(np.array([1, 0, 1, 0]), np.array([0.8, 0.2, 0.2, 0.7]), np.array(["a", "a", "b", "b"]))
+    assert errors.loc["a", "log_loss"] == pytest.approx(expected.loc["a", "log_loss"])
+    with pytest.raises(DataError, match="no validation predictions of network 'random/6-1' for seed 0"):
+        validation_errors(folders, "random/6-1", index)
+    other = _seed_folders(tmp_path / "other", {1: [0.5] * 4}, rows=(0, 1, 2, 4))
+    with pytest.raises(DataError, match="seed 1 validates on other datapoints"):
+        validation_errors({0: folders[0], 1: other[1]}, "targeted/6-0", index)

@@ -9,7 +9,9 @@ The anchors are always training shapes: a validation or test object only points 
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+import json
+from collections.abc import Mapping, Sequence
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -54,6 +56,38 @@ def object_errors(labels: np.ndarray, probability: np.ndarray, object_ids: np.nd
             "ap": ap,
         }
     return pd.DataFrame.from_dict(rows, orient="index").rename_axis("object")
+
+
+def validation_errors(seed_dirs: Mapping[int, Path], network: str, index: pd.DataFrame) -> tuple[pd.DataFrame, list]:
+    """How badly a trained network does on each *validation* object, over its training seeds.
+
+    Parameters
+    ----------
+    seed_dirs : training seed → the folder of that seed's networks (``val_rows.npy``, ``split.json``,
+        ``<network>/val_predictions.npy``); every seed validates on the same datapoints
+    network : the network's folder name, ``<pool>/<B>-<R>`` (e.g. ``targeted/50-0``)
+    index : the original corpus's index (columns ``label``, ``shape_id``)
+
+    Returns
+    -------
+    (errors, validation) — :func:`object_errors` of the mean prediction over seeds, worst first
+    (:func:`worst_objects` order), and every validation shape id (those without datapoints too)
+    """
+    rows, predictions = None, []
+    for seed, folder in seed_dirs.items():
+        path = Path(folder) / network / "val_predictions.npy"
+        if not path.is_file():
+            raise DataError(f"no validation predictions of network {network!r} for seed {seed}: {path}")
+        seed_rows = np.load(Path(folder) / "val_rows.npy")
+        if rows is not None and not np.array_equal(rows, seed_rows):
+            raise DataError(f"seed {seed} validates on other datapoints than seed {next(iter(seed_dirs))}")
+        rows = seed_rows
+        predictions.append(np.load(path))
+    if rows is None:
+        raise DataError("validation_errors: no training seed")
+    errors = object_errors(index.label.to_numpy()[rows], np.mean(predictions, axis=0), index.shape_id.to_numpy()[rows])
+    validation = json.loads((Path(next(iter(seed_dirs.values()))) / "split.json").read_text())["validation"]
+    return errors.loc[worst_objects(errors, len(errors))], list(validation)
 
 
 def worst_objects(errors: pd.DataFrame, count: int) -> list[str]:

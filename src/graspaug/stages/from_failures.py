@@ -1,35 +1,32 @@
-"""``graspaug from-failures``: new training shapes near the objects a planner fails on (the lifelong
-loop's entry point for a planner trained elsewhere). No DVC stage: a command whose adapter sits here as
-it knows the project's files; it needs ``train_ae``, ``embed`` and ``score`` to have run.
+"""``graspaug from-failures``: new training shapes near the objects a planner fails on (the lifelong loop's
+generation step). No DVC stage: a command whose adapter sits here as it knows the project's files.
 
-A folder of meshes (objects the user's planner missed) is loaded, closed and scaled as the corpus is,
-voxelized as ``voxelize`` does and encoded by this project's AE-Critic. Each failure object's
-``per_failure`` nearest train shapes in latent space become anchors
-(:func:`graspaug.experiments.lifelong.failure_anchors`), each interpolated with its neighbours among
-the train shapes, decoded and meshed as ``generate`` does (:func:`graspaug.generation_meshes.failure_shapes`).
-A failure object is never a parent: it only points at the train shapes to generate from.
+The failure objects are a folder of meshes (objects a planner trained anywhere missed: closed and scaled as the
+corpus is, voxelized as ``voxelize`` does, encoded by the AE-Critic) or the ``worst`` *validation* objects of one
+of this project's networks (highest mean log loss, predictions averaged over the seeds; the test split never
+chooses). Each one's ``per_failure`` nearest train shapes in latent space are anchors
+(:func:`graspaug.experiments.lifelong.failure_anchors`), interpolated with their neighbours among the train
+shapes, decoded and meshed as ``generate`` does (:func:`graspaug.generation_meshes.failure_shapes`). A failure
+object is never a parent, and validation objects are no train shapes here.
 
-Writes, all at once: ``<out>/meshes/failure_<order>.obj`` (m), ``<out>/index.csv`` (per shape: its failure
-object, anchor ``parent_a``, neighbour ``parent_b``, ``alpha``, size), ``<out>/rejects.csv`` and
-``<out>/skipped.csv`` (files of the folder that could not be used, and why).
+Writes, all at once, into ``out``: ``meshes/failure_<order>.obj`` (m), ``index.csv`` (per shape: its failure
+object, anchor ``parent_a``, neighbour ``parent_b``, ``alpha``, size), ``failures.csv`` (the objects, worst first;
+with a network every validation object's error), ``rejects.csv``, ``skipped.csv`` (unusable files, and why).
 """
 
 from __future__ import annotations
 
 import logging
-from functools import partial
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
-import torch
 
 from graspaug import paths
 from graspaug.device import resolve_device
 from graspaug.errors import DataError
-from graspaug.experiments.lifelong import failure_anchors
+from graspaug.experiments.lifelong import failure_anchors, validation_errors
 from graspaug.generation_meshes import base_set, failure_shapes, mesh_batches
-from graspaug.geometry.voxelize import fit_grid, voxelize_solid
 from graspaug.io.atomic import atomic_path
 from graspaug.io.checkpoints import load_autoencoder
 from graspaug.io.meshes import mesh_path, write_obj
@@ -38,10 +35,11 @@ from graspaug.io.voxels import read_voxels
 from graspaug.params.ae import AEParams
 from graspaug.params.base import params_model
 from graspaug.params.generate import GenerateParams
+from graspaug.params.gqcnn import GQCNNParams
 from graspaug.params.ingest import IngestParams
 from graspaug.params.score import ScoreParams
 from graspaug.params.voxelize import VoxelizeParams
-from graspaug.training.autoencoder import encode
+from graspaug.training.autoencoder import encode_meshes
 
 log = logging.getLogger(__name__)
 
@@ -51,35 +49,43 @@ Params = params_model(
     voxelize=VoxelizeParams,
     ae=AEParams,
     generate=GenerateParams,
+    gqcnn=GQCNNParams,
     score=ScoreParams,
 )
 
 
-def run(params: Params, folder: Path, count: int, per_failure: int, out: Path) -> None:
+def run(params: Params, folder: Path | None, network: str | None, worst: int, count: int, per_failure: int, out):
     from graspaug.sim.objects import folder_meshes
 
-    if count < 1 or per_failure < 1:
-        raise DataError(f"--count and --per-failure must be at least 1; got {count} and {per_failure}")
-    ingest, grid = params.ingest, params.voxelize
-    try:
-        meshes, skipped = folder_meshes(Path(folder), ingest.surface, ingest.max_faces, ingest.max_file_mb)
-    except ValueError as exc:
-        raise DataError(str(exc).replace("sim.objects_path", "the failure folder")) from None
-    occupancy = []
-    for _, mesh in meshes:
-        cells = fit_grid(mesh.bounds, grid.resolution, grid.margin)
-        occupancy.append(voxelize_solid(mesh.vertices, mesh.faces, cells))
+    if (folder is None) == (network is None):
+        raise DataError("give either a folder of failure meshes or --network (its worst validation objects)")
+    if min(count, per_failure, worst) < 1:
+        raise DataError(f"--count, --per-failure, --worst must be at least 1; got {count}, {per_failure}, {worst}")
     device = resolve_device(params.device)
     ae, _, _ = load_autoencoder(paths.AE_CRITIC_MODEL, params.ae.net)
-    failure_z = encode(ae, torch.from_numpy(np.stack(occupancy)[:, None].astype(np.uint8)), device)
-    shapes, latents = read_table(paths.SHAPES_TABLE), read_table(paths.LATENTS)
-    train = shapes.shape_id[shapes.split == "train"].to_numpy()
-    pool = base_set(train, latents, read_table(paths.SCORES), read_voxels(paths.VOXELS), params.score.k)
+    shapes, latents = read_table(paths.SHAPES_TABLE), read_table(paths.LATENTS).set_index("shape_id")
+    train, skipped = set(shapes.shape_id[shapes.split == "train"]), {}
+    if network is not None:  # this project's network: its worst validation objects, never train shapes here
+        seed_dirs = {s: paths.gqcnn_seed_dir(s) for s in params.gqcnn.seeds}
+        index = read_table(paths.gqcnn_dir("original") / "index.parquet")
+        errors, validation = validation_errors(seed_dirs, network, index)
+        names = list(errors.index[:worst])
+        failure_z, train = np.stack(latents.z.loc[names].to_numpy()), train - set(validation)
+    else:
+        ingest, grid = params.ingest, params.voxelize
+        try:
+            meshes, skipped = folder_meshes(Path(folder), ingest.surface, ingest.max_faces, ingest.max_file_mb)
+        except ValueError as exc:
+            raise DataError(str(exc).replace("sim.objects_path", "the failure folder")) from None
+        names = [name for name, _ in meshes]
+        failure_z = encode_meshes(ae, [m for _, m in meshes], grid.resolution, grid.margin, device)
+        errors = pd.DataFrame(index=pd.Index(names, name="object"))
+    ids = shapes.shape_id[shapes.shape_id.isin(train)].to_numpy()
+    pool = base_set(ids, latents.reset_index(), read_table(paths.SCORES), read_voxels(paths.VOXELS), params.score.k)
     anchors, served = failure_anchors(pool.z, failure_z, per_failure)
-    names = [meshes[f][0] for f in served]
-    run_batch = partial(mesh_batches, ae, device, settings=params.generate.decode, workers=params.workers)
+    run_batch = mesh_batches(ae, device, pool, params.generate.decode, params.workers, "from failures")
     index, rejects, kept, notes = failure_shapes(
-        pool, anchors, names, count, params.generate, run_batch(pool, label="from failures")
+        pool, anchors, [names[f] for f in served], count, params.generate, run_batch
     )
     for note in notes:  # how the stream was widened
         log.info("from-failures: %s", note)
@@ -88,7 +94,7 @@ def run(params: Params, folder: Path, count: int, per_failure: int, out: Path) -
         for shape_id, decoded in zip(index.shape_id, kept):
             write_obj(decoded.mesh, mesh_path(tmp / "meshes", shape_id, ".obj"))
         index.drop(columns=["z", "base_size", "pool", "split"]).to_csv(tmp / "index.csv", index=False)
+        errors.assign(failure=errors.index.isin(names)).to_csv(tmp / "failures.csv")
         rejects.to_csv(tmp / "rejects.csv", index=False)
         pd.DataFrame({"file": list(skipped), "reason": list(skipped.values())}).to_csv(tmp / "skipped.csv", index=False)
-    shapes = f"{len(index)} shapes near {len(meshes)} failure objects ({len(skipped)} files skipped)"
-    log.info("from-failures: %s in %s", shapes, out)
+    log.info("from-failures: %d shapes near %d failure objects in %s", len(index), len(names), out)

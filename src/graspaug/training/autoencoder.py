@@ -207,6 +207,18 @@ def encode(ae: AutoEncoder, voxels: torch.Tensor, device: torch.device, batch_si
 
 
 @torch.no_grad()
+def encode_meshes(ae: AutoEncoder, meshes, resolution: int, margin: int, device: torch.device) -> np.ndarray:
+    """(N, z_dim) float32 latents of N meshes (trimesh, m), each voxelized as the ``voxelize`` stage
+    does (a solid ``resolution``³ grid fitted to its bounds with ``margin`` empty cells)."""
+    from graspaug.geometry.voxelize import fit_grid, voxelize_solid
+
+    grids = [voxelize_solid(m.vertices, m.faces, fit_grid(m.bounds, resolution, margin)) for m in meshes]
+    if not grids:
+        return np.zeros((0, ae.cfg.z_dim), np.float32)
+    return encode(ae, torch.from_numpy(np.stack(grids)[:, None].astype(np.uint8)), device)
+
+
+@torch.no_grad()
 def decode(ae: AutoEncoder, z: np.ndarray, device: torch.device, batch_size: int = 64) -> np.ndarray:
     """(N, R, R, R) float32 occupancy probabilities of (N, z_dim) latents (eval mode)."""
     ae.eval().to(device)
