@@ -163,12 +163,10 @@ def resampled_distances(pp: np.ndarray, rr: np.ndarray, pr: np.ndarray, i: np.nd
     coverage = float(np.isin(j, j[across.argmin(axis=1)]).mean())
     within_pool = np.where(i[:, None] == i[None, :], np.inf, pp[np.ix_(i, i)])
     within_reference = np.where(j[:, None] == j[None, :], np.inf, rr[np.ix_(j, j)])
-    nearest = np.block([[within_pool, across], [across.T, within_reference]]).argmin(axis=1)
-    own = np.r_[np.zeros(len(i), bool), np.ones(len(j), bool)]
     return {
         "coverage": coverage,
-        "mmd": float(across.min(axis=0).mean()),
-        "one_nna": float((own[nearest] == own).mean()),
+        "mmd": coverage_mmd(across)[1],
+        "one_nna": one_nn_accuracy(within_pool, within_reference, across),
     }
 
 
