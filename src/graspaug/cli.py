@@ -202,6 +202,50 @@ def fidelity_command(
 
 
 @app.command(
+    name="lifelong",
+    help="One round of the lifelong loop: generate from the objects the planner fails on, round after round. "
+    "Round 0 (`graspaug lifelong-start`, `dvc repro lifelong_start`) scores every validation object by "
+    "the 1:0 networks of base size `lifelong.base_size` (mean log loss, predictions averaged over the "
+    "seeds; the test split never chooses) and marks the `lifelong.worst` as failures. Round k >= 1 (`dvc "
+    "repro lifelong@r<k>`, after `lifelong.rounds` names it) anchors generation at the "
+    "`lifelong.per_failure` base shapes nearest each failure in latent space; three arms each add "
+    "`lifelong.shapes_per_round` shapes: `failure` (those), `random` (random base pairs, the same "
+    "weights) and `real` (as many more real train shapes, the positive control); grasps and crops are "
+    "made as `grasps` and `render` make them; each arm trains, paired within every seed of "
+    "`gqcnn.seeds`, on the base set plus its shapes of every round so far; the failure arm's worst "
+    "validation objects are round k + 1's failures. Round k reads round k - 1's outputs only (with the "
+    "corpus, the AE and the round-0 networks).\n\nWrites `data/lifelong/r<k>/` (this round's `meshes/`, "
+    "every round's `shapes.parquet`, `dataset/` and `real.csv`, `failures.csv`, `history.csv`, "
+    "`curve.csv`), `models/lifelong/r<k>/s<seed>/<arm>/<B>-<R>/`, `metrics/lifelong/r<k>/` (each arm's "
+    "test AP `ap_<arm>` and the contrasts `failure_vs_random`, `failure_vs_real`, `real_data`, ...: "
+    "mean, lo, hi) and `reports/lifelong/r<k>/` (`report.md`, `curve.png`, `failures.png`, "
+    "`followed.csv`).\n\nFor a planner trained elsewhere, `graspaug from-failures FOLDER` is the same "
+    "generation step from a folder of its failure meshes.",
+)
+def lifelong_command(
+    round_: str = typer.Option(..., "--round", "-r", help="The round: r<k> (or k), one of lifelong.rounds."),
+    params: Path = ParamsOption,
+) -> None:
+    text = round_.removeprefix("r")
+    if not text.isdigit() or int(text) < 1:
+        raise typer.BadParameter(f"a round r<k> with k >= 1; got {round_!r}", param_hint="--round")
+    stage = _stage("lifelong")
+    _run(lambda p: stage.run(p, int(text)), _load(params, stage))
+
+
+@app.command(
+    name="lifelong-start",
+    help="Round 0 of the lifelong loop (see `graspaug lifelong --help`): score every validation object by the 1:0 "
+    "networks of base size `lifelong.base_size` (mean log loss, predictions averaged over the seeds) and mark the "
+    "`lifelong.worst` as the failures round 1 generates from.\n\nWrites `data/lifelong/r0/` (`failures.csv`, "
+    "`history.csv`, `curve.csv`), `metrics/lifelong/r0/` (the round-0 networks' test AP) and `reports/lifelong/r0/`.",
+)
+def lifelong_start_command(params: Path = ParamsOption) -> None:
+    stage = _stage("lifelong_start")
+    _run(stage.run, _load(params, stage))
+
+
+@app.command(
     name="render",
     help="Render a Dex-Net 2.0 style grasp image dataset for a corpus: each shape in its most probable stable poses "
     "on a table, random depth-camera views from above, and for every grasp whose jaw axis is near parallel to the "

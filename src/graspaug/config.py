@@ -24,6 +24,7 @@ from graspaug.params.generate import GenerateParams
 from graspaug.params.gqcnn import GQCNNParams
 from graspaug.params.grasps import GraspsParams
 from graspaug.params.ingest import IngestParams
+from graspaug.params.lifelong import LifelongParams
 from graspaug.params.render import RenderParams
 from graspaug.params.score import ScoreParams
 from graspaug.params.sim import SimParams
@@ -43,6 +44,7 @@ Params = params_model(
     generate=GenerateParams,
     render=RenderParams,
     gqcnn=GQCNNParams,
+    lifelong=LifelongParams,
     sim=SimParams,
 )
 

@@ -9,7 +9,7 @@ augmentation set for ratio ``R``: sets for larger ratios contain those for small
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 from typing import Protocol, TypeVar
 
@@ -119,10 +119,15 @@ def targeted_candidates(
     seen: set[tuple[frozenset[int], float]] = set()
     for k in range(max(len(lst) for lst in lists)):
         for lst in lists:
-            if k < len(lst) and (key := (frozenset((lst[k].a, lst[k].b)), lst[k].alpha)) not in seen:
+            if k < len(lst) and (key := candidate_key(lst[k].a, lst[k].b, lst[k].alpha)) not in seen:
                 seen.add(key)
                 out.append(lst[k])
     return out
+
+
+def candidate_key(a, b, alpha: float) -> tuple[frozenset, float]:
+    """What makes two candidates the same shape: the unordered parents (indices or ids) and the weight."""
+    return frozenset((a, b)), float(alpha)
 
 
 class CandidateStream:
@@ -136,7 +141,7 @@ class CandidateStream:
 
     def _append(self, candidates: list[Candidate]) -> None:
         for c in candidates:
-            key = (frozenset((c.a, c.b)), c.alpha)
+            key = candidate_key(c.a, c.b, c.alpha)
             if key not in self._seen:
                 self._seen.add(key)
                 self.items.append(c)
@@ -264,11 +269,16 @@ class ReconStream(CandidateStream):
 class FollowStream(CandidateStream):
     """Another pool's candidates for a control pool (the ``blend`` pool follows the targeted one):
     ``first`` (that pool's kept candidates, in order: the same pairs and weights) then the rest of
-    its ``stream`` in order, so a failure here is replaced by that pool's next candidate."""
+    its ``stream`` in order, so a failure here is replaced by that pool's next candidate. Candidates
+    whose pair and weight are in ``used`` (:func:`candidate_key`) are skipped: a later round of the
+    lifelong loop does not make an earlier round's shape again. Its notes are ``stream``'s."""
 
-    def __init__(self, first: Sequence[Candidate], stream: CandidateStream) -> None:
+    def __init__(
+        self, first: Sequence[Candidate], stream: CandidateStream, used: Iterable[tuple[frozenset, float]] = ()
+    ) -> None:
         super().__init__()
-        self.stream, self._read = stream, 0
+        self.stream, self._read, self.notes = stream, 0, stream.notes
+        self._seen.update(used)
         self._append(list(first))
 
     def _grow(self, count: int) -> None:

@@ -7,7 +7,7 @@ GQ-CNN experiment imports too, so that decoder and meshing code is code of ``gen
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -18,6 +18,7 @@ from graspaug.errors import DataError
 from graspaug.generation import (
     BASE_SEED,
     Candidate,
+    CandidateStream,
     Decoded,
     FailureStream,
     FollowStream,
@@ -26,6 +27,7 @@ from graspaug.generation import (
     ReconStream,
     TargetedStream,
     base_scores_table,
+    candidate_key,
     draw_base_sets,
     fill_pool,
     pool_size,
@@ -284,6 +286,34 @@ def tsne_groups(base: BaseSet, index: pd.DataFrame, perplexity: float, seed: int
     return xy, groups
 
 
+def stream_shapes(
+    pool: BaseSet,
+    stream: CandidateStream,
+    name: str,
+    count: int,
+    run_batch: Callable[[list[Candidate]], list[Decoded]],
+    first_order: int = 0,
+    prefix: str = "",
+) -> tuple[pd.DataFrame, pd.DataFrame, list[Decoded], list[str]]:
+    """``count`` kept shapes of ``stream`` (candidates indexing ``pool``), decoded by ``run_batch``
+    (:func:`mesh_batches` over ``pool``), as pool ``name``.
+
+    Returns (index, rejects, kept, notes): ``index`` one row per kept shape (the columns of
+    :func:`graspaug.generation.pool_tables`; ``order`` counts from ``first_order``, ``shape_id`` is
+    ``<prefix><order>``), ``rejects`` (:data:`REJECT_COLUMNS`), the kept decodes (meshes in m) in
+    ``index`` order and how the stream was widened; a :class:`DataError` if the candidates run out first.
+    """
+    try:
+        kept, rejected = fill_pool(stream, count, run_batch)
+    except PoolExhausted as exc:
+        raise DataError(f"{name} pool: {exc}") from None
+    rows, reject_rows = pool_tables({name: (pool.ids, pool.z)}, {name: (kept, rejected)}, len(pool.ids))
+    index = pd.DataFrame(rows)
+    index["order"] += first_order
+    index["shape_id"] = [f"{prefix}{order:04d}" for order in index.order]
+    return index, pd.DataFrame(reject_rows, columns=REJECT_COLUMNS), kept, stream.notes
+
+
 def failure_shapes(
     pool: BaseSet,
     anchors: Sequence[int],
@@ -291,6 +321,9 @@ def failure_shapes(
     count: int,
     cfg: GenerateParams,
     run_batch: Callable[[list[Candidate]], list[Decoded]],
+    used: Iterable[tuple[frozenset, float]] = (),
+    first_order: int = 0,
+    prefix: str = "failure_",
 ) -> tuple[pd.DataFrame, pd.DataFrame, list[Decoded], list[str]]:
     """``count`` shapes generated from training shapes near objects a planner fails on.
 
@@ -303,22 +336,73 @@ def failure_shapes(
     count : shapes to keep
     cfg : the ``generate`` params: neighbours (``first_neighbour``, ``extra_neighbours``) and ``alphas``
     run_batch : :func:`mesh_batches` over ``pool``
+    used, first_order, prefix : candidates (:func:`graspaug.generation.candidate_key` of ``pool`` indices) not to
+        make again, and the ids (:func:`stream_shapes`): the lifelong loop's later rounds
 
     Returns
     -------
-    (index, rejects, kept, notes) — ``index``: one row per kept shape (``shape_id`` ``failure_<order>``, the
-    columns of :func:`graspaug.generation.pool_tables` with ``parent_a`` the anchor, and ``failure``), ``rejects``
-    (:data:`REJECT_COLUMNS`), the kept decodes (meshes in m) in ``index`` order, and how the stream was widened;
-    a :class:`DataError` if the candidates run out first
+    :func:`stream_shapes`'s (index, rejects, kept, notes), ``index`` with the column ``failure`` (the failure object
+    each shape's anchor ``parent_a`` serves)
     """
-    stream = FailureStream(pool.z, anchors, cfg.first_neighbour, cfg.extra_neighbours, cfg.alphas)
-    try:
-        kept, rejected = fill_pool(stream, count, run_batch)
-    except PoolExhausted as exc:
-        raise DataError(f"failure pool: {exc}") from None
-    rows, reject_rows = pool_tables({"failure": (pool.ids, pool.z)}, {"failure": (kept, rejected)}, len(pool.ids))
-    index = pd.DataFrame(rows)
+    failing = FailureStream(pool.z, anchors, cfg.first_neighbour, cfg.extra_neighbours, cfg.alphas)
+    stream = FollowStream([], failing, used)
+    index, rejects, kept, notes = stream_shapes(pool, stream, "failure", count, run_batch, first_order, prefix)
     served = dict(zip(anchors, failures))
-    index["shape_id"] = [f"failure_{order:04d}" for order in index.order]
     index["failure"] = [served[d.candidate.a] for d in kept]
-    return index, pd.DataFrame(reject_rows, columns=REJECT_COLUMNS), kept, stream.notes
+    return index, rejects, kept, notes
+
+
+def random_shapes(
+    pool: BaseSet,
+    count: int,
+    cfg: GenerateParams,
+    run_batch: Callable[[list[Candidate]], list[Decoded]],
+    rng: np.random.Generator,
+    used: Iterable[tuple[frozenset, float]] = (),
+    first_order: int = 0,
+    prefix: str = "random_",
+) -> tuple[pd.DataFrame, pd.DataFrame, list[Decoded], list[str]]:
+    """``count`` shapes of random pairs of ``pool`` in an order drawn from ``rng``, the weights cycling through
+    ``cfg.alphas`` as every pool's do; ``used``, ``first_order``, ``prefix`` and the result as
+    :func:`failure_shapes`."""
+    stream = FollowStream([], RandomStream(len(pool.ids), cfg.alphas, rng), used)
+    return stream_shapes(pool, stream, "random", count, run_batch, first_order, prefix)
+
+
+def loop_shapes(
+    base: BaseSet,
+    anchors: Sequence[int],
+    failures: Sequence[str],
+    made: pd.DataFrame | None,
+    count: int,
+    cfg: GenerateParams,
+    run_batch: Callable[[list[Candidate]], list[Decoded]],
+    rng: np.random.Generator,
+    round_: int,
+) -> tuple[pd.DataFrame, pd.DataFrame, list[Decoded], list[str]]:
+    """One round of the lifelong loop's generated arms: ``count`` ``failure`` shapes (:func:`failure_shapes` from
+    ``anchors``, base-set indices near the ``failures`` they serve) and ``count`` ``random`` ones
+    (:func:`random_shapes` drawn by ``rng``), none a pair and weight an earlier round of its arm made.
+
+    ``made``: the earlier rounds' shapes (this function's index; None in round 1). Returns (index, rejects, kept,
+    notes): ``index`` with ``arm`` (= ``pool``), ``round`` = ``round_``, ``order`` counting on from the earlier
+    rounds of the arm and ``shape_id`` ``r<round>_<f|r><order>``; the rest as :func:`stream_shapes`.
+    """
+    position = {shape_id: i for i, shape_id in enumerate(base.ids)}
+    made = made if made is not None else pd.DataFrame(columns=["arm", "parent_a", "parent_b", "alpha"])
+
+    def earlier(arm: str) -> tuple[list, int]:
+        rows = made[made.arm == arm]
+        keys = [
+            candidate_key(position[a], position[b], al) for a, b, al in zip(rows.parent_a, rows.parent_b, rows.alpha)
+        ]
+        return keys, len(rows)
+
+    used, first = earlier("failure")
+    failing = failure_shapes(base, anchors, failures, count, cfg, run_batch, used, first, f"r{round_}_f")
+    used, first = earlier("random")
+    random = random_shapes(base, count, cfg, run_batch, rng, used, first, f"r{round_}_r")
+    index = pd.concat([failing[0], random[0]], ignore_index=True)
+    index["arm"], index["round"] = index.pool, round_
+    rejects = pd.concat([failing[1], random[1]], ignore_index=True)
+    return index, rejects, failing[2] + random[2], failing[3] + random[3]

@@ -157,3 +157,24 @@ CALIBRATION_REPORT_DIR = Path("reports/grasp_calibration")
 def timing_file(stage: str, item: str | None = None) -> Path:
     """Where a stage writes how long it took (not a metric: ``dvc metrics diff`` shows results only)."""
     return Path("reports/timing") / (f"{stage}.json" if item is None else f"{stage}/{item}.json")
+
+
+# lifelong: round k (0: the 1:0 networks of train_gqcnn scored) of the loop
+def lifelong_data(round_: int) -> Path:
+    """Round k's shapes and datapoints: ``meshes/`` (this round's), ``shapes.parquet``, ``dataset/``, ``real.csv``
+    (every round's so far), ``failures.csv``, ``history.csv``, ``curve.csv``."""
+    return Path(f"data/lifelong/r{round_}")
+
+
+def lifelong_models(round_: int) -> Path:
+    """Round k's networks: ``s<seed>/<arm>/<B>-<R>/`` as train_gqcnn writes them."""
+    return Path(f"models/lifelong/r{round_}")
+
+
+def lifelong_metrics(round_: int) -> Path:  # one file per arm's AP and contrast: mean, lo, hi
+    return Path(f"metrics/lifelong/r{round_}")
+
+
+def lifelong_reports(round_: int) -> Path:
+    """Round k's report.md, curve.png, failures.png, followed.csv."""
+    return Path(f"reports/lifelong/r{round_}")

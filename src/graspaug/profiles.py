@@ -28,7 +28,7 @@ def merge(base: dict, overlay: dict, prefix: str = "") -> dict:
             raise ParamsError(f"{prefix}{key}: unknown key; allowed here: {', '.join(base)}")
         out[key] = (
             merge(base[key], value, f"{prefix}{key}.")
-            if isinstance(base[key], dict) and isinstance(value, dict)
+            if isinstance(base[key], dict) and base[key] and isinstance(value, dict)  # {}: a value (lifelong.rounds)
             else value
         )
     return out
@@ -90,7 +90,8 @@ def params_yaml(params: Params, header: str) -> str:
     def emit(data: dict, path: tuple[str, ...], indent: str) -> None:
         for key, value in data.items():
             comment = comments.get(path + (key,), "")
-            if isinstance(value, dict):
+            section = isinstance(value, dict) and any(path + (key, k) in comments for k in value)
+            if section:  # a settings section; a plain mapping (lifelong.rounds) is a value, written inline
                 lines.append(f"{indent}{key}:" + (f"  # {comment}" if comment else ""))
                 emit(value, path + (key,), indent + "  ")
             else:

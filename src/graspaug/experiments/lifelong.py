@@ -1,5 +1,5 @@
-"""The lifelong loop's choices: which objects the planner fails on, and which training
-shapes to generate from.
+"""The lifelong loop's choices and figures: which objects the planner fails on, which training
+shapes to generate from, and what each round's arms gain.
 
 A round scores every *validation* object by the round's networks (the test split never chooses
 anything), takes the worst ones and anchors generation at the training shapes nearest to them in
@@ -19,6 +19,15 @@ from sklearn.metrics import average_precision_score
 from sklearn.neighbors import NearestNeighbors
 
 from graspaug.errors import DataError
+from graspaug.experiments.settings import ARMS
+from graspaug.experiments.stats import (
+    ObjectBootstrap,
+    nested_indices,
+    nested_interval,
+    nested_means,
+    percentile_interval,
+)
+from graspaug.experiments.variants import Variant
 
 EPS = 1e-6  # probabilities are clipped to [EPS, 1 − EPS] for the log loss
 
@@ -135,3 +144,194 @@ def disjoint(training: Sequence[str], held_out: Sequence[str]) -> None:
     in a training set."""
     if leaked := sorted(set(training) & set(held_out)):
         raise DataError(f"held-out shapes in a training set: {leaked[:5]}{' …' if len(leaked) > 5 else ''}")
+
+
+ARM_CONTRASTS = {  # name → (arm a, arm b): AP(a) − AP(b) at one round, paired within a training seed
+    "failure_vs_random": ("failure", "random"),
+    "failure_vs_real": ("failure", "real"),
+    "real_data": ("real", "none"),
+    "failure_vs_none": ("failure", "none"),
+    "random_vs_none": ("random", "none"),
+}
+
+
+def arm_variant(arm: str, base_size: int, added: int) -> Variant:
+    """The network of ``arm`` after ``added`` shapes on a base set of ``base_size``: ``<arm>/<B>-<added / B>``
+    (arm ``none``: the base set alone, the ``targeted`` B-0 network)."""
+    if arm == "none" or added == 0:
+        return Variant("targeted", base_size, 0.0)
+    return Variant(arm, base_size, added / base_size)
+
+
+def arm_contrasts(
+    networks: Mapping[int, Mapping[int, Mapping[str, Path]]],
+    labels: np.ndarray,
+    object_ids: np.ndarray,
+    n_resamples: int,
+    seed: int,
+) -> dict:
+    """Every arm's test AP and the :data:`ARM_CONTRASTS` of one round, over data draws × training seeds × test
+    objects (:func:`graspaug.experiments.stats.nested_interval`; one draw: seeds × objects).
+
+    Parameters
+    ----------
+    networks : data seed → training seed → arm (``none``, ``failure``, ``random``, ``real``) → the network's
+        folder (``test_predictions.npy``); every draw has the same seeds and arms
+    labels, object_ids : (N,) — the test datapoints' labels and objects, in the predictions' order
+    n_resamples, seed : resamples of the objects and of the nested bootstrap, and their seed
+
+    Returns
+    -------
+    dict — ``ap``: arm → ``mean``, ``ci_low``, ``ci_high``; ``contrasts``: name → the same; ``share``: the share of
+    the real shapes' gain that failure-targeted shapes give (ratio of nested means, percentile interval), ``draws``,
+    ``seeds``
+    """
+    draws = list(networks)
+    seeds = sorted(networks[draws[0]])
+    arms = list(networks[draws[0]][seeds[0]])
+    boot = ObjectBootstrap(object_ids, n_resamples, seed)
+    full = np.zeros((len(arms), len(draws), len(seeds)))
+    resampled = np.zeros((len(arms), len(draws), len(seeds), n_resamples))
+    for i, d in enumerate(draws):
+        if sorted(networks[d]) != seeds:
+            raise DataError(f"draw {d} has training seeds {sorted(networks[d])}, not {seeds}")
+        for j, s in enumerate(seeds):
+            for a, arm in enumerate(arms):
+                p = np.load(Path(networks[d][s][arm]) / "test_predictions.npy")
+                full[a, i, j] = average_precision_score(labels, p)
+                resampled[a, i, j] = boot.average_precision(labels, p)
+    rng = np.random.default_rng([seed, 0x11FE])
+    at = {arm: a for a, arm in enumerate(arms)}
+    rounded = lambda d: {k: (round(v, 5) if isinstance(v, float) else v) for k, v in d.items()}  # noqa: E731
+    out = {
+        "ap": {arm: rounded(nested_interval(full[a], resampled[a], rng)) for arm, a in at.items()},
+        "contrasts": {
+            name: rounded(nested_interval(full[at[a]] - full[at[b]], resampled[at[a]] - resampled[at[b]], rng))
+            for name, (a, b) in ARM_CONTRASTS.items()
+            if a in at and b in at
+        },
+        "draws": draws,
+        "seeds": seeds,
+    }
+    if {"none", "failure", "real"} <= set(at):
+        x = resampled[at["failure"]] - resampled[at["none"]]
+        y = resampled[at["real"]] - resampled[at["none"]]
+        indices = nested_indices(len(draws), len(seeds), n_resamples, rng)
+        low, high = percentile_interval(nested_means(x, indices) / nested_means(y, indices))
+        gain = (full[at["real"]] - full[at["none"]]).mean()
+        mean = float((full[at["failure"]] - full[at["none"]]).mean() / gain) if gain else None
+        out["share"] = rounded({"mean": mean, "ci_low": low, "ci_high": high})
+    return out
+
+
+def failure_history(previous: pd.DataFrame | None, round_: int, chosen: Sequence[str]) -> pd.DataFrame:
+    """The objects chosen as failures so far: ``previous`` (None at round 0) plus one row per object of
+    ``chosen`` (worst first) at ``round_``: ``round``, ``object``, ``rank`` (0: the worst)."""
+    rows = pd.DataFrame({"round": round_, "object": list(chosen), "rank": range(len(chosen))})
+    return rows if previous is None else pd.concat([previous, rows], ignore_index=True)
+
+
+def persistent_failures(history: pd.DataFrame) -> pd.DataFrame:
+    """Objects of a :func:`failure_history` by how many rounds chose them (most first, then by mean rank):
+    ``object``, ``rounds`` (count), ``first`` and ``last`` round, ``mean_rank``."""
+    grouped = history.groupby("object").agg(
+        rounds=("round", "size"), first=("round", "min"), last=("round", "max"), mean_rank=("rank", "mean")
+    )
+    return grouped.sort_values(["rounds", "mean_rank"], ascending=[False, True]).reset_index()
+
+
+def followed_failures(before: pd.DataFrame, after: Mapping[str, pd.DataFrame], chosen: Sequence[str]) -> pd.DataFrame:
+    """How the objects ``chosen`` as failures by the last round fare now: one row per object with its
+    ``log_loss`` and ``ap`` before (``before``: :func:`object_errors` of the network that chose them) and under
+    each arm's network now (``after``: arm → its :func:`object_errors`), as ``<arm>_log_loss`` / ``<arm>_ap``."""
+    out = before.loc[list(chosen), ["datapoints", "log_loss", "ap"]].add_prefix("before_")
+    for arm, errors in after.items():
+        out[f"{arm}_log_loss"] = errors.log_loss.reindex(out.index).to_numpy()
+        out[f"{arm}_ap"] = errors.ap.reindex(out.index).to_numpy()
+    return out
+
+
+def curve_rows(round_: int, result: dict) -> pd.DataFrame:
+    """One row per arm of :func:`arm_contrasts`'s ``result`` at ``round_``: ``round``, ``arm``, ``mean``,
+    ``ci_low``, ``ci_high`` (test AP), the rows a round appends to the loop's curve."""
+    return pd.DataFrame(
+        [
+            {"round": round_, "arm": arm, **{k: ap[k] for k in ("mean", "ci_low", "ci_high")}}
+            for arm, ap in result["ap"].items()
+        ]
+    )
+
+
+def curve_series(curve: pd.DataFrame, arms: Sequence[str]) -> tuple[list[int], dict, dict]:
+    """(rounds, arm → test AP per round, arm → (low, high) per round) of a curve (:func:`curve_rows` of every
+    round), each arm's line starting at round 0's ``none`` (the base set alone, which every arm starts from)."""
+    curve = curve.astype({"mean": float, "ci_low": float, "ci_high": float})  # a missing end: NaN
+    rounds = sorted(curve["round"].unique())
+    start = curve[curve.arm == "none"].iloc[0]
+    series, bands = {}, {}
+    for arm in arms:
+        rows = curve[curve.arm == arm].set_index("round")
+        pick = lambda col: [start[col]] + [rows[col].get(r, np.nan) for r in rounds[1:]]  # noqa: B023, E731
+        series[arm], bands[arm] = pick("mean"), (pick("ci_low"), pick("ci_high"))
+    return rounds, series, bands
+
+
+def _table(frame: pd.DataFrame) -> str:
+    """A markdown table of ``frame``'s columns (missing values: n/a)."""
+    cells = [[("n/a" if pd.isna(v) else str(v)) for v in row] for row in frame.itertuples(index=False)]
+    head = [f"| {' | '.join(map(str, frame.columns))} |", "|" + "---|" * len(frame.columns)]
+    return "\n".join(head + [f"| {' | '.join(row)} |" for row in cells])
+
+
+def _interval(c: Mapping | None, spec: str = "+.4f") -> str:
+    """``mean [ci_low, ci_high]`` of an interval dict, n/a for what is missing."""
+    if not c or c.get("mean") is None:
+        return "n/a"
+    ends = [format(c[k], spec) if c.get(k) is not None else "n/a" for k in ("ci_low", "ci_high")]
+    return f"{format(c['mean'], spec)} [{ends[0]}, {ends[1]}]"
+
+
+def round_markdown(
+    round_: int, result: dict, followed: pd.DataFrame | None, persistent: pd.DataFrame, words: dict
+) -> str:
+    """A round's report: each arm's test AP, the contrasts with their verdicts, the share of the real shapes' gain,
+    the last round's failures before and after (``followed``; None in round 0), the objects chosen most often
+    (``persistent``: :func:`persistent_failures`) and ``words`` (``design``, ``command``)."""
+    lines = [f"# Lifelong loop, round {round_}", "", words["design"], ""]
+    lines += ["| arm | test AP |", "|---|---|"]
+    lines += [f"| {arm} | {_interval(ap, '.4f')} |" for arm, ap in result["ap"].items()]
+    if result["contrasts"]:
+        lines += ["", "| contrast | mean [95% interval] | verdict |", "|---|---|---|"]
+        for name, c in result["contrasts"].items():
+            shows = None not in (c["ci_low"], c["ci_high"]) and (c["ci_low"] > 0 or c["ci_high"] < 0)
+            word = ("above zero" if c["ci_low"] > 0 else "below zero") if shows else "no effect detected"
+            lines.append(f"| `{name}@r{round_}` | {_interval(c)} | {word} |")
+    if "share" in result:
+        lines += [
+            "",
+            f"Share of the real shapes' gain that failure-targeted shapes give: {_interval(result['share'])} "
+            "(a ratio of two intervals: read it only when `real_data` shows).",
+        ]
+    if followed is not None:
+        lines += [
+            "",
+            "The last round's failure objects (validation), before and now, per arm:",
+            "",
+            _table(followed.round(4).reset_index()),
+        ]
+    lines += [
+        "",
+        "Objects chosen as failures most often (validation):",
+        "",
+        _table(persistent.head(10)),
+    ]
+    return "\n".join(lines + ["", f"Command: `{words['command']}`", ""])
+
+
+def round_networks(start: Mapping[int, Path], seed_dirs: Mapping[int, Path], variants: Sequence[Variant]) -> dict:
+    """Training seed → arm → network folder of one round, for :func:`arm_contrasts`: ``none`` (the round-0
+    network's folder per seed, ``start``) and each arm's variant (in ``ARMS`` order) in its seed's folder."""
+    return {
+        s: {"none": Path(start[s])} | {a: Path(seed_dirs[s]) / v.name for a, v in zip(ARMS, variants)}
+        for s in seed_dirs
+    }

@@ -310,3 +310,35 @@ def result_lines(results: list[dict]) -> list[str]:
         )
         for r in sorted(results, key=lambda r: (r["pool"], r["base_size"], r["ratio"]))
     ]
+
+
+def train_paired(
+    variants: list[Variant],
+    split: ExperimentSplit,
+    gqcnn,
+    global_seed: int,
+    device: torch.device,
+    out_dir: Path,
+    corpora: Corpora,
+    card: dict,
+    label: str,
+) -> dict[int, list[dict]]:
+    """Train ``variants`` for every training seed of the ``gqcnn`` params as :mod:`train_gqcnn
+    <graspaug.stages.train_gqcnn>` does (the seed's initial weights and noise streams, validated on
+    ``split.validation``, tested on the test split of ``corpora.original``), each seed into
+    ``out_dir``/s<seed>/ with its ``test_rows.npy``, ``val_rows.npy`` and ``split.json``.
+    Returns training seed → the networks' summaries (:func:`train_network`)."""
+    val, val_rows = shapes_datapoints(corpora.original, split.validation)
+    test, test_rows = test_set(corpora.original)
+    out = {}
+    for seed in gqcnn.seeds:
+        inits, noise_seeds = seed_members(gqcnn.net, global_seed, seed, gqcnn.members)
+        folder = Path(out_dir) / f"s{seed}"
+        folder.mkdir(parents=True, exist_ok=True)
+        jobs = [
+            NetworkJob(v, split, gqcnn.net, gqcnn.train, inits, noise_seeds, seed, str(device), folder, corpora, card)
+            for v in variants
+        ]
+        out[seed] = train_jobs(jobs, val, test, f"{label} (seed {seed})")
+        save_seed_split(folder, split, test_rows, val_rows)
+    return out

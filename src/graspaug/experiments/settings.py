@@ -13,3 +13,5 @@ FIDELITY_POINTS = 512
 
 FIDELITY_RESAMPLES = 1000
 """Bootstrap resamples of the fidelity stage's intervals."""
+
+ARMS = ("failure", "random", "real")  # what each round of the lifelong loop adds, at equal counts

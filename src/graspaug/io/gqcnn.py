@@ -89,3 +89,16 @@ class GraspImages:
     def images(self, rows: np.ndarray | None = None) -> np.ndarray:
         """Depth crops (n, out, out) float32 for ``rows``."""
         return self.read("images", rows)
+
+
+def append_grasp_images(
+    folder: str | os.PathLike, previous: str | os.PathLike | None, images: np.ndarray, index: pd.DataFrame, shard_rows
+) -> int:
+    """Write into ``folder`` the datapoints of the dataset folder ``previous`` (None: none) followed by ``images``
+    and ``index`` (as :func:`write_grasp_images` takes them); returns how many there are in all."""
+    data = GraspImages.open(previous) if previous is not None else None
+    if data is not None and len(data):
+        images = np.concatenate([data.images(), images])
+        index = pd.concat([data.index.drop(columns=["shard", "row"]), index], ignore_index=True)
+    write_grasp_images(folder, images, index, shard_rows)
+    return len(index)

@@ -32,6 +32,7 @@ SECTIONS = (
     "generate",
     "render",
     "gqcnn",
+    "lifelong",
     "sim",
 )
 

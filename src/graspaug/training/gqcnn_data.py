@@ -141,7 +141,8 @@ def training_set(variant: Variant, split: ExperimentSplit, corpora: Corpora) -> 
         generated = GraspImages.open(corpora.generated[variant.base_size])
         index = generated.index
         gen_rows = np.flatnonzero(((index.pool == variant.pool) & (index.order < n_generated)).to_numpy())
-        parts.append(_arrays(generated, gen_rows))
+        if len(gen_rows):  # generated shapes may all lack datapoints (too wide for the hand)
+            parts.append(_arrays(generated, gen_rows))
         generated_shapes = int(index.shape_id.iloc[gen_rows].nunique())
     data = _concat(parts)
     info = {

@@ -1,0 +1,164 @@
+"""The lifelong loop over several draws of the data (issue #36): run the ``lifelong`` profile's rounds once per data
+seed and give every round's arms and contrasts one interval over draws, training seeds and test objects.
+
+Each draw k is a clone of this repository's HEAD in ``--workdir``/draw<k> with params.yaml written from the profile
+plus ``data_seed: k``. By default it runs ``dvc repro lifelong@r<K>`` there (the whole pipeline up to the last round,
+sharing this repository's DVC cache). With ``--reuse DIR`` the stages before the loop are not run again: their
+outputs are linked from DIR/draw<k> (an attribution study's draws: the same profile's data, the same data seed) and
+the rounds run as ``graspaug lifelong-start`` and ``graspaug lifelong --round r<k>``, the commands the DVC stages
+run. A finished round is not run again. Then :func:`graspaug.experiments.lifelong.arm_contrasts` combines the draws
+per round and ``summary.json``, ``lifelong.md`` and ``curve.png`` are written into ``--workdir``.
+
+    python studies/lifelong.py [--draws 0 1 2] [--workdir ../lifelong] [--profile lifelong] [--reuse ../attribution]
+        [--resamples 2000] [--combine-only]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pandas as pd
+
+from graspaug.experiments.ap import test_labels
+from graspaug.experiments.lifelong import arm_contrasts, arm_variant, curve_rows, curve_series, round_networks
+from graspaug.experiments.settings import ARMS
+from graspaug.io.tables import read_table
+from graspaug.plots import lines
+from graspaug.profiles import merge, params_yaml, read_overlay
+
+ROOT = Path(__file__).resolve().parents[1]
+REUSED = (  # the loop's inputs, made by the stages before it
+    "data/shapes.parquet",
+    "data/latents.parquet",
+    "data/scores.parquet",
+    "data/voxels.npz",
+    "models/ae_critic.pt",
+    "data/gqcnn/original",
+    "models/gqcnn",
+)
+
+
+def draw_params(profile: str, data_seed: int):
+    from graspaug.config import params_dict, parse_params
+
+    return parse_params(merge(params_dict(), read_overlay(profile, ROOT / "profiles") | {"data_seed": data_seed}))
+
+
+def run_draw(folder: Path, params, profile: str, reuse: Path | None) -> None:
+    """Clone HEAD into ``folder`` (once), write params.yaml and run the rounds (module docstring)."""
+    if not folder.exists():
+        subprocess.run(["git", "clone", "--quiet", str(ROOT), str(folder)], check=True)
+    header = f"graspaug params, profile `{profile}` with data_seed {params.data_seed}: written by studies/lifelong.py"
+    (folder / "params.yaml").write_text(params_yaml(params, header))
+    rounds = params.lifelong.round_numbers()
+    env = {
+        **os.environ,
+        "DVC_NO_ANALYTICS": "1",
+        "PATH": f"{Path(sys.executable).parent}{os.pathsep}{os.environ['PATH']}",
+    }
+    if reuse is None:
+        cache = subprocess.run(
+            [sys.executable, "-m", "dvc", "cache", "dir"], cwd=ROOT, check=True, capture_output=True, text=True
+        ).stdout.strip()
+        subprocess.run([sys.executable, "-m", "dvc", "cache", "dir", "--local", cache], cwd=folder, check=True)
+        subprocess.run(
+            [sys.executable, "-m", "dvc", "repro", f"lifelong@r{max(rounds)}"], cwd=folder, env=env, check=True
+        )
+        return
+    for path in REUSED:
+        (folder / path).parent.mkdir(parents=True, exist_ok=True)
+        if not (folder / path).exists():
+            os.symlink((reuse / path).resolve(), folder / path)
+    for k in [0, *rounds]:
+        if not (folder / f"data/lifelong/r{k}").exists():
+            command = ["graspaug", "lifelong-start"] if k == 0 else ["graspaug", "lifelong", "--round", f"r{k}"]
+            subprocess.run(command, cwd=folder, env=env, check=True)
+
+
+def combine(folders: dict[int, Path], params, n_resamples: int) -> dict:
+    """Every round's arms and contrasts over the draws (``folders``: data seed → draw folder)."""
+    cfg, seeds = params.lifelong, params.gqcnn.seeds
+    first = next(iter(folders.values()))
+    index = read_table(first / "data/gqcnn/original/index.parquet")
+    labels, objects = test_labels(index, first / "models/gqcnn/s0")
+    start = arm_variant("none", cfg.base_size, 0).name
+    out = {}
+    for k in [0, *cfg.round_numbers()]:
+        variants = [arm_variant(arm, cfg.base_size, k * cfg.shapes_per_round) for arm in ARMS]
+        networks = {}
+        for d, folder in folders.items():
+            starts = {s: folder / f"models/gqcnn/s{s}/{start}" for s in seeds}
+            if k == 0:
+                networks[d] = {s: {"none": starts[s]} for s in seeds}
+            else:
+                seed_dirs = {s: folder / f"models/lifelong/r{k}/s{s}" for s in seeds}
+                networks[d] = round_networks(starts, seed_dirs, variants)
+        out[k] = arm_contrasts(networks, labels, objects, n_resamples, params.seed)
+    return out
+
+
+def markdown(result: dict, params, command: str, seconds: float) -> str:
+    cfg = params.lifelong
+    lines_ = [
+        "# The lifelong loop over draws of the data",
+        "",
+        f"B = {cfg.base_size}; {cfg.shapes_per_round} shapes per arm and round; failures: the {cfg.worst} worst "
+        f"validation objects, {cfg.per_failure} anchors each; training seeds {list(params.gqcnn.seeds)}; draws "
+        f"{result[0]['draws']}. Intervals: 95% nested bootstrap over draws × seeds × test objects.",
+        "",
+        "| round | contrast | mean [95% interval] | per round |",
+        "|---|---|---|---|",
+    ]
+    for k, r in result.items():
+        for name, c in r["contrasts"].items():
+            lines_.append(f"| {k} | `{name}@r{k}` | {c['mean']:+.4f} [{c['ci_low']:+.4f}, {c['ci_high']:+.4f}] | |")
+        if "share" in r:
+            s = r["share"]
+            lines_.append(
+                f"| {k} | share of the real gain | {s['mean']:+.2f} [{s['ci_low']:+.2f}, {s['ci_high']:+.2f}] | |"
+            )
+    lines_ += ["", "| round | arm | test AP [95% interval] |", "|---|---|---|"]
+    for k, r in result.items():
+        lines_ += [
+            f"| {k} | {a} | {c['mean']:.4f} [{c['ci_low']:.4f}, {c['ci_high']:.4f}] |" for a, c in r["ap"].items()
+        ]
+    return "\n".join(lines_ + ["", f"Command: `{command}` ({seconds / 60:.0f} min).", ""])
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--draws", type=int, nargs="+", default=[0, 1, 2], help="data seeds, one loop each")
+    parser.add_argument("--workdir", type=Path, default=ROOT.parent / "lifelong")
+    parser.add_argument("--profile", default="lifelong")
+    parser.add_argument("--reuse", type=Path, default=None, help="a study's workdir whose draws hold the inputs")
+    parser.add_argument("--resamples", type=int, default=2000)
+    parser.add_argument("--combine-only", action="store_true", help="combine finished draws, run nothing")
+    args = parser.parse_args()
+    start = time.perf_counter()
+    params = {k: draw_params(args.profile, k) for k in args.draws}
+    folders = {k: args.workdir.resolve() / f"draw{k}" for k in args.draws}
+    for k in args.draws:
+        if not args.combine_only:
+            reuse = args.reuse.resolve() / f"draw{k}" if args.reuse else None
+            run_draw(folders[k], params[k], args.profile, reuse)
+        print(f"draw {k}: done ({time.perf_counter() - start:.0f} s)", flush=True)
+    p = params[args.draws[0]]
+    result = combine(folders, p, args.resamples)
+    (args.workdir / "summary.json").write_text(json.dumps({str(k): r for k, r in result.items()}, indent=1) + "\n")
+    command = "python studies/lifelong.py " + " ".join(sys.argv[1:])
+    (args.workdir / "lifelong.md").write_text(markdown(result, p, command, time.perf_counter() - start))
+    curve = pd.concat([curve_rows(k, r) for k, r in result.items()])
+    rounds, series, bands = curve_series(curve, ARMS)
+    title = f"Test AP per round, {len(args.draws)} draws × {len(p.gqcnn.seeds)} seeds (95% intervals)"
+    lines(rounds, series, args.workdir / "curve.png", "round", "test AP", title, bands)
+    print((args.workdir / "lifelong.md").read_text())
+
+
+if __name__ == "__main__":
+    main()
