@@ -26,7 +26,14 @@ from pathlib import Path
 import pandas as pd
 
 from graspaug.experiments.ap import test_labels
-from graspaug.experiments.lifelong import arm_contrasts, arm_variant, curve_rows, curve_series, round_networks
+from graspaug.experiments.lifelong import (
+    arm_contrasts,
+    arm_variant,
+    curve_rows,
+    curve_series,
+    interval_text,
+    round_networks,
+)
 from graspaug.experiments.settings import ARMS
 from graspaug.io.tables import read_table
 from graspaug.plots import lines
@@ -103,7 +110,22 @@ def combine(folders: dict[int, Path], params, n_resamples: int) -> dict:
     return out
 
 
-def markdown(result: dict, params, command: str, seconds: float) -> str:
+def followed(folders: dict[int, Path], rounds: list[int]) -> pd.DataFrame:
+    """Per round, the last round's failure objects on validation, before (under the network that chose them) and
+    under each arm now: mean AP and mean log loss over the draws' objects (``reports/lifelong/r<k>/followed.csv``).
+    The arms are each other's control: a failure chosen for its high loss moves back toward the mean under any arm."""
+    rows = []
+    for k in rounds:
+        frames = [pd.read_csv(f / f"reports/lifelong/r{k}/followed.csv") for f in folders.values()]
+        both = pd.concat(frames, ignore_index=True)
+        row = {"round": k, "objects": len(both)}
+        for who in ("before", *ARMS):
+            row[f"{who}_ap"], row[f"{who}_log_loss"] = both[f"{who}_ap"].mean(), both[f"{who}_log_loss"].mean()
+        rows.append(row)
+    return pd.DataFrame(rows)
+
+
+def markdown(result: dict, params, command: str, seconds: float, follow: pd.DataFrame) -> str:
     cfg = params.lifelong
     lines_ = [
         "# The lifelong loop over draws of the data",
@@ -112,22 +134,27 @@ def markdown(result: dict, params, command: str, seconds: float) -> str:
         f"validation objects, {cfg.per_failure} anchors each; training seeds {list(params.gqcnn.seeds)}; draws "
         f"{result[0]['draws']}. Intervals: 95% nested bootstrap over draws × seeds × test objects.",
         "",
-        "| round | contrast | mean [95% interval] | per round |",
-        "|---|---|---|---|",
+        "| round | contrast | mean [95% interval] |",
+        "|---|---|---|",
     ]
     for k, r in result.items():
         for name, c in r["contrasts"].items():
-            lines_.append(f"| {k} | `{name}@r{k}` | {c['mean']:+.4f} [{c['ci_low']:+.4f}, {c['ci_high']:+.4f}] | |")
+            lines_.append(f"| {k} | `{name}@r{k}` | {interval_text(c)} |")
         if "share" in r:
-            s = r["share"]
-            lines_.append(
-                f"| {k} | share of the real gain | {s['mean']:+.2f} [{s['ci_low']:+.2f}, {s['ci_high']:+.2f}] | |"
-            )
+            lines_.append(f"| {k} | share of the real gain | {interval_text(r['share'], '+.2f')} |")
     lines_ += ["", "| round | arm | test AP [95% interval] |", "|---|---|---|"]
     for k, r in result.items():
-        lines_ += [
-            f"| {k} | {a} | {c['mean']:.4f} [{c['ci_low']:.4f}, {c['ci_high']:.4f}] |" for a, c in r["ap"].items()
-        ]
+        lines_ += [f"| {k} | {a} | {interval_text(c, '.4f')} |" for a, c in r["ap"].items()]
+    lines_ += [
+        "",
+        "The last round's failure objects on validation (mean over draws and objects), before and under each arm:",
+        "",
+        "| round | objects | " + " | ".join(f"{w} AP / log loss" for w in ("before", *ARMS)) + " |",
+        "|---|---|" + "---|" * (1 + len(ARMS)),
+    ]
+    for row in follow.itertuples(index=False):
+        cells = [f"{getattr(row, f'{w}_ap'):.3f} / {getattr(row, f'{w}_log_loss'):.3f}" for w in ("before", *ARMS)]
+        lines_.append(f"| {row.round} | {row.objects} | " + " | ".join(cells) + " |")
     return "\n".join(lines_ + ["", f"Command: `{command}` ({seconds / 60:.0f} min).", ""])
 
 
@@ -152,7 +179,9 @@ def main() -> None:
     result = combine(folders, p, args.resamples)
     (args.workdir / "summary.json").write_text(json.dumps({str(k): r for k, r in result.items()}, indent=1) + "\n")
     command = "python studies/lifelong.py " + " ".join(sys.argv[1:])
-    (args.workdir / "lifelong.md").write_text(markdown(result, p, command, time.perf_counter() - start))
+    follow = followed(folders, p.lifelong.round_numbers())
+    follow.to_csv(args.workdir / "followed.csv", index=False)
+    (args.workdir / "lifelong.md").write_text(markdown(result, p, command, time.perf_counter() - start, follow))
     curve = pd.concat([curve_rows(k, r) for k, r in result.items()])
     rounds, series, bands = curve_series(curve, ARMS)
     title = f"Test AP per round, {len(args.draws)} draws × {len(p.gqcnn.seeds)} seeds (95% intervals)"

@@ -139,6 +139,30 @@ def test_dvc_repro_score(tiny_repo):
     assert "positive" in shown.stdout and "graspness" in shown.stdout
 
 
+def nearest_train_shapes(work: Path, folder: Path, train: set, count: int) -> dict[str, set[str]]:
+    """Each mesh of ``folder`` (closed and scaled as the corpus, encoded by the tiny run's AE) → its ``count`` nearest
+    train shapes in latent space, computed here from the library's parts."""
+    import torch
+
+    from graspaug.config import load_params
+    from graspaug.io.checkpoints import load_autoencoder
+    from graspaug.sim.objects import folder_meshes
+    from graspaug.training.autoencoder import encode_meshes
+
+    params = load_params(work / "params.yaml")
+    meshes, _ = folder_meshes(folder, params.ingest.surface)
+    ae, _, _ = load_autoencoder(work / "models/ae_critic.pt", params.ae.net)
+    grid = params.voxelize
+    z = encode_meshes(ae, [m for _, m in meshes], grid.resolution, grid.margin, torch.device("cpu"))
+    latents = pd.read_parquet(work / "data/latents.parquet")
+    latents = latents[latents.shape_id.isin(train)]
+    pool = np.stack(latents.z.to_numpy())
+    return {
+        name: set(latents.shape_id.iloc[np.argsort(np.linalg.norm(pool - zi, axis=1))[:count]])
+        for (name, _), zi in zip(meshes, z)
+    }
+
+
 def test_from_failures_generates_from_train_shapes_near_a_users_failure_meshes(tiny_repo, tmp_path):
     import trimesh
 
@@ -161,6 +185,9 @@ def test_from_failures_generates_from_train_shapes_near_a_users_failure_meshes(t
     skipped = pd.read_csv(tmp_path / "out/skipped.csv")
     assert list(skipped.file) == ["broken.obj"] and skipped.reason.iloc[0]
     assert list(pd.read_csv(tmp_path / "out/failures.csv").object) == ["box", "capsule"]
+    # the user's meshes are the anchors' seeds: each anchor is among the 2 train shapes nearest a failure mesh
+    anchors = nearest_train_shapes(work, failures, train, 2)
+    assert set(index.parent_a) <= anchors["box"] | anchors["capsule"]
     run([*command, "-o", str(tmp_path / "again")], work, env)  # the same shapes for the same params
     pd.testing.assert_frame_equal(pd.read_csv(tmp_path / "again/index.csv"), index)
     missing = subprocess.run(
@@ -428,6 +455,57 @@ def test_from_failures_of_a_networks_worst_validation_objects(tiny_repo, tmp_pat
         [*command, str(tmp_path)], cwd=work, env=env, capture_output=True, text=True
     )  # a folder and a network: refused
     assert both.returncode == 1 and "either a folder" in both.stderr
+
+
+def test_dvc_repro_lifelong_rounds(tiny_repo):
+    import json
+
+    import yaml
+
+    work, env = tiny_repo
+    run(["dvc", "repro", "lifelong@r2"], work, env)  # the tiny profile's two rounds, after round 0
+    shapes = pd.read_parquet(work / "data/shapes.parquet")
+    split = json.loads((work / "models/gqcnn/s0/split.json").read_text())
+    held_out = set(split["validation"]) | set(shapes.shape_id[shapes.split == "test"])
+    base = set(split["base"]["6"])
+    for k in (1, 2):
+        data = work / f"data/lifelong/r{k}"
+        made = pd.read_parquet(data / "shapes.parquet")
+        # no validation or test object ever enters a training set: parents are base shapes, the real arm's shapes
+        # are train shapes outside validation, and the datapoints are the generated shapes' own
+        assert set(made.parent_a) | set(made.parent_b) <= base and len(made) == 2 * 2 * k
+        assert list(made.groupby("arm").size()) == [2 * k, 2 * k] and set(made["round"]) == set(range(1, k + 1))
+        real = set(pd.read_csv(data / "real.csv").shape_id)
+        assert len(real) == 2 * k and not real & (held_out | base)
+        trained = set(pd.read_parquet(data / "dataset/index.parquet").shape_id)
+        assert trained <= set(made.shape_id)
+        for s in (0, 1):
+            for arm in ("failure", "random", "real"):
+                folder = work / f"models/lifelong/r{k}/s{s}/{arm}/6-{k * 2 / 6:g}"
+                summary = json.loads((folder / "summary.json").read_text())
+                assert summary["train"]["original_shapes"] == 6 + (2 * k if arm == "real" else 0)
+        failures = pd.read_csv(data / "failures.csv")
+        assert set(failures.object) <= set(split["validation"]) and failures.chosen.sum() == 1
+        for name in ("failure_vs_random", "failure_vs_real", "real_data", "ap_failure"):
+            assert set(json.loads((work / f"metrics/lifelong/r{k}/{name}.json").read_text())) == {"mean", "lo", "hi"}
+        report = (work / f"reports/lifelong/r{k}/report.md").read_text()
+        assert f"`failure_vs_random@r{k}`" in report and "before_log_loss" in report
+        assert (work / f"reports/lifelong/r{k}/curve.png").stat().st_size > 0
+    curve = pd.read_csv(work / "data/lifelong/r2/curve.csv")
+    assert list(curve["round"]) == [0, 1, 1, 1, 1, 2, 2, 2, 2]
+    assert list(pd.read_csv(work / "data/lifelong/r2/history.csv")["round"]) == [0, 1, 2]
+    # round k + 1 reads round k's outputs, not round k - 1's
+    lock = yaml.safe_load((work / "dvc.lock").read_text())["stages"]
+    for k in (1, 2):
+        paths = {d["path"] for d in lock[f"lifelong@r{k}"]["deps"]}
+        assert f"data/lifelong/r{k - 1}" in paths and not {f"data/lifelong/r{j}" for j in range(k - 1)} & paths
+    # a round is deterministic for a seed: run again, round 1's outputs are byte for byte the same (round 2 stays
+    # up to date), and its shapes too
+    before = (work / "data/lifelong/r1/shapes.parquet").read_bytes()
+    run(["dvc", "repro", "-f", "-s", "lifelong@r1"], work, env)
+    assert (work / "data/lifelong/r1/shapes.parquet").read_bytes() == before
+    status = subprocess.run(["dvc", "status", "lifelong@r2"], cwd=work, env=env, capture_output=True, text=True)
+    assert "up to date" in status.stdout, status.stdout
 
 
 def test_a_one_member_network_is_a_plain_gqcnn(tiny_repo, tmp_path):

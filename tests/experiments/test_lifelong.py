@@ -92,3 +92,94 @@ def test_validation_errors_average_the_seeds_predictions_and_rank_worst_first(tm
     other = _seed_folders(tmp_path / "other", {1: [0.5] * 4}, rows=(0, 1, 2, 4))
     with pytest.raises(DataError, match="seed 1 validates on other datapoints"):
         validation_errors({0: folders[0], 1: other[1]}, "targeted/6-0", index)
+
+
+def test_rounds_name_the_round_they_follow_and_none_is_missing():
+    from graspaug.config import ParamsError, params_dict, parse_params
+    from graspaug.profiles import merge
+
+    def rounds(value):
+        return parse_params(merge(params_dict(), {"lifelong": {"rounds": value}})).lifelong
+
+    assert rounds({"r1": "r0", "r2": "r1"}).round_numbers() == [1, 2] and rounds({}).round_numbers() == []
+    for bad in ({"r2": "r1"}, {"r1": "r1"}, {"round1": "r0"}, {"r0": "r-1"}):
+        with pytest.raises(ParamsError, match="lifelong.rounds"):
+            rounds(bad)
+
+
+def test_each_round_adds_new_shapes_to_each_arm_and_never_a_pair_and_weight_made_before():
+    import pandas as pd
+    import trimesh
+
+    from graspaug.generation import Decoded, candidate_key
+    from graspaug.generation_meshes import BaseSet, loop_shapes
+    from graspaug.params.generate import GenerateParams
+    from graspaug.scores import rarity
+
+    box = trimesh.creation.box(extents=(0.04, 0.03, 0.02))
+    rng = np.random.default_rng(0)
+    z = rng.normal(size=(8, 4)).astype(np.float32)
+    base = BaseSet(np.array([f"s{i}" for i in range(8)]), z, rarity(z, 3), rng.random(8), np.full(8, 0.002))
+    cfg = GenerateParams(base_sizes=(8,), first_neighbour=1, extra_neighbours=1, alphas=(0.5, 0.3))
+
+    def every_box(batch):
+        return [Decoded(c, np.zeros(1, np.uint8), box, None) for c in batch]
+
+    made, keys = None, {"failure": set(), "random": set()}
+    for round_ in (1, 2, 3):  # the same anchor every round: its stream must move on
+        index, _, kept, _ = loop_shapes(base, [0], ["val_7"], made, 3, cfg, every_box, rng, round_)
+        assert list(index.arm) == ["failure"] * 3 + ["random"] * 3 and set(index["round"]) == {round_}
+        assert list(index.shape_id[:3]) == [f"r{round_}_f{3 * (round_ - 1) + k:04d}" for k in range(3)]
+        assert set(index.parent_a[:3]) == {"s0"} and set(index.failure[:3]) == {"val_7"}
+        for arm, rows in index.groupby("arm"):
+            new = {candidate_key(a, b, al) for a, b, al in zip(rows.parent_a, rows.parent_b, rows.alpha)}
+            assert len(new) == 3 and not new & keys[arm], f"round {round_} repeats a {arm} shape"
+            keys[arm] |= new
+        made = index if made is None else pd.concat([made, index], ignore_index=True)
+    assert len(made) == 18 and made.shape_id.is_unique
+
+
+def test_arm_contrasts_pair_the_arms_within_a_seed_and_say_when_the_real_data_gain_shows(tmp_path):
+    from graspaug.experiments.lifelong import arm_contrasts, arm_variant, curve_rows, curve_series
+
+    rng = np.random.default_rng(1)
+    objects = np.repeat([f"o{i}" for i in range(40)], 10)
+    labels = rng.integers(0, 2, size=len(objects))
+    noise = {s: rng.normal(size=len(labels)) for s in (0, 1, 2)}
+    skill = {"none": 0.5, "failure": 0.6, "random": 0.6, "real": 1.5}  # more real data: a much better network
+    networks = {}
+    for s in (0, 1, 2):
+        for arm, k in skill.items():
+            folder = tmp_path / f"s{s}" / arm
+            folder.mkdir(parents=True)
+            np.save(folder / "test_predictions.npy", 1 / (1 + np.exp(-(k * (2 * labels - 1) + noise[s]))))
+            networks.setdefault(s, {})[arm] = folder
+    out = arm_contrasts({0: networks}, labels, objects, 300, 0)
+    c = out["contrasts"]
+    assert c["real_data"]["ci_low"] > 0 and c["failure_vs_real"]["ci_high"] < 0  # the control shows
+    assert c["failure_vs_random"]["mean"] == pytest.approx(0.0, abs=1e-12)  # the same network: nothing, exactly
+    assert c["failure_vs_random"]["ci_low"] <= 0 <= c["failure_vs_random"]["ci_high"]
+    assert out["ap"]["real"]["mean"] > out["ap"]["none"]["mean"] and 0 < out["share"]["mean"] < 0.5
+    assert arm_variant("none", 50, 0).name == "targeted/50-0"
+    assert arm_variant("failure", 50, 25).name == "failure/50-0.5"
+    import pandas as pd
+
+    curve = pd.concat([curve_rows(0, {"ap": {"none": out["ap"]["none"]}}), curve_rows(1, out)])
+    rounds, series, bands = curve_series(curve, ["failure", "real"])
+    assert rounds == [0, 1] and series["real"] == [out["ap"]["none"]["mean"], out["ap"]["real"]["mean"]]
+    assert bands["failure"][0][0] == out["ap"]["none"]["ci_low"]  # every arm starts from the base set alone
+
+
+def test_failure_history_counts_the_rounds_an_object_stays_a_failure():
+    import pandas as pd
+
+    from graspaug.experiments.lifelong import failure_history, followed_failures, persistent_failures
+
+    history = failure_history(failure_history(failure_history(None, 0, ["a", "b"]), 1, ["b", "c"]), 2, ["b", "a"])
+    top = persistent_failures(history)
+    assert list(top.object) == ["b", "a", "c"] and list(top.rounds) == [3, 2, 1] and top.first.tolist() == [0, 0, 1]
+    before = pd.DataFrame({"datapoints": [4, 6], "log_loss": [1.0, 2.0], "ap": [0.5, 0.2]}, index=["a", "b"])
+    now = pd.DataFrame({"log_loss": [0.5], "ap": [0.9]}, index=["b"])
+    followed = followed_failures(before, {"failure": now}, ["b", "a"])
+    assert list(followed.index) == ["b", "a"] and followed.loc["b", "failure_ap"] == 0.9
+    assert np.isnan(followed.loc["a", "failure_ap"]) and followed.loc["b", "before_ap"] == 0.2

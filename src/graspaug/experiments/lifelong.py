@@ -283,7 +283,7 @@ def _table(frame: pd.DataFrame) -> str:
     return "\n".join(head + [f"| {' | '.join(row)} |" for row in cells])
 
 
-def _interval(c: Mapping | None, spec: str = "+.4f") -> str:
+def interval_text(c: Mapping | None, spec: str = "+.4f") -> str:
     """``mean [ci_low, ci_high]`` of an interval dict, n/a for what is missing."""
     if not c or c.get("mean") is None:
         return "n/a"
@@ -299,17 +299,17 @@ def round_markdown(
     (``persistent``: :func:`persistent_failures`) and ``words`` (``design``, ``command``)."""
     lines = [f"# Lifelong loop, round {round_}", "", words["design"], ""]
     lines += ["| arm | test AP |", "|---|---|"]
-    lines += [f"| {arm} | {_interval(ap, '.4f')} |" for arm, ap in result["ap"].items()]
+    lines += [f"| {arm} | {interval_text(ap, '.4f')} |" for arm, ap in result["ap"].items()]
     if result["contrasts"]:
         lines += ["", "| contrast | mean [95% interval] | verdict |", "|---|---|---|"]
         for name, c in result["contrasts"].items():
             shows = None not in (c["ci_low"], c["ci_high"]) and (c["ci_low"] > 0 or c["ci_high"] < 0)
             word = ("above zero" if c["ci_low"] > 0 else "below zero") if shows else "no effect detected"
-            lines.append(f"| `{name}@r{round_}` | {_interval(c)} | {word} |")
+            lines.append(f"| `{name}@r{round_}` | {interval_text(c)} | {word} |")
     if "share" in result:
         lines += [
             "",
-            f"Share of the real shapes' gain that failure-targeted shapes give: {_interval(result['share'])} "
+            f"Share of the real shapes' gain that failure-targeted shapes give: {interval_text(result['share'])} "
             "(a ratio of two intervals: read it only when `real_data` shows).",
         ]
     if followed is not None:
