@@ -309,8 +309,8 @@ def round_markdown(
     if "share" in result:
         lines += [
             "",
-            f"Share of the real shapes' gain that failure-targeted shapes give: {interval_text(result['share'])} "
-            "(a ratio of two intervals: read it only when `real_data` shows).",
+            "Share of the real shapes' gain that failure-targeted shapes give: "
+            f"{interval_text(result['share'], '+.2f')} (a ratio of two intervals: read it when `real_data` shows).",
         ]
     if followed is not None:
         lines += [
