@@ -7,7 +7,8 @@ sharing this repository's DVC cache). With ``--reuse DIR`` the stages before the
 outputs are linked from DIR/draw<k> (an attribution study's draws: the same profile's data, the same data seed) and
 the rounds run as ``graspaug lifelong-start`` and ``graspaug lifelong --round r<k>``, the commands the DVC stages
 run. A finished round is not run again. Then :func:`graspaug.experiments.lifelong.arm_contrasts` combines the draws
-per round and ``summary.json``, ``lifelong.md`` and ``curve.png`` are written into ``--workdir``.
+per round and ``summary.json``, ``lifelong.md``, ``followed.csv``, ``curve.png`` (test AP) and ``gain.png`` (the
+gain over round 0) are written into ``--workdir``.
 
     python studies/lifelong.py [--draws 0 1 2] [--workdir ../lifelong] [--profile lifelong] [--reuse ../attribution]
         [--resamples 2000] [--combine-only]
@@ -183,9 +184,11 @@ def main() -> None:
     follow.to_csv(args.workdir / "followed.csv", index=False)
     (args.workdir / "lifelong.md").write_text(markdown(result, p, command, time.perf_counter() - start, follow))
     curve = pd.concat([curve_rows(k, r) for k, r in result.items()])
-    rounds, series, bands = curve_series(curve, ARMS)
-    title = f"Test AP per round, {len(args.draws)} draws × {len(p.gqcnn.seeds)} seeds (95% intervals)"
-    lines(rounds, series, args.workdir / "curve.png", "round", "test AP", title, bands)
+    design = f"{len(args.draws)} draws × {len(p.gqcnn.seeds)} seeds × test objects, 95% intervals"
+    for figure, label, name in (("ap", "test AP", "curve.png"), ("gain", "test AP − round 0's", "gain.png")):
+        rounds, series, bands = curve_series(curve, ARMS, figure)
+        what = "Test AP per round" if figure == "ap" else "Gain over round 0, paired"
+        lines(rounds, series, args.workdir / name, "round", label, f"{what} ({design})", bands)
     print((args.workdir / "lifelong.md").read_text())
 
 

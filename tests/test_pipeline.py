@@ -490,9 +490,10 @@ def test_dvc_repro_lifelong_rounds(tiny_repo):
             assert set(json.loads((work / f"metrics/lifelong/r{k}/{name}.json").read_text())) == {"mean", "lo", "hi"}
         report = (work / f"reports/lifelong/r{k}/report.md").read_text()
         assert f"`failure_vs_random@r{k}`" in report and "before_log_loss" in report
-        assert (work / f"reports/lifelong/r{k}/curve.png").stat().st_size > 0
+        assert all((work / f"reports/lifelong/r{k}/{p}.png").stat().st_size > 0 for p in ("curve", "gain", "failures"))
     curve = pd.read_csv(work / "data/lifelong/r2/curve.csv")
-    assert list(curve["round"]) == [0, 1, 1, 1, 1, 2, 2, 2, 2]
+    assert list(curve["round"][curve.figure == "ap"]) == [0, 1, 1, 1, 1, 2, 2, 2, 2]
+    assert list(curve.arm[(curve.figure == "gain") & (curve["round"] == 2)]) == ["failure", "random", "real"]
     assert list(pd.read_csv(work / "data/lifelong/r2/history.csv")["round"]) == [0, 1, 2]
     # round k + 1 reads round k's outputs, not round k - 1's
     lock = yaml.safe_load((work / "dvc.lock").read_text())["stages"]

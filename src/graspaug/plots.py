@@ -57,6 +57,8 @@ def lines(
         (line,) = ax.plot(x, y, marker="o", label=name)
         if intervals and name in intervals:
             ax.fill_between(x, *intervals[name], color=line.get_color(), alpha=0.15, linewidth=0)
+    if all(float(v).is_integer() for v in x):  # rounds, seeds: whole-number ticks
+        ax.set_xticks(sorted({int(v) for v in x}))
     ax.set_xlabel(xlabel)
     ax.set_ylabel(ylabel)
     ax.set_title(title)

@@ -164,10 +164,12 @@ def test_arm_contrasts_pair_the_arms_within_a_seed_and_say_when_the_real_data_ga
     assert arm_variant("failure", 50, 25).name == "failure/50-0.5"
     import pandas as pd
 
-    curve = pd.concat([curve_rows(0, {"ap": {"none": out["ap"]["none"]}}), curve_rows(1, out)])
+    curve = pd.concat([curve_rows(0, {"ap": {"none": out["ap"]["none"]}, "contrasts": {}}), curve_rows(1, out)])
     rounds, series, bands = curve_series(curve, ["failure", "real"])
     assert rounds == [0, 1] and series["real"] == [out["ap"]["none"]["mean"], out["ap"]["real"]["mean"]]
     assert bands["failure"][0][0] == out["ap"]["none"]["ci_low"]  # every arm starts from the base set alone
+    rounds, series, bands = curve_series(curve, ["failure", "real"], "gain")  # paired: from 0, real_data for real
+    assert series["real"] == [0.0, c["real_data"]["mean"]] and bands["failure"][1][1] == c["failure_vs_none"]["ci_high"]
 
 
 def test_failure_history_counts_the_rounds_an_object_stays_a_failure():

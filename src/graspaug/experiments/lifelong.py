@@ -251,26 +251,33 @@ def followed_failures(before: pd.DataFrame, after: Mapping[str, pd.DataFrame], c
     return out
 
 
+GAINS = {"failure": "failure_vs_none", "random": "random_vs_none", "real": "real_data"}  # arm → its gain over round 0
+
+
 def curve_rows(round_: int, result: dict) -> pd.DataFrame:
-    """One row per arm of :func:`arm_contrasts`'s ``result`` at ``round_``: ``round``, ``arm``, ``mean``,
-    ``ci_low``, ``ci_high`` (test AP), the rows a round appends to the loop's curve."""
-    return pd.DataFrame(
-        [
-            {"round": round_, "arm": arm, **{k: ap[k] for k in ("mean", "ci_low", "ci_high")}}
-            for arm, ap in result["ap"].items()
-        ]
-    )
+    """The rows a round appends to the loop's curve, from :func:`arm_contrasts`'s ``result`` at ``round_``: per arm
+    its test AP (``figure`` ``ap``) and its paired gain over round 0 (``figure`` ``gain``, :data:`GAINS`; 0 at
+    round 0), each as ``round``, ``arm``, ``figure``, ``mean``, ``ci_low``, ``ci_high``."""
+    keys = ("mean", "ci_low", "ci_high")
+    rows = [{"round": round_, "arm": arm, "figure": "ap", **{k: c[k] for k in keys}} for arm, c in result["ap"].items()]
+    for arm, name in GAINS.items():
+        gain = {k: 0.0 for k in keys} if round_ == 0 else result["contrasts"].get(name)
+        if gain is not None:
+            rows.append({"round": round_, "arm": arm, "figure": "gain", **{k: gain[k] for k in keys}})
+    return pd.DataFrame(rows)
 
 
-def curve_series(curve: pd.DataFrame, arms: Sequence[str]) -> tuple[list[int], dict, dict]:
-    """(rounds, arm → test AP per round, arm → (low, high) per round) of a curve (:func:`curve_rows` of every
-    round), each arm's line starting at round 0's ``none`` (the base set alone, which every arm starts from)."""
+def curve_series(curve: pd.DataFrame, arms: Sequence[str], figure: str = "ap") -> tuple[list[int], dict, dict]:
+    """(rounds, arm → ``figure`` per round, arm → (low, high) per round) of a curve (:func:`curve_rows` of every
+    round). The test AP of every arm starts at round 0's ``none`` (the base set alone, which every arm starts
+    from), the gain at 0."""
     curve = curve.astype({"mean": float, "ci_low": float, "ci_high": float})  # a missing end: NaN
     rounds = sorted(curve["round"].unique())
-    start = curve[curve.arm == "none"].iloc[0]
+    curve = curve[curve.figure == figure]
     series, bands = {}, {}
     for arm in arms:
         rows = curve[curve.arm == arm].set_index("round")
+        start = curve[curve.arm == ("none" if figure == "ap" else arm)].set_index("round").loc[0]
         pick = lambda col: [start[col]] + [rows[col].get(r, np.nan) for r in rounds[1:]]  # noqa: B023, E731
         series[arm], bands[arm] = pick("mean"), (pick("ci_low"), pick("ci_high"))
     return rounds, series, bands

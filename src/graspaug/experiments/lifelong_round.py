@@ -1,8 +1,8 @@
 """A round of the lifelong loop's work on files, into folders the caller names: its new shapes' meshes and the
 union of every round's datapoints (:func:`render_round`), the failure arm's validation errors that choose the next
 round's failures (:func:`score_round`), and its metrics files (each arm's test AP and contrast: mean, lo, hi), report
-(``report.md``), curve over rounds (``curve.png``) and the objects it keeps failing on (``failures.png``,
-:func:`write_round`)."""
+(``report.md``), curves over rounds (``curve.png``: test AP; ``gain.png``: the gain over round 0, paired) and the
+objects it keeps failing on (``failures.png``, :func:`write_round`)."""
 
 from __future__ import annotations
 
@@ -141,6 +141,9 @@ def write_round(
         rounds, series, bands = curve_series(curve, ARMS if round_ else ["none"])
         title = f"Test AP per round (B = {cfg.base_size}, 95% intervals over seeds × test objects)"
         lines(rounds, series, folder / "curve.png", "round", "test AP", title, bands)
+        rounds, series, bands = curve_series(curve, ARMS, "gain")
+        title = f"Gain over round 0, paired within seeds (B = {cfg.base_size}, 95% intervals)"
+        lines(rounds, series, folder / "gain.png", "round", "test AP − round 0's", title, bands)
         at = {s: i for i, s in enumerate(voxels.shape_id)}
         shown = persistent.head(PICTURED)
         cells = [(voxels.occupancy[at[o]], voxels.occupancy[at[o]]) for o in shown.object]
