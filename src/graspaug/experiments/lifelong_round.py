@@ -24,7 +24,7 @@ from graspaug.experiments.lifelong import (
 )
 from graspaug.experiments.settings import ARMS
 from graspaug.experiments.stats import headline
-from graspaug.grasping.labelled import grasps_of_shape
+from graspaug.grasping.labelled import grasps_of_shapes
 from graspaug.io.atomic import atomic_path
 from graspaug.io.gqcnn import append_grasp_images
 from graspaug.io.meshes import mesh_path, write_obj
@@ -55,15 +55,12 @@ def grasp_and_render(
     (images (N, out, out) float32, index (N rows, :func:`~graspaug.render.corpus_dataset.datapoints_table`),
     grasp table, the shapes without a datapoint with their reasons)
     """
-    from graspaug.parallel import parallel_map
-
     shapes = with_pool_columns(shapes.copy())
-    jobs = [(mesh_path(Path(mesh_dir).resolve(), s, suffix), s) for s in shapes.shape_id]
-    found = parallel_map(lambda job: grasps_of_shape(job[0], job[1], grasps, seed), jobs, workers, f"grasps ({label})")
-    table = pd.concat([rows for rows, _ in found], ignore_index=True)
-    for shape_id, (_, reason) in zip(shapes.shape_id, found):
-        if reason:
-            log.warning("%s: %s has no grasp: %s", label, shape_id, reason)
+    table, reasons = grasps_of_shapes(
+        mesh_dir, list(shapes.shape_id), suffix, grasps, seed, workers, f"grasps ({label})"
+    )
+    for shape_id, reason in reasons.items():
+        log.warning("%s: %s has no grasp: %s", label, shape_id, reason)
     hand = grasps.gripper
     by_shape, results = render_corpus(shapes, table, Path(mesh_dir), suffix, settings, hand, seed, workers, label)
     images, parts, skipped, _, _ = datapoints_index(shapes, by_shape, results, grasps.threshold)

@@ -80,3 +80,18 @@ def grasps_headline(summary: dict) -> dict[str, float | int | None]:
     """The stage's metrics from its :func:`grasps_summary`: ``shapes`` of the corpus and the share of
     grasps labelled positive (``positive``, robust ε above the threshold)."""
     return {"shapes": summary["n_shapes"], "positive": summary["success_share"]}
+
+
+def grasps_of_shapes(
+    mesh_dir: Path, shape_ids: list[str], suffix: str, cfg: GraspsParams, seed: int, workers, label: str
+) -> tuple[pd.DataFrame, dict[str, str]]:
+    """:func:`grasps_of_shape` for every shape of ``shape_ids`` (meshes ``<mesh_dir>/<shape_id><suffix>``) on
+    ``workers`` processes (progress ``label``): (every grasp row, in shape order; shape id → why it has no grasp, for
+    the shapes without one)."""
+    from graspaug.io.meshes import mesh_path
+    from graspaug.parallel import parallel_map
+
+    jobs = [(mesh_path(Path(mesh_dir).resolve(), s, suffix), s) for s in shape_ids]  # workers may have another cwd
+    results = parallel_map(lambda job: grasps_of_shape(job[0], job[1], cfg, seed), jobs, workers, label)
+    reasons = {shape_id: reason for shape_id, (_, reason) in zip(shape_ids, results) if reason}
+    return pd.concat([rows for rows, _ in results], ignore_index=True), reasons

@@ -14,10 +14,7 @@ from __future__ import annotations
 import logging
 import time
 
-import pandas as pd
-
-from graspaug.grasping.labelled import grasps_headline, grasps_of_shape, grasps_summary
-from graspaug.io.meshes import mesh_path
+from graspaug.grasping.labelled import grasps_headline, grasps_of_shapes, grasps_summary
 from graspaug.io.tables import read_table, write_json, write_table
 from graspaug.params.base import params_model
 from graspaug.params.grasps import GraspsParams
@@ -30,21 +27,14 @@ Params = params_model("The params the `grasps` stage reads.", grasps=GraspsParam
 
 
 def run(params: Params, corpus: str = "original") -> None:
-    from graspaug.parallel import parallel_map
-
-    files = corpus_paths(corpus)
+    table_path, mesh_dir, suffix = corpus_paths(corpus)
     start = time.perf_counter()
-    cfg = params.grasps
-    table_path, mesh_dir, suffix = files
     shape_ids = list(read_table(table_path)["shape_id"])
-    jobs = [(mesh_path(mesh_dir.resolve(), s, suffix), s) for s in shape_ids]  # workers may have another cwd
-    results = parallel_map(
-        lambda job: grasps_of_shape(job[0], job[1], cfg, params.seed), jobs, params.workers, f"grasps ({corpus})"
+    table, reasons = grasps_of_shapes(
+        mesh_dir, shape_ids, suffix, params.grasps, params.seed, params.workers, f"grasps ({corpus})"
     )
-    for shape_id, (_, reason) in zip(shape_ids, results):
-        if reason:
-            log.warning("grasps: %s has no grasp: %s", shape_id, reason)
-    table = pd.concat([rows for rows, _ in results], ignore_index=True)
+    for shape_id, reason in reasons.items():
+        log.warning("grasps: %s has no grasp: %s", shape_id, reason)
     write_table(table, grasps_table(corpus))
 
     seconds = time.perf_counter() - start
