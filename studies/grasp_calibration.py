@@ -6,11 +6,12 @@ in the datapoint's stable pose on the cell's table and executes its grasp with t
 ROC AUC of the robust ε (all grasps, collision-free ones) and of the label, with bootstrap
 intervals over shapes, outcome counts per label, and the time. ``--set`` changes sim params
 (``hand``, ``trial``, ``physics``, ``cell``) to measure what each change does to agreement.
-``--table`` writes the per-grasp table (.csv). Run it in a project where ``render@original`` has
-run (it reads ``data/gqcnn/original/index.parquet``, ``data/grasps/original.parquet`` and
-``data/shapes``):
+``--table`` writes the per-grasp table (.csv); ``--split train`` executes train-split datapoints
+instead, to choose settings of the cell without looking at the test split. Run it in a project
+where ``render@original`` has run (it reads ``data/gqcnn/original/index.parquet``,
+``data/grasps/original.parquet`` and ``data/shapes``):
 
-    python studies/grasp_calibration.py [--n 1000] [--workers 2] [--table out.csv]
+    python studies/grasp_calibration.py [--n 1000] [--workers 2] [--table out.csv] [--split train]
                                         [--set hand.grip_force=20 --set trial.pregrasp_height=0.1 ...]
 """
 
@@ -35,11 +36,14 @@ def main() -> None:
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--table", type=Path, default=None, help="write the per-grasp table here (.csv)")
     parser.add_argument("--set", dest="changes", action="append", default=[])
+    parser.add_argument(
+        "--split", default="test", choices=["test", "train"], help="whose datapoints (tune the cell on train)"
+    )
     args = parser.parse_args()
     params = Params()
     sim = with_changes(params.sim, args.changes)
     start = time.perf_counter()
-    chosen = choose_grasps(read_table(gqcnn_dir("original") / "index.parquet"), args.n, params.seed)
+    chosen = choose_grasps(read_table(gqcnn_dir("original") / "index.parquet"), args.n, params.seed, args.split)
     jobs = shape_jobs(chosen, read_table(grasps_table("original")), SHAPES_DIR, sim, params.seed, args.workers)
     prepared = time.perf_counter() - start
     table = run_calibration(jobs, sim, args.workers)

@@ -10,11 +10,14 @@ physically plausible setting separates the arms. Run it in a project where
 ``data/shapes`` and, with ``--train``, ``data/gqcnn/original``):
 
     python studies/sim_probe.py [--seeds 0 1 2 3] [--n-test 20] [--attempts 2] [--models DIR] [--train]
+                                [--more-real 200] [--trials out.csv]
                                 [--set hand.grip_force=20 --set physics.friction_range=[0.3,0.5] ...]
 
 ``--models`` holds ``s<seed>/targeted/<B>-0/model.pt`` (default ``models/gqcnn``); with ``--train``
 the missing networks are trained there first with the default ``gqcnn`` params, as
-``train_gqcnn`` trains them.
+``train_gqcnn`` trains them. ``--more-real B`` adds the positive control: the targeted B-0
+network of each seed as arm ``more_real`` on the same drops, and the paired ``real_data``
+(more_real − before).
 """
 
 from __future__ import annotations
@@ -92,6 +95,14 @@ def main() -> None:
     parser.add_argument("--train", action="store_true")
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--set", dest="changes", action="append", default=[])
+    parser.add_argument(
+        "--more-real",
+        type=int,
+        default=None,
+        metavar="B",
+        help="add the positive control: the targeted B-0 network (more real shapes) as arm more_real, and real_data",
+    )
+    parser.add_argument("--trials", type=Path, default=None, help="write the per-trial table here (.csv)")
     args = parser.parse_args()
     params = Params()
     sim = with_changes(params.sim, args.changes)
@@ -104,6 +115,8 @@ def main() -> None:
         sim.objects, tests, SHAPES_DIR, sim.physics, params.seed, sim.vhacd_resolution, workers=args.workers
     )
     arms = {"before": ("targeted", 0.0, args.base_size), "antipodal": (None, None, None)}
+    if args.more_real is not None:
+        arms["more_real"] = ("targeted", 0.0, args.more_real)
     seed_dirs = {s: args.models / f"s{s}" for s in args.seeds}
     jobs = object_jobs(objects, arms, seed_dirs, attempts, params.seed, 0)
     start = time.perf_counter()
@@ -121,6 +134,13 @@ def main() -> None:
     rows = [row for rows in parallel_map(work, jobs, args.workers, "sim probe") for row in rows]
     trials = pd.DataFrame([{k: v for k, v in row.items() if not k.startswith("_")} for row in rows])
     seconds = time.perf_counter() - start
+    if args.trials is not None:
+        trials.to_csv(args.trials, index=False)
+    control = (
+        {"real_data": trial_contrast(trials, "more_real", "before", sim.n_bootstrap, params.seed)}
+        if args.more_real is not None
+        else {}
+    )
     print(
         json.dumps(
             {
@@ -134,6 +154,7 @@ def main() -> None:
                 "planning_time_before": round(float(trials.planning_time[trials.arm == "before"].mean()), 3),
                 **{arm: rate_summary(trials.success[trials.arm == arm]) for arm in arms},
                 "network_vs_antipodal": trial_contrast(trials, "before", "antipodal", sim.n_bootstrap, params.seed),
+                **control,
                 "outcomes": trials.groupby(["arm", "outcome"]).size().unstack(fill_value=0).to_dict("index"),
             }
         )

@@ -230,3 +230,33 @@ def test_jaw_angle_convention_on_a_long_bar(sim_cache):
 
     assert run_trial(bar, drop_seed=2, scripted=jaws("across")).outcome == "success"
     assert run_trial(bar, drop_seed=2, scripted=jaws("along")).outcome == "collision"  # a finger lands on the bar's end
+
+
+def test_shaking_drops_a_grasp_far_from_the_center_of_mass(sim_cache):
+    """A 0.3 kg bar (3 × 12 × 3 cm) held with 20 N: grasped across at its middle it survives a 3 g shake; grasped
+    4.5 cm toward one end it is carried to the bin unshaken, but the shake twists it out of the pads (the
+    torque about the jaw axis outgrows the pads' friction), as the grasp's lower wrench resistance says."""
+    import trimesh
+
+    from graspaug.sim.objects import prepare_object
+
+    bar = prepare_object(
+        "heavy-bar", trimesh.creation.box(extents=[0.03, 0.12, 0.03]), sim_cache, mass=0.3, lateral_friction=0.5
+    )
+
+    def across(offset):
+        def scripted(position, quaternion):
+            long_axis = np.array(pybullet.getMatrixFromQuaternion(quaternion)).reshape(3, 3).T[1]
+            return np.asarray(position) + offset * long_axis, float(np.arctan2(long_axis[0], -long_axis[1]))
+
+        return scripted
+
+    hand, shaken, still = (
+        HandSettings(grip_force=20),
+        TrialSettings(shake_acceleration=3),
+        TrialSettings(shake_acceleration=0),
+    )
+    assert run_trial(bar, drop_seed=2, scripted=across(0.0), hand=hand, settings=shaken).outcome == "success"
+    assert run_trial(bar, drop_seed=2, scripted=across(0.045), hand=hand, settings=still).outcome == "success"
+    off_center = run_trial(bar, drop_seed=2, scripted=across(0.045), hand=hand, settings=shaken, record=True)
+    assert off_center.outcome == "dropped" and "shaken" in [name for name, _ in off_center.frames]

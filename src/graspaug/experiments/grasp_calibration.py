@@ -26,16 +26,16 @@ from graspaug.rng import shape_rng
 INDEX_COLUMNS = ("shape_id", "grasp_id", "pose_id", "pose_probability", "eps", "collision_free", "success", "label")
 
 
-def choose_grasps(index: pd.DataFrame, n: int, seed: int) -> pd.DataFrame:
-    """``n`` datapoints of the test split of the rendered dataset's ``index`` (one row per
+def choose_grasps(index: pd.DataFrame, n: int, seed: int, split: str = "test") -> pd.DataFrame:
+    """``n`` datapoints of the ``split`` of the rendered dataset's ``index`` (one row per
     datapoint: ``shape_id``, ``split``, ``label``, …), half labelled positive and half negative
     (negatives fill in for missing positives; fewer than ``n`` only when the split has fewer),
     spread over as many shapes as possible: within a label, every shape gives its first (seeded
     random) datapoint before any gives a second. Sorted by shape. Raises ValueError when the
-    test split is empty."""
-    test = index[index.split == "test"]
+    split is empty. (Settings of the cell are tuned on the train split, measured on test.)"""
+    test = index[index.split == split]
     if test.empty:
-        raise ValueError("the rendered dataset has no test-split datapoints to execute")
+        raise ValueError(f"the rendered dataset has no {split}-split datapoints to execute")
     rng = shape_rng(seed, "sim", "grasp-calibration")
     positives = min(n - n // 2, int(test.label.sum()))
     chosen = []

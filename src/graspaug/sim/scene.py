@@ -116,6 +116,24 @@ class PickScene:
                 return (i + 1) * self.layout.time_step
         return max_time
 
+    def shake(self, acceleration: float, pulse_time: float) -> None:
+        """Load the held object as shaking the hand would: one half-sine pulse of ``pulse_time`` s
+        along each of +x, −x, +y, −y, +z, −z (table frame), peaking at the object's mass ×
+        ``acceleration`` (m/s²), applied at its center of mass while the arm holds still (in the
+        hand's frame, accelerating the hand by a loads the object with −m·a at its center of mass)."""
+        c = self.client
+        mass = pybullet.getDynamicsInfo(self.object, -1, physicsClientId=c)[0]
+        steps = max(1, int(round(pulse_time / self.layout.time_step)))
+        arm = self.robot.arm_angles()
+        for direction in np.vstack([np.eye(3), -np.eye(3)])[[0, 3, 1, 4, 2, 5]]:
+            for i in range(steps):
+                force = mass * acceleration * np.sin(np.pi * (i + 0.5) / steps) * direction
+                position, _ = self.object_pose()
+                pybullet.applyExternalForce(
+                    self.object, -1, force.tolist(), position.tolist(), pybullet.WORLD_FRAME, physicsClientId=c
+                )
+                self.robot.step(1, arm)
+
     def object_in_bin(self) -> bool:
         """Whether the object's center lies inside the bin's walls, below its rim."""
         position, _ = self.object_pose()

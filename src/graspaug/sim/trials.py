@@ -179,6 +179,10 @@ def run_trial(
         if not lifted:
             result.outcome = "not_lifted"
             return result
+        if settings.shake_acceleration > 0:
+            scene.shake(settings.shake_acceleration * layout.gravity, settings.shake_pulse)
+            if record:
+                frames.append(("shaken", scene.color_frame()))
         above_bin = np.array(
             [layout.bin_position[0], layout.bin_position[1], layout.bin_position[2] + settings.carry_height]
         )
