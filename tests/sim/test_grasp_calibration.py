@@ -38,6 +38,8 @@ def test_choose_grasps_takes_half_positives_from_the_test_split_spread_over_shap
     assert len(choose_grasps(index, 100, seed=0)) == 60  # every test datapoint
     with pytest.raises(ValueError, match="no test-split"):
         choose_grasps(index[index.split == "train"], 4, seed=0)
+    tuning = choose_grasps(index, 4, seed=0, split="train")  # the cell's settings are chosen on train datapoints
+    assert set(tuning.shape_id) == {"t0"} and len(tuning) == 2 and tuning.label.all()  # t0 has no negatives
 
 
 def test_a_grasp_follows_the_body_from_its_stable_pose():

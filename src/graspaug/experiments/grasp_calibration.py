@@ -33,14 +33,14 @@ def choose_grasps(index: pd.DataFrame, n: int, seed: int, split: str = "test") -
     spread over as many shapes as possible: within a label, every shape gives its first (seeded
     random) datapoint before any gives a second. Sorted by shape. Raises ValueError when the
     split is empty. (Settings of the cell are tuned on the train split, measured on test.)"""
-    test = index[index.split == split]
-    if test.empty:
+    candidates = index[index.split == split]
+    if candidates.empty:
         raise ValueError(f"the rendered dataset has no {split}-split datapoints to execute")
     rng = shape_rng(seed, "sim", "grasp-calibration")
-    positives = min(n - n // 2, int(test.label.sum()))
+    positives = min(n - n // 2, int(candidates.label.sum()))
     chosen = []
     for label, want in ((True, positives), (False, n - positives)):
-        rows = test[test.label == label]
+        rows = candidates[candidates.label == label]
         rows = rows.iloc[rng.permutation(len(rows))]
         rank = rows.groupby("shape_id").cumcount()
         chosen.append(rows.assign(_rank=rank.to_numpy()).sort_values("_rank", kind="stable").head(want))

@@ -5,7 +5,9 @@ on the object, the drop seed and the grasp: the same seed gives the same drop (a
 noisy depth image: the sensor noise is drawn from the drop seed too) to every planner. The hand
 travels from its rest pose to the pre-grasp pose and down to the grasp along straight lines;
 a contact pressing harder than ``collision_force`` on the way, before the fingers close, ends
-the trial as ``collision``. The grasp comes from a grasp source (depth image → planned grasp,
+the trial as ``collision``. After the lift the held object is shaken (``shake_acceleration``:
+loads at its center of mass, :meth:`~graspaug.sim.scene.PickScene.shake`) before it is carried.
+The grasp comes from a grasp source (depth image → planned grasp,
 :class:`graspaug.planning.PlannedGrasp`) or, for scripted tests, directly as a table-frame pose.
 """
 
