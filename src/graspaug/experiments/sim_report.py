@@ -158,6 +158,8 @@ def trial_setup(
         "skipped_meshes": skipped,
         "camera_height": sim.cell.camera_height,
         "sensor_noise": sim.sensor.enabled,
+        "grip_force": sim.hand.grip_force,
+        "shake_acceleration": sim.trial.shake_acceleration,
         "model_seeds": model_seeds,
     }
 
@@ -297,7 +299,13 @@ def report_text(metrics: dict, trials: pd.DataFrame, calibration_table: pd.DataF
         f"({noise}), "
         f"{setup['objects']} objects × {setup['attempts']} seeded drops, the same drops and planner seeds for every "
         f"arm; networks of training seeds {setup['model_seeds']} (B = {setup['base_size']}). "
-        "Success = the object ends inside the bin.",
+        f"Grip {setup['grip_force']:g} N; "
+        + (
+            f"after the lift the object is shaken at {setup['shake_acceleration']:g} g. "
+            if setup["shake_acceleration"]
+            else ""
+        )
+        + "Success = the object ends inside the bin.",
         "",
         "| arm | planner | successes | rate | 95% Wilson interval |",
         "|---|---|---|---|---|",
