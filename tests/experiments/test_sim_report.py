@@ -109,7 +109,7 @@ def test_contrast_interval_excludes_zero_for_a_clear_effect_and_report_says_so()
     assert "`network_vs_antipodal` excludes zero: before succeeds more often than antipodal" in text
     assert "`after_vs_before` excludes zero: after succeeds less often than before" in text
     assert "| o11 | test_shape | 3 | 0.00 | n/a |" in text  # no labels for o10, o11
-    assert "Grip 20 N; after the lift the object is shaken at 5 g." in text
+    assert "Grip 20 N, the object shaken at 5 g after the lift." in text
     headline = sim_headline(metrics)  # the metrics files: one per contrast, its mean and bootstrap interval
     assert list(headline) == ["after_vs_before", "network_vs_antipodal"]
     assert headline["network_vs_antipodal"] == {"mean": round(c["mean"], 5), "lo": c["ci_low"], "hi": c["ci_high"]}

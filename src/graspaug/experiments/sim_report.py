@@ -292,6 +292,9 @@ def report_text(metrics: dict, trials: pd.DataFrame, calibration_table: pd.DataF
     (named in the calibration's text)."""
     setup, arms = metrics["setup"], metrics["arms"]
     noise = "D435-like noise, missing pixels and 1 mm steps" if setup["sensor_noise"] else "exact depth"
+    shake = (
+        f"shaken at {setup['shake_acceleration']:g} g after the lift" if setup["shake_acceleration"] else "not shaken"
+    )
     lines = [
         "# Simulated robot trials",
         "",
@@ -299,13 +302,7 @@ def report_text(metrics: dict, trials: pd.DataFrame, calibration_table: pd.DataF
         f"({noise}), "
         f"{setup['objects']} objects × {setup['attempts']} seeded drops, the same drops and planner seeds for every "
         f"arm; networks of training seeds {setup['model_seeds']} (B = {setup['base_size']}). "
-        f"Grip {setup['grip_force']:g} N; "
-        + (
-            f"after the lift the object is shaken at {setup['shake_acceleration']:g} g. "
-            if setup["shake_acceleration"]
-            else ""
-        )
-        + "Success = the object ends inside the bin.",
+        f"Grip {setup['grip_force']:g} N, the object {shake}. Success = the object ends inside the bin.",
         "",
         "| arm | planner | successes | rate | 95% Wilson interval |",
         "|---|---|---|---|---|",

@@ -19,6 +19,9 @@ from graspaug.sim.objects import SimObject
 from graspaug.sim.panda import HandSettings, Panda
 from graspaug.sim.settings import CellLayout
 
+#: The shake's load directions in turn (table frame): +x, −x, +y, −y, +z, −z.
+SHAKE_DIRECTIONS = np.array([[1, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1]], dtype=float)
+
 
 def camera_pose(layout: CellLayout) -> CameraPose:
     """The overhead depth camera of ``layout``: ``camera_height`` m above the table origin, looking straight down."""
@@ -125,7 +128,7 @@ class PickScene:
         mass = pybullet.getDynamicsInfo(self.object, -1, physicsClientId=c)[0]
         steps = max(1, int(round(pulse_time / self.layout.time_step)))
         arm = self.robot.arm_angles()
-        for direction in np.vstack([np.eye(3), -np.eye(3)])[[0, 3, 1, 4, 2, 5]]:
+        for direction in SHAKE_DIRECTIONS:
             for i in range(steps):
                 force = mass * acceleration * np.sin(np.pi * (i + 0.5) / steps) * direction
                 position, _ = self.object_pose()

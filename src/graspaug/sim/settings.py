@@ -54,7 +54,7 @@ class HandSettings:
         gt=0,
         description="Closing force limit per finger motor (N). With both fingers on the object each presses with "
         "this force, so it is the grasp's clamping force (the Franka Hand is rated 70 N continuous, "
-        "140 N peak; 20 N is a gentle grasp, under which a grasp's wrench resistance decides the shake).",
+        "140 N peak; 20 N is a gentle grasp).",
     )
     finger_friction: float = Field(
         1.0,
@@ -114,8 +114,7 @@ class TrialSettings:
         5.0,
         ge=0,
         description="After the lift, the held object is shaken: loaded along ±x, ±y, ±z in turn with its weight times "
-        "this (in g), as a hand shaken with this peak acceleration would load it (0: no shaking). A grasp far "
-        "from the center of mass, or on few and slanted contacts, lets go; one the robust ε scores high holds.",
+        "this (in g), as a hand shaken with this peak acceleration would load it (0: no shaking).",
     )
     shake_pulse: float = Field(0.25, gt=0, description="Duration of each of the six half-sine shaking pulses (s).")
     collision_force: float = Field(
@@ -181,8 +180,8 @@ class ObjectPhysics:
     )
     mass_range: tuple[float, float] = Field(
         (0.2, 1.0),
-        description="The mass is clipped to this range (kg; the Panda hand and arm carry 3 kg). The floor of 0.2 kg "
-        "loads the grip: the corpus's 6 cm shapes would weigh 3-60 g at the densities above.",
+        description="The mass is clipped to this range (kg; the Panda hand and arm carry 3 kg). The floor is the "
+        "least weight that loads the grip.",
     )
     friction_range: tuple[float, float] = Field(
         (0.3, 0.7),
