@@ -581,6 +581,12 @@ def test_dvc_repro_sim(tiny_repo, tmp_path):
         assert c["n_seeds"] == 2 and c["t_ci_low"] <= c["mean"] <= c["t_ci_high"]
         headline = json.loads((work / f"metrics/sim/{name}.json").read_text())
         assert headline == {"mean": round(c["mean"], 5), "lo": c["ci_low"], "hi": c["ci_high"]}
+    ranking, executed = metrics["ranking"], pd.read_csv(work / "reports/grasp_calibration/grasps.csv")
+    assert ranking["n_grasps"] == len(executed) == 6  # every arm's networks rank the executed calibration grasps
+    assert list(ranking["arms"]) == (network_arms if executed.executed_success.nunique() == 2 else [])
+    for name, c in ranking["contrasts"].items():
+        headline = json.loads((work / f"metrics/sim/ranking_{name}.json").read_text())
+        assert headline == {"mean": c["mean"], "lo": c["ci_low"], "hi": c["ci_high"]}
     trials = pd.read_csv(work / "reports/sim/trials.csv")
     assert len(trials) == 4 * len(network_arms) * 2 + 4 and set(trials.object) == {
         "cube",
@@ -624,6 +630,7 @@ def test_dvc_repro_grasp_calibration(tiny_repo):
     index = pd.read_parquet(work / "data/gqcnn/original/index.parquet")
     test = index[index.split == "test"].set_index(["shape_id", "pose_id", "grasp_id"])
     assert len(grasps) == 6 and grasps.set_index(["shape_id", "pose_id", "grasp_id"]).index.isin(test.index).all()
+    assert (index.shape_id.to_numpy()[grasps.datapoint] == grasps.shape_id).all()  # its row in the index
     from graspaug.sim.trials import OUTCOMES
 
     assert set(grasps.outcome) <= set(OUTCOMES) and (grasps.executed_success == (grasps.outcome == "success")).all()

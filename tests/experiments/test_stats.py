@@ -114,3 +114,21 @@ def test_the_fieller_interval_inverts_the_t_test_of_the_paired_difference():
         assert abs(d.mean() / (d.std(ddof=1) / 2)) == pytest.approx(critical)
     noisy = fieller_interval(gain, np.array([0.03, -0.02, 0.01, -0.015]))  # the real gain is not clearly nonzero
     assert not noisy["bounded"] and noisy["ci_low"] is None and noisy["ci_high"] is None
+
+
+def test_weighted_roc_auc_is_sklearns_with_ties_and_weights():
+    from sklearn.metrics import roc_auc_score
+
+    from graspaug.experiments.stats import weighted_roc_auc
+
+    rng = np.random.default_rng(3)
+    labels = rng.integers(0, 2, 300).astype(bool)
+    scores = np.round(rng.random(300) + 0.4 * labels, 1)  # rounded: many ties
+    weights = rng.integers(0, 4, (5, 300)).astype(float)
+    got = weighted_roc_auc(labels, scores, weights)
+    want = [roc_auc_score(labels, scores, sample_weight=w) for w in weights]
+    assert got == pytest.approx(want)
+    assert weighted_roc_auc(labels, scores, np.ones(300)) == pytest.approx(roc_auc_score(labels, scores))
+    assert np.isnan(weighted_roc_auc(labels, scores, labels.astype(float)))  # no negative left: undefined
+    boot = ObjectBootstrap(np.arange(300) // 10, 50, 0)
+    assert boot.roc_auc(labels, scores).shape == (50,)

@@ -36,6 +36,7 @@ def test_choose_grasps_takes_half_positives_from_the_test_split_spread_over_shap
     few = choose_grasps(index, 50, seed=0)  # 18 positives in all: every one of them, negatives fill in
     assert few.label.sum() == 18 and (~few.label).sum() == 32
     assert len(choose_grasps(index, 100, seed=0)) == 60  # every test datapoint
+    assert (index.shape_id[chosen.datapoint].to_numpy() == chosen.shape_id).all()  # its row in the index
     with pytest.raises(ValueError, match="no test-split"):
         choose_grasps(index[index.split == "train"], 4, seed=0)
     tuning = choose_grasps(index, 4, seed=0, split="train")  # the cell's settings are chosen on train datapoints
@@ -68,6 +69,7 @@ def test_executed_grasps_on_a_cube_in_its_stable_pose(cube):
     beside = middle + pose[:3, :3].T @ np.array([0.0, 0.06, 0.0])
     rows = pd.DataFrame(
         {
+            "datapoint": [10, 11],
             "shape_id": ["cube", "cube"],
             "grasp_id": [0, 1],
             "pose_id": [0, 0],

@@ -22,18 +22,29 @@ from scipy.spatial.transform import Rotation
 
 from graspaug.rng import shape_rng
 
-#: Columns of the rendered dataset's index that a calibration row keeps.
-INDEX_COLUMNS = ("shape_id", "grasp_id", "pose_id", "pose_probability", "eps", "collision_free", "success", "label")
+#: Columns of the rendered dataset's index that a calibration row keeps (``datapoint``: the row in the index).
+INDEX_COLUMNS = (
+    "datapoint",
+    "shape_id",
+    "grasp_id",
+    "pose_id",
+    "pose_probability",
+    "eps",
+    "collision_free",
+    "success",
+    "label",
+)
 
 
 def choose_grasps(index: pd.DataFrame, n: int, seed: int, split: str = "test") -> pd.DataFrame:
     """``n`` datapoints of the ``split`` of the rendered dataset's ``index`` (one row per
-    datapoint: ``shape_id``, ``split``, ``label``, …), half labelled positive and half negative
-    (negatives fill in for missing positives; fewer than ``n`` only when the split has fewer),
+    datapoint: ``shape_id``, ``split``, ``label``, …; the result's ``datapoint`` is the row
+    there), half labelled positive and half negative (negatives fill in for missing positives;
+    fewer than ``n`` only when the split has fewer),
     spread over as many shapes as possible: within a label, every shape gives its first (seeded
     random) datapoint before any gives a second. Sorted by shape. Raises ValueError when the
     split is empty. (Settings of the cell are tuned on the train split, measured on test.)"""
-    candidates = index[index.split == split]
+    candidates = index.assign(datapoint=np.arange(len(index)))[index.split.to_numpy() == split]
     if candidates.empty:
         raise ValueError(f"the rendered dataset has no {split}-split datapoints to execute")
     rng = shape_rng(seed, "sim", "grasp-calibration")

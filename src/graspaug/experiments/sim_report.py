@@ -198,8 +198,14 @@ def summarize(trials: pd.DataFrame, objects: Sequence, chosen: dict, setup: dict
 
 def sim_headline(summary: dict) -> dict[str, dict]:
     """The experiment's metrics from its :func:`summarize` report: per contrast the mean paired success
-    difference and its 95% bootstrap interval over objects (:func:`~graspaug.experiments.stats.headline`)."""
-    return {name: headline(c) for name, c in summary["contrasts"].items()}
+    difference and its 95% bootstrap interval over objects (:func:`~graspaug.experiments.stats.headline`),
+    and, as ``ranking_<contrast>``, the paired difference in ROC AUC against the cell's outcomes of the
+    executed calibration grasps (``summary["ranking"]``, :func:`graspaug.experiments.cell_ranking.cell_ranking`)."""
+    ranking = (summary.get("ranking") or {}).get("contrasts", {})
+    return {
+        **{name: headline(c) for name, c in summary["contrasts"].items()},
+        **{f"ranking_{name}": headline(c) for name, c in ranking.items()},
+    }
 
 
 def objects_table(objects: Sequence) -> pd.DataFrame:
@@ -250,6 +256,10 @@ def success_bar_data(metrics: dict, chosen: dict) -> tuple[list[str], dict[str, 
     return names, bars
 
 
+def _number(x) -> str:
+    return "n/a" if x is None else f"{x:.3f}"
+
+
 def _interval(c: dict) -> str:
     return f"{c['mean']:+.3f} [{c['ci_low']:+.3f}, {c['ci_high']:+.3f}]"
 
@@ -284,6 +294,65 @@ def control_words(contrasts: dict) -> str:
         f"({_interval(c)}), so this cell cannot judge training data and after_vs_before measures the cell, not "
         "the augmentation."
     )
+
+
+def ranking_words(ranking: dict) -> str:
+    """Whether the networks' ranking of the cell's outcomes can judge training data, in one sentence: its
+    positive control ``real_data`` (AUC of more real training shapes vs ``before``) shows or not, and so
+    whether its ``after_vs_before`` says anything about augmentation."""
+    c, n = ranking["contrasts"].get("real_data"), ranking["n_grasps"]
+    if c is None:
+        return "No network of a larger base size: the ranking has no positive control, so after_vs_before is not read."
+    if c["ci_low"] > 0:
+        return (
+            f"The positive control shows on the {n} executed grasps: the networks trained on more real shapes rank "
+            f"the cell's outcomes better (ROC AUC {_interval(c)}), so this readout can judge training data and its "
+            "after_vs_before is read as a test of augmentation."
+        )
+    return (
+        f"The positive control does not show on the {n} executed grasps (ROC AUC {_interval(c)}), so this readout "
+        "cannot judge training data either and its after_vs_before is not read as a test of augmentation."
+    )
+
+
+def ranking_lines(ranking: dict) -> list[str]:
+    """The report's section on how each arm's networks rank the cell's outcomes of the executed
+    calibration grasps (:func:`graspaug.experiments.cell_ranking.cell_ranking`)."""
+    ref = ranking["reference"]
+    if ref is None:
+        return [
+            "",
+            f"Every one of the {ranking['n_grasps']} executed calibration grasps had the same outcome: the "
+            "networks' ranking of the cell's outcomes is not measured.",
+        ]
+    lines = [
+        "",
+        "## How the networks rank the cell's outcomes",
+        "",
+        f"The `grasp_calibration` stage executed {ranking['n_grasps']} labelled test grasps on "
+        f"{ranking['n_objects']} shapes in this cell. Every network scored those datapoints; its ROC AUC against "
+        "what the cell did with them says how well it ranks the grasps that held through the lift and the shake. "
+        "All arms are scored on the same executed grasps: no drop, sensor noise or planner search differs between "
+        f"them. For reference, the robust ε ranks them at {ref['eps']:.3f}, the label at {ref['label']:.3f}. "
+        "The networks' ROC AUC against the grasps' labels is beside it (means over training seeds). Intervals: "
+        "95% bootstrap over the shapes, 95% t over training seeds.",
+        "",
+        "| arm | ROC AUC against the cell's outcomes | against the labels |",
+        "|---|---|---|",
+        *[f"| {arm} | {a['auc']:.3f} | {_number(a.get('auc_label'))} |" for arm, a in ranking["arms"].items()],
+        "",
+        "| contrast | AUC difference | 95% bootstrap (shapes) | 95% t (seeds) |",
+        "|---|---|---|---|",
+    ]
+    for name, c in ranking["contrasts"].items():
+        t = "–" if c["t_ci_low"] is None else f"[{c['t_ci_low']:+.3f}, {c['t_ci_high']:+.3f}]"
+        lines.append(f"| {name} | {c['mean']:+.3f} | [{c['ci_low']:+.3f}, {c['ci_high']:+.3f}] | {t} |")
+    lines += ["", f"**{ranking_words(ranking)}**", ""]
+    c = ranking["contrasts"].get("after_vs_before")
+    if c is not None and ranking["contrasts"].get("real_data", {}).get("ci_low", 0) > 0:
+        shown = "raises" if c["ci_low"] > 0 else "lowers" if c["ci_high"] < 0 else "shows no change in"
+        lines.append(f"- Augmentation {shown} the networks' ranking of the cell's outcomes ({_interval(c)}).")
+    return lines
 
 
 def report_text(metrics: dict, trials: pd.DataFrame, calibration_table: pd.DataFrame, scores_file: str) -> str:
@@ -358,6 +427,8 @@ def report_text(metrics: dict, trials: pd.DataFrame, calibration_table: pd.DataF
             )
         if len({np.sign(row["difference"]) for row in seeds.values()} - {0.0}) > 1:
             lines.append("\nThe sign of after − before changes with the training seed.")
+    if metrics.get("ranking"):
+        lines += ranking_lines(metrics["ranking"])
     names = list(arms)
     lines += [
         "",

@@ -8,7 +8,8 @@
   (of paired differences) with its percentile bootstrap interval;
 * :func:`weighted_average_precision`: Average Precision as sklearn's (step-wise, no
   interpolation): the mean over positives of the precision at their rank, with datapoint
-  weights for the bootstrap;
+  weights for the bootstrap; :func:`weighted_roc_auc`: ROC AUC as sklearn's (ties count
+  half), with datapoint weights;
 * :func:`nested_interval`: one interval over data draws, training seeds and test objects (a
   hierarchical bootstrap); :func:`fieller_interval`: a ratio of paired means (a share of a gain);
 * :func:`wilson_interval` (a success rate). No McNemar test: the robot trials' picks cluster by
@@ -69,6 +70,11 @@ class ObjectBootstrap:
         w = self.object_counts[:, self.object_index[order]]
         return weighted_average_precision(y, w)
 
+    def roc_auc(self, labels: np.ndarray, scores: np.ndarray) -> np.ndarray:
+        """(n_resamples,) ROC AUC of ``scores`` (N,) for ``labels`` (N,) under every resample
+        (NaN where a resample lacks one label)."""
+        return weighted_roc_auc(labels, scores, self.object_counts[:, self.object_index])
+
     def means(self, values: np.ndarray) -> np.ndarray:
         """(n_resamples,) mean of ``values`` (N,), one per datapoint, under every resample: each
         drawn object brings all its datapoints, once per draw."""
@@ -113,6 +119,23 @@ def weighted_average_precision(labels_sorted: np.ndarray, weights: np.ndarray) -
         out=np.full_like(positives, np.nan),
         where=positives > 0,
     )
+
+
+def weighted_roc_auc(labels: np.ndarray, scores: np.ndarray, weights: np.ndarray) -> np.ndarray:
+    """ROC AUC of ``scores`` (N,) for ``labels`` (N,) with datapoint ``weights`` (..., N): the
+    weighted share of (positive, negative) pairs that the scores order correctly, a tie counting
+    half (sklearn's ``roc_auc_score`` with ``sample_weight``). (...,); NaN where either label
+    has no weight."""
+    order = np.argsort(np.asarray(scores), kind="stable")
+    s, y = np.asarray(scores)[order], np.asarray(labels, dtype=bool)[order]
+    w = np.asarray(weights, dtype=float)[..., order]
+    starts = np.flatnonzero(np.r_[True, s[1:] != s[:-1]])  # groups of tied scores
+    positive = np.add.reduceat(w * y, starts, axis=-1)
+    negative = np.add.reduceat(w * ~y, starts, axis=-1)
+    below = np.cumsum(negative, axis=-1) - negative
+    pairs = positive.sum(axis=-1) * negative.sum(axis=-1)
+    ordered = (positive * (below + 0.5 * negative)).sum(axis=-1)
+    return np.divide(ordered, pairs, out=np.full_like(pairs, np.nan), where=pairs > 0)
 
 
 def percentile_interval(samples: np.ndarray, level: float = 0.95) -> tuple[float | None, float | None]:

@@ -22,8 +22,8 @@ def write_csv(df: pd.DataFrame, path: str | os.PathLike) -> None:
 
 
 def read_table(path: str | os.PathLike) -> pd.DataFrame:
-    """Read a parquet table written by :func:`write_table`."""
-    return pd.read_parquet(path)
+    """Read a table written by :func:`write_table` (parquet) or :func:`write_csv` (a ``.csv`` path)."""
+    return pd.read_csv(path) if str(path).endswith(".csv") else pd.read_parquet(path)
 
 
 def write_json(obj: object, path: str | os.PathLike) -> None:

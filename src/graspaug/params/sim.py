@@ -27,10 +27,12 @@ class SimParams:
         "Relative to the project or absolute; DVC tracks this value, not the folder's files.",
     )
     attempts: int = Field(
-        2,
+        1,
         ge=1,
         description="Attempts per object and arm (paper: 10); each attempt drops the object anew from a seeded pose, "
-        "the same for every arm. Paired attempts per network arm = objects × attempts × training seeds.",
+        "the same for every arm. Paired attempts per network arm = objects × attempts × training seeds. (The default "
+        "spends the make repro budget on `calibration_grasps` instead, whose paired contrasts need far fewer grasps "
+        "than picks do.)",
     )
     base_size: int = Field(
         50,
@@ -39,11 +41,11 @@ class SimParams:
         "(after, and the `real` pool's network at that ratio); one of gqcnn.augment_base_sizes.",
     )
     calibration_grasps: int = Field(
-        100,
+        1000,
         ge=2,
         description="Labelled grasps of the rendered test split (half positive, spread over the test shapes) that the "
-        "`grasp_calibration` stage executes in the cell, each shape in its datapoint's stable pose (the default "
-        "fits the make repro budget; the study profile executes 1000).",
+        "`grasp_calibration` stage executes in the cell, each shape in its datapoint's stable pose. The `sim` stage "
+        "has every arm's networks rank these grasps' outcomes (the `ranking_*` contrasts).",
     )
     n_bootstrap: int = Field(
         2000, ge=100, description="Bootstrap resamples of the objects for the contrasts' 95% intervals."
