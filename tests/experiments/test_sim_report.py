@@ -134,7 +134,11 @@ def test_the_outcome_line_gives_rates_contrasts_and_planning_time():
     }
     timing = {"planning_time_mean": 0.01234, "planning_time_max": None}
     assert outcome_words(metrics, timing) == (
-        "before 3/4, after 4/4; after_vs_before +0.25 [-0.12, +0.50]; planning 0.012 s per grasp (max 0.000)"
+        "before 3/4, after 4/4; after_vs_before +0.250 [-0.125, +0.500]; planning 0.012 s per grasp (max 0.000)"
+    )
+    metrics["ranking"] = {"contrasts": {"real_data": {"mean": 0.0104, "ci_low": 0.0024, "ci_high": 0.0186}}}
+    assert "after_vs_before +0.250 [-0.125, +0.500], ranking_real_data +0.010 [+0.002, +0.019];" in outcome_words(
+        metrics, timing
     )
 
 

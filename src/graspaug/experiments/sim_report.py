@@ -498,11 +498,14 @@ def planning_timing(trials: pd.DataFrame, arms: list[str]) -> dict:
 
 def outcome_words(metrics: dict, timing: dict) -> str:
     """One line on the trials: successes/attempts per arm, each contrast's mean [95 % bootstrap
-    interval] (:func:`summarize` metrics) and the planning time per grasp, mean and max (s;
+    interval] (:func:`summarize` metrics; the ranking's as ``ranking_<contrast>``) and the planning
+    time per grasp, mean and max (s;
     :func:`planning_timing`)."""
     rates = ", ".join(f"{arm} {a['successes']}/{a['attempts']}" for arm, a in metrics["arms"].items())
+    ranked = {f"ranking_{n}": c for n, c in (metrics.get("ranking") or {}).get("contrasts", {}).items()}
     contrasts = ", ".join(
-        f"{n} {c['mean']:+.2f} [{c['ci_low']:+.2f}, {c['ci_high']:+.2f}]" for n, c in metrics["contrasts"].items()
+        f"{n} {c['mean']:+.3f} [{c['ci_low']:+.3f}, {c['ci_high']:+.3f}]"
+        for n, c in {**metrics["contrasts"], **ranked}.items()
     )
     return "%s; %s; planning %.3f s per grasp (max %.3f)" % (
         rates,
