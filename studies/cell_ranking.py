@@ -10,10 +10,13 @@ shapes. Also, exploratory: each network's top-scored executed grasp per shape (a
 shape's executed grasps), closer to what the planner does than the AUC. The outcomes are executed
 once (``--grasps``, the ``grasps.csv`` of a ``grasp_calibration`` run): they do not depend on the
 networks. Arms: ``before`` (targeted B-0), ``after`` and ``real`` (B at each project's ratio chosen
-on validation AP), ``more_real`` (targeted ``--more-real``-0). Prints one JSON line.
+on validation AP: its AP report, or its targeted B networks' validation AP), ``more_real`` (targeted
+``--more-real``-0, by default the next larger base size). Each project's ``params.yaml`` is read;
+``--models`` names the networks' folder in it (``studies/train_networks.py --out`` writes one).
+Prints one JSON line.
 
     python studies/cell_ranking.py --grasps reports/grasp_calibration/grasps.csv \\
-        --projects . ../draw1 ../draw2 [--seeds 0 1 2 3] [--base-size 50] [--more-real 200]
+        --projects . ../draw1 ../draw2 [--models models/gqcnn] [--seeds 0 1 2 3] [--base-size 50] [--more-real 200]
 """
 
 from __future__ import annotations
@@ -25,11 +28,13 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from graspaug.config import Params
+from graspaug.config import load_params
+from graspaug.experiments.ap import choose_ratios, collect
 from graspaug.experiments.cell_ranking import arm_scores, auc_samples, cell_ranking, ranking_bootstrap
 from graspaug.experiments.sim import after_ratio
 from graspaug.experiments.sim_report import CONTRASTS
 from graspaug.experiments.stats import nested_interval
+from graspaug.experiments.variants import Variant
 from graspaug.io.tables import read_table
 from graspaug.rng import shape_rng
 
@@ -49,30 +54,46 @@ def top_pick(grasps: pd.DataFrame, scores: dict[str, np.ndarray]) -> dict:
     return picks
 
 
+def project_arms(project: Path, params, models: Path, seeds, base_size: int, more_real: int | None) -> dict:
+    """The ``sim`` stage's network arms in ``project`` (its ``params``): "after" at the ratio of its
+    ``reports/gqcnn/ap.json`` or, without one, of the best mean validation AP of the targeted B
+    networks found in ``models``; more_real at ``more_real`` or the next larger base size."""
+    report = project / "reports/gqcnn/ap.json"
+    if report.exists():
+        best, _ = after_ratio(json.loads(report.read_text()), base_size, params.generate.ratios)
+    else:
+        nonzero = [Variant("targeted", base_size, float(r)) for r in params.generate.ratios if r > 0]
+        runs = collect({s: project / models / f"s{s}" for s in seeds}, nonzero)
+        best = choose_ratios(runs, [base_size])[base_size]
+    larger = more_real or min(b for b in params.generate.base_sizes if b > base_size)
+    return {
+        "before": ("targeted", 0.0, base_size),
+        "after": ("targeted", best, base_size),
+        "real": ("real", best, base_size),
+        "more_real": ("targeted", 0.0, larger),
+    }
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--grasps", type=Path, required=True, help="grasps.csv of a grasp_calibration run")
     parser.add_argument("--projects", type=Path, nargs="+", required=True, help="one project folder per draw")
-    parser.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2, 3])
+    parser.add_argument("--models", type=Path, default=Path("models/gqcnn"), help="in each project")
+    parser.add_argument("--seeds", type=int, nargs="+", default=None, help="default: the project's gqcnn.seeds")
     parser.add_argument("--base-size", type=int, default=50)
-    parser.add_argument("--more-real", type=int, default=200)
+    parser.add_argument("--more-real", type=int, default=None, help="default: the next larger base size")
     args = parser.parse_args()
-    params = Params()
+    params = load_params(args.projects[0] / "params.yaml")
     grasps = read_table(args.grasps)
     boot = ranking_bootstrap(grasps, params.sim.n_bootstrap, params.seed)
     draws, full, resampled = {}, [], []
     for project in args.projects:
-        ap = json.loads((project / "reports/gqcnn/ap.json").read_text())
-        best, _ = after_ratio(ap, args.base_size, params.generate.ratios)
-        chosen = {
-            "before": ("targeted", 0.0, args.base_size),
-            "after": ("targeted", best, args.base_size),
-            "real": ("real", best, args.base_size),
-            "more_real": ("targeted", 0.0, args.more_real),
-        }
-        seed_dirs = {s: project / f"models/gqcnn/s{s}" for s in args.seeds}
+        params = load_params(project / "params.yaml")
+        seeds = args.seeds if args.seeds is not None else list(params.gqcnn.seeds)
+        chosen = project_arms(project, params, args.models, seeds, args.base_size, args.more_real)
+        seed_dirs = {s: project / args.models / f"s{s}" for s in seeds}
         ranking = cell_ranking(grasps, seed_dirs, chosen, params.sim.n_bootstrap, params.seed)
-        draws[str(project)] = {"after_ratio": best, "arms": ranking["arms"], "contrasts": ranking["contrasts"]}
+        draws[str(project)] = {"arms_networks": chosen, "arms": ranking["arms"], "contrasts": ranking["contrasts"]}
         scores = arm_scores(grasps, seed_dirs, chosen)
         draws[str(project)]["top_pick"] = top_pick(grasps, scores)
         f, r = auc_samples(grasps.executed_success.to_numpy(bool), scores, boot)
@@ -84,7 +105,7 @@ def main() -> None:
         if arm in full[0] and reference in full[0]:
             f = np.stack([d[arm] - d[reference] for d in full])  # (D, S)
             r = np.stack([d[arm] - d[reference] for d in resampled])  # (D, S, R)
-            pooled[name] = nested_interval(f, r, rng)
+            pooled[name] = nested_interval(f, r, rng) if len(full) > 1 else None
     summary = {"grasps": len(grasps), "shapes": int(grasps.shape_id.nunique()), "reference": ranking["reference"]}
     print(json.dumps({**summary, "draws": draws, "pooled": pooled}))
 

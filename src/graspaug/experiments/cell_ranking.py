@@ -52,14 +52,14 @@ def cell_ranking(grasps: pd.DataFrame, seed_dirs: Mapping[int, Path], chosen: Ma
     """ROC AUC of each arm's network against the cell's outcomes (``executed_success``) of the
     executed calibration ``grasps`` (:func:`arm_scores`), and the paired contrasts between arms.
 
-    Returns ``{"n_grasps", "n_objects", "reference": {"eps", "label"}, "arms": {arm: {"auc",
-    "per_seed", "auc_label"}}, "contrasts": {name: {...}}}``: ``auc`` the mean over training seeds
-    (``auc_label``: the same networks' ROC AUC against the grasps' labels instead, NaN without both); a contrast's
-    ``mean`` is the mean over seeds of the AUC difference, ``ci_low``, ``ci_high`` its 95 % bootstrap
-    interval over the grasps' objects (shapes; one resample for every network), ``t_ci_low``,
-    ``t_ci_high`` the t-interval over seeds, ``per_seed``. The robust ε and the label, scored the same
-    way, are the reference. When every grasp had the same outcome there is nothing to rank: no arms,
-    no contrasts, reference None."""
+    Returns ``{"n_grasps", "n_objects", "reference": {"eps", "label"}, "arms": {arm: {"auc", "per_seed",
+    "auc_label"}}, "contrasts": {name: {...}}}``: ``auc`` the mean over training seeds (``auc_label``:
+    the same networks' ROC AUC against the grasps' labels instead; None when the grasps hold one label
+    only); a contrast's ``mean`` is the mean over seeds of the AUC difference, ``ci_low``, ``ci_high``
+    its 95 % bootstrap interval over the grasps' objects (shapes; one resample for every network),
+    ``t_ci_low``, ``t_ci_high`` the t-interval over seeds, ``per_seed``. The robust ε and the label,
+    scored the same way, are the reference. When every grasp had the same outcome there is nothing to
+    rank: no arms, no contrasts, reference None."""
     y = grasps.executed_success.to_numpy(bool)
     counts = {"n_grasps": int(len(grasps)), "n_objects": int(grasps.shape_id.nunique())}
     if len(np.unique(y)) < 2:  # every grasp held, or none: nothing to rank

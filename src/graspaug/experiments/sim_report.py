@@ -260,6 +260,11 @@ def _number(x) -> str:
     return "n/a" if x is None else f"{x:.3f}"
 
 
+def _t(c: dict) -> str:
+    """A contrast's t-interval over seeds as a table cell ("–" with one seed)."""
+    return "–" if c["t_ci_low"] is None else f"[{c['t_ci_low']:+.3f}, {c['t_ci_high']:+.3f}]"
+
+
 def _interval(c: dict) -> str:
     return f"{c['mean']:+.3f} [{c['ci_low']:+.3f}, {c['ci_high']:+.3f}]"
 
@@ -275,24 +280,24 @@ def _verdict(name: str, c: dict) -> str:
 
 
 def control_words(contrasts: dict) -> str:
-    """Whether the cell can judge training data, in one sentence: its positive control ``real_data``
+    """Whether the picks can judge training data, in one sentence: its positive control ``real_data``
     (more real training shapes vs ``before``, bootstrap over objects) shows or not, and so whether
     ``after_vs_before`` says anything about augmentation."""
     c = contrasts.get("real_data")
     if c is None:
         return (
-            "No positive control (no network of a larger base size): whether this cell can tell better training "
+            "No positive control (no network of a larger base size): whether these picks can tell better training "
             "data is unknown, so after_vs_before is not read as a test of augmentation."
         )
     if c["ci_low"] > 0:
         return (
-            f"The positive control shows: more real training shapes raise pick success ({_interval(c)}), so the "
-            "cell can judge training data and after_vs_before is read as a test of augmentation."
+            f"The positive control shows: more real training shapes raise pick success ({_interval(c)}), so these "
+            "picks can judge training data and after_vs_before is read as a test of augmentation."
         )
     return (
         f"The positive control does not show: more real training shapes do not raise pick success here "
-        f"({_interval(c)}), so this cell cannot judge training data and after_vs_before measures the cell, not "
-        "the augmentation."
+        f"({_interval(c)}), so these picks cannot judge training data and their after_vs_before measures the cell, "
+        "not the augmentation."
     )
 
 
@@ -345,8 +350,7 @@ def ranking_lines(ranking: dict) -> list[str]:
         "|---|---|---|---|",
     ]
     for name, c in ranking["contrasts"].items():
-        t = "–" if c["t_ci_low"] is None else f"[{c['t_ci_low']:+.3f}, {c['t_ci_high']:+.3f}]"
-        lines.append(f"| {name} | {c['mean']:+.3f} | [{c['ci_low']:+.3f}, {c['ci_high']:+.3f}] | {t} |")
+        lines.append(f"| {name} | {c['mean']:+.3f} | [{c['ci_low']:+.3f}, {c['ci_high']:+.3f}] | {_t(c)} |")
     lines += ["", f"**{ranking_words(ranking)}**", ""]
     c = ranking["contrasts"].get("after_vs_before")
     if c is not None and ranking["contrasts"].get("real_data", {}).get("ci_low", 0) > 0:
@@ -364,13 +368,13 @@ def report_text(metrics: dict, trials: pd.DataFrame, calibration_table: pd.DataF
     shake = (
         f"shaken at {setup['shake_acceleration']:g} g after the lift" if setup["shake_acceleration"] else "not shaken"
     )
+    drops = f"{setup['attempts']} seeded drop{'' if setup['attempts'] == 1 else 's'}"
     lines = [
         "# Simulated robot trials",
         "",
-        f"Franka Panda in pybullet, overhead depth camera {setup['camera_height']} m above the table "
-        f"({noise}), "
-        f"{setup['objects']} objects × {setup['attempts']} seeded drops, the same drops and planner seeds for every "
-        f"arm; networks of training seeds {setup['model_seeds']} (B = {setup['base_size']}). "
+        f"Franka Panda in pybullet, overhead depth camera {setup['camera_height']} m above the table ({noise}), "
+        f"{setup['objects']} objects × {drops}, the same drops and planner seeds for every arm; networks of "
+        f"training seeds {setup['model_seeds']} (B = {setup['base_size']}). "
         f"Grip {setup['grip_force']:g} N, the object {shake}. Success = the object ends inside the bin.",
         "",
         "| arm | planner | successes | rate | 95% Wilson interval |",
@@ -400,9 +404,8 @@ def report_text(metrics: dict, trials: pd.DataFrame, calibration_table: pd.DataF
         "|---|---|---|---|---|---|",
     ]
     for name, c in metrics["contrasts"].items():
-        t = "–" if c["t_ci_low"] is None else f"[{c['t_ci_low']:+.3f}, {c['t_ci_high']:+.3f}]"
         lines.append(
-            f"| {name} | {c['mean']:+.3f} | [{c['ci_low']:+.3f}, {c['ci_high']:+.3f}] | {t} | "
+            f"| {name} | {c['mean']:+.3f} | [{c['ci_low']:+.3f}, {c['ci_high']:+.3f}] | {_t(c)} | "
             f"{c['n_trials']} | {c['n_objects']} |"
         )
     lines += ["", f"**{control_words(metrics['contrasts'])}**", ""]
