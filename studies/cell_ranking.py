@@ -11,7 +11,7 @@ shape's executed grasps), closer to what the planner does than the AUC. The outc
 once (``--grasps``, the ``grasps.csv`` of a ``grasp_calibration`` run): they do not depend on the
 networks. Arms: ``before`` (targeted B-0), ``after`` and ``real`` (B at each project's ratio chosen
 on validation AP: its AP report, or its targeted B networks' validation AP), ``more_real`` (targeted
-``--more-real``-0, by default the next larger base size). Each project's ``params.yaml`` is read;
+``--more-real``-0, by default the largest base size). Each project's ``params.yaml`` is read;
 ``--models`` names the networks' folder in it (``studies/train_networks.py --out`` writes one).
 Prints one JSON line.
 
@@ -56,16 +56,16 @@ def top_pick(grasps: pd.DataFrame, scores: dict[str, np.ndarray]) -> dict:
 
 def project_arms(project: Path, params, models: Path, seeds, base_size: int, more_real: int | None) -> dict:
     """The ``sim`` stage's network arms in ``project`` (its ``params``): "after" at the ratio of its
-    ``reports/gqcnn/ap.json`` or, without one, of the best mean validation AP of the targeted B
-    networks found in ``models``; more_real at ``more_real`` or the next larger base size."""
-    report = project / "reports/gqcnn/ap.json"
-    if report.exists():
+    ``reports/gqcnn/ap.json`` for the networks of ``models/gqcnn``, else of the best mean validation
+    AP of the targeted B networks in ``models``; more_real at ``more_real`` or the largest base size."""
+    report = project / "reports/gqcnn/ap.json"  # it describes the networks of models/gqcnn only
+    if models == Path("models/gqcnn") and report.exists():
         best, _ = after_ratio(json.loads(report.read_text()), base_size, params.generate.ratios)
     else:
         nonzero = [Variant("targeted", base_size, float(r)) for r in params.generate.ratios if r > 0]
         runs = collect({s: project / models / f"s{s}" for s in seeds}, nonzero)
         best = choose_ratios(runs, [base_size])[base_size]
-    larger = more_real or min(b for b in params.generate.base_sizes if b > base_size)
+    larger = more_real or max(params.generate.base_sizes)
     return {
         "before": ("targeted", 0.0, base_size),
         "after": ("targeted", best, base_size),
@@ -81,7 +81,7 @@ def main() -> None:
     parser.add_argument("--models", type=Path, default=Path("models/gqcnn"), help="in each project")
     parser.add_argument("--seeds", type=int, nargs="+", default=None, help="default: the project's gqcnn.seeds")
     parser.add_argument("--base-size", type=int, default=50)
-    parser.add_argument("--more-real", type=int, default=None, help="default: the next larger base size")
+    parser.add_argument("--more-real", type=int, default=None, help="default: the largest base size")
     args = parser.parse_args()
     params = load_params(args.projects[0] / "params.yaml")
     grasps = read_table(args.grasps)

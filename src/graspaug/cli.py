@@ -348,7 +348,7 @@ stage_command(
     "friction drawn per object, dropped from seeded poses) from the table into a bin, with grasps planned on a "
     "D435-like noisy overhead depth image: antipodal seeds on depth edges, cross-entropy refinement by the GQ-CNN. "
     "Arms: `before` (B-0), `after` (B at the ratio chosen on validation AP), `real` (the real pool there), "
-    "`more_real` (the next larger base size at ratio 0: the positive control; each when trained) and `antipodal` "
+    "`more_real` (the largest base size at ratio 0: the positive control; each when trained) and `antipodal` "
     "(a random antipodal grasp, no network), the same drops for all.\n\nWrites `metrics/sim/<contrast>.json` "
     "(real_data, after_vs_before, network_vs_antipodal, after_vs_real: mean, lo, hi, bootstrap "
     "over objects) and `reports/sim/` (`summary.json`: success per arm and object with 95% Wilson intervals, the "

@@ -22,10 +22,11 @@ def test_arms_pair_before_and_after_and_add_real_only_when_every_seed_has_it(tmp
     assert model_path(dirs[0], 50, 0.0, "real") == dirs[0] / "targeted/50-0/model.pt"  # ratio 0 is the targeted network
     expected = {"before": ("targeted", 0.0, 50), "after": ("targeted", 1.5, 50), "antipodal": (None, None, None)}
     assert arms(1.5, 50, dirs, (50, 200)) == expected  # no B = 200 network: no positive control arm
-    seed_dirs_with(tmp_path, ["real/50-1.5", "targeted/200-0"])
+    seed_dirs_with(tmp_path, ["real/50-1.5", "targeted/100-0"])
     chosen = arms(1.5, 50, dirs, (50, 100, 200))
-    assert chosen["real"] == ("real", 1.5, 50) and "more_real" not in chosen  # the next larger B is 100
-    assert arms(1.5, 50, dirs, (50, 200))["more_real"] == ("targeted", 0.0, 200)
+    assert chosen["real"] == ("real", 1.5, 50) and "more_real" not in chosen  # the largest B, 200, is missing
+    seed_dirs_with(tmp_path, ["targeted/200-0"])
+    assert arms(1.5, 50, dirs, (50, 100, 200))["more_real"] == ("targeted", 0.0, 200)  # as the AP's real_data
     with pytest.raises(DataError, match=r"s0/targeted/50-2/model.pt is missing"):
         arms(2.0, 50, dirs)
 

@@ -4,7 +4,7 @@ and their physics, one object's attempts in one arm, and the trials table.
 Every arm sees the same seeded drops, sensor noise and planner seeds (paired). Arms: ``before``
 = the targeted network of base size B at ratio 0, ``after`` = the same B at the ratio chosen on
 validation AP (by the GQ-CNN experiment's report), ``real`` = the ``real`` pool's network at that
-B and ratio (when it was trained), ``more_real`` = the network of the next larger base size at
+B and ratio (when it was trained), ``more_real`` = the network of the largest base size at
 ratio 0 (more real shapes, no augmentation: the cell's positive control for training data, when
 trained), each once per training seed, and ``antipodal`` = a random antipodal seed grasp without a
 network (once: it has no training seed). The numbers and the
@@ -61,10 +61,10 @@ def arms(
 ) -> dict[str, ArmNetwork]:
     """Arm → (pool, ratio, base size): ``before`` (targeted, 0, B), ``after`` (targeted, ``best_ratio``:
     the ratio chosen on validation AP for B = ``base_size``), ``real`` (real, that ratio, B) and
-    ``more_real`` (targeted, 0, the smallest of ``base_sizes`` above B: more real shapes, the cell's
-    positive control) when their networks exist for every training seed, ``antipodal`` (None, None, None).
-    ``seed_dirs``: training seed → the folder of its networks; a missing ``before`` or ``after`` network
-    is a :class:`DataError`."""
+    ``more_real`` (targeted, 0, the largest of ``base_sizes`` above B: the most real shapes, the cell's
+    positive control, as the AP experiment's ``real_data``) when their networks exist for every
+    training seed, ``antipodal`` (None, None, None). ``seed_dirs``: training seed → the folder of its
+    networks; a missing ``before`` or ``after`` network is a :class:`DataError`."""
     best = float(best_ratio)
     chosen: dict[str, ArmNetwork] = {"before": ("targeted", 0.0, base_size), "after": ("targeted", best, base_size)}
     for seed_dir in seed_dirs.values():
@@ -74,7 +74,7 @@ def arms(
     optional = {"real": ("real", best, base_size)} if best > 0 else {}
     larger = [b for b in base_sizes if b > base_size]
     if larger:
-        optional["more_real"] = ("targeted", 0.0, min(larger))
+        optional["more_real"] = ("targeted", 0.0, max(larger))
     for arm, (pool, ratio, b) in optional.items():
         if all(model_path(seed_dir, b, ratio, pool).exists() for seed_dir in seed_dirs.values()):
             chosen[arm] = (pool, ratio, b)

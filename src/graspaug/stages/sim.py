@@ -1,7 +1,7 @@
 """Stage ``sim``: simulated Panda pick-and-place trials with the GQ-CNN before and after augmentation.
 
 Arms (:mod:`graspaug.experiments.sim`): ``before`` (B = ``sim.base_size``, ratio 0), ``after`` (the ratio chosen on
-validation AP), ``real`` (the ``real`` pool there), ``more_real`` (the next larger B at ratio 0: the positive
+validation AP), ``real`` (the ``real`` pool there), ``more_real`` (the largest B at ratio 0: the positive
 control), each per training seed, and ``antipodal`` (no network). Every object (``sim.objects``, ``sim.n_test_objects``
 test shapes, ``sim.objects_path``) is dropped ``sim.attempts`` times, the same drops for every arm; the planner sees a
 D435-like noisy depth image. Each arm's networks also rank the grasps ``grasp_calibration`` executed in this cell
