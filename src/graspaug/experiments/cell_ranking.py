@@ -31,20 +31,20 @@ def arm_scores(grasps: pd.DataFrame, seed_dirs: Mapping[int, Path], chosen: Mapp
     table, its ``datapoint`` column: the row in the rendered dataset's index). ``chosen``: arm →
     (pool, ratio, base size), as :func:`graspaug.experiments.sim.arms` gives; arms without a
     network are left out. Raises DataError when a datapoint is not among a seed's test rows."""
+    where = {}  # seed → each grasp's position among the seed's test predictions
+    for seed, seed_dir in seed_dirs.items():
+        where[seed] = pd.Index(test_rows(seed_dir)).get_indexer(grasps.datapoint.to_numpy())
+        if (where[seed] < 0).any():
+            raise DataError(
+                f"sim: {int((where[seed] < 0).sum())} executed calibration grasps are not test datapoints of seed "
+                f"{seed} ({seed_dir}): rerun `dvc repro grasp_calibration`"
+            )
     scores = {}
     for arm, (pool, ratio, base_size) in chosen.items():
-        if pool is None:
-            continue
-        rows = []
-        for seed, seed_dir in seed_dirs.items():
-            where = pd.Index(test_rows(seed_dir)).get_indexer(grasps.datapoint.to_numpy())
-            if (where < 0).any():
-                raise DataError(
-                    f"sim: {int((where < 0).sum())} executed calibration grasps are not test datapoints of seed "
-                    f"{seed} ({seed_dir}): rerun `dvc repro grasp_calibration`"
-                )
-            rows.append(test_predictions(seed_dir, (pool, base_size, ratio))[where])
-        scores[arm] = np.stack(rows)
+        if pool is not None:
+            scores[arm] = np.stack(
+                [test_predictions(seed_dir, (pool, base_size, ratio))[where[s]] for s, seed_dir in seed_dirs.items()]
+            )
     return scores
 
 
