@@ -30,7 +30,7 @@ import pandas as pd
 
 from graspaug.config import load_params
 from graspaug.experiments.ap import choose_ratios, collect
-from graspaug.experiments.cell_ranking import arm_scores, auc_samples, cell_ranking, ranking_bootstrap
+from graspaug.experiments.cell_ranking import arm_scores, auc_samples, ranking_bootstrap, ranking_summary
 from graspaug.experiments.sim import after_ratio
 from graspaug.experiments.sim_report import CONTRASTS
 from graspaug.experiments.stats import nested_interval
@@ -92,11 +92,11 @@ def main() -> None:
         seeds = args.seeds if args.seeds is not None else list(params.gqcnn.seeds)
         chosen = project_arms(project, params, args.models, seeds, args.base_size, args.more_real)
         seed_dirs = {s: project / args.models / f"s{s}" for s in seeds}
-        ranking = cell_ranking(grasps, seed_dirs, chosen, params.sim.n_bootstrap, params.seed)
-        draws[str(project)] = {"arms_networks": chosen, "arms": ranking["arms"], "contrasts": ranking["contrasts"]}
         scores = arm_scores(grasps, seed_dirs, chosen)
+        f, r = auc_samples(grasps.executed_success.to_numpy(bool), scores, boot)  # the sim stage's resamples
+        ranking = ranking_summary(grasps, seeds, scores, f, r)
+        draws[str(project)] = {"arms_networks": chosen, "arms": ranking["arms"], "contrasts": ranking["contrasts"]}
         draws[str(project)]["top_pick"] = top_pick(grasps, scores)
-        f, r = auc_samples(grasps.executed_success.to_numpy(bool), scores, boot)
         full.append(f)
         resampled.append(r)
     rng = shape_rng(params.seed, "sim", "ranking-draws")

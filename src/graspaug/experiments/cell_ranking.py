@@ -66,8 +66,15 @@ def cell_ranking(grasps: pd.DataFrame, seed_dirs: Mapping[int, Path], chosen: Ma
         return {**counts, "reference": None, "arms": {}, "contrasts": {}}
     scores = arm_scores(grasps, seed_dirs, chosen)
     full, resampled = auc_samples(y, scores, ranking_bootstrap(grasps, n_boot, seed))
-    label = grasps.label.to_numpy(bool)
-    seeds = [str(s) for s in seed_dirs]
+    return {**counts, **ranking_summary(grasps, list(seed_dirs), scores, full, resampled)}
+
+
+def ranking_summary(grasps: pd.DataFrame, seeds: list, scores: dict, full: dict, resampled: dict) -> dict:
+    """The ``reference``, ``arms`` and ``contrasts`` of :func:`cell_ranking` from the arms' ``scores``
+    (:func:`arm_scores`) and their AUCs ``full``, ``resampled`` (:func:`auc_samples`) for the training
+    ``seeds`` in that order."""
+    y, label = grasps.executed_success.to_numpy(bool), grasps.label.to_numpy(bool)
+    seeds = [str(s) for s in seeds]
     rounded = lambda x: None if x is None or not np.isfinite(x) else round(float(x), 5)  # noqa: E731
     contrasts = {}
     for name, (arm, reference) in CONTRASTS.items():
@@ -86,7 +93,6 @@ def cell_ranking(grasps: pd.DataFrame, seed_dirs: Mapping[int, Path], chosen: Ma
             "per_seed": dict(zip(seeds, map(rounded, per_seed))),
         }
     return {
-        **counts,
         "reference": {k: rounded(boot_auc(y, grasps[k].to_numpy(float), None)) for k in ("eps", "label")},
         "arms": {
             arm: {
