@@ -183,6 +183,21 @@ def test_profile_command_writes_a_complete_params_file(repo_root, tmp_path):
     assert missing.exit_code == 2 and "profile 'nope' not found" in missing.output
 
 
+def test_profile_keeps_hand_edits_unless_forced(repo_root, tmp_path):
+    """`graspaug profile` overwrites a file some profile wrote, but refuses one with hand edits, naming the keys."""
+    out, profiles = tmp_path / "params.yaml", ["--profiles", str(repo_root / "profiles")]
+    assert CliRunner().invoke(app, ["profile", "tiny", "--out", str(out), *profiles]).exit_code == 0
+    assert CliRunner().invoke(app, ["profile", "default", "--out", str(out), *profiles]).exit_code == 0  # unedited
+    edited = out.read_text().replace("\nseed: 0", "\nseed: 7", 1)
+    assert edited != out.read_text()
+    out.write_text(edited)
+    refused = CliRunner().invoke(app, ["profile", "tiny", "--out", str(out), *profiles])
+    assert refused.exit_code == 2 and "seed: 7" in refused.output and refused.output.count("\n") == 1
+    assert out.read_text() == edited  # nothing lost
+    forced = CliRunner().invoke(app, ["profile", "tiny", "--out", str(out), "--force", *profiles])
+    assert forced.exit_code == 0 and load_params(out) == profile_params("tiny", repo_root / "profiles")
+
+
 def test_a_yaml_syntax_error_names_its_line(tmp_path):
     bad = tmp_path / "params.yaml"
     bad.write_text("seed: 0\ngqcnn:\n  seeds: [0, 1\n  members: 3\n")

@@ -190,10 +190,27 @@ def test_from_failures_generates_from_train_shapes_near_a_users_failure_meshes(t
     assert set(index.parent_a) <= anchors["box"] | anchors["capsule"]
     run([*command, "-o", str(tmp_path / "again")], work, env)  # the same shapes for the same params
     pd.testing.assert_frame_equal(pd.read_csv(tmp_path / "again/index.csv"), index)
+    # per failure object: its shapes and rejected decodes, and why none; each reject names the failure it served
+    table = pd.read_csv(tmp_path / "out/failures.csv").set_index("object")
+    assert table.shapes.to_dict() == index.failure.value_counts().reindex(table.index, fill_value=0).to_dict()
+    assert (table.why_none.isna() == (table.shapes > 0)).all() and (table.anchors <= 2).all()
+    rejects = pd.read_csv(tmp_path / "out/rejects.csv")
+    assert "failure" in rejects and set(rejects.failure) <= {"box", "capsule"}
+    # nothing a user has is lost: a folder of theirs, and the input folder itself, are refused with one line
+    mine = tmp_path / "myproject"
+    mine.mkdir()
+    (mine / "notes.txt").write_text("my notes")
+    for out in (mine, failures, failures / "out"):
+        refused = subprocess.run([*command, "-o", str(out)], cwd=work, env=env, capture_output=True, text=True)
+        assert refused.returncode == 2 and refused.stderr.strip().count("\n") == 0, refused.stderr
+        assert str(out) in refused.stderr
+    assert (mine / "notes.txt").read_text() == "my notes" and len(list(mine.iterdir())) == 1
+    assert sorted(p.name for p in failures.iterdir()) == ["box.obj", "broken.obj", "capsule.stl"]
+    run([*command, "-o", str(tmp_path / "out")], work, env)  # its own folder: replaced
     missing = subprocess.run(
         [*command[:2], str(tmp_path / "nowhere")], cwd=work, env=env, capture_output=True, text=True
     )
-    assert missing.returncode == 1 and "the failure folder" in missing.stderr and "nowhere" in missing.stderr
+    assert missing.returncode == 2 and "the failure folder" in missing.stderr and "nowhere" in missing.stderr
 
 
 def summary_rejects(work, base_size: int, pool: str) -> int:
@@ -387,6 +404,17 @@ def test_dvc_repro_gqcnn_matrix_and_report(tiny_repo):
     )
     ap = json.loads((work / "reports/gqcnn/ap.json").read_text())
     report = (work / "reports/gqcnn/report.md").read_text()
+    # the tiny test set holds both labels: every network's pooled test AP (over all its test datapoints, mean over
+    # seeds; ap.json writes an undefined one as null) is a number, so the report's AP column and contrasts have values
+    pooled = {
+        f"{pool}/{b}-{r}": net["test_ap"]
+        for pool, by_b in ap["networks"].items()
+        for b, by_r in by_b.items()
+        for r, net in by_r.items()
+    }
+    assert len(pooled) == len(names), sorted(pooled)
+    assert all(v is not None and np.isfinite(v) for v in pooled.values()), pooled
+    assert "no value (a test set with one class?)" not in report
     # one metrics file per declared contrast: its mean and t-interval ends
     assert {p.stem for p in (work / "metrics/ap").glob("*.json")} == set(ap["contrasts"])
     matched = {n for n in ap["contrasts"] if n.endswith("_vs_real_datapoints@6")}  # where the real curve reaches
@@ -454,7 +482,7 @@ def test_from_failures_of_a_networks_worst_validation_objects(tiny_repo, tmp_pat
     both = subprocess.run(
         [*command, str(tmp_path)], cwd=work, env=env, capture_output=True, text=True
     )  # a folder and a network: refused
-    assert both.returncode == 1 and "either a folder" in both.stderr
+    assert both.returncode == 2 and "either a folder" in both.stderr
 
 
 def test_dvc_repro_lifelong_rounds(tiny_repo):
@@ -675,7 +703,8 @@ def test_metrics_hold_few_scalars_and_fit_a_terminal(tiny_repo):
         keys |= set(leaves(json.loads((work / path).read_text())))
     assert len(keys) <= 16, sorted(keys)  # shared names merge into one column
     table = run(["dvc", "metrics", "show"], work, env).stdout.splitlines()
-    assert len(table) == len(files) + 1 and max(map(len, table)) <= 200, max(table, key=len)
+    # 203 characters on the tiny run since its test APs are defined (a test_ap column, negative contrast means)
+    assert len(table) == len(files) + 1 and max(map(len, table)) <= 210, max(table, key=len)
 
 
 DATA_PLOT_SUFFIXES = (".csv", ".tsv", ".json", ".yaml", ".yml")
@@ -811,7 +840,8 @@ def test_queued_two_point_sweep_lines_up_metrics(tiny_repo):
     ) == (10.0, 40.0)
     diff = json.loads(run(["dvc", "metrics", "diff", "grip-10", "grip-40", "--json", "--all"], work, env).stdout)
     assert set(diff["metrics/sim/after_vs_before.json"]) == {"mean", "lo", "hi"}  # --all lines up every metric
-    assert set(diff["metrics/gqcnn/s0.json"]["val_ap"]) == {"old", "new", "diff"}  # tiny: no test AP, val AP
+    for key in ("test_ap", "val_ap"):  # the tiny run's test AP is defined, as its validation AP
+        assert set(diff["metrics/gqcnn/s0.json"][key]) == {"old", "new", "diff"}, key
     run(["dvc", "queue", "stop"], work, env)
 
 
@@ -853,11 +883,11 @@ def test_killed_stage_leaves_no_output_and_repro_completes(tiny_repo):
 
 def test_editing_a_sim_setting_reruns_only_sim(tiny_repo):
     """Exact code deps: a cell-only module's edit (a settings description) changes the stages that run the robot
-    cell (`sim`, `grasp_calibration`) alone."""
+    cell (`sim`, `grasp_calibration`) and the params check (it reads every section) alone."""
     import json
 
     work, env = tiny_repo
-    run(["dvc", "repro", "sim"], work, env)  # the pipeline is complete (no-op after the tests above)
+    run(["dvc", "repro"], work, env)  # the pipeline is complete (after the tests above: check_params alone runs)
     settings = work / "src/graspaug/sim/settings.py"
     original = settings.read_text()
     edited = original.replace('description="', 'description="(edited) ', 1)
@@ -867,5 +897,30 @@ def test_editing_a_sim_setting_reruns_only_sim(tiny_repo):
         changed = json.loads(run(["dvc", "status", "--json"], work, env).stdout)
     finally:
         settings.write_text(original)
-    assert set(changed) == {"sim", "grasp_calibration"}, f"changed stages: {sorted(changed)}"
+    assert set(changed) == {"sim", "grasp_calibration", "check_params"}, f"changed stages: {sorted(changed)}"
     assert json.loads(run(["dvc", "status", "--json"], work, env).stdout) == {}
+
+
+def test_a_bad_params_file_stops_dvc_repro_before_any_stage_deletes_outputs(tiny_repo):
+    """A mistyped top-level key, and a bad value, stop `dvc repro` in `check_params` (the first stage) with one line
+    naming the key: no other stage runs and every output stays, even when nothing else would have run."""
+    import yaml
+
+    work, env = tiny_repo
+    run(["dvc", "repro"], work, env)  # up to date
+    params = work / "params.yaml"
+    original = params.read_text()
+    outputs = sorted((work / "models").rglob("*")) + sorted((work / "data").rglob("*"))
+    bad_value = yaml.safe_load(original)
+    bad_value["gqcnn"]["train"]["lr"] = -1.0
+    try:
+        for text, key in ((original + "sede: 3\n", "sede"), (yaml.safe_dump(bad_value), "gqcnn.train.lr")):
+            params.write_text(text)
+            result = subprocess.run(["dvc", "repro"], cwd=work, env=env, capture_output=True, text=True)
+            said = result.stdout + result.stderr
+            assert result.returncode != 0 and key in said, said
+            assert said.count("Running stage") == 1 and "Running stage 'check_params'" in said, said
+            assert all(p.exists() for p in outputs), "an output was deleted"
+    finally:
+        params.write_text(original)
+    assert "Running stage" not in run(["dvc", "repro"], work, env).stdout

@@ -9,33 +9,86 @@ from __future__ import annotations
 
 import importlib
 import logging
+import os
 import sys
+import warnings
 from pathlib import Path
 
 import typer
 from typer.core import TyperCommand
 
+EXIT_CODES = (
+    "Exit codes, the same for every command: 0 an answer; 1 no acceptable answer (`plan`: no grasp, or the best one "
+    "below the quality floor; `from-failures`: no shape kept); 2 bad input or usage (a missing or broken file, a bad "
+    "param, an output folder it may not write), one line naming the culprit; 3 an unexpected error (a bug: `graspaug "
+    "--debug <command> ...` shows its traceback)."
+)
+
 app = typer.Typer(
     help="graspaug: augment a grasp planner's training objects with generated shapes.\n\n"
-    "Each command runs one stage of the DVC pipeline with the settings in params.yaml; `dvc repro` runs them in order.",
+    "Each command runs one stage of the DVC pipeline with the settings in params.yaml; `dvc repro` runs them in order."
+    "\n\n" + EXIT_CODES,
     rich_markup_mode="markdown",
     no_args_is_help=True,
     add_completion=False,
 )
 
 ParamsOption = typer.Option(Path("params.yaml"), "--params", "-p", help="The params file to read.")
+ForceOption = typer.Option(
+    False, "--force", help="Replace an output folder that holds files this command did not write."
+)
+_debug = {"on": False}  # set by the root callback (--debug, GRASPAUG_DEBUG) on every invocation
+
+
+def _bad_input_errors() -> tuple[type[BaseException], ...]:
+    """The errors that mean bad input or usage (exit 2): each carries a one-line message naming the culprit."""
+    from graspaug.errors import CheckpointMismatch, DataError, StageError  # the planner's PlanningError is a DataError
+    from graspaug.params.base import ParamsError
+
+    return (DataError, StageError, CheckpointMismatch, ParamsError, OSError)
+
+
+class Command(TyperCommand):
+    """A command that keeps the exit-code contract (:data:`EXIT_CODES`): an error of bad input is one line and exit
+    2, any other exception one line and exit 3; ``--debug`` re-raises both (the traceback) and shows the warnings
+    that other packages raise, which are otherwise hidden."""
+
+    def invoke(self, ctx):
+        if _debug["on"]:
+            return super().invoke(ctx)
+        with warnings.catch_warnings():
+            warnings.filterwarnings("ignore", module=r"^(?!graspaug)")
+            try:
+                return super().invoke(ctx)
+            except (typer.Exit, typer.Abort, KeyboardInterrupt):
+                raise
+            except _bad_input_errors() as exc:
+                typer.echo(f"error: {_one_line(exc)}", err=True)
+                raise typer.Exit(code=2) from None
+            except Exception as exc:  # noqa: BLE001 - the contract: one line, exit 3, the traceback with --debug
+                if type(exc).__module__.startswith("click"):
+                    raise
+                typer.echo(
+                    f"error: unexpected {type(exc).__name__}: {_one_line(exc)} (a bug? `graspaug --debug` shows "
+                    "the traceback)",
+                    err=True,
+                )
+                raise typer.Exit(code=3) from None
+
+
+def _one_line(exc: BaseException) -> str:
+    text = " ".join(str(exc).split()) if str(exc) else type(exc).__name__
+    if isinstance(exc, OSError) and exc.filename is not None and exc.strerror:
+        text = f"{exc.filename}: {exc.strerror.lower()}"
+    return text
 
 
 def _load(path: Path, stage):
-    """The params ``stage`` (a stage module) reads from the file at ``path``; exit 2 with one line when they are bad."""
-    from graspaug.params.base import ParamsError, load
+    """The params ``stage`` (a stage module) reads from the file at ``path`` (a bad one: ParamsError, exit 2)."""
+    from graspaug.params.base import load
 
     logging.basicConfig(level=logging.INFO, format="%(asctime)s %(levelname)s %(name)s: %(message)s", stream=sys.stderr)
-    try:
-        return load(path, stage.Params)
-    except ParamsError as exc:
-        typer.echo(f"error: {exc}", err=True)
-        raise typer.Exit(code=2) from None
+    return load(path, stage.Params)
 
 
 def _stage(module: str):
@@ -45,7 +98,7 @@ def _stage(module: str):
 def _with_params(module: str, *sections: str) -> type[TyperCommand]:
     """A command class whose help fills ``{params}`` with the keys of ``sections`` of stage ``module``'s params."""
 
-    class StageCommand(TyperCommand):
+    class StageCommand(Command):
         def format_help(self, ctx, formatter) -> None:
             if "{params}" in (self.help or ""):
                 from graspaug.settings import describe
@@ -60,14 +113,9 @@ def _with_params(module: str, *sections: str) -> type[TyperCommand]:
 
 def _run(stage_run, params) -> None:
     from graspaug.device import keep_freed_memory
-    from graspaug.errors import CheckpointMismatch, DataError, StageError
 
     keep_freed_memory()  # no page faults for every freed tensor (GQ-CNN training: bench/gqcnn_train_speed.py)
-    try:
-        stage_run(params)
-    except (StageError, DataError, CheckpointMismatch, FileNotFoundError) as exc:
-        typer.echo(f"error: {exc}", err=True)
-        raise typer.Exit(code=1) from None
+    stage_run(params)
 
 
 def stage_command(name: str, help: str, *sections: str) -> None:
@@ -82,6 +130,12 @@ def stage_command(name: str, help: str, *sections: str) -> None:
     app.command(name=name, help=help, cls=_with_params(module, *sections))(command)
 
 
+stage_command(
+    "check-params",
+    "Check the whole params.yaml: every key known, every value valid, the cross-section rules kept. The first stage "
+    "of `dvc repro`, so that a mistyped key or a bad value stops the run, with one line naming the key, before any "
+    "stage deletes its outputs. Writes nothing.",
+)
 stage_command(
     "ingest",
     "Load the shape corpus, reject broken meshes with a reason, rebuild one closed outer surface per shape, center and "
@@ -181,6 +235,7 @@ def generate_command(
 
 
 @app.command(
+    cls=Command,
     name="fidelity",
     help="How close each pool of one base size B is to real shapes, before any network trains on it: per pool of "
     "`gqcnn.pools` (the shapes of its 1:1 augmentation set), graspness and the share of the parents' graspness a "
@@ -202,6 +257,7 @@ def fidelity_command(
 
 
 @app.command(
+    cls=Command,
     name="lifelong",
     help="One round of the lifelong loop: generate from the objects the planner fails on, round after round. "
     "Round 0 (`graspaug lifelong-start`, `dvc repro lifelong_start`) scores every validation object by "
@@ -234,6 +290,7 @@ def lifelong_command(
 
 
 @app.command(
+    cls=Command,
     name="lifelong-start",
     help="Round 0 of the lifelong loop (see `graspaug lifelong --help`): score every validation object by the 1:0 "
     "networks of base size `lifelong.base_size` (mean log loss, predictions averaged over the seeds) and mark the "
@@ -272,6 +329,7 @@ def render_command(
 
 
 @app.command(
+    cls=Command,
     name="export-dexnet",
     help="Export a rendered dataset in Dex-Net 2.0's tensor layout for Berkeley's gqcnn tools: "
     "`<out>/tensors/{depth_ims_tf_table,hand_poses,robust_ferrari_canny,collision_free,obj_labels,pose_labels,"
@@ -289,11 +347,7 @@ def export_dexnet_command(
     from graspaug.io.dexnet import export_dexnet
     from graspaug.paths import gqcnn_dir
 
-    try:
-        n = export_dexnet(gqcnn_dir(corpus), out, rows_per_file)
-    except (FileNotFoundError, FileExistsError) as exc:
-        typer.echo(f"error: {exc}", err=True)
-        raise typer.Exit(1) from None
+    n = export_dexnet(gqcnn_dir(corpus), out, rows_per_file)
     typer.echo(f"wrote {n} datapoints to {out}")
 
 
@@ -371,7 +425,11 @@ stage_command(
 )
 
 
+PLAN_MARK = "graspaug plan"  # grasp.json's "written_by": plan replaces only its own grasp.json and grasp.png
+
+
 @app.command(
+    cls=Command,
     name="plan",
     help="Plan a grasp on one depth image with a trained GQ-CNN (the planner the simulated robot uses: antipodal pairs "
     "on depth edges, GQ-CNN scores, cross-entropy refinement; a grasp is kept only if the image shows it antipodal and "
@@ -381,12 +439,13 @@ stage_command(
     "`<out>/grasp.json` (the grasps, best first: image center, angle, depth, width; camera-frame pose and width in m; "
     "quality; the model card) and `<out>/grasp.png` (the image with the grasps drawn). A best grasp below the quality "
     "floor (`--min-quality`) is written and drawn as rejected, with exit code 1; a warning says where the image lies "
-    "outside the training data (camera distance, object height above the table, gripper depth).",
+    "outside the training data (camera distance, object height above the table, gripper depth) or the intrinsics look "
+    "like another image's (a principal point far from the image center).\n\n" + EXIT_CODES,
 )
 def plan_command(
     depth: Path = typer.Argument(..., help="Depth image: .npy (meters) or 16-bit .png (millimeters)."),
     model: Path = typer.Option(
-        ..., "--model", "-m", help="A trained GQ-CNN, e.g. models/gqcnn/s0/targeted/50-0/model.pt."
+        ..., "--model", "-m", help="A trained GQ-CNN, e.g. models/gqcnn/s0/targeted/50-1/model.pt."
     ),
     intrinsics: Path | None = typer.Option(
         None, "--intrinsics", "-i", help="JSON file with fx, fy, cx, cy (px); instead of the flags."
@@ -410,14 +469,17 @@ def plan_command(
         "every grasp. Default: the model card's validation operating point (the threshold that maximises F1 on the "
         "network's validation predictions), or 0.1 for a model without one.",
     ),
-    out: Path = typer.Option(Path("."), "--out", "-o", help="Folder for grasp.json and grasp.png."),
+    out: Path = typer.Option(
+        Path("."), "--out", "-o", help="Folder for grasp.json and grasp.png (an earlier plan's are replaced)."
+    ),
+    force: bool = typer.Option(False, "--force", help="Replace a grasp.json or grasp.png that plan did not write."),
 ) -> None:
     import json
 
     import numpy as np
 
-    from graspaug.errors import CheckpointMismatch
     from graspaug.io.atomic import atomic_path
+    from graspaug.io.outputs import check_output_files
     from graspaug.planning import (
         PlanningError,
         check_depth,
@@ -429,22 +491,19 @@ def plan_command(
     from graspaug.planning.limits import quality_floor, range_warnings, rejected_line
     from graspaug.plots import planned_grasps
 
+    if min_quality is not None and not 0.0 <= min_quality <= 1.0:
+        raise PlanningError(f"--min-quality must lie in [0, 1] (a P(success)), got {min_quality:g}")
+    check_output_files(out, ["grasp.json", "grasp.png"], "plan", PLAN_MARK, force)
+    # one step per input, so that an error names what is at fault: the image, the camera, the model
+    image = read_depth_image(depth)
     try:
-        if min_quality is not None and not 0.0 <= min_quality <= 1.0:
-            raise PlanningError(f"--min-quality must lie in [0, 1] (a P(success)), got {min_quality:g}")
-        # one step per input, so that an error names what is at fault: the image, the camera, the model
-        image = read_depth_image(depth)
-        try:
-            checked = check_depth(image, fill_missing)  # missing pixels filled once, here
-        except PlanningError as exc:
-            raise PlanningError(f"{depth}: {exc}") from None
-        camera = intrinsics_for(checked.shape, read_intrinsics(intrinsics, fx, fy, cx, cy, checked.shape))
-        planner = load_planner(model)
-        grasps = planner.plan(checked, camera, seed, top, camera_distance)
-        warnings = range_warnings(planner.card, checked, camera, grasps, camera_distance)
-    except (PlanningError, FileNotFoundError, CheckpointMismatch) as exc:
-        typer.echo(f"error: {exc}", err=True)
-        raise typer.Exit(code=2) from None
+        checked = check_depth(image, fill_missing)  # missing pixels filled once, here
+    except PlanningError as exc:
+        raise PlanningError(f"{depth}: {exc}") from None
+    camera = intrinsics_for(checked.shape, read_intrinsics(intrinsics, fx, fy, cx, cy, checked.shape))
+    planner = load_planner(model)
+    grasps = planner.plan(checked, camera, seed, top, camera_distance)
+    warnings = range_warnings(planner.card, checked, camera, grasps, camera_distance)
     for warning in warnings:
         typer.echo(f"warning: {warning}", err=True)
     floor = quality_floor(planner.card, min_quality)
@@ -454,6 +513,7 @@ def plan_command(
         tmp.write_text(
             json.dumps(
                 {
+                    "written_by": PLAN_MARK,
                     "depth": str(depth),
                     "model": str(model),
                     "accepted": bool(grasps) and accepted[0],  # the best grasp clears the quality floor
@@ -506,6 +566,7 @@ def plan_command(
 
 
 @app.command(
+    cls=Command,
     name="from-failures",
     help="Generate new training shapes near objects a grasp planner fails on. The failure objects are either FOLDER, "
     "meshes (.obj, .stl, .ply) of objects a planner trained anywhere missed (each closed and scaled as the corpus is, "
@@ -517,9 +578,12 @@ def plan_command(
     "parent, and with `--network` no validation object is one either. Needs `dvc repro score` (and `train_gqcnn` for "
     "`--network`).\n\nWrites `<out>/meshes/failure_<order>.obj` (m), `<out>/index.csv` (per shape: the failure "
     "object it serves, anchor `parent_a`, neighbour `parent_b`, `alpha`, size), `<out>/failures.csv` (the failure "
-    "objects worst first; with `--network` every validation object's datapoints, log loss and AP), `<out>/rejects.csv` "
-    "and `<out>/skipped.csv` (files that could not be used, and why). Feed the meshes to your own pipeline, or to this "
-    "one (`data.source: folder`, `data.path`).",
+    "objects worst first, each with its `anchors`, `shapes` made, decodes `rejected` and, for one that got no shape, "
+    "`why_none`; with `--network` every validation object's datapoints, log loss and AP), `<out>/rejects.csv` (each "
+    "rejected decode, its reason and the `failure` it served) and `<out>/skipped.csv` (files that could not be used, "
+    "and why); the log has a line per failure object, a warning for one that got nothing. An existing `--out` that "
+    "from-failures did not write is refused (`--force` replaces it); one inside FOLDER is always refused. Feed the "
+    "meshes to your own pipeline, or to this one (`data.source: folder`, `data.path`).\n\n" + EXIT_CODES,
 )
 def from_failures_command(
     folder: Path | None = typer.Argument(None, help="Folder of meshes of the objects the planner failed on."),
@@ -529,15 +593,23 @@ def from_failures_command(
     worst: int = typer.Option(10, "--worst", help="With --network: how many of its worst validation objects."),
     count: int = typer.Option(20, "--count", "-n", help="Shapes to generate."),
     per_failure: int = typer.Option(3, "--per-failure", help="Train shapes anchored near each failure object."),
-    out: Path = typer.Option(Path("failures_generated"), "--out", "-o", help="Folder to write (replaced whole)."),
+    out: Path = typer.Option(
+        Path("failures_generated"),
+        "--out",
+        "-o",
+        help="Folder to write: a new or empty one, or one from-failures wrote (then replaced whole). Never inside "
+        "FOLDER, data/ or models/.",
+    ),
+    force: bool = ForceOption,
     params: Path = ParamsOption,
 ) -> None:
     import graspaug.stages.from_failures as command
 
-    _run(lambda p: command.run(p, folder, network, worst, count, per_failure, out), _load(params, command))
+    _run(lambda p: command.run(p, folder, network, worst, count, per_failure, out, force), _load(params, command))
 
 
 @app.command(
+    cls=Command,
     name="export-model",
     help="Export a trained GQ-CNN for use without graspaug: `<out>/model.ts` (TorchScript: images (N, 1, 32, 32) and "
     "gripper depths (N,) in meters → P(success) (N,)), `<out>/card.json` (the model card: training camera, crop sizes, "
@@ -545,47 +617,53 @@ def from_failures_command(
     "is installed (it is not a dependency).",
 )
 def export_model_command(
-    model: Path = typer.Argument(..., help="A trained GQ-CNN, e.g. models/gqcnn/s0/targeted/50-0/model.pt."),
-    out: Path = typer.Argument(..., help="Folder to write."),
+    model: Path = typer.Argument(..., help="A trained GQ-CNN, e.g. models/gqcnn/s0/targeted/50-1/model.pt."),
+    out: Path = typer.Argument(..., help="Folder to write (new, empty, or one export-model wrote)."),
+    force: bool = ForceOption,
 ) -> None:
-    from graspaug.errors import CheckpointMismatch
+    from graspaug.io.outputs import check_output_folder, mark
     from graspaug.planning import export_model
 
-    try:
-        info = export_model(model, out)
-    except (FileNotFoundError, CheckpointMismatch) as exc:
-        typer.echo(f"error: {exc}", err=True)
-        raise typer.Exit(code=2) from None
+    check_output_folder(out, "export-model", force=force)
+    info = export_model(model, out)
+    mark(out, "export-model")
     typer.echo(f"wrote {', '.join(str(out / f) for f in [*info['files'], 'card.json'])} (ONNX: {info['onnx']})")
 
 
 @app.command(
+    cls=Command,
     name="profile",
     help="Write params.yaml for a profile: the defaults plus the few keys `profiles/<name>.yaml` changes "
     "(`default`: the defaults alone). Profiles: `tiny` (every stage in minutes, for trying changes), `study` (the "
     "GQ-CNN experiment over several seeds), `paper` (the paper's sizes, for a GPU). Every key is written, commented, "
-    "so DVC tracks each value; `graspaug profile default` restores the defaults.",
+    "so DVC tracks each value; `graspaug profile default` restores the defaults. A params.yaml with hand edits "
+    "(values no profile writes) is kept, and the edited keys named, unless `--force`.",
 )
 def profile_command(
     name: str = typer.Argument(..., help="Profile name: `default` or a file stem in profiles/."),
     out: Path = typer.Option(Path("params.yaml"), "--out", "-o", help="File to write."),
     profiles: Path = typer.Option(Path("profiles"), "--profiles", help="Folder of profile overlays."),
+    force: bool = typer.Option(False, "--force", help="Overwrite a params.yaml with values no profile writes."),
 ) -> None:
     from graspaug.io.atomic import atomic_path
     from graspaug.params.base import ParamsError
-    from graspaug.profiles import profile_yaml
+    from graspaug.profiles import hand_edits, profile_yaml
 
-    try:
-        text = profile_yaml(name, profiles)
-    except ParamsError as exc:
-        typer.echo(f"error: {exc}", err=True)
-        raise typer.Exit(code=2) from None
+    text = profile_yaml(name, profiles)
+    edits = hand_edits(out.read_text(), profiles) if out.is_file() and not force else []
+    if edits:
+        shown = ", ".join(edits[:3]) + (f" and {len(edits) - 3} more" if len(edits) > 3 else "")
+        raise ParamsError(
+            f"{out} holds values no profile writes ({shown}); copy it to keep them, then `graspaug profile {name} "
+            "--force` overwrites it"
+        )
     with atomic_path(out) as tmp:
         tmp.write_text(text)
     typer.echo(f"wrote {out} (profile {name})")
 
 
 @app.command(
+    cls=Command,
     name="schema",
     help="Write the JSON Schema of params.yaml (every key's type, range, default and meaning), for editors: "
     "params.yaml's first line `# yaml-language-server: $schema=params.schema.json` makes VS Code's YAML extension "
@@ -611,8 +689,15 @@ def _root(
     version: bool = typer.Option(
         False, "--version", callback=_version, is_eager=True, help="Print the version and exit."
     ),
+    debug: bool = typer.Option(
+        False,
+        "--debug",
+        help="On an error, show its traceback instead of one line, and show the warnings other packages raise "
+        "(also GRASPAUG_DEBUG=1).",
+    ),
 ) -> None:
     """graspaug: augment a grasp planner's training objects with generated shapes."""
+    _debug["on"] = debug or os.environ.get("GRASPAUG_DEBUG", "") not in ("", "0")
 
 
 def main() -> None:

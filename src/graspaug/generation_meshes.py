@@ -7,6 +7,7 @@ GQ-CNN experiment imports too, so that decoder and meshing code is code of ``gen
 
 from __future__ import annotations
 
+import logging
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 
@@ -39,6 +40,7 @@ from graspaug.params.generate import GenerateParams
 from graspaug.scores import rarity
 from graspaug.training.autoencoder import decode
 
+log = logging.getLogger(__name__)
 LOW_YIELD = 0.95  # a pool keeping a smaller share of its decodes is warned about
 REJECT_COLUMNS = ["pool", "parent_a", "parent_b", "alpha", "selected_by", "reason"]
 
@@ -349,7 +351,56 @@ def failure_shapes(
     index, rejects, kept, notes = stream_shapes(pool, stream, "failure", count, run_batch, first_order, prefix)
     served = dict(zip(anchors, failures))
     index["failure"] = [served[d.candidate.a] for d in kept]
+    rejects["failure"] = rejects.parent_a.map({pool.ids[a]: name for a, name in served.items()})
     return index, rejects, kept, notes
+
+
+def failure_summary(failures: Sequence[str], served: Sequence[str], index: pd.DataFrame, rejects: pd.DataFrame):
+    """One row per failure object (in the order of ``failures``): its ``anchors`` (how many entries of
+    ``served``, the failure each anchor serves, name it), the ``shapes`` kept and decodes ``rejected`` for it
+    (``index`` and ``rejects`` of :func:`failure_shapes`), and ``why`` in words when it got no shape.
+    """
+    anchors = pd.Series(list(served), dtype=object).value_counts()
+    made, rejected = index.failure.value_counts(), rejects.failure.value_counts()
+    reasons = rejects.groupby("failure").reason.agg(
+        lambda r: "; ".join(f"{k}: {v}" for k, v in r.value_counts().items())
+    )
+    rows = []
+    for name in failures:
+        n_anchors, n_made, n_rejected = int(anchors.get(name, 0)), int(made.get(name, 0)), int(rejected.get(name, 0))
+        if n_made:
+            why = ""
+        elif not n_anchors:
+            why = "no anchor: its nearest train shapes already anchor failures listed before it"
+        elif n_rejected:
+            why = f"every decode near it was rejected ({reasons[name]})"
+        else:
+            why = "the requested count was reached before its anchors were used (raise --count)"
+        rows.append(
+            {
+                "failure": name,
+                "anchors": n_anchors,
+                "shapes": n_made,
+                "rejected": n_rejected,
+                "reject_reasons": reasons.get(name, ""),
+                "why_none": why,
+            }
+        )
+    return pd.DataFrame(rows, columns=["failure", "anchors", "shapes", "rejected", "reject_reasons", "why_none"])
+
+
+def log_failure_summary(summary: pd.DataFrame, notes: Sequence[str], out) -> None:
+    """Log how the stream was widened (``notes``), one line per failure object of ``summary``
+    (:func:`failure_summary`; a warning naming one that got no shape) and the total written to ``out``."""
+    for note in notes:
+        log.info("from-failures: %s", note)
+    for row in summary.itertuples():
+        line = f"{row.failure}: {row.shapes} shapes, {row.rejected} decodes rejected {row.why_none}".rstrip()
+        log.log(logging.WARNING if row.why_none else logging.INFO, "from-failures: %s", line)
+    served = int((summary.shapes > 0).sum())
+    log.info(
+        "from-failures: %d shapes for %d of %d failure objects in %s", summary.shapes.sum(), served, len(summary), out
+    )
 
 
 def random_shapes(

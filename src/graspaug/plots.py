@@ -343,6 +343,9 @@ def scatter_colored(
     _save(fig, path)
 
 
+BARS_PER_ROW = 12  # success_bars wraps its objects into rows of at most this many (about 1,400 px wide)
+
+
 def success_bars(
     names: Sequence[str],
     arms: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]],
@@ -350,23 +353,31 @@ def success_bars(
     title: str,
 ) -> None:
     """Grouped bars of success rate per object and arm; ``arms[label] = (rate, low, high)``,
-    each (len(names),), drawn with the interval as error bars."""
+    each (len(names),), drawn with the interval as error bars. The objects wrap into as few rows as
+    hold at most :data:`BARS_PER_ROW` each, filled evenly, so many objects make a taller figure,
+    not a wider one."""
     plt = _pyplot()
-    fig, ax = plt.subplots(figsize=(max(6.0, 0.9 * len(names) + 2), 4))
-    x = np.arange(len(names))
+    n_rows = max(1, -(-len(names) // BARS_PER_ROW))
+    per_row = max(1, -(-len(names) // n_rows))
+    fig, axes = plt.subplots(
+        n_rows, 1, figsize=(max(6.0, 0.9 * per_row + 2), 3.2 * n_rows + 0.8), squeeze=False, layout="constrained"
+    )
     width = 0.8 / max(1, len(arms))
-    for i, (label, (rate, low, high)) in enumerate(arms.items()):
-        rate, low, high = (np.asarray(a, dtype=float) for a in (rate, low, high))
-        ax.bar(
-            x + (i - (len(arms) - 1) / 2) * width, rate, width, yerr=[rate - low, high - rate], capsize=3, label=label
-        )
-    ax.set_xticks(x)
-    ax.set_xticklabels(names, rotation=30, ha="right")
-    ax.set_ylim(0, 1.25)
-    ax.set_yticks(np.linspace(0, 1, 6))
-    ax.set_ylabel("grasp success rate")
-    ax.set_title(title)
-    ax.legend(loc="upper center", ncol=len(arms), fontsize=8)
+    for row, ax in enumerate(axes[:, 0]):
+        shown = slice(row * per_row, (row + 1) * per_row)
+        x = np.arange(len(names[shown]))
+        for i, (label, (rate, low, high)) in enumerate(arms.items()):
+            rate, low, high = (np.asarray(a, dtype=float)[shown] for a in (rate, low, high))
+            offset = x + (i - (len(arms) - 1) / 2) * width
+            ax.bar(offset, rate, width, yerr=[rate - low, high - rate], capsize=3, label=label)
+        ax.set_xticks(x)
+        ax.set_xticklabels(names[shown], rotation=30, ha="right")
+        ax.set_xlim(-0.5, per_row - 0.5)  # the same bar width in every row
+        ax.set_ylim(0, 1.25)
+        ax.set_yticks(np.linspace(0, 1, 6))
+        ax.set_ylabel("grasp success rate")
+    axes[0, 0].set_title(title)
+    axes[0, 0].legend(loc="upper center", ncol=min(len(arms), 3), fontsize=8)
     _save(fig, path)
 
 

@@ -110,3 +110,29 @@ def profile_yaml(name: str, folder: Path = PROFILES_DIR) -> str:
         "Edit values here (or sweep them with `dvc exp run -S key=value`); `graspaug <stage> --help` explains each key."
     )
     return params_yaml(profile_params(name, folder), header)
+
+
+def _flat(data: Any, prefix: str = "") -> dict[str, Any]:
+    if not isinstance(data, dict) or not data:
+        return {prefix.rstrip("."): data}
+    return {k: v for key, value in data.items() for k, v in _flat(value, f"{prefix}{key}.").items()}
+
+
+def hand_edits(text: str, folder: Path = PROFILES_DIR) -> list[str]:
+    """The keys of a params.yaml ``text`` whose values no ``graspaug profile`` would write: ``[]`` when ``text`` is
+    exactly a profile's file; else each key (``key: value``) that differs from the profile its header names (the
+    defaults when it names none or an unknown one), or ``["its text"]`` when only comments or layout differ."""
+    import re
+
+    names = profile_names(folder)
+    if any(text == profile_yaml(name, folder) for name in names):
+        return []
+    named = re.search(r"profile `([^`]+)`", text.split("\n", 3)[1] if text.count("\n") > 1 else "")
+    name = named.group(1) if named and named.group(1) in names else DEFAULT
+    try:
+        mine = _flat(yaml.safe_load(text) or {})
+    except yaml.YAMLError:
+        return ["its text (not valid YAML)"]
+    theirs = _flat(params_dict(profile_params(name, folder)))
+    changed = [f"{k}: {_scalar(v)}" for k, v in mine.items() if k not in theirs or theirs[k] != v]
+    return changed + [f"{k} (removed)" for k in theirs if k not in mine] or ["its comments or layout"]

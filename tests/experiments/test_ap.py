@@ -3,6 +3,7 @@
 import json
 
 import numpy as np
+import pandas as pd
 import pytest
 
 from graspaug.errors import DataError
@@ -223,3 +224,20 @@ def test_datapoint_matched_contrasts_interpolate_the_real_shape_curve_in_datapoi
         {("recon", 50, 1.0): 1.0, ("real", 50, 1.0): -0.5, ("targeted", 200, 0.0): -0.5}
     )
     assert datapoint_matched_contrasts(runs, [50, 200], [0.0, 1.0], [50], ("targeted", "recon")) == []  # no real pool
+
+
+def test_the_report_scopes_its_verdicts_to_its_one_draw_of_the_data():
+    """One run's intervals cover its draw of the data and its training seeds: report.md says which, that
+    other draws are not covered and where they are combined, and calls a loss a loss in this draw."""
+    loss = {"mean": -0.034, "ci_low": -0.055, "ci_high": -0.014, "n_seeds": 4, "sd": 0.013}
+    loss |= {"boot_low": -0.05, "boot_high": -0.02, "meaning": "m"}
+    table = pd.DataFrame(
+        [("targeted", 50, 0.0, 0.3, 0.01, 0.3, 0.3, 0.8, 4)],
+        columns=["pool", "base_size", "ratio", "test_ap", "test_ap_ci", "per_object_ap", "val_ap", "test_roc_auc", "n"],
+    )
+    text = ap.report_markdown(table, {"targeted_vs_random@50": loss}, {}, [], [0, 1, 2, 3], 0.3, "Words.", 1)
+    assert "over training seeds [0, 1, 2, 3] of one draw of the data (`data_seed` = 1)" in text
+    assert "does not cover other draws" in text and "`python studies/attribution.py --draws 0 1 2`" in text
+    assert "Over three draws of the data" in text
+    assert "a loss in this draw of the data" in text and "a real loss" not in text
+    assert "a real gain" not in ap.verdict("x", loss | {"mean": 0.03, "ci_low": 0.01, "ci_high": 0.05})

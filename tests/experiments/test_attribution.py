@@ -79,6 +79,7 @@ def test_the_losing_step_is_the_most_negative_with_its_interval_below_zero():
         "targeted_vs_blend@50": {"mean": -0.05, "ci_low": -0.09, "ci_high": 0.01, "n_draws": 3, "n_seeds": 4},
     }
     assert "`recon_vs_real`: -0.0300 AP [-0.0500, -0.0100] over 3 draws × 4 seeds" in losing_step(c, 50)
+    assert losing_step(c, 50).endswith("a loss over 3 draws of the data.")
     assert losing_step({}, 50).startswith("At B = 50 no step (none measured)")
 
 
@@ -90,8 +91,9 @@ def test_one_draw_gives_intervals_over_seeds_and_objects_and_says_they_miss_othe
     assert step["n_draws"] == 1 and step["n_seeds"] == 3 and step["ci_low"] < step["mean"] < step["ci_high"]
     text = decomposition_markdown(result, [10], "dvc repro report")
     assert "One draw of the data" in text and "does not cover other draws" in text and "Draws (data_seed)" not in text
+    assert "`data_seed` = 0 and training seeds [0, 1, 2]" in text and "studies/attribution.py --draws 0 1 2" in text
     c = {"recon_vs_real@50": {"mean": -0.03, "ci_low": -0.05, "ci_high": -0.01, "n_draws": 1, "n_seeds": 4}}
-    assert "over 4 seeds of one draw and the test objects" in losing_step(c, 50)
+    assert "over 4 seeds of one draw and the test objects, a loss in this draw of the data." in losing_step(c, 50)
 
 
 def test_a_network_without_a_test_ap_gives_no_mean_and_valid_json(tmp_path):

@@ -185,3 +185,17 @@ def test_failure_history_counts_the_rounds_an_object_stays_a_failure():
     followed = followed_failures(before, {"failure": now}, ["b", "a"])
     assert list(followed.index) == ["b", "a"] and followed.loc["b", "failure_ap"] == 0.9
     assert np.isnan(followed.loc["a", "failure_ap"]) and followed.loc["b", "before_ap"] == 0.2
+
+
+def test_a_rounds_verdicts_are_scoped_to_its_one_draw_of_the_data():
+    import pandas as pd
+
+    from graspaug.experiments.lifelong import round_markdown
+
+    c = {"mean": -0.02, "ci_low": -0.03, "ci_high": -0.01}
+    result = {"ap": {"failure": {"mean": 0.3, "ci_low": 0.2, "ci_high": 0.4}}, "contrasts": {"failure_vs_real": c}}
+    persistent = pd.DataFrame({"object": ["o1"], "rounds": [1]})
+    text = round_markdown(1, result | {"draws": [0]}, None, persistent, {"design": "D.", "command": "c"})
+    assert "| `failure_vs_real@r1` | -0.0200 [-0.0300, -0.0100] | a loss in this draw of the data |" in text
+    text = round_markdown(1, result | {"draws": [0, 1, 2]}, None, persistent, {"design": "D.", "command": "c"})
+    assert "| a loss over 3 draws of the data |" in text

@@ -10,6 +10,7 @@ from graspaug.experiments.sim_report import (
     rate_summary,
     report_text,
     sim_headline,
+    success_bar_data,
     trial_contrast,
 )
 
@@ -79,6 +80,7 @@ def test_contrast_interval_excludes_zero_for_a_clear_effect_and_report_says_so()
             "objects": 12,
             "attempts": 3,
             "model_seeds": [0],
+            "data_seed": 2,
             "base_size": 50,
         },
         "arms": {
@@ -108,6 +110,9 @@ def test_contrast_interval_excludes_zero_for_a_clear_effect_and_report_says_so()
     text = report_text(metrics, trials, table, "scores.parquet")
     assert "`network_vs_antipodal` excludes zero: before succeeds more often than antipodal" in text
     assert "`after_vs_before` excludes zero: after succeeds less often than before" in text
+    assert "paired drops): a loss in this draw of the data." in text  # the picks' networks come from one draw
+    assert "`data_seed` = 2 and training seeds [0]" in text and "does not cover other draws" in text
+    assert "python studies/cell_ranking.py" in text
     assert "| o11 | test_shape | 3 | 0.00 | n/a |" in text  # no labels for o10, o11
     assert "Grip 20 N, the object shaken at 5 g after the lift." in text
     headline = sim_headline(metrics)  # the metrics files: one per contrast, its mean and bootstrap interval
@@ -154,3 +159,20 @@ def test_the_report_reads_augmentation_only_when_the_positive_control_shows():
         control_words(fails)
     )
     assert control_words({}).startswith("No positive control")
+
+
+def test_the_success_bars_of_many_objects_wrap_into_rows_of_a_readable_width(tmp_path):
+    """29 objects (the default run) made a 2474 × 440 px strip; 100 objects now wrap into rows of at most 12."""
+    from PIL import Image
+
+    from graspaug.plots import success_bars
+
+    chosen = {arm: ("targeted", 0.0, 50) for arm in ("before", "after", "real", "more_real")}
+    chosen["antipodal"] = (None, None, None)
+    rate = {"successes": 1, "attempts": 2, "success_rate": 0.5, "wilson_low": 0.1, "wilson_high": 0.9}
+    for n in (2, 100):
+        metrics = {"per_object": {f"object_{k:03d}": {arm: rate for arm in chosen} for k in range(n)}}
+        metrics["arms"] = {arm: rate for arm in chosen}
+        success_bars(*success_bar_data(metrics, chosen), tmp_path / f"{n}.png", "Pick success per object, B = 50")
+        width, height = Image.open(tmp_path / f"{n}.png").size
+        assert 400 <= width <= 1600 and height >= width / 3, (n, width, height)

@@ -8,6 +8,8 @@ from sklearn.metrics import average_precision_score
 
 from graspaug.experiments.stats import (
     ObjectBootstrap,
+    draw_scope,
+    draw_verdict,
     percentile_interval,
     t_interval,
     weighted_average_precision,
@@ -132,3 +134,16 @@ def test_weighted_roc_auc_is_sklearns_with_ties_and_weights():
     assert np.isnan(weighted_roc_auc(labels, scores, labels.astype(float)))  # no negative left: undefined
     boot = ObjectBootstrap(np.arange(300) // 10, 50, 0)
     assert boot.roc_auc(labels, scores).shape == (50,)
+
+
+def test_a_one_draw_interval_is_a_gain_or_loss_in_this_draw_only_and_says_where_the_draws_are_combined():
+    assert draw_verdict(-0.055, -0.014) == "a loss in this draw of the data"  # not "a real loss"
+    assert draw_verdict(0.01, 0.03) == "a gain in this draw of the data"
+    assert draw_verdict(-0.03, 0.02) == "no effect we can claim in this draw of the data"
+    assert draw_verdict(None, None) == "no effect we can claim in this draw of the data"
+    assert draw_verdict(-0.05, -0.01, n_draws=3) == "a loss over 3 draws of the data"
+    scope = draw_scope(2, [0, 1, 2, 3], "ap")
+    assert "`data_seed` = 2" in scope and "training seeds [0, 1, 2, 3] (`gqcnn.seeds`)" in scope
+    assert "does not cover other draws" in scope
+    assert "`python studies/attribution.py --draws 0 1 2`" in scope and '"Over three draws of the data"' in scope
+    assert "studies/lifelong.py --draws 0 1 2" in draw_scope(0, [0], "lifelong")

@@ -278,6 +278,9 @@ def test_each_refusal_names_its_culprit(scene, model_path, tmp_path):
     np.save(tmp_path / "truncated.npy", depth)
     (tmp_path / "truncated.npy").write_bytes((tmp_path / "truncated.npy").read_bytes()[:200])
     Image.fromarray(np.round(depth).astype(np.uint16)).save(tmp_path / "meters.png")  # meters in a 16-bit PNG
+    np.save(tmp_path / "pixel.npy", np.full((1, 1), 0.7))
+    (tmp_path / "models/s0").mkdir(parents=True)
+    (tmp_path / "models/s0/model.pt").write_bytes(model_path.read_bytes())
     (tmp_path / "empty.pt").write_bytes(b"")
     (tmp_path / "junk.pt").write_text("not a checkpoint")
     missing_model = str(tmp_path / "modle.pt")
@@ -289,6 +292,9 @@ def test_each_refusal_names_its_culprit(scene, model_path, tmp_path):
         (good_image, missing_model, ["--fx", "-525"], "fx must be a positive focal length", "intrinsics"),
         (good_image, missing_model, ["--cx", "3000"], "cx = 3000 px lies outside the 640 px wide image", "intrinsics"),
         (good_image, missing_model, [], "no such file", "modle.pt"),
+        (good_image, str(tmp_path / "models"), [], "a folder, not a model.pt file: it holds s0/model.pt", "models"),
+        (tmp_path / "pixel.npy", missing_model, [], "the depth image is 1×1 px; planning needs at least", "pixel"),
+        (good_image, good_model, ["--out", str(tmp_path / "depth.npy")], "is a file; give a folder", "depth.npy"),
         (good_image, str(tmp_path / "empty.pt"), [], "the file is empty", "empty.pt"),
         (good_image, str(tmp_path / "junk.pt"), [], "not a readable PyTorch checkpoint", "junk.pt"),
         (good_image, good_model, ["--min-quality", "1.5"], "--min-quality must lie in [0, 1]", "--min-quality"),
@@ -296,7 +302,8 @@ def test_each_refusal_names_its_culprit(scene, model_path, tmp_path):
     runner = CliRunner()
     for image, model, flags, text, culprit in cases:
         fx = [] if "--fx" in flags else ["--fx", "525"]
-        args = ["plan", str(image), "--model", model, *fx, *flags, "--out", str(tmp_path / "out")]
+        out = [] if "--out" in flags else ["--out", str(tmp_path / "out")]
+        args = ["plan", str(image), "--model", model, *fx, *flags, *out]
         result = runner.invoke(app, args)
         line = result.output.strip()
         assert result.exit_code == 2 and "\n" not in line, (image, result.output)
@@ -474,3 +481,46 @@ def test_an_object_inside_the_training_range_gives_no_warning(scene, carded_mode
     assert "quality floor 0.500: --min-quality" in result.output
     planned = json.loads((tmp_path / "out/grasp.json").read_text())
     assert planned["accepted"] is True and planned["grasps"][0]["accepted"] is True and planned["warnings"] == []
+
+
+def test_intrinsics_of_another_image_size_are_warned_of_naming_the_principal_point(scene, model_path, tmp_path):
+    """A 1280×720 image planned with a 640×480 camera's principal point: a warning names it and the image center;
+    with the principal point at the center (no --cx/--cy) that warning goes."""
+    wide = Intrinsics(width=1280, height=720, fx=525.0, fy=525.0, cx=639.5, cy=359.5)
+    np.save(tmp_path / "wide.npy", depth_of(scene, wide))
+    base = ["plan", str(tmp_path / "wide.npy"), "--model", str(model_path), "--fx", "525"]
+    wrong = CliRunner().invoke(app, [*base, "--cx", "319.5", "--cy", "239.5", "--out", str(tmp_path / "a")])
+    assert wrong.exit_code in (0, 1), wrong.output
+    assert "warning: the principal point (cx, cy) = (319.5, 239.5) px lies (-320, -120) px from the center" in (
+        wrong.output
+    )
+    assert "the image is 1280×720 px and the network's training camera 640×480 px" in wrong.output
+    warned = json.loads((tmp_path / "a/grasp.json").read_text())["warnings"]
+    assert any("principal point" in w for w in warned)
+    right = CliRunner().invoke(app, [*base, "--out", str(tmp_path / "b")])
+    assert right.exit_code in (0, 1) and "principal point" not in right.output, right.output
+
+
+def test_the_exit_code_contract_and_debug(scene, model_path, tmp_path, monkeypatch):
+    """2 and one line for bad input, an existing grasp.json of the user's kept; 3 and one line for an unexpected
+    error, its traceback with --debug."""
+    np.save(tmp_path / "depth.npy", depth_of(scene))
+    (tmp_path / "mine").mkdir()
+    (tmp_path / "mine/grasp.json").write_text('{"my": "notes"}')
+    args = ["plan", str(tmp_path / "depth.npy"), "--model", str(model_path), "--fx", "525"]
+    kept = CliRunner().invoke(app, [*args, "--out", str(tmp_path / "mine")])
+    assert kept.exit_code == 2 and "not written by graspaug plan" in kept.output and kept.output.count("\n") == 1
+    assert (tmp_path / "mine/grasp.json").read_text() == '{"my": "notes"}'
+    first = CliRunner().invoke(app, [*args, "--out", str(tmp_path / "ours")])
+    again = CliRunner().invoke(app, [*args, "--out", str(tmp_path / "ours")])  # its own files: replaced
+    assert first.exit_code == again.exit_code and first.exit_code in (0, 1), again.output
+
+    def boom(path):
+        raise RuntimeError("a bug\nover two lines")
+
+    monkeypatch.setattr("graspaug.planning.read_depth_image", boom)
+    crash = CliRunner().invoke(app, [*args, "--out", str(tmp_path / "c")])
+    assert crash.exit_code == 3 and crash.output.count("\n") == 1, crash.output
+    assert "unexpected RuntimeError: a bug over two lines" in crash.output and "--debug" in crash.output
+    debug = CliRunner().invoke(app, ["--debug", *args, "--out", str(tmp_path / "c")])
+    assert isinstance(debug.exception, RuntimeError)

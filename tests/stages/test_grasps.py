@@ -59,5 +59,5 @@ def test_unknown_corpus_is_a_clear_error(tmp_path):
 
     (tmp_path / "params.yaml").write_text("seed: 0\n")
     result = CliRunner().invoke(app, ["grasps", "--corpus", "nope", "--params", str(tmp_path / "params.yaml")])
-    assert result.exit_code == 1
+    assert result.exit_code == 2  # bad input (the exit-code contract of graspaug --help)
     assert "unknown corpus 'nope'; known: original, gen_<base size>" in result.output

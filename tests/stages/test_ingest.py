@@ -148,7 +148,7 @@ def test_too_few_shapes_fails_clearly_and_writes_nothing(tmp_path, corpus_params
     params, _ = corpus_params
     params["ingest"]["min_shapes"] = 8
     result = run_stage(tmp_path, "ingest", params)
-    assert result.exit_code == 1
+    assert result.exit_code == 2
     assert "error: only 7 of 15 shapes are usable, ingest.min_shapes=8" in result.output
     assert not (tmp_path / "data/shapes.parquet").exists()
     assert not (tmp_path / "data/shapes").exists()

@@ -110,9 +110,9 @@ def test_render_writes_shards_index_metrics_and_a_dexnet_export(tmp_path, monkey
     )
 
     again = CliRunner().invoke(app, ["export-dexnet", "original", str(out)])
-    assert again.exit_code == 1 and "is not empty" in again.output
+    assert again.exit_code == 2 and "is not empty" in again.output
     missing = CliRunner().invoke(app, ["export-dexnet", "gen_50", str(tmp_path / "other")])
-    assert missing.exit_code == 1 and "no rendered dataset" in missing.output
+    assert missing.exit_code == 2 and "no rendered dataset" in missing.output
 
 
 def test_render_params_are_checked(tmp_path):

@@ -22,10 +22,12 @@ def contrast(values, boot=(0.01, 0.03)):
 
 
 def test_a_consistent_gain_is_claimed_and_a_noisy_one_is_not():
-    assert "a real gain" in verdict("real_data", contrast([0.04, 0.05, 0.045]))
+    assert "a gain in this draw of the data" in verdict("real_data", contrast([0.04, 0.05, 0.045]))
     noisy = verdict("targeted_vs_none@50", contrast([0.06, -0.04, 0.01], boot=(-0.02, 0.03)))
     assert "includes zero" in noisy and "no effect we can claim" in noisy
-    assert "a real loss" in verdict("targeted_vs_real@50", contrast([-0.03, -0.04, -0.035], boot=(-0.05, -0.02)))
+    assert "a loss in this draw of the data" in verdict(
+        "targeted_vs_real@50", contrast([-0.03, -0.04, -0.035], boot=(-0.05, -0.02))
+    )
     assert "one seed, no interval" in verdict("x", contrast([0.05]))
 
 

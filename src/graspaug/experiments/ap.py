@@ -37,7 +37,15 @@ from sklearn.metrics import average_precision_score
 
 from graspaug.errors import DataError
 from graspaug.experiments.settings import POOLS
-from graspaug.experiments.stats import ObjectBootstrap, fieller_interval, headline, percentile_interval, t_interval
+from graspaug.experiments.stats import (
+    ObjectBootstrap,
+    draw_scope,
+    draw_verdict,
+    fieller_interval,
+    headline,
+    percentile_interval,
+    t_interval,
+)
 from graspaug.experiments.variants import network_variant, seed_variants
 from graspaug.io.tables import read_table
 
@@ -455,7 +463,8 @@ def gain_sentences(
 
 
 def verdict(name: str, c: dict) -> str:
-    """One sentence: does the contrast's interval exclude zero, by both intervals."""
+    """One sentence: does the contrast's interval exclude zero, by both intervals; the words scoped to
+    the run's one draw of the data (:func:`~graspaug.experiments.stats.draw_verdict`)."""
     if c["mean"] is None:
         return f"`{name}` ({c['meaning']}): no value (a test set with one class?)."
     if c["ci_low"] is None:
@@ -464,7 +473,7 @@ def verdict(name: str, c: dict) -> str:
     b_side = (
         "above zero" if (c["boot_low"] or 0) > 0 else ("below zero" if (c["boot_high"] or 0) < 0 else "includes zero")
     )
-    word = {"above zero": "a real gain", "below zero": "a real loss"}.get(t_side, "no effect we can claim")
+    word = draw_verdict(c["ci_low"], c["ci_high"])
     return (
         f"`{name}` ({c['meaning']}): {c['mean']:+.4f} AP, 95% t-interval over {c['n_seeds']} seeds "
         f"[{c['ci_low']:+.4f}, {c['ci_high']:+.4f}] "
@@ -644,13 +653,15 @@ def report_markdown(
     seeds,
     positive_share: float,
     train_words: str,
+    data_seed: int,
 ) -> str:
-    """report.md: the network table, the contrasts with intervals, the verdicts in words, the figures."""
+    """report.md: the network table, the contrasts with intervals, the verdicts in words (scoped to the
+    draw of the data ``data_seed``: :func:`~graspaug.experiments.stats.draw_scope`), the figures."""
     lines = [
         "# GQ-CNN augmentation experiment",
         "",
         "Every number is test Average Precision on every test-split grasp of the original corpus, over training "
-        f"seeds {list(seeds)}; "
+        f"seeds {list(seeds)} of one draw of the data (`data_seed` = {data_seed}); "
         f"± is the 95% t-interval half-width over seeds. {train_words} A predictor without skill has AP = the "
         "positive share, "
         f"{positive_share:.4f}. Ratios are chosen on validation AP (train shapes no network trains on), never on the "
@@ -684,6 +695,8 @@ def report_markdown(
     lines += [
         "",
         "## What the numbers say",
+        "",
+        draw_scope(data_seed, seeds, "ap"),
         "",
         "- Contrasts whose t-interval excludes zero: "
         f"{', '.join(f'`{n}`' for n in excluding) if excluding else 'none'}.",

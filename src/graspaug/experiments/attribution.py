@@ -30,6 +30,8 @@ from graspaug.experiments.ap import (
 )
 from graspaug.experiments.stats import (
     ObjectBootstrap,
+    draw_scope,
+    draw_verdict,
     nested_indices,
     nested_interval,
     nested_means,
@@ -143,13 +145,16 @@ def losing_step(contrasts: Mapping[str, dict], base_size: int) -> str:
     over = f"{c['n_draws']} draws × {c['n_seeds']} seeds" if c["n_draws"] > 1 else f"{c['n_seeds']} seeds of one draw"
     return (
         f"At B = {base_size} the step that loses most is `{worst}`: {c['mean']:+.4f} AP "
-        f"[{c['ci_low']:+.4f}, {c['ci_high']:+.4f}] over {over} and the test objects."
+        f"[{c['ci_low']:+.4f}, {c['ci_high']:+.4f}] over {over} and the test objects, "
+        f"{draw_verdict(c['ci_low'], c['ci_high'], c['n_draws'])}."
     )
 
 
 def decomposition_markdown(result: dict, augment_base_sizes: Sequence[int], command: str) -> str:
     """The attribution report: every contrast with its interval over draws, seeds and objects, the
-    share of the real-shape gain, and per base size the step that loses it."""
+    share of the real-shape gain, and per base size the step that loses it. One draw (the ``report``
+    stage) says which, and that its intervals do not cover other draws
+    (:func:`~graspaug.experiments.stats.draw_scope`)."""
     if len(result["draws"]) > 1:
         design = (
             f"Draws (data_seed) {result['draws']} × training seeds {result['seeds']}; every interval is a 95% "
@@ -157,9 +162,8 @@ def decomposition_markdown(result: dict, augment_base_sizes: Sequence[int], comm
         )
     else:
         design = (
-            f"One draw of the data × training seeds {result['seeds']}; every interval is a 95% bootstrap over the "
-            "seeds and the test objects. It does not cover other draws of the base sets, validation shapes and "
-            "pools: `python studies/attribution.py` runs several and gives intervals that do."
+            f"{draw_scope(result['draws'][0], result['seeds'], 'ap')} Every interval is a 95% bootstrap over the "
+            "seeds and the test objects."
         )
     lines = [
         "# Why generated shapes help or not: the gap to real shapes, step by step",

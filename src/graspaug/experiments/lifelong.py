@@ -22,6 +22,7 @@ from graspaug.errors import DataError
 from graspaug.experiments.settings import ARMS
 from graspaug.experiments.stats import (
     ObjectBootstrap,
+    draw_verdict,
     nested_indices,
     nested_interval,
     nested_means,
@@ -301,7 +302,8 @@ def interval_text(c: Mapping | None, spec: str = "+.4f") -> str:
 def round_markdown(
     round_: int, result: dict, followed: pd.DataFrame | None, persistent: pd.DataFrame, words: dict
 ) -> str:
-    """A round's report: each arm's test AP, the contrasts with their verdicts, the share of the real shapes' gain,
+    """A round's report: each arm's test AP, the contrasts with their verdicts (scoped to the draws of the data
+    in ``result``: :func:`~graspaug.experiments.stats.draw_verdict`), the share of the real shapes' gain,
     the last round's failures before and after (``followed``; None in round 0), the objects chosen most often
     (``persistent``: :func:`persistent_failures`) and ``words`` (``design``, ``command``)."""
     lines = [f"# Lifelong loop, round {round_}", "", words["design"], ""]
@@ -310,8 +312,7 @@ def round_markdown(
     if result["contrasts"]:
         lines += ["", "| contrast | mean [95% interval] | verdict |", "|---|---|---|"]
         for name, c in result["contrasts"].items():
-            shows = None not in (c["ci_low"], c["ci_high"]) and (c["ci_low"] > 0 or c["ci_high"] < 0)
-            word = ("above zero" if c["ci_low"] > 0 else "below zero") if shows else "no effect detected"
+            word = draw_verdict(c["ci_low"], c["ci_high"], len(result["draws"]))
             lines.append(f"| `{name}@r{round_}` | {interval_text(c)} | {word} |")
     if "share" in result:
         lines += [

@@ -23,7 +23,7 @@ from graspaug.experiments.lifelong import (
     validation_errors,
 )
 from graspaug.experiments.settings import ARMS
-from graspaug.experiments.stats import headline
+from graspaug.experiments.stats import draw_scope, headline
 from graspaug.grasping.labelled import grasps_of_shapes
 from graspaug.io.atomic import atomic_path
 from graspaug.io.gqcnn import append_grasp_images
@@ -125,12 +125,11 @@ def write_round(
     write_json_files(figures, metrics_dir)
     curve = curve_rows(round_, result) if curve is None else pd.concat([curve, curve_rows(round_, result)])
     persistent = persistent_failures(history)
-    seeds = ", ".join(map(str, params.gqcnn.seeds))
     design = (
         f"Base set B = {cfg.base_size}; each arm adds {cfg.shapes_per_round} shapes per round (round {round_}: "
         f"{round_ * cfg.shapes_per_round}); failures: the {cfg.worst} worst validation objects, {cfg.per_failure} "
-        f"anchors each. Training seeds {seeds}, data seed {params.data_seed}; intervals: 95% bootstrap over the "
-        "seeds and the test objects of this one draw (`studies/lifelong.py` adds draws)."
+        "anchors each. Intervals: 95% bootstrap over the seeds and the test objects. "
+        f"{draw_scope(params.data_seed, params.gqcnn.seeds, 'lifelong')}"
     )
     words = {"design": design, "command": f"dvc repro lifelong@r{round_}" if round_ else "dvc repro lifelong_start"}
     with atomic_path(report_dir, directory=True) as folder:

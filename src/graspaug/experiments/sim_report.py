@@ -18,6 +18,8 @@ import pandas as pd
 from graspaug.errors import DataError
 from graspaug.experiments.stats import (
     ObjectBootstrap,
+    draw_scope,
+    draw_verdict,
     headline,
     paired_contrast,
     t_interval,
@@ -142,11 +144,12 @@ def calibration(trials: pd.DataFrame, graspness: pd.Series) -> tuple[pd.DataFram
 
 
 def trial_setup(
-    sim, objects: Sequence, skipped: dict[str, str], model_seeds: list[int], after_from_report: bool
+    sim, objects: Sequence, skipped: dict[str, str], model_seeds: list[int], after_from_report: bool, data_seed: int
 ) -> dict:
     """The metrics' ``setup``: base size, whether the ``after`` ratio came from the AP report, the
     object count and attempts per object, the test shapes and user objects among ``objects``, the
-    user's meshes skipped (file → why), camera height (m), sensor noise on or off, training seeds.
+    user's meshes skipped (file → why), camera height (m), sensor noise on or off, training seeds,
+    the draw of the data the networks were trained on (``data_seed``).
     ``sim``: the ``sim`` params section (``SimParams``)."""
     return {
         "base_size": sim.base_size,
@@ -161,6 +164,7 @@ def trial_setup(
         "grip_force": sim.hand.grip_force,
         "shake_acceleration": sim.trial.shake_acceleration,
         "model_seeds": model_seeds,
+        "data_seed": data_seed,
     }
 
 
@@ -270,8 +274,10 @@ def _interval(c: dict) -> str:
 
 
 def _verdict(name: str, c: dict) -> str:
+    """One sentence on a pick contrast's bootstrap interval, scoped to the run's one draw of the data
+    (:func:`~graspaug.experiments.stats.draw_verdict`)."""
     arm, reference = CONTRASTS[name]
-    evidence = f"({_interval(c)}, {c['n_trials']} paired drops)."
+    evidence = f"({_interval(c)}, {c['n_trials']} paired drops): {draw_verdict(c['ci_low'], c['ci_high'])}."
     if c["ci_low"] > 0:
         return f"`{name}` excludes zero: {arm} succeeds more often than {reference} {evidence}"
     if c["ci_high"] < 0:
@@ -376,6 +382,8 @@ def report_text(metrics: dict, trials: pd.DataFrame, calibration_table: pd.DataF
         f"{setup['objects']} objects × {drops}, the same drops and planner seeds for every arm; networks of "
         f"training seeds {setup['model_seeds']} (B = {setup['base_size']}). "
         f"Grip {setup['grip_force']:g} N, the object {shake}. Success = the object ends inside the bin.",
+        "",
+        draw_scope(setup["data_seed"], setup["model_seeds"], "sim"),
         "",
         "| arm | planner | successes | rate | 95% Wilson interval |",
         "|---|---|---|---|---|",

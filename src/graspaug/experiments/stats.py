@@ -13,7 +13,9 @@
 * :func:`nested_interval`: one interval over data draws, training seeds and test objects (a
   hierarchical bootstrap); :func:`fieller_interval`: a ratio of paired means (a share of a gain);
 * :func:`wilson_interval` (a success rate). No McNemar test: the robot trials' picks cluster by
-  object and training seed, so they are compared with the object bootstrap and the t-interval.
+  object and training seed, so they are compared with the object bootstrap and the t-interval;
+* :func:`draw_scope`, :func:`draw_verdict`: the words every report uses for intervals over one draw
+  of the data (``data_seed``), which do not cover other draws.
 """
 
 from __future__ import annotations
@@ -174,6 +176,46 @@ def headline(contrast: dict) -> dict[str, float | None]:
     ``dvc metrics show`` lines every experiment's contrasts up in three columns."""
     keys = {"mean": "mean", "lo": "ci_low", "hi": "ci_high"}
     return {k: None if contrast.get(v) is None else round(float(contrast[v]), 5) for k, v in keys.items()}
+
+
+#: Where each experiment is run over several draws of the data: (command, section of docs/results.md).
+OVER_DRAWS = {
+    "ap": ("python studies/attribution.py --draws 0 1 2", "Over three draws of the data"),
+    "lifelong": (
+        "python studies/lifelong.py --draws 0 1 2",
+        "The lifelong loop: generating from the planner's failures",
+    ),
+    "sim": (
+        "python studies/cell_ranking.py --grasps reports/grasp_calibration/grasps.csv --projects . <draw1> <draw2>",
+        "The networks rank the cell's outcomes: the positive control shows",
+    ),
+}
+
+
+def draw_scope(data_seed: int, seeds, experiment: str) -> str:
+    """The sentence that bounds a report's intervals over one draw of the data: they cover the draw
+    ``data_seed`` (its base sets, validation shapes and generated pools) and the training ``seeds``
+    (``gqcnn.seeds``), not other draws; ``experiment`` (a key of :data:`OVER_DRAWS`) names the command
+    that runs it over several draws and the section of docs/results.md that holds that result."""
+    command, section = OVER_DRAWS[experiment]
+    return (
+        f"One draw of the data: every interval here covers the draw `data_seed` = {data_seed} and training seeds "
+        f"{list(seeds)} (`gqcnn.seeds`) and does not cover other draws of the base sets, validation shapes and "
+        f"generated pools, so each verdict holds for this draw only. Over several draws: `{command}` "
+        f'(docs/results.md, "{section}").'
+    )
+
+
+def draw_verdict(low: float | None, high: float | None, n_draws: int = 1) -> str:
+    """A 95% interval [``low``, ``high``] in words: a gain or a loss when it lies above or below zero, else
+    no effect we can claim; an interval over one draw of the data is scoped to that draw
+    (:func:`draw_scope` says which), one over several draws says how many."""
+    scope = "in this draw of the data" if n_draws == 1 else f"over {n_draws} draws of the data"
+    if low is not None and low > 0:
+        return f"a gain {scope}"
+    if high is not None and high < 0:
+        return f"a loss {scope}"
+    return f"no effect we can claim {scope}"
 
 
 def wilson_interval(successes: int, attempts: int, confidence: float = 0.95) -> tuple[float, float]:

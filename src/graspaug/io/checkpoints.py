@@ -243,6 +243,10 @@ def read_gqcnn(path: str | os.PathLike):
     from graspaug.nets.gqcnn import GQCNN, GQCNNConfig, GQCNNEnsemble
 
     path = Path(path)
+    if path.is_dir():
+        inside = sorted(p.relative_to(path).as_posix() for p in path.rglob("model.pt"))[:2]
+        hint = f": it holds {' and '.join(inside)}" if inside else ""
+        raise CheckpointMismatch(f"model {path}: a folder, not a model.pt file{hint}")
     if not path.is_file():
         raise FileNotFoundError(f"model {path}: no such file (a trained GQ-CNN is a model.pt file)")
     if path.stat().st_size == 0:

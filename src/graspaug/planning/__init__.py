@@ -3,7 +3,7 @@
     import numpy as np
     from graspaug.planning import load_planner, plan_grasp
 
-    planner = load_planner("models/gqcnn/s0/targeted/50-0/model.pt")
+    planner = load_planner("models/gqcnn/s0/targeted/50-1/model.pt")
     depth = np.load("depth.npy")                              # (H, W) meters, camera looking down
     grasp = plan_grasp(depth, {"fx": 525, "fy": 525, "cx": 319.5, "cy": 239.5}, planner)
     grasp.pose                                                # (4, 4) gripper pose in the camera frame, m

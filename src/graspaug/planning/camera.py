@@ -25,6 +25,9 @@ MAX_DOWNSAMPLING = 4.0  # ... and with at most 4× more (more only costs time: r
 MAX_DISTANCE_RATIO = 1.5  # camera distance within [lowest / 1.5, highest × 1.5] of the training range
 DISTANCE_TOLERANCE = 0.01  # m: a camera this close outside the training range counts as inside
 
+MIN_IMAGE_PX = 8  # the smallest image side planning takes (a grasp crop needs neighbours)
+PRINCIPAL_POINT_OFFSET = 0.1  # share of the image side beyond which a principal point off the center is warned about
+
 _KEYS = ("width", "height", "fx", "fy", "cx", "cy")
 
 
@@ -76,8 +79,13 @@ def check_depth(depth: np.ndarray, fill_missing: bool = False) -> np.ndarray:
     depth = np.asarray(depth)
     if depth.ndim == 3 and depth.shape[2] == 1:
         depth = depth[..., 0]
-    if depth.ndim != 2 or min(depth.shape, default=0) < 8:
+    if depth.ndim != 2:
         raise PlanningError(f"the depth image must be a 2-D array (H, W) in meters, got shape {depth.shape}")
+    if min(depth.shape) < MIN_IMAGE_PX:
+        raise PlanningError(
+            f"the depth image is {depth.shape[1]}×{depth.shape[0]} px; planning needs at least "
+            f"{MIN_IMAGE_PX}×{MIN_IMAGE_PX}"
+        )
     if not np.issubdtype(depth.dtype, np.number):
         raise PlanningError(f"the depth image must hold numbers (meters), got dtype {depth.dtype}")
     depth = depth.astype(np.float64)

@@ -4,7 +4,9 @@ and the warnings for an image outside the range of the training data.
 The floor (:func:`quality_floor`) is, in order: the caller's (``--min-quality``), the model card's
 validation operating point (:func:`graspaug.io.checkpoints.operating_point`: the threshold on P(success)
 that maximises F1 on the network's validation predictions), or :data:`DEFAULT_MIN_QUALITY` for a card
-without one. The warnings (:func:`range_warnings`) compare the image with the card: the camera distance
+without one. The warnings (:func:`range_warnings`) check the intrinsics against the image and the card
+(:func:`intrinsics_warnings`: a principal point far from the image center, an image size other than the
+training camera's), and compare the image with the card: the camera distance
 with the rendered viewpoints' range, the height above the table of the object under the best grasp with
 the training crops' object heights, the best grasp's gripper depth with the training gripper depths.
 """
@@ -18,7 +20,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from scipy import ndimage
 
-from graspaug.planning.camera import DISTANCE_TOLERANCE, camera_adapter, intrinsics_for
+from graspaug.planning.camera import DISTANCE_TOLERANCE, PRINCIPAL_POINT_OFFSET, camera_adapter, intrinsics_for
 from graspaug.planning.card import ModelCard
 from graspaug.render.settings import Intrinsics
 
@@ -116,6 +118,37 @@ def object_height(depth: np.ndarray, intrinsics: Intrinsics, jaws: np.ndarray | 
     return max(float(heights.max()), 0.0)
 
 
+def intrinsics_warnings(card: ModelCard, intrinsics: Intrinsics) -> list[str]:
+    """One line per way ``intrinsics`` (checked against the image by :func:`intrinsics_for`) look like another
+    camera's than the image's, each saying what planning assumed; [] when they look right.
+
+    - the principal point more than :data:`~graspaug.planning.camera.PRINCIPAL_POINT_OFFSET` of the image side
+      from the image center (real cameras put it within a few percent of it; intrinsics of a 640×480 camera
+      given for a 1280×720 image put it 320 px off and every grasp position with it);
+    - an image size other than the training camera's (the card's ``intrinsics``): the image is planned on with the
+      intrinsics given, resampled to the training focal length where needed.
+    """
+    w, h = intrinsics.width, intrinsics.height
+    off_u, off_v = intrinsics.cx - (w - 1) / 2, intrinsics.cy - (h - 1) / 2
+    warnings = []
+    if abs(off_u) > PRINCIPAL_POINT_OFFSET * w or abs(off_v) > PRINCIPAL_POINT_OFFSET * h:
+        warnings.append(
+            f"the principal point (cx, cy) = ({intrinsics.cx:g}, {intrinsics.cy:g}) px lies ({off_u:+.0f}, "
+            f"{off_v:+.0f}) px from the center ({(w - 1) / 2:g}, {(h - 1) / 2:g}) of this {w}×{h} image, more than "
+            f"{PRINCIPAL_POINT_OFFSET:.0%} of its sides: are the intrinsics another image size's? They are used as "
+            "given, and grasp positions in meters shift with the principal point (without --cx/--cy it is the "
+            "image center)"
+        )
+    trained = (int(card.intrinsics["width"]), int(card.intrinsics["height"]))
+    if (w, h) != trained:
+        warnings.append(
+            f"the image is {w}×{h} px and the network's training camera {trained[0]}×{trained[1]} px: planning "
+            f"assumes the intrinsics given (fx = {intrinsics.fx:g}, fy = {intrinsics.fy:g}, cx = {intrinsics.cx:g}, "
+            f"cy = {intrinsics.cy:g} px) are this image's"
+        )
+    return warnings
+
+
 def range_warnings(
     card: ModelCard,
     depth: np.ndarray,
@@ -125,7 +158,8 @@ def range_warnings(
 ) -> list[str]:
     """One line per way the image ``depth`` (H, W) m (checked, as :meth:`Planner.plan` got it) lies
     outside the data the network of ``card`` was trained on, each naming the training range and the
-    measured value; [] when it lies inside (or the card records no range).
+    measured value; [] when it lies inside (or the card records no range). First those of
+    :func:`intrinsics_warnings`, then:
 
     - the camera distance (m; ``camera_distance``, default the image's median depth, as the planner
       takes it) outside the card's ``camera_distance`` (the rendered viewpoints, ± :data:`DISTANCE_TOLERANCE`);
@@ -136,7 +170,7 @@ def range_warnings(
       central share of the training gripper depths (``training_range.gripper_depth``).
     """
     intrinsics = intrinsics_for(np.shape(depth), intrinsics)
-    warnings = []
+    warnings = intrinsics_warnings(card, intrinsics)
     distance = float(np.median(depth)) if camera_distance is None else float(camera_distance)
     said = "the image's median depth" if camera_distance is None else "--camera-distance"
     low, high = card.camera_distance

@@ -1,22 +1,18 @@
 """``graspaug from-failures``: new training shapes near the objects a planner fails on (the lifelong loop's
 generation step). No DVC stage: a command whose adapter sits here as it knows the project's files.
 
-The failure objects are a folder of meshes (objects a planner trained anywhere missed: closed and scaled as the
-corpus is, voxelized as ``voxelize`` does, encoded by the AE-Critic) or the ``worst`` *validation* objects of one
-of this project's networks (highest mean log loss, predictions averaged over the seeds; the test split never
-chooses). Each one's ``per_failure`` nearest train shapes in latent space are anchors
-(:func:`graspaug.experiments.lifelong.failure_anchors`), interpolated with their neighbours among the train
-shapes, decoded and meshed as ``generate`` does (:func:`graspaug.generation_meshes.failure_shapes`). A failure
-object is never a parent, and validation objects are no train shapes here.
+The failure objects are a folder of meshes (closed, scaled, voxelized and encoded as the corpus is) or the ``worst``
+*validation* objects of one of this project's networks (the test split never chooses). Their nearest train shapes in
+latent space anchor interpolants decoded and meshed as ``generate`` does; a failure object is never a parent.
 
-Writes, all at once, into ``out``: ``meshes/failure_<order>.obj`` (m), ``index.csv`` (per shape: its failure
-object, anchor ``parent_a``, neighbour ``parent_b``, ``alpha``, size), ``failures.csv`` (the objects, worst first;
-with a network every validation object's error), ``rejects.csv``, ``skipped.csv`` (unusable files, and why).
+Writes, all at once, into ``out`` (refused if it holds files this command did not write, :mod:`graspaug.io.outputs`):
+``meshes/failure_<order>.obj`` (m), ``index.csv`` (per shape: its failure object, parents, ``alpha``, size),
+``failures.csv`` (the objects, worst first: shapes, rejected decodes and why none), ``rejects.csv`` (with the failure
+each decode served), ``skipped.csv`` (unusable files, and why).
 """
 
 from __future__ import annotations
 
-import logging
 from pathlib import Path
 
 import numpy as np
@@ -26,10 +22,11 @@ from graspaug import paths
 from graspaug.device import resolve_device
 from graspaug.errors import DataError
 from graspaug.experiments.lifelong import failure_anchors, validation_errors
-from graspaug.generation_meshes import base_set, failure_shapes, mesh_batches
+from graspaug.generation_meshes import base_set, failure_shapes, failure_summary, log_failure_summary, mesh_batches
 from graspaug.io.atomic import atomic_path
 from graspaug.io.checkpoints import load_autoencoder
 from graspaug.io.meshes import mesh_path, write_obj
+from graspaug.io.outputs import check_output_folder, mark
 from graspaug.io.tables import read_table
 from graspaug.io.voxels import read_voxels
 from graspaug.params.ae import AEParams
@@ -41,7 +38,7 @@ from graspaug.params.score import ScoreParams
 from graspaug.params.voxelize import VoxelizeParams
 from graspaug.training.autoencoder import encode_meshes
 
-log = logging.getLogger(__name__)
+COMMAND = "from-failures"
 
 Params = params_model(
     "The params `graspaug from-failures` reads.",
@@ -54,13 +51,14 @@ Params = params_model(
 )
 
 
-def run(params: Params, folder: Path | None, network: str | None, worst: int, count: int, per_failure: int, out):
+def run(params: Params, folder, network: str | None, worst: int, count: int, per_failure: int, out, force=False):
     from graspaug.sim.objects import folder_meshes
 
     if (folder is None) == (network is None):
         raise DataError("give either a folder of failure meshes or --network (its worst validation objects)")
     if min(count, per_failure, worst) < 1:
         raise DataError(f"--count, --per-failure, --worst must be at least 1; got {count}, {per_failure}, {worst}")
+    check_output_folder(out, COMMAND, [folder, "data", "models"] if folder else ["data", "models"], force)
     device = resolve_device(params.device)
     ae, _, _ = load_autoencoder(paths.AE_CRITIC_MODEL, params.ae.net)
     shapes, latents = read_table(paths.SHAPES_TABLE), read_table(paths.LATENTS).set_index("shape_id")
@@ -83,18 +81,17 @@ def run(params: Params, folder: Path | None, network: str | None, worst: int, co
     ids = shapes.shape_id[shapes.shape_id.isin(train)].to_numpy()
     pool = base_set(ids, latents.reset_index(), read_table(paths.SCORES), read_voxels(paths.VOXELS), params.score.k)
     anchors, served = failure_anchors(pool.z, failure_z, per_failure)
+    served = [names[f] for f in served]  # the failure object each anchor serves
     run_batch = mesh_batches(ae, device, pool, params.generate.decode, params.workers, "from failures")
-    index, rejects, kept, notes = failure_shapes(
-        pool, anchors, [names[f] for f in served], count, params.generate, run_batch
-    )
-    for note in notes:  # how the stream was widened
-        log.info("from-failures: %s", note)
+    index, rejects, kept, notes = failure_shapes(pool, anchors, served, count, params.generate, run_batch)
+    summary = failure_summary(names, served, index, rejects)
     with atomic_path(out, directory=True) as tmp:
+        mark(tmp, COMMAND)
         (tmp / "meshes").mkdir()
         for shape_id, decoded in zip(index.shape_id, kept):
             write_obj(decoded.mesh, mesh_path(tmp / "meshes", shape_id, ".obj"))
         index.drop(columns=["z", "base_size", "pool", "split"]).to_csv(tmp / "index.csv", index=False)
-        errors.assign(failure=errors.index.isin(names)).to_csv(tmp / "failures.csv")
+        errors.assign(failure=errors.index.isin(names)).join(summary.set_index("failure")).to_csv(tmp / "failures.csv")
         rejects.to_csv(tmp / "rejects.csv", index=False)
         pd.DataFrame({"file": list(skipped), "reason": list(skipped.values())}).to_csv(tmp / "skipped.csv", index=False)
-    log.info("from-failures: %d shapes near %d failure objects in %s", len(index), len(names), out)
+    log_failure_summary(summary, notes, out)

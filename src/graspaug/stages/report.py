@@ -95,6 +95,6 @@ def run(params: Params) -> None:
     write_json_files(ap_headline(ap_report), AP_METRICS)
     words = training_words(cfg.train, cfg.members)
     with atomic_path(REPORT_DIR / "report.md") as tmp:
-        tmp.write_text(report_markdown(table, results, chosen, extras, seeds, positive_share, words))
+        tmp.write_text(report_markdown(table, results, chosen, extras, seeds, positive_share, words, params.data_seed))
     for name, c in results.items():
         log.info("report: %s", verdict(name, c))

@@ -82,7 +82,7 @@ def run(params: Params) -> None:
     log.info("sim: %s", trials_plan(objects, chosen, cfg.attempts, len(model_seeds), skipped))
     rows = run_trials(jobs, cfg, params.render.crop, params.workers)
     trials = trials_table(rows, chosen)
-    setup = trial_setup(cfg, objects, skipped, model_seeds, after_from_report=from_report)
+    setup = trial_setup(cfg, objects, skipped, model_seeds, after_from_report=from_report, data_seed=params.data_seed)
     metrics = summarize(trials, objects, chosen, setup, cfg.n_bootstrap, params.seed)
     scores = read_table(paths.SCORES).set_index("shape_id")  # no grasp sampled: n/a, not 0
     calibration_table, metrics["calibration"] = calibration(trials, scores.graspness[scores.n_grasps > 0])
