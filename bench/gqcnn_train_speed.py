@@ -40,7 +40,7 @@ LOOPS = ["reference", "float32", "bfloat16", "members"]
 
 def load(n: int):
     from graspaug.io.gqcnn import GraspImages
-    from graspaug.paths import gqcnn_dir
+    from graspaug.pipeline.paths import gqcnn_dir
     from graspaug.training.gqcnn import GraspArrays
 
     data = GraspImages.open(gqcnn_dir("original"))
@@ -137,7 +137,7 @@ def measure(which: str, steps: int, datapoints: int, members: int) -> dict:
         from graspaug.device import keep_freed_memory
         from graspaug.training.gqcnn import train_gqcnn
 
-        keep_freed_memory()  # as every stage does (graspaug.cli)
+        keep_freed_memory()  # as every stage does (graspaug.pipeline.cli)
         settings = TrainSettings(min_steps=steps, max_steps=steps, evals=1, precision=which)
         net, batch = GQCNN(GQCNNConfig()), settings.batch_size
         start = time.perf_counter()

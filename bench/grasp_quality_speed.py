@@ -23,10 +23,10 @@ import time
 import numpy as np
 from _corpus import default_shapes
 
-from graspaug.config import GraspsParams
 from graspaug.grasping.antipodal import sample_antipodal_grasps
 from graspaug.grasping.quality import ferrari_canny, ferrari_canny_qhull
 from graspaug.grasping.robust import robust_ferrari_canny
+from graspaug.pipeline.params.model import GraspsParams
 from graspaug.rng import shape_rng
 
 

@@ -27,8 +27,8 @@ import numpy as np
 import trimesh
 from _corpus import default_shapes
 
-from graspaug.config import GraspsParams, RenderParams
 from graspaug.grasping.antipodal import sample_antipodal_grasps
+from graspaug.pipeline.params.model import GraspsParams, RenderParams
 from graspaug.render.crops import crops_by_ray_casting, crops_from_depth_image
 from graspaug.render.dataset import plan_scenes
 from graspaug.render.depth import render_depth

@@ -25,11 +25,11 @@ from pathlib import Path
 
 import yaml
 
-from graspaug.config import params_dict, parse_params
 from graspaug.experiments.ap import test_labels
 from graspaug.experiments.attribution import combine_draws, decomposition_markdown
 from graspaug.io.tables import read_table
-from graspaug.profiles import merge, params_yaml, read_overlay
+from graspaug.pipeline.params.model import params_dict, parse_params
+from graspaug.pipeline.params.profiles import merge, params_yaml, read_overlay
 
 ROOT = Path(__file__).resolve().parents[1]
 

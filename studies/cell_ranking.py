@@ -28,15 +28,15 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from graspaug.config import load_params
 from graspaug.experiments.ap import choose_ratios, collect
 from graspaug.experiments.cell_ranking import arm_scores, auc_samples, ranking_bootstrap, ranking_summary
 from graspaug.experiments.sim import after_ratio
 from graspaug.experiments.sim_report import CONTRASTS
 from graspaug.experiments.stats import nested_interval
-from graspaug.experiments.variants import Variant
 from graspaug.io.tables import read_table
+from graspaug.pipeline.params.model import load_params
 from graspaug.rng import shape_rng
+from graspaug.training.variants import Variant
 
 
 def top_pick(grasps: pd.DataFrame, scores: dict[str, np.ndarray]) -> dict:

@@ -34,7 +34,7 @@ from graspaug.geometry.voxelize import fit_grid, pack_bits, voxelize_solid
 from graspaug.io.gqcnn import GraspImages
 from graspaug.io.sources import pybullet_sources
 from graspaug.io.tables import read_table
-from graspaug.paths import SHAPES_TABLE, gqcnn_dir
+from graspaug.pipeline.paths import SHAPES_TABLE, gqcnn_dir
 
 HERE = Path(__file__).resolve().parent
 DATA = HERE / "out" / "cuda" / "data"

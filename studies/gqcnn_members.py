@@ -27,9 +27,13 @@ import numpy as np
 import pandas as pd
 from sklearn.metrics import average_precision_score
 
-from graspaug.config import load_params
 from graspaug.experiments.ap import choose_ratios, declared_contrasts
-from graspaug.experiments.networks import (
+from graspaug.experiments.stats import t_interval
+from graspaug.io.tables import read_table
+from graspaug.pipeline.params.model import load_params
+from graspaug.pipeline.paths import SHAPES_TABLE, gqcnn_dir, gqcnn_seed_dir
+from graspaug.training.gqcnn_data import Corpora, load_split, shapes_datapoints, test_set
+from graspaug.training.networks import (
     NetworkJob,
     initial_weights,
     members_digest,
@@ -38,11 +42,7 @@ from graspaug.experiments.networks import (
     stream_seeds,
     train_network,
 )
-from graspaug.experiments.stats import t_interval
-from graspaug.experiments.variants import seed_variants
-from graspaug.io.tables import read_table
-from graspaug.paths import SHAPES_TABLE, gqcnn_dir, gqcnn_seed_dir
-from graspaug.training.gqcnn_data import Corpora, load_split, shapes_datapoints, test_set
+from graspaug.training.variants import seed_variants
 
 
 def train_extra_members(params, split, variants, val, test, members: int, out: Path, corpora: Corpora) -> None:

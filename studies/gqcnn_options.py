@@ -21,15 +21,15 @@ import time
 import numpy as np
 import torch
 
-from graspaug.config import Params
-from graspaug.experiments.networks import initial_weights, stream_seeds
 from graspaug.experiments.stats import t_interval
-from graspaug.experiments.variants import Variant
 from graspaug.io.tables import read_table
 from graspaug.nets.gqcnn import GQCNN
-from graspaug.paths import SHAPES_TABLE, gqcnn_dir
+from graspaug.pipeline.params.model import Params
+from graspaug.pipeline.paths import SHAPES_TABLE, gqcnn_dir
 from graspaug.training.gqcnn import classification_metrics, predict, train_gqcnn
 from graspaug.training.gqcnn_data import Corpora, load_split, shapes_datapoints, training_set
+from graspaug.training.networks import initial_weights, stream_seeds
+from graspaug.training.variants import Variant
 
 OPTIONS = {  # name → (changes to gqcnn.net, changes to gqcnn.train); the first is the params' own
     "params as they are": ({}, {}),

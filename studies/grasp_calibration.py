@@ -24,10 +24,10 @@ from pathlib import Path
 
 from _cell import with_changes
 
-from graspaug.config import Params
 from graspaug.experiments.grasp_calibration import choose_grasps, run_calibration, shape_jobs, summarize
 from graspaug.io.tables import read_table
-from graspaug.paths import SHAPES_DIR, gqcnn_dir, grasps_table
+from graspaug.pipeline.params.model import Params
+from graspaug.pipeline.paths import SHAPES_DIR, gqcnn_dir, grasps_table
 
 
 def main() -> None:

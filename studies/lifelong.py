@@ -37,8 +37,8 @@ from graspaug.experiments.lifelong import (
 )
 from graspaug.experiments.settings import ARMS
 from graspaug.io.tables import read_table
+from graspaug.pipeline.params.profiles import merge, params_yaml, read_overlay
 from graspaug.plots import lines
-from graspaug.profiles import merge, params_yaml, read_overlay
 
 ROOT = Path(__file__).resolve().parents[1]
 REUSED = (  # the loop's inputs, made by the stages before it
@@ -53,7 +53,7 @@ REUSED = (  # the loop's inputs, made by the stages before it
 
 
 def draw_params(profile: str, data_seed: int):
-    from graspaug.config import params_dict, parse_params
+    from graspaug.pipeline.params.model import params_dict, parse_params
 
     return parse_params(merge(params_dict(), read_overlay(profile, ROOT / "profiles") | {"data_seed": data_seed}))
 

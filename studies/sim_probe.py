@@ -31,20 +31,20 @@ from pathlib import Path
 import pandas as pd
 from _cell import with_changes
 
-from graspaug.config import Params
 from graspaug.experiments.sim import object_jobs, prepare_objects, run_object, test_shape_ids
 from graspaug.experiments.sim_report import rate_summary, trial_contrast
 from graspaug.io.tables import read_table
 from graspaug.parallel import parallel_map
-from graspaug.paths import SHAPES_DIR, SHAPES_TABLE, gqcnn_dir
+from graspaug.pipeline.params.model import Params
+from graspaug.pipeline.paths import SHAPES_DIR, SHAPES_TABLE, gqcnn_dir
 
 
 def train_before(models: Path, seeds: list[int], base_size: int, params: Params) -> None:
     """Train the targeted B-0 network of every seed that ``models`` lacks."""
-    from graspaug.experiments.networks import NetworkJob, initial_weights, stream_seeds, train_network
-    from graspaug.experiments.variants import Variant
     from graspaug.io.checkpoints import gqcnn_card
     from graspaug.training.gqcnn_data import Corpora, load_split, shapes_datapoints, test_set
+    from graspaug.training.networks import NetworkJob, initial_weights, stream_seeds, train_network
+    from graspaug.training.variants import Variant
 
     missing = [s for s in seeds if not (models / f"s{s}/targeted/{base_size}-0/model.pt").exists()]
     if not missing:

@@ -20,12 +20,12 @@ import fnmatch
 import time
 from pathlib import Path
 
-from graspaug.config import load_params
-from graspaug.experiments.networks import NetworkJob, save_seed_split, seed_card, seed_members, train_network
-from graspaug.experiments.variants import seed_variants
 from graspaug.io.tables import read_table
-from graspaug.paths import SHAPES_TABLE, gqcnn_dir
+from graspaug.pipeline.params.model import load_params
+from graspaug.pipeline.paths import SHAPES_TABLE, gqcnn_dir
 from graspaug.training.gqcnn_data import Corpora, load_split, shapes_datapoints, test_set
+from graspaug.training.networks import NetworkJob, save_seed_split, seed_card, seed_members, train_network
+from graspaug.training.variants import seed_variants
 
 
 def main() -> None:

@@ -1,8 +1,11 @@
-"""Every dvc.yaml stage lists exactly the graspaug source files it runs: no more, no less, no folders.
+"""Every dvc.yaml stage lists exactly the graspaug source it runs: no more, no less.
 
 A stage's code is the import closure (found with ``ast``, nothing is imported) of the CLI entry point
-plus the stage module that its ``cmd`` names: ``graspaug x-y ...`` runs ``graspaug.stages.x_y``.
-``python tests/test_dvc_deps.py`` prints each stage's expected ``src/`` deps, ready to paste.
+plus the stage module that its ``cmd`` names: ``graspaug x-y ...`` runs ``graspaug.pipeline.stages.x_y``.
+dvc.yaml lists it by room (:func:`dvc_deps`): a library package (``geometry/``, ``augment/``, ...) as its folder,
+the pipeline's modules and the top-level ones as files. ``python tests/test_dvc_deps.py --write`` rewrites every
+stage's ``src/`` deps in dvc.yaml from the import graph (the one source of truth this test checks against);
+without ``--write`` it prints them.
 """
 
 from __future__ import annotations
@@ -16,8 +19,8 @@ import yaml
 REPO = Path(__file__).resolve().parents[1]
 SRC = REPO / "src"
 DVC_YAML = REPO / "dvc.yaml"
-CLI = "graspaug.cli"
-STAGES = "graspaug.stages."
+CLI = "graspaug.pipeline.cli"
+STAGES = "graspaug.pipeline.stages."
 
 
 def module_file(module: str, src: Path) -> Path | None:
@@ -109,21 +112,33 @@ def stage_code(cmd: str, src: Path = SRC) -> set[str]:
     return _closure({stage_module} | cli_imports(src), src) | {cli_file}
 
 
+def dvc_deps(files: set[str]) -> set[str]:
+    """``files`` (repo-relative ``src/graspaug/...`` paths) as dvc.yaml lists them: a module of a library package
+    as the package's folder (``src/graspaug/geometry``: editing any of its modules re-runs the stage), a module
+    of ``pipeline/`` or at the top of the package as its file (a stage re-runs for its own adapter and params
+    sections, not every stage's)."""
+    out = set()
+    for path in files:
+        parts = path.split("/")
+        out.add("/".join(parts[:3]) if len(parts) > 3 and parts[2] != "pipeline" else path)
+    return out
+
+
 def dvc_stages(dvc: dict) -> dict[str, dict]:
     """Stage name -> its definition; a ``foreach`` stage's is its ``do:`` block (matrix stages are flat)."""
     return {name: body.get("do", body) for name, body in dvc["stages"].items()}
 
 
 def expected_code_deps(dvc_yaml: Path = DVC_YAML, src: Path = SRC) -> dict[str, set[str]]:
-    """Stage name -> the ``src/`` files it must list as deps."""
+    """Stage name -> the ``src/`` files it runs (dvc.yaml lists them as :func:`dvc_deps` does)."""
     return {
         name: stage_code(body["cmd"], src) for name, body in dvc_stages(yaml.safe_load(dvc_yaml.read_text())).items()
     }
 
 
 def compare_code_deps(dvc: dict, src: Path = SRC) -> dict[str, dict[str, set[str]]]:
-    """Stage name -> {"missing": expected but not listed, "extra": listed but not expected (folders
-    always)}, for stages where either is non-empty."""
+    """Stage name -> {"missing": expected but not listed, "extra": listed but not expected}, both as
+    :func:`dvc_deps` lists them, for stages where either is non-empty."""
     problems = {}
     for name, body in dvc_stages(dvc).items():
         listed = {
@@ -131,7 +146,7 @@ def compare_code_deps(dvc: dict, src: Path = SRC) -> dict[str, dict[str, set[str
             for d in (d if isinstance(d, str) else next(iter(d)) for d in body.get("deps", []))
             if d.startswith("src/")
         }
-        expected = stage_code(body["cmd"], src)
+        expected = dvc_deps(stage_code(body["cmd"], src))
         missing, extra = expected - listed, listed - expected
         if missing or extra:
             problems[name] = {"missing": missing, "extra": extra}
@@ -153,10 +168,7 @@ def test_every_stage_lists_exactly_its_code():
         f"\n{name}:\n" + "".join(f"  {kind}: {p}\n" for kind in ("missing", "extra") for p in sorted(d[kind]))
         for name, d in problems.items()
     )
-    expected = {name: paths for name, paths in expected_code_deps().items() if name in problems}
-    assert not problems, (
-        f"dvc.yaml code deps differ from the imports:{report}\nExpected src/ deps:\n{_yaml_lists(expected)}"
-    )
+    assert not problems, f"dvc.yaml code deps differ from the imports:{report}(python tests/test_dvc_deps.py --write)"
 
 
 def test_a_stage_depends_only_on_the_settings_it_reads():
@@ -167,7 +179,9 @@ def test_a_stage_depends_only_on_the_settings_it_reads():
     deps = expected_code_deps()
     cell = {name for name, files in deps.items() if "src/graspaug/sim/settings.py" in files}
     assert cell == {"sim", "grasp_calibration", "check_params"}
-    assert {name for name, files in deps.items() if "src/graspaug/config.py" in files} == {"check_params"}
+    assert {name for name, files in deps.items() if "src/graspaug/pipeline/params/model.py" in files} == {
+        "check_params"
+    }
     early = deps["ingest"] | deps["voxelize"]
     assert not {
         f for f in early if f.startswith(("src/graspaug/sim/", "src/graspaug/planning/", "src/graspaug/render/"))
@@ -176,17 +190,47 @@ def test_a_stage_depends_only_on_the_settings_it_reads():
 
 def test_a_planted_missing_dep_is_caught():
     """Drop one listed src file from one stage: exactly that path becomes missing."""
-    dvc, planted = _real_dvc(), "src/graspaug/stages/render.py"
+    dvc, planted = _real_dvc(), "src/graspaug/pipeline/stages/render.py"
     dvc_stages(dvc)["render"]["deps"].remove(planted)
     before = compare_code_deps(_real_dvc()).get("render", {}).get("missing", set())
     assert compare_code_deps(dvc)["render"]["missing"] - before == {planted}
 
 
-def test_a_listed_folder_is_caught():
-    """A folder is never an exact code dep."""
+def test_a_folder_the_stage_does_not_run_is_caught():
+    """A library folder the stage never imports is an extra dep; a library module is listed as its folder."""
     dvc = _real_dvc()
-    dvc_stages(dvc)["voxelize"]["deps"].append("src/graspaug/io")
-    assert "src/graspaug/io" in compare_code_deps(dvc)["voxelize"]["extra"]
+    dvc_stages(dvc)["voxelize"]["deps"].append("src/graspaug/sim")
+    assert "src/graspaug/sim" in compare_code_deps(dvc)["voxelize"]["extra"]
+    assert dvc_deps({"src/graspaug/geometry/voxelize.py", "src/graspaug/pipeline/stages/voxelize.py"}) == {
+        "src/graspaug/geometry",
+        "src/graspaug/pipeline/stages/voxelize.py",
+    }
+
+
+def written_deps(text: str, deps: dict[str, set[str]]) -> str:
+    """dvc.yaml's ``text`` with each stage's ``src/`` deps replaced by ``deps[stage]`` (sorted, where its first
+    ``src/`` dep was); comments, other deps and every other line kept."""
+    out, stage, written = [], None, False
+    for line in text.splitlines(keepends=True):
+        if line.startswith("  ") and not line.startswith("   ") and line.split("#")[0].rstrip().endswith(":"):
+            stage, written = line.split(":")[0].strip(), False
+        if stage in deps and line.lstrip().startswith("- src/"):
+            if not written:
+                indent = line[: len(line) - len(line.lstrip())]
+                out += [f"{indent}- {d}\n" for d in sorted(deps[stage])]
+                written = True
+            continue
+        out.append(line)
+    return "".join(out)
+
+
+def test_write_puts_back_what_the_check_expects():
+    """`--write` on a dvc.yaml with a stage's src deps scrambled gives a file this test passes on."""
+    text = DVC_YAML.read_text()
+    scrambled = text.replace("- src/graspaug/pipeline/stages/voxelize.py", "- src/graspaug/sim", 1)
+    assert scrambled != text
+    expected = {name: dvc_deps(files) for name, files in expected_code_deps().items()}
+    assert compare_code_deps(yaml.safe_load(written_deps(scrambled, expected))) == {}
 
 
 def test_import_closure_follows_every_import_form(tmp_path):
@@ -215,15 +259,19 @@ def test_import_closure_follows_every_import_form(tmp_path):
 def test_stages_are_thin_adapters_that_import_no_stage():
     """A stage reads its params, calls library code and writes outputs: at most ~100 lines as ruff formats them, and
     what a test or another stage needs lives in a library module, not in a stage."""
-    for path in sorted((SRC / "graspaug/stages").glob("*.py")):
+    for path in sorted((SRC / "graspaug/pipeline/stages").glob("*.py")):
         if path.name == "__init__.py":
             continue
         assert len(path.read_text().splitlines()) <= 100, f"{path.name} is {len(path.read_text().splitlines())} lines"
-        imported = module_imports(f"graspaug.stages.{path.stem}", SRC)
+        imported = module_imports(f"graspaug.pipeline.stages.{path.stem}", SRC)
         assert not {m for m in imported if m.startswith(STAGES)}, (
             f"{path.name} imports a stage: {sorted(m for m in imported if m.startswith(STAGES))}"
         )
 
 
 if __name__ == "__main__":
-    sys.stdout.write(_yaml_lists(expected_code_deps()))
+    listed = {name: dvc_deps(files) for name, files in expected_code_deps().items()}
+    if "--write" in sys.argv[1:]:
+        DVC_YAML.write_text(written_deps(DVC_YAML.read_text(), listed))
+    else:
+        sys.stdout.write(_yaml_lists(listed))

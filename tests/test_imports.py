@@ -77,13 +77,13 @@ def test_planning_does_not_import_sim_or_experiments():
 
 
 def test_libraries_know_no_file_layout():
-    """Only stages and the CLI know file names (graspaug.paths) and raise StageError."""
+    """Only stages and the CLI know file names (graspaug.pipeline.paths) and raise StageError."""
     graph = import_graph(SRC)
-    users = {m for m in graph.predecessors("graspaug.paths")}
-    assert {m for m in users if not (m.startswith("graspaug.stages") or m == "graspaug.cli")} == set()
+    users = {m for m in graph.predecessors("graspaug.pipeline.paths")}
+    assert {m for m in users if not (m.startswith("graspaug.pipeline.stages") or m == "graspaug.pipeline.cli")} == set()
     for path in sorted((SRC / "graspaug").rglob("*.py")):
         module = module_name(path, SRC)
-        if module.startswith("graspaug.stages") or module in ("graspaug.cli", "graspaug.errors"):
+        if module.startswith("graspaug.pipeline.stages") or module in ("graspaug.pipeline.cli", "graspaug.errors"):
             continue
         assert "StageError" not in path.read_text(), f"{module} uses StageError (libraries raise DataError)"
 
@@ -91,8 +91,47 @@ def test_libraries_know_no_file_layout():
 def test_settings_modules_are_plain_data():
     """A settings module imports only other settings modules (its section is data, not code)."""
     graph = import_graph(SRC)
-    data = {m for m in graph if m.endswith(".settings") or m.startswith("graspaug.params.")} - {"graspaug.params.base"}
-    allowed = data | {"graspaug.settings", "graspaug.params", "graspaug.sim.catalog", "graspaug.grasping.gripper"}
+    code = {"graspaug.pipeline.params.base", "graspaug.pipeline.params.model", "graspaug.pipeline.params.profiles"}
+    data = {m for m in graph if m.endswith(".settings") or m.startswith("graspaug.pipeline.params.")} - code
+    allowed = data | {
+        "graspaug.settings",
+        "graspaug.pipeline.params",
+        "graspaug.sim.catalog",
+        "graspaug.grasping.gripper",
+    }
     for module in sorted(data):
         reached = nx.descendants(graph, module)
         assert reached <= allowed, f"{module} imports code: {sorted(reached - allowed)}"
+
+
+def _room(module: str) -> str:
+    """The room of a module: its package under graspaug (``graspaug.augment.pools`` → ``augment``)."""
+    return (module.split(".") + [""])[1]
+
+
+def test_rooms_point_down():
+    """pipeline → experiments / planning → augment / training → libraries: nothing outside ``pipeline`` imports
+    it (params, stages, paths, the CLI: a library takes its own settings classes, never a params section), and
+    ``training`` never reaches the experiments."""
+    graph = import_graph(SRC)
+    up = sorted((a, b) for a, b in graph.edges if _room(b) == "pipeline" and _room(a) != "pipeline")
+    assert not up, f"imports of the pipeline from below it: {up}"
+    training = [m for m in graph if _room(m) == "training"]
+    reached = set().union(*(nx.descendants(graph, m) for m in training))
+    assert not {m for m in reached if _room(m) == "experiments"}, "training reaches the experiments"
+
+
+def test_a_planted_upward_import_is_found(tmp_path):
+    for name, text in {
+        "graspaug/__init__.py": "",
+        "graspaug/pipeline/__init__.py": "",
+        "graspaug/pipeline/params.py": "X = 1\n",
+        "graspaug/grasping/__init__.py": "",
+        "graspaug/grasping/labelled.py": "from graspaug.pipeline.params import X\n",
+    }.items():
+        (tmp_path / name).parent.mkdir(parents=True, exist_ok=True)
+        (tmp_path / name).write_text(text)
+    graph = import_graph(tmp_path)
+    assert [(a, b) for a, b in graph.edges if _room(b) == "pipeline" and _room(a) != "pipeline"] == [
+        ("graspaug.grasping.labelled", "graspaug.pipeline.params")
+    ]

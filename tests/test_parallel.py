@@ -9,7 +9,7 @@ import pandas as pd
 import pytest
 
 from graspaug.parallel import Workers, parallel_map
-from graspaug.profiles import profile_params
+from graspaug.pipeline.params.profiles import profile_params
 
 
 def square(x: int) -> int:
@@ -35,7 +35,7 @@ def worker_address(_: int) -> str:
 
 def run_ingest_and_voxelize(folder, params, monkeypatch) -> tuple[pd.DataFrame, dict, dict]:
     from graspaug.io.voxels import read_voxels
-    from graspaug.stages import ingest, voxelize
+    from graspaug.pipeline.stages import ingest, voxelize
 
     monkeypatch.chdir(folder)
     ingest.run(params)
@@ -77,9 +77,9 @@ def test_workers_hand_freed_memory_back_so_loky_restarts_none(tmp_path):
     2 GiB, so none is restarted and nothing is warned of."""
     import warnings
 
-    from graspaug.corpus import ingest_source
+    from graspaug.augment.corpus import ingest_source
     from graspaug.io.sources import pybullet_sources
-    from graspaug.params.ingest import IngestParams
+    from graspaug.pipeline.params.ingest import IngestParams
 
     cfg = IngestParams()
     sources = pybullet_sources(60)

@@ -144,8 +144,8 @@ def nearest_train_shapes(work: Path, folder: Path, train: set, count: int) -> di
     train shapes in latent space, computed here from the library's parts."""
     import torch
 
-    from graspaug.config import load_params
     from graspaug.io.checkpoints import load_autoencoder
+    from graspaug.pipeline.params.model import load_params
     from graspaug.sim.objects import folder_meshes
     from graspaug.training.autoencoder import encode_meshes
 
@@ -223,7 +223,7 @@ def test_dvc_repro_generate_and_its_grasps(tiny_repo):
 
     import trimesh
 
-    from graspaug.generation import draw_base_sets
+    from graspaug.augment.candidates import draw_base_sets
     from graspaug.training.gqcnn_data import load_split
 
     work, env = tiny_repo
@@ -539,11 +539,11 @@ def test_dvc_repro_lifelong_rounds(tiny_repo):
 
 def test_a_one_member_network_is_a_plain_gqcnn(tiny_repo, tmp_path):
     """gqcnn.members = 1 (the study and paper profiles) writes one GQ-CNN, as before ensembles existed."""
-    from graspaug.config import load_params
-    from graspaug.experiments.networks import NetworkJob, seed_members, train_network, weights_digest
-    from graspaug.experiments.variants import Variant
     from graspaug.io.tables import read_table
+    from graspaug.pipeline.params.model import load_params
     from graspaug.training.gqcnn_data import Corpora, load_split
+    from graspaug.training.networks import NetworkJob, seed_members, train_network, weights_digest
+    from graspaug.training.variants import Variant
 
     work, env = tiny_repo
     run(["dvc", "repro", "render@original"], work, env)

@@ -413,7 +413,7 @@ def pick_story(
 
 
 def generated_pairs(base: np.ndarray, voxels, decoded: list, path: str | os.PathLike, title: str) -> None:
-    """Parent a | child | parent b for each of ``decoded`` (``graspaug.generation.Decoded``), from
+    """Parent a | child | parent b for each of ``decoded`` (``graspaug.augment.candidates.Decoded``), from
     base set ``base`` (shape ids, indexed by the candidates) and the corpus' ``voxels`` (VoxelSet)."""
     row_of = {s: i for i, s in enumerate(voxels.shape_id)}
 

@@ -10,7 +10,7 @@ from graspaug.errors import DataError
 from graspaug.experiments import ap
 from graspaug.experiments.ap import collect, declared_contrasts
 from graspaug.experiments.settings import POOLS
-from graspaug.experiments.variants import seed_variants
+from graspaug.training.variants import seed_variants
 
 
 def test_the_declared_contrasts():
@@ -180,7 +180,7 @@ def test_evaluate_networks_is_the_report_chain_step_by_step(tmp_path):
 def test_the_augmentation_set_is_the_targeted_pools_first_rows():
     import pandas as pd
 
-    from graspaug.generation import ratio_count
+    from graspaug.augment.candidates import ratio_count
 
     generated = pd.DataFrame({"pool": ["targeted"] * 6 + ["random"] * 6, "order": list(range(6)) * 2})
     chosen = ap.augmentation_set(generated, 4, 0.5)

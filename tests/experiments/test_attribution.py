@@ -9,7 +9,7 @@ from sklearn.metrics import average_precision_score
 
 from graspaug.errors import DataError
 from graspaug.experiments.attribution import combine_draws, decomposition_markdown, losing_step
-from graspaug.experiments.variants import seed_variants
+from graspaug.training.variants import seed_variants
 
 GENERATE = SimpleNamespace(base_sizes=[10, 20], ratios=[0.0, 1.0])
 GQCNN = SimpleNamespace(augment_base_sizes=[10], pools=("targeted", "random", "real", "recon", "blend"))

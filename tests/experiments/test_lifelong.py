@@ -1,13 +1,14 @@
-"""The lifelong loop's choices (graspaug.experiments.lifelong, graspaug.generation.FailureStream) on hand-made data."""
+"""The lifelong loop's choices (graspaug.experiments.lifelong, graspaug.augment.candidates.FailureStream) on
+hand-made data."""
 
 from collections import Counter
 
 import numpy as np
 import pytest
 
+from graspaug.augment.candidates import EXTRA_ALPHAS, FailureStream, neighbour_pairs
 from graspaug.errors import DataError
 from graspaug.experiments.lifelong import disjoint, failure_anchors, object_errors, worst_objects
-from graspaug.generation import EXTRA_ALPHAS, FailureStream, neighbour_pairs
 
 
 def test_object_errors_rank_the_object_the_network_gets_wrong_first():
@@ -95,8 +96,8 @@ def test_validation_errors_average_the_seeds_predictions_and_rank_worst_first(tm
 
 
 def test_rounds_name_the_round_they_follow_and_none_is_missing():
-    from graspaug.config import ParamsError, params_dict, parse_params
-    from graspaug.profiles import merge
+    from graspaug.pipeline.params.model import ParamsError, params_dict, parse_params
+    from graspaug.pipeline.params.profiles import merge
 
     def rounds(value):
         return parse_params(merge(params_dict(), {"lifelong": {"rounds": value}})).lifelong
@@ -111,10 +112,10 @@ def test_each_round_adds_new_shapes_to_each_arm_and_never_a_pair_and_weight_made
     import pandas as pd
     import trimesh
 
-    from graspaug.generation import Decoded, candidate_key
-    from graspaug.generation_meshes import BaseSet, loop_shapes
-    from graspaug.params.generate import GenerateParams
-    from graspaug.scores import rarity
+    from graspaug.augment.candidates import Decoded, candidate_key
+    from graspaug.augment.pools import BaseSet, loop_shapes
+    from graspaug.augment.scores import rarity
+    from graspaug.pipeline.params.generate import GenerateParams
 
     box = trimesh.creation.box(extents=(0.04, 0.03, 0.02))
     rng = np.random.default_rng(0)

@@ -2,8 +2,8 @@
 
 import torch
 
-from graspaug.experiments.networks import initial_weights, seed_headline, seed_members, stream_seeds, weights_digest
 from graspaug.nets.settings import GQCNNConfig
+from graspaug.training.networks import initial_weights, seed_headline, seed_members, stream_seeds, weights_digest
 
 
 def test_the_networks_of_a_seed_share_initial_weights_and_seeds_differ():
@@ -49,8 +49,8 @@ def test_a_seeds_lines_timing_and_split_files(tmp_path):
 
     import numpy as np
 
-    from graspaug.experiments.networks import precision_warning, result_lines, save_seed_split, seed_timing
     from graspaug.training.gqcnn_data import experiment_split
+    from graspaug.training.networks import precision_warning, result_lines, save_seed_split, seed_timing
 
     results = [_summary("targeted", 50, 1.5, 0.5, None), _summary("ceiling", 0, 0.0, 0.61234, 0.7)]
     assert result_lines(results) == [

@@ -89,11 +89,11 @@ def _dataset(folder, rng, shapes: dict[str, str], per_shape: int = 24) -> None:
 def test_train_network_writes_the_operating_point_of_its_validation_predictions(tmp_path):
     """The card's operating point is the max-F1 threshold of the network's validation predictions (and
     not of its test predictions); its training range that of the crops it trained on."""
-    from graspaug.experiments.networks import NetworkJob, seed_members, train_network
-    from graspaug.experiments.variants import Variant
     from graspaug.nets.settings import GQCNNConfig
     from graspaug.training.gqcnn_data import Corpora, ExperimentSplit, shapes_datapoints, test_set
+    from graspaug.training.networks import NetworkJob, seed_members, train_network
     from graspaug.training.settings import TrainSettings
+    from graspaug.training.variants import Variant
 
     corpora = Corpora(tmp_path / "original")
     _dataset(

@@ -14,7 +14,6 @@ import trimesh
 from PIL import Image
 from typer.testing import CliRunner
 
-from graspaug.cli import app
 from graspaug.geometry.loading import load_shape
 from graspaug.geometry.prepare import SurfaceSettings, prepare_shape
 from graspaug.grasping.antipodal import force_closure
@@ -31,6 +30,7 @@ from graspaug.io.checkpoints import (
 from graspaug.io.sources import pybullet_sources
 from graspaug.nets.gqcnn import GQCNN
 from graspaug.nets.settings import GQCNNConfig
+from graspaug.pipeline.cli import app
 from graspaug.planning import ModelCard, NoGraspFound, PlanningError, load_planner, plan_grasp, plan_grasps
 from graspaug.render.camera import look_at
 from graspaug.render.depth import render_depth

@@ -22,7 +22,7 @@ def train_settings(**overrides) -> AETrainConfig:
     """The default ``ae`` params' training settings with a few changed."""
     from dataclasses import replace
 
-    from graspaug.config import Params
+    from graspaug.pipeline.params.model import Params
 
     return replace(Params().ae.train, **overrides)
 

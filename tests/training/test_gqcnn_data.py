@@ -2,8 +2,8 @@
 
 import pytest
 
-from graspaug.experiments.variants import seed_variants
 from graspaug.training.gqcnn_data import experiment_split, training_shapes
+from graspaug.training.variants import seed_variants
 
 TRAIN = [f"rnd_{i:03d}" for i in range(60)]
 BASE = {10: TRAIN[:10], 20: TRAIN[:20]}  # nested, as generate draws them

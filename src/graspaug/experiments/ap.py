@@ -3,7 +3,7 @@ of every network, pre-declared paired contrasts with t-intervals over seeds and 
 intervals over test objects, the ratio chosen on validation, per-object AP, the report's text.
 
 A network is (pool, base size B, ratio R) of a training seed (see
-:mod:`graspaug.experiments.networks`). A contrast is a fixed linear combination of networks'
+:mod:`graspaug.training.networks`). A contrast is a fixed linear combination of networks'
 test AP, evaluated per seed (paired: the networks of a seed share initial weights, noise and
 validation), then summarized over seeds. The contrasts are declared from params before any
 network is read:
@@ -36,7 +36,6 @@ import pandas as pd
 from sklearn.metrics import average_precision_score
 
 from graspaug.errors import DataError
-from graspaug.experiments.settings import POOLS
 from graspaug.experiments.stats import (
     ObjectBootstrap,
     draw_scope,
@@ -46,8 +45,9 @@ from graspaug.experiments.stats import (
     percentile_interval,
     t_interval,
 )
-from graspaug.experiments.variants import network_variant, seed_variants
 from graspaug.io.tables import read_table
+from graspaug.training.settings import POOLS
+from graspaug.training.variants import network_variant, seed_variants
 
 Key = tuple[str, int, float]  # (pool, base size, ratio); ratio 0 of any pool is ("targeted", B, 0.0)
 PAIRS = {  # pool a vs pool b at equal shape counts: what the difference measures
@@ -245,7 +245,7 @@ class Evaluation:
 def evaluate_networks(
     seed_dirs: Mapping[int, Path], original: Path, generate, gqcnn, seed: int, n_resamples: int = 1000
 ) -> Evaluation:
-    """Read every network of every seed (:func:`~graspaug.experiments.variants.seed_variants` of the
+    """Read every network of every seed (:func:`~graspaug.training.variants.seed_variants` of the
     ``generate`` and ``gqcnn`` params) in its seed's folder (``seed_dirs``: training seed → folder;
     a missing network is a :class:`DataError`), choose the ratios on validation AP, evaluate the
     declared contrasts (``n_resamples`` bootstrap resamples of the test objects, seeded by the
@@ -541,7 +541,7 @@ def compared_predictions(seed_dir: Path, base_size: int, ratio: float, ceiling: 
 def augmentation_set(generated: pd.DataFrame, base_size: int, ratio: float) -> pd.DataFrame:
     """The rows of the generated index ``generated`` (of base size ``base_size``) that the targeted
     network at 1:``ratio`` trains on: the targeted pool's first ``ratio_count(ratio, base_size)``."""
-    from graspaug.generation import ratio_count
+    from graspaug.augment.candidates import ratio_count
 
     return generated[(generated.pool == "targeted") & (generated.order < ratio_count(ratio, base_size))]
 
@@ -561,7 +561,7 @@ def score_panels(
     rows of the generated index; ``grasps``: the generated shapes' grasps (``shape_id``, ``success``);
     ``latents``, ``scores``: by shape id. Also returns the generated shapes' graspness (share of
     successful grasps, 0 without grasps)."""
-    from graspaug.scores import rarity
+    from graspaug.augment.scores import rarity
 
     generated_graspness = grasps.groupby("shape_id").success.mean().reindex(generated.shape_id).fillna(0.0).to_numpy()
     z_base = np.stack(latents.loc[base_set.shape_id, "z"].to_numpy())

@@ -37,7 +37,7 @@ from graspaug.experiments.stats import (
     nested_means,
     percentile_interval,
 )
-from graspaug.experiments.variants import seed_variants
+from graspaug.training.variants import seed_variants
 
 STEPS = ("recon_vs_real", "blend_vs_recon", "targeted_vs_blend", "targeted_vs_random")
 

@@ -3,7 +3,7 @@ shapes to generate from, and what each round's arms gain.
 
 A round scores every *validation* object by the round's networks (the test split never chooses
 anything), takes the worst ones and anchors generation at the training shapes nearest to them in
-latent space (:class:`graspaug.generation.FailureStream` pairs each anchor with its neighbours).
+latent space (:class:`graspaug.augment.candidates.FailureStream` pairs each anchor with its neighbours).
 The anchors are always training shapes: a validation or test object only points at them.
 """
 
@@ -28,7 +28,7 @@ from graspaug.experiments.stats import (
     nested_means,
     percentile_interval,
 )
-from graspaug.experiments.variants import Variant
+from graspaug.training.variants import Variant
 
 EPS = 1e-6  # probabilities are clipped to [EPS, 1 − EPS] for the log loss
 

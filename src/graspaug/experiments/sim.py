@@ -24,9 +24,9 @@ import numpy as np
 import pandas as pd
 
 from graspaug.errors import DataError
-from graspaug.experiments.variants import network_variant
 from graspaug.rng import shape_rng
 from graspaug.sim.objects import PreparedObject, prepare_objects
+from graspaug.training.variants import network_variant
 
 log = logging.getLogger(__name__)
 

@@ -9,14 +9,14 @@ import pandas as pd
 
 from graspaug.grasping.antipodal import sample_antipodal_grasps
 from graspaug.grasping.robust import grasp_epsilon, robust_ferrari_canny
+from graspaug.grasping.settings import GraspsSettings
 from graspaug.io.meshes import read_mesh
-from graspaug.params.grasps import GraspsParams
 from graspaug.rng import shape_rng
 
 VECTORS = ("center", "axis", "p1", "n1", "p2", "n2")
 
 
-def grasps_of_shape(path: Path, shape_id: str, cfg: GraspsParams, seed: int) -> tuple[pd.DataFrame, str | None]:
+def grasps_of_shape(path: Path, shape_id: str, cfg: GraspsSettings, seed: int) -> tuple[pd.DataFrame, str | None]:
     """The grasp rows of one mesh file and, if it has none, why.
 
     Parameters
@@ -83,7 +83,7 @@ def grasps_headline(summary: dict) -> dict[str, float | int | None]:
 
 
 def grasps_of_shapes(
-    mesh_dir: Path, shape_ids: list[str], suffix: str, cfg: GraspsParams, seed: int, workers, label: str
+    mesh_dir: Path, shape_ids: list[str], suffix: str, cfg: GraspsSettings, seed: int, workers, label: str
 ) -> tuple[pd.DataFrame, dict[str, str]]:
     """:func:`grasps_of_shape` for every shape of ``shape_ids`` (meshes ``<mesh_dir>/<shape_id><suffix>``) on
     ``workers`` processes (progress ``label``): (every grasp row, in shape order; shape id → why it has no grasp, for

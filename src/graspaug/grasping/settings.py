@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from graspaug.grasping.gripper import ParallelJawGripper
 from graspaug.settings import Field, settings
 
 
@@ -65,4 +66,28 @@ class Perturbations:
     object_rotation_sigma: float = Field(0.01, ge=0, description="Std of the object rotation in rad.")
     friction_sigma: float = Field(
         0.1, ge=0, description="Std of the perturbed friction coefficient (truncated to [0, 1])."
+    )
+
+
+@settings
+class GraspsSettings:
+    """Antipodal grasps on every shape, labelled by robust Ferrari-Canny (Dex-Net 2.0)."""
+
+    threshold: float = Field(
+        0.002,
+        ge=0,
+        description="A grasp succeeds when its robust ε exceeds this (Dex-Net 2.0, with the torque scaling and "
+        "object size of the defaults).",
+    )
+    gripper: ParallelJawGripper = Field(
+        default_factory=ParallelJawGripper, description="The Franka Panda hand every grasp is made for."
+    )
+    sampler: AntipodalSettings = Field(
+        default_factory=AntipodalSettings, description="Antipodal grasp sampling on the mesh."
+    )
+    quality: QualitySettings = Field(
+        default_factory=QualitySettings, description="The grasp wrench model of Ferrari-Canny ε."
+    )
+    perturbations: Perturbations = Field(
+        default_factory=Perturbations, description="The robust metric's perturbations."
     )

@@ -3,7 +3,7 @@ the `real` pool and the ceiling, and the datapoints of every training set, the v
 and the test set, read from the rendered corpora (GQ-CNN dataset folders, :mod:`graspaug.io.gqcnn`).
 
 Datapoints are :class:`~graspaug.training.gqcnn.GraspArrays`. A network is a
-:class:`~graspaug.experiments.variants.Variant`:
+:class:`~graspaug.training.variants.Variant`:
 
 * ``targeted`` / ``random`` at base size B and ratio R: the datapoints of the B base shapes
   (drawn from the shape table as ``generate`` draws them) in the original corpus plus those of
@@ -26,13 +26,13 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from graspaug.augment.candidates import draw_base_sets, ratio_count
 from graspaug.errors import DataError
-from graspaug.experiments.variants import Variant
-from graspaug.generation import draw_base_sets, ratio_count
 from graspaug.io.gqcnn import GraspImages
 from graspaug.io.tables import read_table
 from graspaug.rng import shape_rng
 from graspaug.training.gqcnn import GraspArrays
+from graspaug.training.variants import Variant
 
 
 @dataclass(frozen=True)

@@ -127,3 +127,10 @@ class TrainSettings:
     def steps_for(self, n_datapoints: int) -> int:
         """SGD steps for a training set of ``n_datapoints``: ``epochs`` passes, clipped to [min_steps, max_steps]."""
         return int(min(self.max_steps, max(self.min_steps, -(-self.epochs * n_datapoints // self.batch_size))))
+
+
+POOLS = ("targeted", "random", "real", "recon", "blend")
+"""Pools of augmented networks, in report order: ``targeted`` / ``random`` (interpolants of the
+base set's rare-and-graspable neighbours / of random pairs), ``real`` (more real train shapes, the
+positive control), ``recon`` (the real pool's shapes decoded from their own latents) and ``blend``
+(the targeted pool's pairs and weights interpolated with no network: mixed signed distance fields)."""

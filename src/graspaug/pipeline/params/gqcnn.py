@@ -1,0 +1,73 @@
+"""The ``gqcnn`` section: the GQ-CNN networks of the experiment, their training and the design."""
+
+from __future__ import annotations
+
+from graspaug.nets.settings import GQCNNConfig
+from graspaug.settings import Field, settings
+from graspaug.training.settings import POOLS, TrainSettings
+
+
+@settings
+class GQCNNParams:
+    """GQ-CNN networks per base size × augmentation ratio (paper Section IV-C), their training and the experiment's
+    design.
+
+    Per training seed: a 1:0 network (the base set alone) at every base size of `generate`;
+    `targeted`, `random` (random-pair interpolants) and `real` (more real train shapes, the
+    positive control for augmentation) at every nonzero ratio of `augment_base_sizes`; the
+    `ceiling` (every train shape outside validation). Every network of a seed starts from the same weights and noise
+    stream; all are validated on the same `val_shapes` train shapes that no network trains on.
+    """
+
+    net: GQCNNConfig = Field(default_factory=GQCNNConfig, description="Layer sizes.")
+    train: TrainSettings = Field(
+        default_factory=TrainSettings, description="SGD schedule, checkpoint choice and train-time noise."
+    )
+    val_shapes: int = Field(
+        100,
+        ge=1,
+        description="Train-split shapes outside every base set held out for validation (checkpoints and the best "
+        "ratio are chosen on them), the same for every network and seed.",
+    )
+    seeds: tuple[int, ...] = Field(
+        (0, 1, 2, 3),
+        description="Training seeds, the replicates of the paired design; intervals need at least 2 (the 95% "
+        "t-interval is 3.18 standard errors wide on each side with 4 seeds, 2.78 with 5, 4.30 with 3).",
+    )
+    augment_base_sizes: tuple[int, ...] = Field(
+        (50,),
+        description="Base sizes that get augmented networks: targeted, random and real at every nonzero ratio of "
+        "generate.ratios (the others get their 1:0 network only; study profile: all).",
+    )
+    ceiling: bool = Field(
+        False,
+        description="Also train one network per seed on every train shape outside validation (how much of the gap "
+        "augmentation closes; study and paper profiles: on).",
+    )
+    pools: tuple[str, ...] = Field(
+        ("targeted", "random", "real", "recon"),
+        description="Pools that get augmented networks at every nonzero ratio of augment_base_sizes: `targeted` "
+        "(interpolants of rare and graspable neighbours), `random` (interpolants of random pairs), `real` (more real "
+        "train shapes, the positive control), `recon` (the real pool's shapes passed through the AutoEncoder alone: "
+        "what decoding and meshing cost), `blend` (the targeted pool's pairs and weights interpolated with no "
+        "network, by mixing the parents' signed distance fields); `generate` makes the generated ones. `targeted` is "
+        "always trained.",
+    )
+    members: int = Field(
+        2,
+        ge=1,
+        le=64,
+        description="GQ-CNNs trained per network, each from its own initial weights and noise stream (member m of "
+        "every network of a seed shares them, so the design stays paired); the network's P(success) is their mean "
+        "(an ensemble, validated, tested and planned with). More members narrow the seed-to-seed spread of the "
+        "contrasts; each costs one more network's training time (study and paper profiles: 1).",
+    )
+
+    def __post_init__(self) -> None:
+        unknown = sorted(set(self.pools) - set(POOLS))
+        if unknown or "targeted" not in self.pools or len(set(self.pools)) != len(self.pools):
+            raise ValueError(
+                f"gqcnn.pools: distinct names of {list(POOLS)}, targeted among them; got {list(self.pools)}"
+            )
+        if not self.seeds or len(set(self.seeds)) != len(self.seeds) or min(self.seeds) < 0:
+            raise ValueError(f"gqcnn.seeds: must be distinct seeds >= 0; got {list(self.seeds)}")

@@ -1,0 +1,99 @@
+"""Stage ``generate``: for one base set of B train shapes (``generate@50`` …), pools of new shapes.
+
+Targeted: the base set's rare, and separately graspable, shapes with their N-th … (N+K)-th latent
+neighbours, ``(1 - α) z_a + α z_b`` decoded by the AE-Critic and meshed (paper Section III-C);
+random: random pairs; recon: the real pool's shapes (the GQ-CNN experiment's order) from their own
+latents; blend: the targeted pairs with no network. ``gqcnn.pools`` says which; each holds
+``ceil(max ratio × B)`` kept shapes, the first ``round(R × B)`` ratio R's set; a failed shape is
+replaced by the next candidate. Writes ``data/generated/<B>/`` (``meshes/``, ``index``, ``rejects``
+and ``base.parquet``), ``metrics/generate/<B>.json``, ``reports/generate/<B>/`` (summary, pictures)."""
+
+from __future__ import annotations
+
+import logging
+import time
+from functools import partial
+
+import numpy as np
+
+from graspaug.augment.candidates import generate_headline
+from graspaug.augment.pools import (
+    GENERATED_POOLS,
+    ReconSource,
+    base_ids,
+    base_set,
+    blend_batches,
+    generate_pools,
+    mesh_batches,
+    tsne_groups,
+)
+from graspaug.device import resolve_device
+from graspaug.io.atomic import atomic_path
+from graspaug.io.checkpoints import load_autoencoder
+from graspaug.io.meshes import mesh_path, read_mesh, write_obj
+from graspaug.io.tables import read_table, write_json, write_table
+from graspaug.io.voxels import read_voxels
+from graspaug.pipeline import paths
+from graspaug.pipeline.params.ae import AEParams
+from graspaug.pipeline.params.base import params_model
+from graspaug.pipeline.params.embed import EmbedParams
+from graspaug.pipeline.params.generate import GenerateParams
+from graspaug.pipeline.params.gqcnn import GQCNNParams
+from graspaug.pipeline.params.score import ScoreParams
+from graspaug.plots import generated_pairs, scatter_2d
+from graspaug.training.gqcnn_data import load_split
+
+log = logging.getLogger(__name__)
+
+Params = params_model(
+    "The params the `generate` stage reads.",
+    ae=AEParams,
+    embed=EmbedParams,
+    score=ScoreParams,
+    generate=GenerateParams,
+    gqcnn=GQCNNParams,
+)
+
+
+def run(params: Params, base_size: int) -> None:
+    start = time.perf_counter()
+    cfg = params.generate
+    shapes, latents, scores = (read_table(path) for path in (paths.SHAPES_TABLE, paths.LATENTS, paths.SCORES))
+    voxels = read_voxels(paths.VOXELS)
+    ids = base_ids(shapes, cfg.base_sizes, base_size, params.data_seed)
+    base = base_set(ids, latents, scores, voxels, params.score.k)
+
+    ae, _, _ = load_autoencoder(paths.AE_CRITIC_MODEL, params.ae.net)
+    meshes = partial(mesh_batches, ae, resolve_device(params.device), settings=cfg.decode, workers=params.workers)
+    gq = params.gqcnn
+    pools, recon, blend = [p for p in GENERATED_POOLS if p in gq.pools], None, None
+    if "recon" in pools:  # the real pool as the GQ-CNN experiment draws it
+        split = load_split(paths.gqcnn_dir("original"), shapes, list(cfg.base_sizes), gq.val_shapes, params.data_seed)
+        real = base_set(np.array(split.real_pool), latents, scores, voxels, params.score.k)
+        recon = ReconSource(real, meshes(real, label=f"generate {base_size} recon"))
+    if "blend" in pools:  # the base shapes' own surfaces
+        solids = [read_mesh(mesh_path(paths.SHAPES_DIR, s)) for s in ids]
+        blend = blend_batches(solids, cfg.blend.resolution, cfg.blend.margin, params.workers, f"blend {base_size}")
+    run_batch = meshes(base, label=f"generate {base_size}")
+    out = generate_pools(base, cfg, params.data_seed, run_batch, params.score.k, pools, recon, blend)
+    for level, message in [(logging.INFO, n) for n in out.notes] + [(logging.WARNING, w) for w in out.warnings]:
+        log.log(level, "generate %d: %s", base_size, message)
+
+    with atomic_path(paths.generated_dir(base_size), directory=True) as folder:
+        (folder / "meshes").mkdir()
+        for shape_id, d in zip(out.index.shape_id, out.kept):
+            write_obj(d.mesh, mesh_path(folder / "meshes", shape_id, paths.GENERATED_SUFFIX))
+        for name, table in (("index", out.index), ("rejects", out.rejects), ("base", out.base_table)):
+            write_table(table, folder / f"{name}.parquet")
+
+    reports = paths.generate_reports(base_size)
+    generated_pairs(ids, voxels, out.examples, reports / "pairs.png", f"Generated shapes of base set {base_size}")
+    xy, groups = tsne_groups(base, out.index, params.embed.perplexity, params.seed)
+    scatter_2d(xy, groups, reports / "tsne.png", f"t-SNE of base set {base_size} and its generated shapes")
+
+    write_json(out.summary, paths.generate_summary(base_size))
+    write_json(generate_headline(out.summary), paths.generate_metrics(base_size))
+    seconds = round(time.perf_counter() - start, 1)
+    write_json({"seconds": seconds}, paths.timing_file("generate", str(base_size)))
+    counts = " + ".join(f"{out.summary[p]['kept']} {p} ({out.summary[p]['tried']} tried)" for p in pools)
+    log.info("generate %d: %s shapes, %d rejected, in %.1f s", base_size, counts, len(out.rejects), seconds)

@@ -1,0 +1,100 @@
+"""Stage ``report``: the paper's GQ-CNN experiment in one table, declared contrasts with intervals, figures, words.
+
+Reads every network of every seed (``models/gqcnn/s<seed>/``). Writes ``metrics/ap/<contrast>.json`` (``mean``,
+``lo``, ``hi``: 95% t over seeds) and, in ``reports/gqcnn/``: ``ap.json`` (per declared contrast ``mean``,
+``ci_low``/``ci_high``, ``n_seeds``, ``sd``, ``boot_low``/``boot_high`` (95% bootstrap over test objects); test,
+validation and per-object AP per network; ``chosen_ratio`` per base size, picked on validation AP), ``ap_table.csv``,
+``report.md``, ``decomposition.{md,json}`` (the gap to real shapes step by step, real → recon → blend → targeted /
+random, intervals over the seeds and test objects of this run's one draw of the data), ``ap_vs_ratio.png`` (Fig. 7),
+``improvement_by_score.png`` (Fig. 8: per-object AP change of the chosen ratio over 1:0 at the largest base size, by
+rarity and graspness interval) and ``tsne_graspness.png`` (Fig. 1).
+"""
+
+from __future__ import annotations
+
+import logging
+
+from graspaug.experiments.ap import (
+    ap_headline,
+    ap_metrics,
+    evaluate_networks,
+    gain_sentences,
+    improvement_data,
+    ratio_curves,
+    report_markdown,
+    training_words,
+    verdict,
+)
+from graspaug.experiments.ap_figures import draw_ap_vs_ratio, draw_improvement, draw_latent_map, draw_pr_roc
+from graspaug.experiments.attribution import combine_draws, decomposition_markdown, losing_step
+from graspaug.io.atomic import atomic_path
+from graspaug.io.tables import read_table, write_csv, write_json, write_json_files
+from graspaug.pipeline.params.base import params_model
+from graspaug.pipeline.params.embed import EmbedParams
+from graspaug.pipeline.params.generate import GenerateParams
+from graspaug.pipeline.params.gqcnn import GQCNNParams
+from graspaug.pipeline.params.score import ScoreParams
+from graspaug.pipeline.paths import (
+    AP_METRICS,
+    AP_REPORT,
+    LATENTS,
+    REPORT_DIR,
+    SCORES,
+    base_set_table,
+    generated_index,
+    gqcnn_dir,
+    gqcnn_seed_dir,
+    grasps_table,
+)
+
+log = logging.getLogger(__name__)
+
+Params = params_model(
+    "The params the `report` stage reads.",
+    embed=EmbedParams,
+    score=ScoreParams,
+    generate=GenerateParams,
+    gqcnn=GQCNNParams,
+)
+
+
+def run(params: Params) -> None:
+    gen, cfg, seeds = params.generate, params.gqcnn, list(params.gqcnn.seeds)
+    seed_dirs = {seed: gqcnn_seed_dir(seed) for seed in seeds}
+    # a missing network is a DataError, which the CLI prints in one line
+    ev = evaluate_networks(seed_dirs, gqcnn_dir("original"), gen, cfg, params.seed)
+    table, chosen, results, labels = ev.table, ev.chosen, ev.contrasts, ev.labels
+    write_csv(table, REPORT_DIR / "ap_table.csv")
+    write_csv(ratio_curves(table), REPORT_DIR / "ap_vs_ratio.csv")  # the curves of ap_vs_ratio.png, one column each
+    extras = gain_sentences(results, table, chosen, cfg.augment_base_sizes, ev.ceiling_shapes if cfg.ceiling else None)
+    draw_ap_vs_ratio(table, seeds, REPORT_DIR / "ap_vs_ratio.png")
+    # real → recon → blend → targeted / random, step by step, on this run's one draw of the data
+    steps = combine_draws({params.data_seed: seed_dirs}, labels, ev.object_ids, gen, cfg, 1000, params.seed)
+    write_json(steps, REPORT_DIR / "decomposition.json")
+    extras += [losing_step(steps["contrasts"], b) for b in cfg.augment_base_sizes]
+    with atomic_path(REPORT_DIR / "decomposition.md") as tmp:
+        tmp.write_text(decomposition_markdown(steps, cfg.augment_base_sizes, "dvc repro report"))
+    # Fig. 8: the largest augmented base size, its ratio chosen on validation against 1:0
+    base = max(cfg.augment_base_sizes)
+    compare = chosen.get(base, max(gen.ratios))
+    # the networks sim compares (and the ceiling): PR and ROC curves of their test predictions
+    draw_pr_roc(labels, seed_dirs[seeds[0]], seeds[0], base, compare, cfg.ceiling, REPORT_DIR / "pr_roc.png")
+    scores, latents = read_table(SCORES).set_index("shape_id"), read_table(LATENTS).set_index("shape_id")
+    base_set, generated = read_table(base_set_table(base)), read_table(generated_index(base))
+    grasps = read_table(grasps_table(f"gen_{base}"))
+    improvement, augmentation, panels, generated_graspness = improvement_data(
+        ev.by_network, seeds, base, compare, base_set, generated, grasps, latents, scores, params.score.k
+    )
+    draw_improvement(panels, improvement, base, compare, REPORT_DIR / "improvement_by_score.png")
+    # Fig. 1: t-SNE of original train and generated latents by graspness
+    tsne, perplexity = REPORT_DIR / "tsne_graspness.png", params.embed.perplexity
+    draw_latent_map(latents, scores, augmentation, generated_graspness, base, perplexity, params.seed, tsne)
+    positive_share = float(labels.mean())
+    ap_report = ap_metrics(results, table, chosen, positive_share, seeds)
+    write_json(ap_report, AP_REPORT)
+    write_json_files(ap_headline(ap_report), AP_METRICS)
+    words = training_words(cfg.train, cfg.members)
+    with atomic_path(REPORT_DIR / "report.md") as tmp:
+        tmp.write_text(report_markdown(table, results, chosen, extras, seeds, positive_share, words, params.data_seed))
+    for name, c in results.items():
+        log.info("report: %s", verdict(name, c))

@@ -1,0 +1,100 @@
+"""Stage ``sim``: simulated Panda pick-and-place trials with the GQ-CNN before and after augmentation.
+
+Arms (:mod:`graspaug.experiments.sim`): ``before`` (B = ``sim.base_size``, ratio 0), ``after`` (the ratio chosen on
+validation AP), ``real`` (the ``real`` pool there), ``more_real`` (the largest B at ratio 0: the positive
+control), each per training seed, and ``antipodal`` (no network). Every object (``sim.objects``, ``sim.n_test_objects``
+test shapes, ``sim.objects_path``) is dropped ``sim.attempts`` times, the same drops for every arm; the planner sees a
+D435-like noisy depth image. Each arm's networks also rank the grasps ``grasp_calibration`` executed in this cell
+(:mod:`graspaug.experiments.cell_ranking`). Writes ``metrics/sim/<contrast>.json`` (``mean``, ``lo``, ``hi``: paired
+difference in success, bootstrap over objects; ``ranking_<contrast>``: in ROC AUC against the executed grasps'
+outcomes) and ``reports/sim/`` (``summary.json``, ``report.md``, ``trials.csv``, ``success.{csv,png}``,
+``objects.csv``, ``calibration.csv``, ``timing.json``, ``trials/<arm>-<object>.png``).
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import time
+
+from graspaug.experiments.cell_ranking import cell_ranking
+from graspaug.experiments.sim import (
+    after_ratio,
+    arms,
+    object_jobs,
+    run_trials,
+    trial_objects,
+    trials_plan,
+    trials_table,
+)
+from graspaug.experiments.sim_outputs import write_trials_report
+from graspaug.experiments.sim_report import (
+    calibration,
+    outcome_words,
+    planning_timing,
+    sim_headline,
+    summarize,
+    trial_setup,
+)
+from graspaug.io.atomic import atomic_path
+from graspaug.io.tables import read_table, write_json, write_json_files
+from graspaug.pipeline import paths
+from graspaug.pipeline.params.base import params_model
+from graspaug.pipeline.params.generate import GenerateParams
+from graspaug.pipeline.params.gqcnn import GQCNNParams
+from graspaug.pipeline.params.grasps import GraspsParams
+from graspaug.pipeline.params.ingest import IngestParams
+from graspaug.pipeline.params.render import RenderParams
+from graspaug.pipeline.params.sim import SimParams
+from graspaug.pipeline.stages import StageError
+
+log = logging.getLogger(__name__)
+NO_AP = "sim: %s has no AP for base size %d; comparing ratio 0 with the largest ratio %g"
+
+Params = params_model(
+    "The params the `sim` stage reads.",
+    ingest=IngestParams,
+    grasps=GraspsParams,
+    generate=GenerateParams,
+    render=RenderParams,
+    gqcnn=GQCNNParams,
+    sim=SimParams,
+)
+
+
+def run(params: Params) -> None:
+    start = time.perf_counter()
+    cfg, model_seeds = params.sim, list(params.gqcnn.seeds)
+    executed = paths.CALIBRATION_REPORT_DIR / "grasps.csv"  # the calibration's grasps, which every network ranks
+    for path, stage in ((paths.AP_REPORT, "report"), (executed, "grasp_calibration")):
+        if not path.exists():
+            raise StageError(f"{path} is missing: run `dvc repro {stage}` first")
+    best, from_report = after_ratio(json.loads(paths.AP_REPORT.read_text()), cfg.base_size, params.generate.ratios)
+    if not from_report:
+        log.warning(NO_AP, paths.AP_REPORT, cfg.base_size, best)
+    seed_dirs = {seed: paths.gqcnn_seed_dir(seed) for seed in model_seeds}
+    chosen = arms(best, cfg.base_size, seed_dirs, params.generate.base_sizes)
+    # an empty or unreadable sim.objects_path: a DataError, which the CLI prints in one line
+    objects, skipped = trial_objects(
+        cfg, read_table(paths.SHAPES_TABLE), paths.SHAPES_DIR, params.ingest, params.seed, params.workers
+    )
+    jobs = object_jobs(objects, chosen, seed_dirs, cfg.attempts, params.seed, cfg.n_pictures)
+    log.info("sim: %s", trials_plan(objects, chosen, cfg.attempts, len(model_seeds), skipped))
+    rows = run_trials(jobs, cfg, params.render.crop, params.workers)
+    trials = trials_table(rows, chosen)
+    setup = trial_setup(cfg, objects, skipped, model_seeds, after_from_report=from_report, data_seed=params.data_seed)
+    metrics = summarize(trials, objects, chosen, setup, cfg.n_bootstrap, params.seed)
+    scores = read_table(paths.SCORES).set_index("shape_id")  # no grasp sampled: n/a, not 0
+    calibration_table, metrics["calibration"] = calibration(trials, scores.graspness[scores.n_grasps > 0])
+    metrics["ranking"] = cell_ranking(read_table(executed), seed_dirs, chosen, cfg.n_bootstrap, params.seed)
+    timing = planning_timing(trials, list(chosen))
+
+    with atomic_path(paths.SIM_REPORT_DIR, directory=True) as out:
+        write_trials_report(
+            out, rows, trials, objects, calibration_table, metrics, chosen, model_seeds, paths.SCORES.as_posix()
+        )
+        timing["stage_seconds"] = round(time.perf_counter() - start, 1)
+        write_json(timing, out / "timing.json")
+        write_json(metrics, out / "summary.json")
+    write_json_files(sim_headline(metrics), paths.SIM_METRICS)
+    log.info("sim: %s; %.0f s", outcome_words(metrics, timing), time.perf_counter() - start)

@@ -1,0 +1,100 @@
+"""Stage ``train_gqcnn``: every GQ-CNN of one training seed, as a paired set.
+
+Networks (``experiments.variants.seed_variants``): targeted at every base size × ratio of ``generate``; the other
+``gqcnn.pools`` at every nonzero ratio of ``gqcnn.augment_base_sizes``; the ceiling. All start from the seed's
+initial weights and noise stream, are validated on the same ``gqcnn.val_shapes`` train shapes and keep the weights
+of their best validation AP (``gqcnn.members`` > 1: ensembles); tested on every test datapoint of the corpus.
+
+Outputs: ``models/gqcnn/s<seed>/`` (one folder per network, ``test_rows.npy``, ``val_rows.npy``, ``split.json``),
+``metrics/gqcnn/s<seed>.json`` (test and validation AP, means over the networks), ``reports/gqcnn/networks/
+s<seed>.json`` (AP per network), ``reports/gqcnn/validation/s<seed>.{png,csv}`` (validation AP vs step).
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+
+from graspaug.device import resolve_device
+from graspaug.io.atomic import atomic_path
+from graspaug.io.tables import read_table, write_csv, write_json
+from graspaug.pipeline.params.base import params_model
+from graspaug.pipeline.params.generate import GenerateParams
+from graspaug.pipeline.params.gqcnn import GQCNNParams
+from graspaug.pipeline.params.grasps import GraspsParams
+from graspaug.pipeline.params.render import RenderParams
+from graspaug.pipeline.paths import (
+    SHAPES_TABLE,
+    gqcnn_dir,
+    gqcnn_seed_dir,
+    gqcnn_seed_metrics,
+    gqcnn_seed_networks,
+    gqcnn_val_curves,
+    timing_file,
+)
+from graspaug.pipeline.stages import StageError
+from graspaug.plots import validation_curves
+from graspaug.training.gqcnn_data import Corpora, load_split, shapes_datapoints, test_set
+from graspaug.training.networks import (
+    NetworkJob,
+    precision_warning,
+    read_history,
+    result_lines,
+    save_seed_split,
+    seed_card,
+    seed_headline,
+    seed_members,
+    seed_plan,
+    seed_table,
+    seed_timing,
+    train_jobs,
+)
+from graspaug.training.variants import seed_variants
+
+log = logging.getLogger(__name__)
+
+Params = params_model(
+    "The params the `train_gqcnn` stage reads.",
+    grasps=GraspsParams,
+    generate=GenerateParams,
+    render=RenderParams,
+    gqcnn=GQCNNParams,
+)
+
+
+def run(params: Params, seed: int) -> None:
+    cfg, gen = params.gqcnn, params.generate
+    if seed not in cfg.seeds:
+        raise StageError(f"seed {seed} is not in gqcnn.seeds {list(cfg.seeds)}")
+    start = time.perf_counter()
+    corpora = Corpora(gqcnn_dir("original"), {b: gqcnn_dir(f"gen_{b}") for b in cfg.augment_base_sizes})
+    shapes = read_table(SHAPES_TABLE)  # too few for the validation set: a DataError, printed in one line
+    split = load_split(corpora.original, shapes, list(gen.base_sizes), cfg.val_shapes, params.data_seed)
+    variants = seed_variants(gen.base_sizes, gen.ratios, cfg.augment_base_sizes, cfg.ceiling, cfg.pools)
+    device = resolve_device(params.device)
+    inits, noise_seeds = seed_members(cfg.net, params.seed, seed, cfg.members)
+    val, val_rows = shapes_datapoints(corpora.original, split.validation)
+    test, test_rows = test_set(corpora.original)
+    plan = seed_plan(variants, cfg.members, len(split.validation), val_rows, test_rows, device)
+    log.info("train_gqcnn seed %d: %s", seed, plan)
+    if (warning := precision_warning(cfg.train.precision, device)) is not None:
+        log.warning("%s", warning)
+    # one network at a time with every thread: two 1-thread workers were slower on 2 cores (docs/results.md#benchmarks)
+    with atomic_path(gqcnn_seed_dir(seed), directory=True) as folder:
+        card = seed_card(params.render, params.grasps, params.seed)
+        jobs = [
+            NetworkJob(v, split, cfg.net, cfg.train, inits, noise_seeds, seed, str(device), folder, corpora, card)
+            for v in variants
+        ]
+        results = train_jobs(jobs, val, test, f"train GQ-CNNs (seed {seed})")
+        save_seed_split(folder, split, test_rows, val_rows)
+        history = read_history(folder, variants)
+    write_csv(history, gqcnn_val_curves(seed).with_suffix(".csv"))
+    title = f"Validation AP of every network of seed {seed} (dots: the kept weights)"
+    validation_curves(history, gqcnn_val_curves(seed), title)
+    write_json({"seed": seed, "networks": (table := seed_table(results))}, gqcnn_seed_networks(seed))
+    write_json(seed_headline(table), gqcnn_seed_metrics(seed))
+    write_json(seed_timing(results, time.perf_counter() - start), timing_file("train_gqcnn", f"s{seed}"))
+    for line in result_lines(results):
+        log.info("train_gqcnn seed %d %s", seed, line)
+    log.info("train_gqcnn seed %d: %d networks in %.1f s", seed, len(results), time.perf_counter() - start)

@@ -1,0 +1,157 @@
+"""The generate stage's pool assembly (graspaug.augment.pools) with a stand-in decoder."""
+
+import numpy as np
+import pandas as pd
+import pytest
+import trimesh
+
+from graspaug.augment.candidates import Decoded, pool_size
+from graspaug.augment.pools import REJECT_COLUMNS, BaseSet, ReconSource, base_ids, generate_pools, tsne_groups
+from graspaug.augment.scores import rarity
+from graspaug.errors import DataError
+from graspaug.pipeline.params.generate import GenerateParams
+
+BOX = trimesh.creation.box(extents=(0.04, 0.03, 0.02))
+
+
+def some_rejected(batch):
+    """Rejects the candidates whose pair-and-weight hash says so; the others get a box."""
+    out = []
+    for c in batch:
+        bad = (c.a * 7 + c.b * 3 + int(c.alpha * 10)) % 3 == 0
+        out.append(Decoded(c, np.zeros(1, np.uint8), None if bad else BOX, "empty decode: no voxel" if bad else None))
+    return out
+
+
+def make_base(n=10, seed=0):
+    rng = np.random.default_rng(seed)
+    z = rng.normal(size=(n, 4)).astype(np.float32)
+    ids = np.array([f"s{i}" for i in range(n)])
+    return BaseSet(ids, z, rarity(z, 3), rng.random(n), np.full(n, 0.002))
+
+
+def test_base_ids_checks_the_size_and_the_train_split():
+    shapes = pd.DataFrame({"shape_id": [f"s{i}" for i in range(6)], "split": ["train"] * 4 + ["test"] * 2})
+    assert len(base_ids(shapes, (2, 4), 4, 0)) == 4 and set(base_ids(shapes, (2, 4), 2, 0)) <= {"s0", "s1", "s2", "s3"}
+    with pytest.raises(DataError, match="is not in generate.base_sizes"):
+        base_ids(shapes, (2, 4), 3, 0)
+    with pytest.raises(DataError, match="larger than the 4 train shapes"):
+        base_ids(shapes, (2, 5), 2, 0)
+
+
+def test_generate_pools_assembles_tables_in_pool_order():
+    base, cfg = make_base(), GenerateParams(base_sizes=(10,), ratios=(0.0, 1.0), n_examples=2)
+    out = generate_pools(base, cfg, 0, some_rejected, k=3)
+    needed = pool_size(cfg.ratios, 10)
+    assert len(out.index) == len(out.kept) == 2 * needed and list(out.rejects.columns) == REJECT_COLUMNS
+    assert list(out.index.pool) == ["targeted"] * needed + ["random"] * needed
+    assert [d.candidate.a for d in out.kept] == [list(base.ids).index(p) for p in out.index.parent_a]
+    assert len(out.rejects) == sum(out.summary[p]["tried"] - out.summary[p]["kept"] for p in ("targeted", "random"))
+    assert out.summary["rejects"] == {"empty decode": len(out.rejects)}
+    assert [d.candidate for d in out.examples] == [d.candidate for d in out.kept[:2] + out.kept[needed : needed + 2]]
+    assert out.warnings and len(out.warnings) == sum(share < 0.95 for share in out.kept_share.values())
+    assert all(w.startswith("only ") and w.endswith("pool's decodes were usable meshes") for w in out.warnings)
+    xy, groups = tsne_groups(base, out.index, 5.0, 0)
+    assert xy.shape == (10 + 2 * needed, 2) and groups[:10] == ["base"] * 10 and groups[10].startswith("generated (")
+
+
+def test_generate_pools_reports_an_exhausted_pool():
+    base, cfg = make_base(3), GenerateParams(base_sizes=(3,), ratios=(1.0, 2.0), alphas=(0.5,))
+    with pytest.raises(DataError, match=r"generate 3, \w+ pool: only"):
+        generate_pools(base, cfg, 0, lambda batch: [Decoded(c, None, None, "bad") for c in batch], k=2)
+
+
+def test_the_recon_pool_reconstructs_the_real_pool_in_order_and_skips_a_failed_decode():
+    base, cfg = make_base(), GenerateParams(base_sizes=(10,), ratios=(0.0, 0.5), n_examples=2)
+    real = make_base(8, seed=1)
+    real = BaseSet(np.array([f"real{i}" for i in range(8)]), real.z, real.rarity, real.graspness, real.pitch)
+
+    def second_fails(batch):
+        return [
+            Decoded(c, np.zeros(1, np.uint8), None, "tiny") if c.a == 1 else Decoded(c, None, BOX, None) for c in batch
+        ]
+
+    out = generate_pools(base, cfg, 0, some_rejected, 3, ("targeted", "recon"), ReconSource(real, second_fails))
+    recon = out.index[out.index.pool == "recon"]
+    assert list(out.index.pool.unique()) == ["targeted", "recon"]  # random was not asked for
+    assert list(recon.parent_a) == list(recon.parent_b) == ["real0", "real2", "real3", "real4", "real5"]
+    assert (recon.alpha == 0).all() and (recon.selected_by == "recon").all()
+    assert list(recon.shape_id) == [f"gen_10_c{k:04d}" for k in range(5)]
+    np.testing.assert_array_equal(np.stack(recon.z.to_numpy()), real.z[[0, 2, 3, 4, 5]])
+    assert out.summary["recon"]["tried"] == 6 and out.summary["recon"]["distinct_parents"] == 5
+    assert list(out.rejects.parent_a[out.rejects.pool == "recon"]) == ["real1"]
+    with pytest.raises(DataError, match="the recon pool needs the real pool's shapes"):
+        generate_pools(base, cfg, 0, some_rejected, 3, ("targeted", "recon"))
+
+
+def test_a_recon_shape_is_the_autoencoders_reconstruction_meshed_at_its_own_scale():
+    """The recon pool's grid of a shape is decode(encode(its voxels)), cleaned as every decode is."""
+    import torch
+
+    from graspaug.augment.candidates import ReconStream
+    from graspaug.augment.pools import mesh_batches
+    from graspaug.geometry.from_voxels import clean_occupancy
+    from graspaug.geometry.settings import DecodeSettings
+    from graspaug.nets.ae_critic import AEConfig, AutoEncoder
+    from graspaug.training.autoencoder import decode, encode
+
+    torch.manual_seed(0)
+    ae = AutoEncoder(AEConfig(resolution=16, z_dim=8, base_width=4, top_width=16))
+    with torch.no_grad():  # untrained: a bias that leaves most of the grid occupied, varying with the latent
+        ae.decoder.net[-1].bias.fill_(1.0)
+    grids = torch.zeros(3, 1, 16, 16, 16)
+    grids[:, :, 4:12, 5:11, 6:10] = 1
+    z = encode(ae, grids, torch.device("cpu"))
+    pitch = np.array([0.002, 0.003, 0.004])
+    real = BaseSet(np.array(["a", "b", "c"]), z, np.zeros(3), np.zeros(3), pitch)
+    settings = DecodeSettings(threshold=0.5, min_voxels=1, min_main_share=0.01, smoothing_iterations=0)
+    run_batch = mesh_batches(ae, torch.device("cpu"), real, settings, 1, "test")
+    decoded = run_batch(ReconStream(3).take(0, 3))
+    probability = decode(ae, z, torch.device("cpu"))
+    for k, d in enumerate(decoded):
+        grid = clean_occupancy(probability[k], 0.5, settings.opening, 1, 0.01)
+        np.testing.assert_array_equal(d.packed_grid, np.packbits(grid.occupancy))
+        assert d.mesh is not None and d.reason is None  # meshed at its own pitch: extent in voxels × pitch
+        filled = np.argwhere(grid.occupancy)
+        voxels_across = filled.max(0) - filled.min(0) + 1
+        np.testing.assert_allclose(np.sort(d.mesh.extents), np.sort(voxels_across * pitch[k]), rtol=0.2)
+
+
+def test_the_blend_pool_takes_the_targeted_pools_pairs_and_weights_and_replaces_a_failure():
+    base, cfg = make_base(), GenerateParams(base_sizes=(10,), ratios=(0.0, 1.0))
+
+    def first_fails(batch):  # the blend of the targeted pool's first kept pair fails
+        first = out_targeted[0]
+        return [
+            Decoded(c, np.zeros(0, np.uint8), None if c == first else BOX, "empty" if c == first else None)
+            for c in batch
+        ]
+
+    plain = generate_pools(base, cfg, 0, some_rejected, 3, ("targeted",))
+    out_targeted = [d.candidate for d in plain.kept]
+    out = generate_pools(base, cfg, 0, some_rejected, 3, ("targeted", "blend"), blend=first_fails)
+    targeted, blend = (out.index[out.index.pool == p] for p in ("targeted", "blend"))
+    key = lambda rows: list(zip(rows.parent_a, rows.parent_b, rows.alpha))  # noqa: E731
+    assert key(blend)[: len(blend) - 1] == key(targeted)[1:]  # the same pairs and weights, in order
+    assert key(blend)[-1] not in key(targeted)  # the failure replaced by the targeted stream's next candidate
+    assert list(blend.shape_id) == [f"gen_10_b{k:04d}" for k in range(len(blend))]
+    assert (
+        len(blend) == len(targeted) == out.summary["blend"]["kept"] and out.summary["blend"]["tried"] == len(blend) + 1
+    )
+    with pytest.raises(DataError, match="the blend pool needs the base set's meshes"):
+        generate_pools(base, cfg, 0, some_rejected, 3, ("targeted", "blend"))
+
+
+def test_blend_batches_mix_the_parents_meshes_at_each_weight():
+    from graspaug.augment.candidates import Candidate
+    from graspaug.augment.pools import blend_batches
+    from graspaug.geometry.voxelize import fit_grid, iou, voxelize_solid
+
+    meshes = [trimesh.creation.capsule(height=0.03, radius=0.01), trimesh.creation.icosphere(radius=0.02)]
+    run_batch = blend_batches(meshes, 96, 3, 1, "test")  # the default: the ingest surface resolution
+    ends = run_batch([Candidate(0, 1, 0.0, "rarity"), Candidate(0, 1, 1.0, "rarity"), Candidate(0, 1, 0.5, "rarity")])
+    for d, parent in zip(ends[:2], meshes):  # voxel IoU in the parent's 32³ grid, the child placed as it
+        grid, child = fit_grid(parent.bounds, 32, 1), d.mesh.vertices + parent.bounds.mean(0) - d.mesh.bounds.mean(0)
+        grids = [voxelize_solid(v, m.faces, grid) for v, m in ((child, d.mesh), (parent.vertices, parent))]
+        assert d.reason is None and iou(*grids) >= 0.95
+    assert ends[2].reason is None and ends[2].mesh.is_watertight

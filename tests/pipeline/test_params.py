@@ -1,0 +1,205 @@
+import dataclasses
+import json
+
+import pydantic
+import pytest
+import yaml
+from typer.testing import CliRunner
+
+from graspaug.pipeline.cli import app
+from graspaug.pipeline.params.model import Params, ParamsError, json_schema, load_params, params_dict, parse_params
+from graspaug.pipeline.params.profiles import merge, profile_names, profile_params, profile_yaml
+from graspaug.training.settings import TrainSettings
+
+
+def test_params_yaml_holds_exactly_the_settings_defaults(repo_root):
+    """One default per value: params.yaml is what `graspaug profile default` writes from the
+    settings classes' fields, key for key."""
+    text = (repo_root / "params.yaml").read_text()
+    assert yaml.safe_load(text) == params_dict()
+    assert load_params(repo_root / "params.yaml") == Params()
+    assert text == profile_yaml("default", repo_root / "profiles")
+
+
+def test_schema_file_is_up_to_date(repo_root):
+    assert (repo_root / "params.schema.json").read_text() == json_schema()
+    schema = json.loads(json_schema())
+    steps = schema["$defs"]["TrainSettings"]["properties"]["max_steps"]
+    assert (
+        steps["default"] == TrainSettings().max_steps and steps["minimum"] == 1 and "SGD steps" in steps["description"]
+    )
+
+
+@pytest.mark.parametrize(
+    ("raw", "message"),
+    [
+        (
+            {"ingest": {"max_facez": 3}},
+            "ingest.max_facez: unknown key; allowed here: max_faces, max_file_mb, min_shapes, test_fraction, surface",
+        ),
+        ({"colour": 1}, "colour: unknown key; allowed here: seed,"),
+        (
+            {"sim": {"cell": {"intrinsics": {"fz": 1}}}},
+            "sim.cell.intrinsics.fz: unknown key; allowed here: width, height, fx, fy, cx, cy",
+        ),
+        (
+            {"ingest": {"max_faces": "many"}},
+            "ingest.max_faces: Input should be a valid integer, unable to parse string as an integer; got 'many'",
+        ),
+        (
+            {"ingest": {"max_faces": 2.5}},
+            "ingest.max_faces: Input should be a valid integer, got a number with a fractional part; got 2.5",
+        ),
+        ({"ingest": {"max_faces": 0}}, "ingest.max_faces: Input should be greater than or equal to 1; got 0"),
+        (
+            {"ingest": {"test_fraction": 1.5}},
+            "ingest.test_fraction: Input should be less than or equal to 0.9; got 1.5",
+        ),
+        (
+            {"ingest": {"surface": {"size_rule": "median"}}},
+            "ingest.surface.size_rule: Input should be 'min', 'mid' or 'max'; got 'median'",
+        ),
+        ({"voxelize": {"resolution": 48}}, "voxelize.resolution: Input should be 16, 32, 64 or 128; got 48"),
+        ({"voxelize": {"resolution": 16}}, "ae.net.resolution: must equal voxelize.resolution (16); got 32"),
+        ({"device": "tpu"}, "device: Input should be 'auto', 'cpu' or 'cuda'; got 'tpu'"),
+        ({"data": {"source": "folder"}}, "data.path: required when data.source is folder"),
+        ({"data": 3}, "data: Input should be a dictionary"),
+        ({"n_jobs": 0}, "n_jobs: must be >= 1, or -1 for all cores; got 0"),
+        ({"executor": "dask"}, "scheduler: required when executor is dask"),
+        ({"executor": "ray"}, "executor: Input should be 'joblib' or 'dask'; got 'ray'"),
+        ({"ae": {"train": {"lambda": -1}}}, "ae.train.lambda: Input should be greater than or equal to 0; got -1"),
+        (
+            {"critic_eval": {"alphas": [0.1, 0.104]}},
+            "critic_eval.alphas: weights must differ in the first two decimals",
+        ),
+        ({"critic_eval": {"alphas": [0.1, 1.5]}}, "critic_eval.alphas: must be a non-empty list of weights in [0, 1]"),
+        ({"generate": {"ratios": [0, 1.0]}}, "generate.ratios: write every ratio as a float (1.0, not 1)"),
+        (
+            {"grasps": {"gripper": {"max_width": 0.1}}},
+            "sim.sampler.max_width: must equal grasps.gripper.max_width (0.1); got 0.08",
+        ),
+        ({"render": {"crop": {"out_size": 16}}}, "gqcnn.net.image_size: must equal render.crop.out_size (16); got 32"),
+        ({"sim": {"objects": ["mug", "teapot"]}}, "sim.objects: must be distinct names among mug, duck,"),
+        ({"sim": {"objects": [], "n_test_objects": 0}}, "sim.objects: no objects to pick"),
+        ({"sim": {"base_size": 300}}, "sim.base_size: must be one of gqcnn.augment_base_sizes [50]; got 300"),
+        (
+            {"sim": {"sampler": {"min_depth_offset": 0.05}}},
+            "sim.sampler.max_depth_offset: must be >= min_depth_offset (0.05); got 0.04",
+        ),
+        ({"sim": {"attempts": 0}}, "sim.attempts: Input should be greater than or equal to 1; got 0"),
+    ],
+)
+def test_bad_params_name_the_key(raw, message):
+    with pytest.raises(ParamsError) as exc:
+        parse_params(raw)
+    assert str(exc.value).startswith(message)
+    assert "\n" not in str(exc.value)
+
+
+def test_ints_are_accepted_for_floats_and_null_for_optionals():
+    params = parse_params({"ingest": {"surface": {"size_m": 1}}, "data": {"limit": None}})
+    assert params.ingest.surface.size_m == 1.0 and isinstance(params.ingest.surface.size_m, float)
+    assert params.data.limit is None
+
+
+def test_params_and_sections_are_frozen():
+    with pytest.raises(pydantic.ValidationError):
+        Params().seed = 3
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        Params().gqcnn.train.max_steps = 3
+
+
+def test_sections_are_the_library_settings():
+    """No adapters: a section is the object the library takes."""
+    from graspaug.grasping.antipodal import AntipodalSettings
+    from graspaug.nets.gqcnn import GQCNNConfig
+    from graspaug.sim.scene import CellLayout
+    from graspaug.training.gqcnn import NoiseSettings
+
+    params = Params()
+    assert isinstance(params.grasps.sampler, AntipodalSettings) and isinstance(params.gqcnn.net, GQCNNConfig)
+    assert isinstance(params.sim.cell, CellLayout) and isinstance(params.gqcnn.train.noise, NoiseSettings)
+    assert params.gqcnn.train.noise == NoiseSettings()
+
+
+def test_cli_bad_params_exit_2_with_one_line(tmp_path):
+    bad = tmp_path / "params.yaml"
+    bad.write_text(yaml.safe_dump({"voxelize": {"resolution": 7}}))
+    result = CliRunner().invoke(app, ["voxelize", "--params", str(bad)])
+    assert result.exit_code == 2
+    lines = [line for line in result.output.splitlines() if line.strip()]
+    assert lines == ["error: voxelize.resolution: Input should be 16, 32, 64 or 128; got 7"]
+
+
+def test_cli_help_lists_stages_and_explains_params():
+    runner = CliRunner()
+    top = runner.invoke(app, ["--help"])
+    assert top.exit_code == 0
+    for stage in ("ingest", "voxelize", "profile", "schema"):
+        assert stage in top.output
+    sub = runner.invoke(app, ["ingest", "--help"])
+    assert sub.exit_code == 0
+    for key in ("max_faces", "ingest.surface.resolution", "size_rule", "test_fraction", "data.source"):
+        assert key in sub.output
+    version = runner.invoke(app, ["--version"])
+    assert version.exit_code == 0 and version.output.startswith("graspaug ")
+
+
+def test_every_overlay_names_only_real_keys(repo_root):
+    folder = repo_root / "profiles"
+    assert set(profile_names(folder)) >= {"default", "tiny", "study", "paper"}
+    for name in profile_names(folder):
+        profile_params(name, folder)  # raises on an unknown key or a bad value
+    with pytest.raises(ParamsError, match=r"gqcnn\.train\.stepz: unknown key"):
+        merge(params_dict(), {"gqcnn": {"train": {"stepz": 3}}})
+
+
+def test_profiles_are_small_overlays(repo_root):
+    folder = repo_root / "profiles"
+    study, paper, tiny = (profile_params(n, folder) for n in ("study", "paper", "tiny"))
+    assert (
+        len(study.gqcnn.seeds) >= 5 and study.generate.base_sizes == (50, 100, 200) and len(study.generate.ratios) == 5
+    )
+    assert set(study.gqcnn.augment_base_sizes) == set(study.generate.base_sizes)  # the paper's 15 cells, three pools
+    assert yaml.safe_load((folder / "study.yaml").read_text()).keys() == {"generate", "gqcnn", "sim"}
+    per_seed = (len(study.sim.objects) + study.sim.n_test_objects) * study.sim.attempts
+    assert per_seed >= 400  # paired attempts per network arm and training seed (issue 18)
+    assert paper.voxelize.resolution == paper.ae.net.resolution == 64
+    assert (paper.ae.net.base_width, paper.ae.net.top_width, paper.ae.net.z_dim) == (64, 512, 128)
+    assert (paper.gqcnn.net.filters, paper.gqcnn.net.fc) == (64, 1024) and len(paper.gqcnn.seeds) >= 3
+    assert (len(paper.sim.objects), paper.sim.n_test_objects, paper.sim.attempts) == (8, 0, 10)
+    assert tiny.data.limit == 20 and tiny.voxelize.resolution == 16
+
+
+def test_profile_command_writes_a_complete_params_file(repo_root, tmp_path):
+    out = tmp_path / "params.yaml"
+    result = CliRunner().invoke(app, ["profile", "study", "--out", str(out), "--profiles", str(repo_root / "profiles")])
+    assert result.exit_code == 0, result.output
+    assert load_params(out) == profile_params("study", repo_root / "profiles")
+    assert (
+        yaml.safe_load(out.read_text())["gqcnn"]["train"]["max_steps"] == TrainSettings().max_steps
+    )  # every key written, for DVC
+    missing = CliRunner().invoke(app, ["profile", "nope", "--out", str(out), "--profiles", str(repo_root / "profiles")])
+    assert missing.exit_code == 2 and "profile 'nope' not found" in missing.output
+
+
+def test_profile_keeps_hand_edits_unless_forced(repo_root, tmp_path):
+    """`graspaug profile` overwrites a file some profile wrote, but refuses one with hand edits, naming the keys."""
+    out, profiles = tmp_path / "params.yaml", ["--profiles", str(repo_root / "profiles")]
+    assert CliRunner().invoke(app, ["profile", "tiny", "--out", str(out), *profiles]).exit_code == 0
+    assert CliRunner().invoke(app, ["profile", "default", "--out", str(out), *profiles]).exit_code == 0  # unedited
+    edited = out.read_text().replace("\nseed: 0", "\nseed: 7", 1)
+    assert edited != out.read_text()
+    out.write_text(edited)
+    refused = CliRunner().invoke(app, ["profile", "tiny", "--out", str(out), *profiles])
+    assert refused.exit_code == 2 and "seed: 7" in refused.output and refused.output.count("\n") == 1
+    assert out.read_text() == edited  # nothing lost
+    forced = CliRunner().invoke(app, ["profile", "tiny", "--out", str(out), "--force", *profiles])
+    assert forced.exit_code == 0 and load_params(out) == profile_params("tiny", repo_root / "profiles")
+
+
+def test_a_yaml_syntax_error_names_its_line(tmp_path):
+    bad = tmp_path / "params.yaml"
+    bad.write_text("seed: 0\ngqcnn:\n  seeds: [0, 1\n  members: 3\n")
+    with pytest.raises(ParamsError, match=r"params.yaml: not valid YAML at line \d+, column \d+"):
+        load_params(bad)
