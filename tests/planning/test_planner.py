@@ -382,7 +382,7 @@ def test_network_crops_are_what_the_network_scored(scene, model_path):
 
 def test_the_picture_enlarges_the_object(scene, model_path, tmp_path):
     """grasp.png's main panel is a window around the object and the grasps, not the whole frame."""
-    from graspaug.plots import _grasp_region, planned_grasps
+    from graspaug.planning.picture import _grasp_region, planned_grasps
 
     depth = depth_of(scene)
     grasps = plan_grasps(depth, K, model_path, top=3)
@@ -518,7 +518,7 @@ def test_the_exit_code_contract_and_debug(scene, model_path, tmp_path, monkeypat
     def boom(path):
         raise RuntimeError("a bug\nover two lines")
 
-    monkeypatch.setattr("graspaug.planning.read_depth_image", boom)
+    monkeypatch.setattr("graspaug.planning.report.read_depth_image", boom)
     crash = CliRunner().invoke(app, [*args, "--out", str(tmp_path / "c")])
     assert crash.exit_code == 3 and crash.output.count("\n") == 1, crash.output
     assert "unexpected RuntimeError: a bug over two lines" in crash.output and "--debug" in crash.output

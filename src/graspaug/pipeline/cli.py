@@ -425,9 +425,6 @@ stage_command(
 )
 
 
-PLAN_MARK = "graspaug plan"  # grasp.json's "written_by": plan replaces only its own grasp.json and grasp.png
-
-
 @app.command(
     cls=Command,
     name="plan",
@@ -474,95 +471,14 @@ def plan_command(
     ),
     force: bool = typer.Option(False, "--force", help="Replace a grasp.json or grasp.png that plan did not write."),
 ) -> None:
-    import json
+    from graspaug.planning.report import plan_files
 
-    import numpy as np
-
-    from graspaug.io.atomic import atomic_path
-    from graspaug.io.outputs import check_output_files
-    from graspaug.planning import (
-        PlanningError,
-        check_depth,
-        intrinsics_for,
-        load_planner,
-        read_depth_image,
-        read_intrinsics,
+    report = plan_files(
+        depth, model, intrinsics, (fx, fy, cx, cy), top, seed, camera_distance, fill_missing, min_quality, out, force
     )
-    from graspaug.planning.limits import quality_floor, range_warnings, rejected_line
-    from graspaug.plots import planned_grasps
-
-    if min_quality is not None and not 0.0 <= min_quality <= 1.0:
-        raise PlanningError(f"--min-quality must lie in [0, 1] (a P(success)), got {min_quality:g}")
-    check_output_files(out, ["grasp.json", "grasp.png"], "plan", PLAN_MARK, force)
-    # one step per input, so that an error names what is at fault: the image, the camera, the model
-    image = read_depth_image(depth)
-    try:
-        checked = check_depth(image, fill_missing)  # missing pixels filled once, here
-    except PlanningError as exc:
-        raise PlanningError(f"{depth}: {exc}") from None
-    camera = intrinsics_for(checked.shape, read_intrinsics(intrinsics, fx, fy, cx, cy, checked.shape))
-    planner = load_planner(model)
-    grasps = planner.plan(checked, camera, seed, top, camera_distance)
-    warnings = range_warnings(planner.card, checked, camera, grasps, camera_distance)
-    for warning in warnings:
-        typer.echo(f"warning: {warning}", err=True)
-    floor = quality_floor(planner.card, min_quality)
-    accepted = [floor.accepts(g.quality) for g in grasps]
-    out.mkdir(parents=True, exist_ok=True)
-    with atomic_path(out / "grasp.json") as tmp:
-        tmp.write_text(
-            json.dumps(
-                {
-                    "written_by": PLAN_MARK,
-                    "depth": str(depth),
-                    "model": str(model),
-                    "accepted": bool(grasps) and accepted[0],  # the best grasp clears the quality floor
-                    "quality_floor": floor.to_dict(),
-                    "warnings": warnings,
-                    "grasps": [{**g.to_dict(), "accepted": ok} for g, ok in zip(grasps, accepted, strict=True)],
-                    "model_card": planner.card.to_dict(),
-                },
-                indent=1,
-            )
-            + "\n"
-        )
-    labels = [
-        f"#{i + 1}  Q = {g.quality:.3f}, {1000 * g.width:.0f} mm" + ("" if ok else f"  rejected (< {floor.value:.3f})")
-        for i, (g, ok) in enumerate(zip(grasps, accepted, strict=True))
-    ]
-    verdict = f"; rejected: Q < floor {floor.value:.3f}" if grasps and not accepted[0] else ""
-    shown = np.where(np.isfinite(image) & (image > 0), image, np.nan) if image.dtype.kind == "f" else image
-    crops, openings = planner.network_crops(image, camera, grasps, camera_distance, fill_missing)
-    finger = float(planner.card.gripper.get("finger_width", 0.0))
-    planned_grasps(
-        np.nan_to_num(shown, nan=float(np.nanmax(shown))),
-        [g.jaw_pixels for g in grasps],
-        labels,
-        out / "grasp.png",
-        f"{depth.name}: {len(grasps)} grasp(s), model {model.resolve().parent.name}/{model.name}{verdict}",
-        rejected=[not ok for ok in accepted],
-        finger_px=[finger * camera.fx / g.depth for g in grasps] if finger > 0 else None,
-        crops=crops,
-        crop_openings=openings,
-        px_per_cm=0.01 * camera.fx / grasps[0].depth if grasps else None,
-    )
-    if not grasps:
-        typer.echo(
-            f"no grasp: no antipodal pair of depth edges in {depth} fits the gripper (wrote {out / 'grasp.json'})"
-        )
-        raise typer.Exit(code=1)
-    for i, (g, ok) in enumerate(zip(grasps, accepted, strict=True)):
-        typer.echo(
-            f"#{i + 1}: center ({g.u:.1f}, {g.v:.1f}) px, angle {np.degrees(g.angle):.1f} deg, depth {g.depth:.3f} m, "
-            f"width {1000 * g.width:.1f} mm, quality {g.quality:.3f}{'' if ok else ' (below the floor)'}"
-        )
-    if not accepted[0]:
-        typer.echo(f"{rejected_line(grasps[0].quality, floor)} (wrote {out / 'grasp.json'} and {out / 'grasp.png'})")
-        raise typer.Exit(code=1)
-    typer.echo(
-        f"wrote {out / 'grasp.json'} and {out / 'grasp.png'} ({grasps[0].planning_time:.2f} s; quality floor "
-        f"{floor.value:.3f}: {floor.source})"
-    )
+    for line in report.lines:
+        typer.echo(line, err=line.startswith("warning: "))
+    raise typer.Exit(code=report.exit_code)
 
 
 @app.command(
