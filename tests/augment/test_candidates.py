@@ -13,13 +13,13 @@ from graspaug.augment.candidates import (
     TargetedStream,
     above_percentile,
     fill_pool,
-    generate_headline,
     neighbour_pairs,
     nested_base_sets,
     pool_size,
     ratio_count,
     targeted_candidates,
 )
+from graspaug.augment.pool_tables import generate_headline
 
 # Points on a line at 0, 1, 3, 7, 12, 18: no ties, so every point's neighbour ranks are clear:
 # 0: 1 2 3 4 5 | 1: 0 2 3 4 5 | 2: 1 0 3 4 5 | 3: 2 4 1 0 5 | 4: 3 5 2 1 0 | 5: 4 3 2 1 0
@@ -101,7 +101,7 @@ def test_targeted_and_random_pools_use_each_weight_equally_often():
 
 
 def test_a_pools_makeup_counts_parents_and_weights():
-    from graspaug.augment.candidates import pool_makeup
+    from graspaug.augment.pool_tables import pool_makeup
 
     rows = pd.DataFrame({"parent_a": ["s1", "s1", "s2"], "parent_b": ["s2", "s3", "s3"], "alpha": [0.5, 0.3, 0.5]})
     assert pool_makeup(rows) == {"distinct_parents": 3, "alphas": {"0.3": 1, "0.5": 2}}

@@ -89,7 +89,7 @@ def test_a_recon_shape_is_the_autoencoders_reconstruction_meshed_at_its_own_scal
     import torch
 
     from graspaug.augment.candidates import ReconStream
-    from graspaug.augment.pools import mesh_batches
+    from graspaug.augment.decode import mesh_batches
     from graspaug.geometry.from_voxels import clean_occupancy
     from graspaug.geometry.settings import DecodeSettings
     from graspaug.nets.ae_critic import AEConfig, AutoEncoder
@@ -144,7 +144,7 @@ def test_the_blend_pool_takes_the_targeted_pools_pairs_and_weights_and_replaces_
 
 def test_blend_batches_mix_the_parents_meshes_at_each_weight():
     from graspaug.augment.candidates import Candidate
-    from graspaug.augment.pools import blend_batches
+    from graspaug.augment.decode import blend_batches
     from graspaug.geometry.voxelize import fit_grid, iou, voxelize_solid
 
     meshes = [trimesh.creation.capsule(height=0.03, radius=0.01), trimesh.creation.icosphere(radius=0.02)]

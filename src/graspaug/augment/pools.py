@@ -25,20 +25,16 @@ from graspaug.augment.candidates import (
     RandomStream,
     ReconStream,
     TargetedStream,
-    base_scores_table,
     candidate_key,
     draw_base_sets,
     fill_pool,
     pool_size,
-    pool_summary,
-    pool_tables,
 )
 from graspaug.augment.embedding import tsne_2d
+from graspaug.augment.pool_tables import base_scores_table, pool_summary, pool_tables
 from graspaug.augment.scores import rarity
 from graspaug.augment.settings import GenerateSettings
 from graspaug.errors import DataError
-from graspaug.geometry.from_voxels import mesh_decoded
-from graspaug.training.autoencoder import decode
 
 log = logging.getLogger(__name__)
 LOW_YIELD = 0.95  # a pool keeping a smaller share of its decodes is warned about
@@ -88,32 +84,6 @@ def base_set(ids: np.ndarray, latents: pd.DataFrame, scores: pd.DataFrame, voxel
     return BaseSet(ids, z, base_rarity, graspness.loc[ids].to_numpy(), np.array([pitch_of[s] for s in ids]))
 
 
-def mesh_batches(
-    ae, device, base: BaseSet, settings, workers: int, label: str
-) -> Callable[[list[Candidate]], list[Decoded]]:
-    """A batch runner for :func:`graspaug.augment.candidates.fill_pool`: decodes each candidate's
-    ``(1 - α) z_a + α z_b`` with the autoencoder ``ae`` on ``device`` and meshes the grid
-    (:func:`graspaug.geometry.from_voxels.mesh_decoded` with ``settings``, at the parents' pitches
-    interpolated the same way, m) on ``workers`` processes, ``label`` naming the progress."""
-    from graspaug.parallel import parallel_map
-
-    z, pitch = base.z, base.pitch
-
-    def run_batch(candidates: list[Candidate]) -> list[Decoded]:
-        a = np.array([c.a for c in candidates])
-        b = np.array([c.b for c in candidates])
-        alpha = np.array([c.alpha for c in candidates], dtype=np.float32)[:, None]
-        probability = decode(ae, (1 - alpha) * z[a] + alpha * z[b], device)
-        child_pitch = (1 - alpha[:, 0]) * pitch[a] + alpha[:, 0] * pitch[b]  # metric size: parents' interpolated
-        jobs = list(zip(probability, child_pitch))
-        out = parallel_map(lambda job: mesh_decoded(job[0], job[1], settings), jobs, workers, label)
-        return [
-            Decoded(c, np.packbits(grid.occupancy), mesh, reason) for c, (grid, mesh, reason) in zip(candidates, out)
-        ]
-
-    return run_batch
-
-
 Pools = dict[str, tuple[list[Decoded], list[Decoded]]]
 GENERATED_POOLS = ("targeted", "random", "recon", "blend")  # the pools generate can make, in index order
 
@@ -121,32 +91,10 @@ GENERATED_POOLS = ("targeted", "random", "recon", "blend")  # the pools generate
 @dataclass(frozen=True)
 class ReconSource:
     """What the ``recon`` pool reconstructs: ``shapes``, the real pool's shapes in its order (a
-    :class:`BaseSet`: ids, latents, pitches), and ``run_batch``, :func:`mesh_batches` over them."""
+    :class:`BaseSet`: ids, latents, pitches), and ``run_batch``, :func:`.decode.mesh_batches` over them."""
 
     shapes: BaseSet
     run_batch: Callable[[list[Candidate]], list[Decoded]]
-
-
-def blend_batches(
-    meshes: Sequence, resolution: int, margin: int, workers: int, label: str
-) -> Callable[[list[Candidate]], list[Decoded]]:
-    """A batch runner for :func:`graspaug.augment.candidates.fill_pool` that makes each candidate with no
-    network: :func:`graspaug.geometry.blend.blend_solids` of its parents among ``meshes`` (the
-    base set's meshes, m, in base-set order) at its weight, on ``resolution``-cell grids with
-    ``margin`` empty cells, on ``workers`` processes; each parent's distance field is computed once
-    per batch. Its grids are not kept (an empty array)."""
-    from graspaug.geometry.blend import blend_fields, signed_distance_grid
-    from graspaug.parallel import parallel_map
-
-    def run_batch(candidates: list[Candidate]) -> list[Decoded]:
-        parents = sorted({i for c in candidates for i in (c.a, c.b)})
-        grids = parallel_map(lambda i: signed_distance_grid(meshes[i], resolution, margin), parents, workers, label)
-        field = dict(zip(parents, grids))
-        jobs = [(field[c.a], field[c.b], c.alpha) for c in candidates]
-        out = parallel_map(lambda job: blend_fields(*job), jobs, workers, label)
-        return [Decoded(c, np.zeros(0, np.uint8), mesh, reason) for c, (mesh, reason) in zip(candidates, out)]
-
-    return run_batch
 
 
 def fill_pools(
@@ -160,9 +108,9 @@ def fill_pools(
 ) -> tuple[Pools, TargetedStream, int]:
     """Fill each of ``pools`` (of :data:`GENERATED_POOLS`; the targeted one always) to
     ``pool_size(cfg.ratios, B)`` kept shapes: ``targeted`` and ``random`` (seeded by
-    ``[seed, BASE_SEED, B]``) with ``run_batch`` (:func:`mesh_batches` over the base set),
+    ``[seed, BASE_SEED, B]``) with ``run_batch`` (:func:`.decode.mesh_batches` over the base set),
     ``recon`` from ``recon`` (the real pool's shapes, each decoded from its own latent),
-    ``blend`` with the runner ``blend`` (:func:`blend_batches`) on the targeted pool's candidates
+    ``blend`` with the runner ``blend`` (:func:`.decode.blend_batches`) on the targeted pool's candidates
     (its kept ones first: the same pairs and weights).
 
     Returns (pools: name → (kept, rejected) Decoded lists, in :data:`GENERATED_POOLS` order, the
@@ -199,12 +147,12 @@ def fill_pools(
 class GeneratedSet:
     """A base set's generated shapes, ready to write.
 
-    index : one row per kept shape in pool order (:func:`graspaug.augment.candidates.pool_tables` columns
+    index : one row per kept shape in pool order (:func:`graspaug.augment.pool_tables.pool_tables` columns
         plus ``rarity_vs_base``, the rarity of its latent against the base set)
     rejects : one row per rejected decode (:data:`REJECT_COLUMNS`)
-    base_table : the base set with its scores (:func:`graspaug.augment.candidates.base_scores_table`)
+    base_table : the base set with its scores (:func:`graspaug.augment.pool_tables.base_scores_table`)
     kept : the kept decodes (Decoded, with their meshes in m), in ``index`` order
-    summary : the ``generate`` summary (:func:`.candidates.pool_summary`; metrics: ``generate_headline``)
+    summary : the ``generate`` summary (:func:`.pool_tables.pool_summary`; metrics: ``generate_headline``)
     kept_share : pool name → share of its decodes that were kept
     examples : the decodes to picture (:func:`example_decodes`)
     notes : how the targeted stream was widened, in order
@@ -298,10 +246,10 @@ def stream_shapes(
     prefix: str = "",
 ) -> tuple[pd.DataFrame, pd.DataFrame, list[Decoded], list[str]]:
     """``count`` kept shapes of ``stream`` (candidates indexing ``pool``), decoded by ``run_batch``
-    (:func:`mesh_batches` over ``pool``), as pool ``name``.
+    (:func:`~graspaug.augment.decode.mesh_batches` over ``pool``), as pool ``name``.
 
     Returns (index, rejects, kept, notes): ``index`` one row per kept shape (the columns of
-    :func:`graspaug.augment.candidates.pool_tables`; ``order`` counts from ``first_order``, ``shape_id`` is
+    :func:`graspaug.augment.pool_tables.pool_tables`; ``order`` counts from ``first_order``, ``shape_id`` is
     ``<prefix><order>``), ``rejects`` (:data:`REJECT_COLUMNS`), the kept decodes (meshes in m) in
     ``index`` order and how the stream was widened; a :class:`DataError` if the candidates run out first.
     """
@@ -337,7 +285,7 @@ def failure_shapes(
     failures : (len(anchors),) — the name of the failure object each anchor is nearest to
     count : shapes to keep
     cfg : the ``generate`` params: neighbours (``first_neighbour``, ``extra_neighbours``) and ``alphas``
-    run_batch : :func:`mesh_batches` over ``pool``
+    run_batch : :func:`~graspaug.augment.decode.mesh_batches` over ``pool``
     used, first_order, prefix : candidates (:func:`.candidates.candidate_key` of ``pool`` indices) not to
         make again, and the ids (:func:`stream_shapes`): the lifelong loop's later rounds
 

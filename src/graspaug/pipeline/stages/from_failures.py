@@ -18,7 +18,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from graspaug.augment.pools import base_set, failure_shapes, failure_summary, log_failure_summary, mesh_batches
+from graspaug.augment.decode import mesh_batches
+from graspaug.augment.pools import base_set, failure_shapes, failure_summary, log_failure_summary
 from graspaug.device import resolve_device
 from graspaug.errors import DataError
 from graspaug.experiments.lifelong import failure_anchors, validation_errors

@@ -16,17 +16,9 @@ from functools import partial
 
 import numpy as np
 
-from graspaug.augment.candidates import generate_headline
-from graspaug.augment.pools import (
-    GENERATED_POOLS,
-    ReconSource,
-    base_ids,
-    base_set,
-    blend_batches,
-    generate_pools,
-    mesh_batches,
-    tsne_groups,
-)
+from graspaug.augment.decode import blend_batches, mesh_batches
+from graspaug.augment.pool_tables import generate_headline
+from graspaug.augment.pools import GENERATED_POOLS, ReconSource, base_ids, base_set, generate_pools, tsne_groups
 from graspaug.device import resolve_device
 from graspaug.io.atomic import atomic_path
 from graspaug.io.checkpoints import load_autoencoder

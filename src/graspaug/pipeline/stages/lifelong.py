@@ -11,7 +11,8 @@ import logging
 import numpy as np
 import pandas as pd
 
-from graspaug.augment.pools import base_set, loop_shapes, mesh_batches
+from graspaug.augment.decode import mesh_batches
+from graspaug.augment.pools import base_set, loop_shapes
 from graspaug.device import resolve_device
 from graspaug.experiments.ap import test_labels
 from graspaug.experiments.lifelong import arm_variant, disjoint, failure_anchors, round_networks
@@ -90,10 +91,8 @@ def run(params: Params, round_: int) -> None:
         history.to_csv(folder / "history.csv", index=False)
         labels, objects = test_labels(corpus, seed_dirs[gq.seeds[0]])
         start = {s: paths.gqcnn_seed_dir(s) / arm_variant("none", b, 0).name for s in gq.seeds}
-        networks, curve = (
-            {params.data_seed: round_networks(start, seed_dirs, variants)},
-            pd.read_csv(before / "curve.csv"),
-        )
+        networks = {params.data_seed: round_networks(start, seed_dirs, variants)}
+        curve = pd.read_csv(before / "curve.csv")
         reports = paths.lifelong_metrics(round_), paths.lifelong_reports(round_)
         curve = write_round(round_, networks, labels, objects, curve, history, params, voxels, *reports, followed)
         curve.to_csv(folder / "curve.csv", index=False)
