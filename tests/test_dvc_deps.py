@@ -82,7 +82,7 @@ def import_closure(module: str, src: Path) -> set[str]:
     return _closure({module}, src)
 
 
-CLI_SHARED = ("_load", "_run", "_bad_input_errors", "Command")  # the cli.py code every stage command runs
+CLI_SHARED = ("_load", "_run")  # the cli.py functions every stage command runs (and its module-level imports)
 
 
 def cli_imports(src: Path) -> set[str]:

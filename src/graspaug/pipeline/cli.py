@@ -11,18 +11,12 @@ import importlib
 import logging
 import os
 import sys
-import warnings
 from pathlib import Path
 
 import typer
 from typer.core import TyperCommand
 
-EXIT_CODES = (
-    "Exit codes, the same for every command: 0 an answer; 1 no acceptable answer (`plan`: no grasp, or the best one "
-    "below the quality floor; `from-failures`: no shape kept); 2 bad input or usage (a missing or broken file, a bad "
-    "param, an output folder it may not write), one line naming the culprit; 3 an unexpected error (a bug: `graspaug "
-    "--debug <command> ...` shows its traceback)."
-)
+from graspaug.pipeline.command import EXIT_CODES, Command, debug_mode
 
 app = typer.Typer(
     help="graspaug: augment a grasp planner's training objects with generated shapes.\n\n"
@@ -37,50 +31,6 @@ ParamsOption = typer.Option(Path("params.yaml"), "--params", "-p", help="The par
 ForceOption = typer.Option(
     False, "--force", help="Replace an output folder that holds files this command did not write."
 )
-_debug = {"on": False}  # set by the root callback (--debug, GRASPAUG_DEBUG) on every invocation
-
-
-def _bad_input_errors() -> tuple[type[BaseException], ...]:
-    """The errors that mean bad input or usage (exit 2): each carries a one-line message naming the culprit."""
-    from graspaug.errors import CheckpointMismatch, DataError, StageError  # the planner's PlanningError is a DataError
-    from graspaug.pipeline.params.base import ParamsError
-
-    return (DataError, StageError, CheckpointMismatch, ParamsError, OSError)
-
-
-class Command(TyperCommand):
-    """A command that keeps the exit-code contract (:data:`EXIT_CODES`): an error of bad input is one line and exit
-    2, any other exception one line and exit 3; ``--debug`` re-raises both (the traceback) and shows the warnings
-    that other packages raise, which are otherwise hidden."""
-
-    def invoke(self, ctx):
-        if _debug["on"]:
-            return super().invoke(ctx)
-        with warnings.catch_warnings():
-            warnings.filterwarnings("ignore", module=r"^(?!graspaug)")
-            try:
-                return super().invoke(ctx)
-            except (typer.Exit, typer.Abort, KeyboardInterrupt):
-                raise
-            except _bad_input_errors() as exc:
-                typer.echo(f"error: {_one_line(exc)}", err=True)
-                raise typer.Exit(code=2) from None
-            except Exception as exc:  # noqa: BLE001 - the contract: one line, exit 3, the traceback with --debug
-                if type(exc).__module__.startswith("click"):
-                    raise
-                typer.echo(
-                    f"error: unexpected {type(exc).__name__}: {_one_line(exc)} (a bug? `graspaug --debug` shows "
-                    "the traceback)",
-                    err=True,
-                )
-                raise typer.Exit(code=3) from None
-
-
-def _one_line(exc: BaseException) -> str:
-    text = " ".join(str(exc).split()) if str(exc) else type(exc).__name__
-    if isinstance(exc, OSError) and exc.filename is not None and exc.strerror:
-        text = f"{exc.filename}: {exc.strerror.lower()}"
-    return text
 
 
 def _load(path: Path, stage):
@@ -613,7 +563,7 @@ def _root(
     ),
 ) -> None:
     """graspaug: augment a grasp planner's training objects with generated shapes."""
-    _debug["on"] = debug or os.environ.get("GRASPAUG_DEBUG", "") not in ("", "0")
+    debug_mode(debug or os.environ.get("GRASPAUG_DEBUG", "") not in ("", "0"))
 
 
 def main() -> None:
