@@ -77,7 +77,7 @@ def test_planning_does_not_import_sim_or_experiments():
 
 
 def test_libraries_know_no_file_layout():
-    """Only stages and the CLI know file names (graspaug.pipeline.paths); only the pipeline raises or catches StageError."""
+    """Only stages and the CLI know file names (graspaug.pipeline.paths); only the pipeline handles StageError."""
     graph = import_graph(SRC)
     users = {m for m in graph.predecessors("graspaug.pipeline.paths")}
     assert {m for m in users if not (m.startswith("graspaug.pipeline.stages") or m == "graspaug.pipeline.cli")} == set()
