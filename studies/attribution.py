@@ -6,7 +6,7 @@ Each draw k is a clone of this repository's HEAD in ``--workdir``/draw<k> that s
 repository's DVC cache (so the stages no data seed reaches, ingest to ``render@original``, come
 from the run cache), with params.yaml written from the profile plus ``data_seed: k`` and any
 ``--set key=value``; it runs ``dvc repro report`` (the GQ-CNN experiment, not the robot cell).
-Then :func:`graspaug.experiments.attribution.combine_draws` combines the draws' networks (a
+Then :func:`graspaug.experiments.ap.attribution.combine_draws` combines the draws' networks (a
 hierarchical bootstrap over draws, seeds within draws and test objects) and writes
 ``summary.json`` and ``decomposition.md`` into ``--workdir``. A finished draw is not run again.
 
@@ -25,8 +25,8 @@ from pathlib import Path
 
 import yaml
 
-from graspaug.experiments.ap import test_labels
-from graspaug.experiments.attribution import combine_draws, decomposition_markdown
+from graspaug.experiments.ap.attribution import combine_draws, decomposition_markdown
+from graspaug.experiments.ap.numbers import test_labels
 from graspaug.io.tables import read_table
 from graspaug.pipeline.params.model import params_dict, parse_params
 from graspaug.pipeline.params.profiles import merge, params_yaml, read_overlay

@@ -28,7 +28,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from graspaug.experiments.ap import choose_ratios, collect
+from graspaug.experiments.ap.numbers import choose_ratios, collect
 from graspaug.experiments.cell_ranking import arm_scores, auc_samples, ranking_bootstrap, ranking_summary
 from graspaug.experiments.sim import after_ratio
 from graspaug.experiments.sim_report import CONTRASTS

@@ -27,7 +27,7 @@ import numpy as np
 import pandas as pd
 from sklearn.metrics import average_precision_score
 
-from graspaug.experiments.ap import choose_ratios, declared_contrasts
+from graspaug.experiments.ap.numbers import choose_ratios, declared_contrasts
 from graspaug.experiments.stats import t_interval
 from graspaug.io.tables import read_table
 from graspaug.pipeline.params.model import load_params

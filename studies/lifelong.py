@@ -26,7 +26,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from graspaug.experiments.ap import test_labels
+from graspaug.experiments.ap.numbers import test_labels
 from graspaug.experiments.lifelong import (
     arm_contrasts,
     arm_variant,

@@ -196,7 +196,7 @@ def ap_vs_ratio(table: pd.DataFrame, path: str | os.PathLike, title: str) -> Non
     """The paper's Fig. 7: test AP against the augmentation ratio, one panel per base size, one
     line per pool (targeted solid, random dashed, real dotted, recon dash-dotted), each starting from the base
     set alone at ratio 0, with 95% t-interval error bars; the ceiling (every train shape) as a
-    grey band. ``table``: :func:`graspaug.experiments.ap.network_table` (columns ``pool``,
+    grey band. ``table``: :func:`graspaug.experiments.ap.numbers.network_table` (columns ``pool``,
     ``base_size``, ``ratio``, ``test_ap``, ``test_ap_ci``)."""
     plt = pyplot()
     networks = table[table.pool != "ceiling"]

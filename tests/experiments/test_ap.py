@@ -7,8 +7,8 @@ import pandas as pd
 import pytest
 
 from graspaug.errors import DataError
-from graspaug.experiments import ap
-from graspaug.experiments.ap import collect, declared_contrasts
+from graspaug.experiments.ap import figures, numbers, words
+from graspaug.experiments.numbers.numbers import collect, declared_contrasts
 from graspaug.experiments.settings import POOLS
 from graspaug.training.variants import seed_variants
 
@@ -59,7 +59,7 @@ def test_the_declared_contrasts():
 def test_gain_sentences_give_shares_and_call_a_gap_within_the_ceilings_interval_no_gap():
     import pandas as pd
 
-    from graspaug.experiments.ap import gain_sentences
+    from graspaug.experiments.numbers.words import gain_sentences
     from graspaug.experiments.stats import fieller_interval
 
     table = pd.DataFrame(
@@ -111,7 +111,7 @@ def test_networks_are_read_from_the_seed_folders_given(tmp_path):
         }
     ]
     # ratio 0 of any pool is the targeted network
-    assert ap.test_predictions(seed_dirs[3], ("random", 50, 0.0)).tolist() == pytest.approx([0.1, 0.9])
+    assert numbers.test_predictions(seed_dirs[3], ("random", 50, 0.0)).tolist() == pytest.approx([0.1, 0.9])
     with pytest.raises(DataError, match=r"s3/targeted/50-1/summary.json is missing"):
         collect(seed_dirs, seed_variants([50], [0.0, 1.0], [50], ceiling=False))
 
@@ -155,26 +155,28 @@ def test_evaluate_networks_is_the_report_chain_step_by_step(tmp_path):
     gqcnn = SimpleNamespace(augment_base_sizes=[10], ceiling=True, val_shapes=1, pools=("targeted", "recon", "real"))
     variants = seed_variants(generate.base_sizes, generate.ratios, gqcnn.augment_base_sizes, gqcnn.ceiling, gqcnn.pools)
     seed_dirs, index = _seed_folders(tmp_path, variants)
-    ev = ap.evaluate_networks(seed_dirs, tmp_path / "original", generate, gqcnn, seed=5, n_resamples=50)
+    ev = numbers.evaluate_networks(seed_dirs, tmp_path / "original", generate, gqcnn, seed=5, n_resamples=50)
 
     runs = collect(seed_dirs, variants)
-    chosen = ap.choose_ratios(runs, gqcnn.augment_base_sizes)
+    chosen = numbers.choose_ratios(runs, gqcnn.augment_base_sizes)
     contrasts = declared_contrasts(generate.base_sizes, generate.ratios, gqcnn.augment_base_sizes, chosen, gqcnn.pools)
     assert [c.name for c in contrasts][-3:] == ["targeted_vs_real@10", "recon_vs_real@10", "targeted_vs_recon@10"]
-    rows = ap.test_rows(seed_dirs[0])
+    rows = numbers.test_rows(seed_dirs[0])
     labels, object_ids = index.label.to_numpy()[rows], index.shape_id.to_numpy()[rows]
-    results = ap.evaluate_contrasts(contrasts, runs, seed_dirs, labels, object_ids, n_resamples=50, seed=5)
-    per_object, by_network = ap.per_object_aps(seed_dirs, variants, labels, object_ids)
+    results = numbers.evaluate_contrasts(contrasts, runs, seed_dirs, labels, object_ids, n_resamples=50, seed=5)
+    per_object, by_network = numbers.per_object_aps(seed_dirs, variants, labels, object_ids)
     assert ev.chosen == chosen and ev.contrasts == results
-    pd.testing.assert_frame_equal(ev.table, ap.network_table(runs, per_object))
+    pd.testing.assert_frame_equal(ev.table, numbers.network_table(runs, per_object))
     assert ev.by_network.keys() == by_network.keys() and np.array_equal(ev.labels, labels)
     assert np.array_equal(ev.object_ids, object_ids)
     assert ev.ceiling_shapes == 2 - 1  # the train shapes t0, t1 but one validation shape
 
-    predictions = ap.compared_predictions(seed_dirs[0], 10, 1.0, ceiling=True)
+    predictions = figures.compared_predictions(seed_dirs[0], 10, 1.0, ceiling=True)
     assert list(predictions) == ["B = 10, 1:0", "B = 10, 1:1", "ceiling"]
-    np.testing.assert_array_equal(predictions["B = 10, 1:1"], ap.test_predictions(seed_dirs[0], ("targeted", 10, 1.0)))
-    assert list(ap.compared_predictions(seed_dirs[0], 10, 1.0, ceiling=False)) == ["B = 10, 1:0", "B = 10, 1:1"]
+    np.testing.assert_array_equal(
+        predictions["B = 10, 1:1"], numbers.test_predictions(seed_dirs[0], ("targeted", 10, 1.0))
+    )
+    assert list(figures.compared_predictions(seed_dirs[0], 10, 1.0, ceiling=False)) == ["B = 10, 1:0", "B = 10, 1:1"]
 
 
 def test_the_augmentation_set_is_the_targeted_pools_first_rows():
@@ -183,19 +185,19 @@ def test_the_augmentation_set_is_the_targeted_pools_first_rows():
     from graspaug.augment.candidates import ratio_count
 
     generated = pd.DataFrame({"pool": ["targeted"] * 6 + ["random"] * 6, "order": list(range(6)) * 2})
-    chosen = ap.augmentation_set(generated, 4, 0.5)
+    chosen = figures.augmentation_set(generated, 4, 0.5)
     assert (chosen.pool == "targeted").all() and list(chosen.order) == list(range(ratio_count(0.5, 4)))
 
 
 def test_the_pr_roc_figure_draws_the_compared_networks(tmp_path):
     from types import SimpleNamespace
 
-    from graspaug.experiments.ap_figures import draw_pr_roc
+    from graspaug.experiments.numbers.figures import draw_pr_roc
 
     generate, gqcnn = SimpleNamespace(base_sizes=[10], ratios=[0.0, 1.0]), SimpleNamespace(augment_base_sizes=[10])
     variants = seed_variants(generate.base_sizes, generate.ratios, gqcnn.augment_base_sizes, ceiling=False)
     seed_dirs, index = _seed_folders(tmp_path, variants, seeds=(0,))
-    labels = index.label.to_numpy()[ap.test_rows(seed_dirs[0])]
+    labels = index.label.to_numpy()[numbers.test_rows(seed_dirs[0])]
     draw_pr_roc(labels, seed_dirs[0], 0, 10, 1.0, False, tmp_path / "pr_roc.png")
     assert (tmp_path / "pr_roc.png").stat().st_size > 0
 
@@ -203,7 +205,7 @@ def test_the_pr_roc_figure_draws_the_compared_networks(tmp_path):
 def test_datapoint_matched_contrasts_interpolate_the_real_shape_curve_in_datapoints():
     import pandas as pd
 
-    from graspaug.experiments.ap import datapoint_matched_contrasts
+    from graspaug.experiments.numbers.numbers import datapoint_matched_contrasts
 
     rows = [  # (pool, B, R, training datapoints): real shapes at 3,000 / 6,000 / 12,000 datapoints
         ("targeted", 50, 0.0, 3000),
@@ -235,9 +237,9 @@ def test_the_report_scopes_its_verdicts_to_its_one_draw_of_the_data():
         [("targeted", 50, 0.0, 0.3, 0.01, 0.3, 0.3, 0.8, 4)],
         columns=["pool", "base_size", "ratio", "test_ap", "test_ap_ci", "per_object_ap", "val_ap", "test_roc_auc", "n"],
     )
-    text = ap.report_markdown(table, {"targeted_vs_random@50": loss}, {}, [], [0, 1, 2, 3], 0.3, "Words.", 1)
+    text = words.report_markdown(table, {"targeted_vs_random@50": loss}, {}, [], [0, 1, 2, 3], 0.3, "Words.", 1)
     assert "over training seeds [0, 1, 2, 3] of one draw of the data (`data_seed` = 1)" in text
     assert "does not cover other draws" in text and "`python studies/attribution.py --draws 0 1 2`" in text
     assert "Over three draws of the data" in text
     assert "a loss in this draw of the data" in text and "a real loss" not in text
-    assert "a real gain" not in ap.verdict("x", loss | {"mean": 0.03, "ci_low": 0.01, "ci_high": 0.05})
+    assert "a real gain" not in words.verdict("x", loss | {"mean": 0.03, "ci_low": 0.01, "ci_high": 0.05})

@@ -1,4 +1,4 @@
-"""Contrasts over data draws × training seeds (graspaug.experiments.attribution) on hand-made networks."""
+"""Contrasts over data draws × training seeds (graspaug.experiments.ap.attribution) on hand-made networks."""
 
 import json
 from types import SimpleNamespace
@@ -8,7 +8,7 @@ import pytest
 from sklearn.metrics import average_precision_score
 
 from graspaug.errors import DataError
-from graspaug.experiments.attribution import combine_draws, decomposition_markdown, losing_step
+from graspaug.experiments.ap.attribution import combine_draws, decomposition_markdown, losing_step
 from graspaug.training.variants import seed_variants
 
 GENERATE = SimpleNamespace(base_sizes=[10, 20], ratios=[0.0, 1.0])

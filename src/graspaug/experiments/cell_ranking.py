@@ -19,7 +19,7 @@ import numpy as np
 import pandas as pd
 
 from graspaug.errors import DataError
-from graspaug.experiments.ap import test_predictions, test_rows
+from graspaug.experiments.ap.numbers import test_predictions, test_rows
 from graspaug.experiments.sim_report import CONTRASTS
 from graspaug.experiments.stats import ObjectBootstrap, percentile_interval, t_interval, weighted_roc_auc
 from graspaug.rng import shape_rng

@@ -5,7 +5,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from graspaug.experiments.ap import choose_ratios, network_table, verdict
+from graspaug.experiments.ap.numbers import choose_ratios, network_table
+from graspaug.experiments.ap.words import verdict
 
 
 def contrast(values, boot=(0.01, 0.03)):

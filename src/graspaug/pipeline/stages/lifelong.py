@@ -14,7 +14,7 @@ import pandas as pd
 from graspaug.augment.decode import mesh_batches
 from graspaug.augment.pools import base_set, loop_shapes
 from graspaug.device import resolve_device
-from graspaug.experiments.ap import test_labels
+from graspaug.experiments.ap.numbers import test_labels
 from graspaug.experiments.lifelong import arm_variant, disjoint, failure_anchors, round_networks
 from graspaug.experiments.lifelong_round import render_round, score_round, write_round
 from graspaug.experiments.settings import ARMS

@@ -12,7 +12,7 @@ import logging
 
 import numpy as np
 
-from graspaug.experiments.ap import test_labels
+from graspaug.experiments.ap.numbers import test_labels
 from graspaug.experiments.lifelong import arm_variant, failure_history, validation_errors
 from graspaug.experiments.lifelong_round import write_round
 from graspaug.io.atomic import atomic_path

@@ -14,19 +14,16 @@ from __future__ import annotations
 
 import logging
 
-from graspaug.experiments.ap import (
-    ap_headline,
-    ap_metrics,
-    evaluate_networks,
-    gain_sentences,
+from graspaug.experiments.ap.attribution import combine_draws, decomposition_markdown, losing_step
+from graspaug.experiments.ap.figures import (
+    draw_ap_vs_ratio,
+    draw_improvement,
+    draw_latent_map,
+    draw_pr_roc,
     improvement_data,
-    ratio_curves,
-    report_markdown,
-    training_words,
-    verdict,
 )
-from graspaug.experiments.ap_figures import draw_ap_vs_ratio, draw_improvement, draw_latent_map, draw_pr_roc
-from graspaug.experiments.attribution import combine_draws, decomposition_markdown, losing_step
+from graspaug.experiments.ap.numbers import ap_headline, ap_metrics, evaluate_networks, ratio_curves
+from graspaug.experiments.ap.words import gain_sentences, report_markdown, training_words, verdict
 from graspaug.io.atomic import atomic_path
 from graspaug.io.tables import read_table, write_csv, write_json, write_json_files
 from graspaug.pipeline.params.base import params_model

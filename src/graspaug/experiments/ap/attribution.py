@@ -21,7 +21,7 @@ import numpy as np
 import pandas as pd
 
 from graspaug.errors import DataError
-from graspaug.experiments.ap import (
+from graspaug.experiments.ap.numbers import (
     Contrast,
     collect,
     datapoint_matched_contrasts,
@@ -43,7 +43,7 @@ STEPS = ("recon_vs_real", "blend_vs_recon", "targeted_vs_blend", "targeted_vs_ra
 
 
 def draw_contrasts(runs: pd.DataFrame, generate, gqcnn) -> list[Contrast]:
-    """The contrasts of one draw (``runs``: :func:`graspaug.experiments.ap.collect`): the declared
+    """The contrasts of one draw (``runs``: :func:`graspaug.experiments.ap.numbers.collect`): the declared
     ones without the validation-chosen ratio (it may differ between draws), and the
     datapoint-matched ones (their weights come from the draw's own datapoint counts)."""
     base_sizes, ratios, augment = generate.base_sizes, generate.ratios, gqcnn.augment_base_sizes
