@@ -8,8 +8,8 @@ import pytest
 
 from graspaug.errors import DataError
 from graspaug.experiments.ap import figures, numbers, words
-from graspaug.experiments.numbers.numbers import collect, declared_contrasts
-from graspaug.experiments.settings import POOLS
+from graspaug.experiments.ap.numbers import collect, declared_contrasts
+from graspaug.training.settings import POOLS
 from graspaug.training.variants import seed_variants
 
 
@@ -59,7 +59,7 @@ def test_the_declared_contrasts():
 def test_gain_sentences_give_shares_and_call_a_gap_within_the_ceilings_interval_no_gap():
     import pandas as pd
 
-    from graspaug.experiments.numbers.words import gain_sentences
+    from graspaug.experiments.ap.words import gain_sentences
     from graspaug.experiments.stats import fieller_interval
 
     table = pd.DataFrame(
@@ -192,7 +192,7 @@ def test_the_augmentation_set_is_the_targeted_pools_first_rows():
 def test_the_pr_roc_figure_draws_the_compared_networks(tmp_path):
     from types import SimpleNamespace
 
-    from graspaug.experiments.numbers.figures import draw_pr_roc
+    from graspaug.experiments.ap.figures import draw_pr_roc
 
     generate, gqcnn = SimpleNamespace(base_sizes=[10], ratios=[0.0, 1.0]), SimpleNamespace(augment_base_sizes=[10])
     variants = seed_variants(generate.base_sizes, generate.ratios, gqcnn.augment_base_sizes, ceiling=False)
@@ -205,7 +205,7 @@ def test_the_pr_roc_figure_draws_the_compared_networks(tmp_path):
 def test_datapoint_matched_contrasts_interpolate_the_real_shape_curve_in_datapoints():
     import pandas as pd
 
-    from graspaug.experiments.numbers.numbers import datapoint_matched_contrasts
+    from graspaug.experiments.ap.numbers import datapoint_matched_contrasts
 
     rows = [  # (pool, B, R, training datapoints): real shapes at 3,000 / 6,000 / 12,000 datapoints
         ("targeted", 50, 0.0, 3000),

@@ -13,8 +13,8 @@ from typer.testing import CliRunner
 from graspaug.io.voxels import read_voxels
 from graspaug.pipeline.cli import app
 
-from ..geometry import scan_meshes
-from ..geometry.test_loading import write_broken_corpus
+from ...geometry import scan_meshes
+from ...geometry.test_loading import write_broken_corpus
 
 
 def make_corpus(folder):
