@@ -200,13 +200,12 @@ def test_from_failures_generates_from_train_shapes_near_a_users_failure_meshes(t
     mine = tmp_path / "myproject"
     mine.mkdir()
     (mine / "notes.txt").write_text("my notes")
-    for out in (mine, failures, failures / "out"):
+    for out in (mine, failures / "out"):  # a folder of the user's; one inside the input (tests/io: the rest)
         refused = subprocess.run([*command, "-o", str(out)], cwd=work, env=env, capture_output=True, text=True)
         assert refused.returncode == 2 and refused.stderr.strip().count("\n") == 0, refused.stderr
         assert str(out) in refused.stderr
     assert (mine / "notes.txt").read_text() == "my notes" and len(list(mine.iterdir())) == 1
     assert sorted(p.name for p in failures.iterdir()) == ["box.obj", "broken.obj", "capsule.stl"]
-    run([*command, "-o", str(tmp_path / "out")], work, env)  # its own folder: replaced
     missing = subprocess.run(
         [*command[:2], str(tmp_path / "nowhere")], cwd=work, env=env, capture_output=True, text=True
     )
@@ -810,7 +809,7 @@ def test_queued_two_point_sweep_lines_up_metrics(tiny_repo):
             work,
             env,
         )
-    run(["dvc", "queue", "start", "-j", "1"], work, env)
+    run(["dvc", "queue", "start", "-j", "2"], work, env)  # both points at once: the suite's other tests are done
     deadline = time.time() + 600
     while time.time() < deadline:
         status = run(["dvc", "queue", "status"], work, env).stdout

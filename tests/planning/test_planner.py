@@ -250,6 +250,20 @@ def test_no_edges_no_grasp_and_old_checkpoints_assume_the_defaults(model_path, t
     assert math.isclose(planner.card.focal_length, 525.0)
 
 
+def test_export_model_replaces_only_its_own_folder(model_path, tmp_path):
+    """export-model writes into a new folder or one it wrote; a folder of the user's is refused and kept."""
+    mine = tmp_path / "mine"
+    mine.mkdir()
+    (mine / "notes.txt").write_text("mine")
+    refused = CliRunner().invoke(app, ["export-model", str(model_path), str(mine)])
+    assert refused.exit_code == 2 and "did not write (notes.txt)" in refused.output, refused.output
+    assert sorted(p.name for p in mine.iterdir()) == ["notes.txt"]
+    for _ in range(2):  # its own folder: written again
+        assert CliRunner().invoke(app, ["export-model", str(model_path), str(tmp_path / "ours")]).exit_code == 0
+    forced = CliRunner().invoke(app, ["export-model", str(model_path), str(mine), "--force"])
+    assert forced.exit_code == 0 and (mine / "model.ts").is_file()
+
+
 def test_export_model_gives_the_same_probabilities(model_path, tmp_path):
     result = CliRunner().invoke(app, ["export-model", str(model_path), str(tmp_path / "export")])
     assert result.exit_code == 0, result.output
