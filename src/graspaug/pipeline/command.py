@@ -10,9 +10,9 @@ from typer.core import TyperCommand
 
 EXIT_CODES = (
     "Exit codes, the same for every command: 0 an answer; 1 no acceptable answer (`plan`: no grasp, or the best one "
-    "below the quality floor; `from-failures`: no shape kept); 2 bad input or usage (a missing or broken file, a bad "
-    "param, an output folder it may not write), one line naming the culprit; 3 an unexpected error (a bug: `graspaug "
-    "--debug <command> ...` shows its traceback)."
+    "below the quality floor); 2 bad input or usage (a missing or broken file, a bad param, an output folder it may "
+    "not write, too few usable candidates for `--count`), one line naming the culprit; 3 an unexpected error (a bug: "
+    "`graspaug --debug <command> ...` shows its traceback)."
 )
 
 _debug = {"on": False}  # set by the root callback (--debug, GRASPAUG_DEBUG) on every invocation
