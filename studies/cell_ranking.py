@@ -1,7 +1,7 @@
 """Do networks trained on more real shapes rank the cell's outcomes better, over draws of the training data?
 
 The ``sim`` stage scores each arm's networks on the grasps that ``grasp_calibration`` executed in
-the cell (ROC AUC against the outcomes: :mod:`graspaug.experiments.cell_ranking`). This study does
+the cell (ROC AUC against the outcomes: :mod:`graspaug.experiments.cell.numbers`). This study does
 the same for the networks of several projects that share the rendered dataset and the cell but were
 trained on different draws of the training shapes (``data_seed``; e.g. the attribution study's
 ``draw<k>`` folders), and pools them: per draw the contrasts of the ``sim`` stage (bootstrap over
@@ -29,9 +29,8 @@ import numpy as np
 import pandas as pd
 
 from graspaug.experiments.ap.numbers import choose_ratios, collect
-from graspaug.experiments.cell_ranking import arm_scores, auc_samples, ranking_bootstrap, ranking_summary
-from graspaug.experiments.sim import after_ratio
-from graspaug.experiments.sim_report import CONTRASTS
+from graspaug.experiments.cell.numbers import CONTRASTS, arm_scores, auc_samples, ranking_bootstrap, ranking_summary
+from graspaug.experiments.cell.trials import after_ratio
 from graspaug.experiments.stats import nested_interval
 from graspaug.io.tables import read_table
 from graspaug.pipeline.params.model import load_params

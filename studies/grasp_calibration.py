@@ -2,7 +2,7 @@
 
 Chooses ``--n`` datapoints of the rendered test split (half labelled positive), puts each shape
 in the datapoint's stable pose on the cell's table and executes its grasp with the Panda
-(:mod:`graspaug.experiments.grasp_calibration`), then prints one JSON line: success per label,
+(:mod:`graspaug.experiments.cell.calibration`), then prints one JSON line: success per label,
 ROC AUC of the robust ε (all grasps, collision-free ones) and of the label, with bootstrap
 intervals over shapes, outcome counts per label, and the time. ``--set`` changes sim params
 (``hand``, ``trial``, ``physics``, ``cell``) to measure what each change does to agreement.
@@ -24,7 +24,7 @@ from pathlib import Path
 
 from _cell import with_changes
 
-from graspaug.experiments.grasp_calibration import choose_grasps, run_calibration, shape_jobs, summarize
+from graspaug.experiments.cell.calibration import choose_grasps, run_calibration, shape_jobs, summarize
 from graspaug.io.tables import read_table
 from graspaug.pipeline.params.model import Params
 from graspaug.pipeline.paths import SHAPES_DIR, gqcnn_dir, grasps_table

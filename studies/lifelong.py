@@ -6,9 +6,9 @@ plus ``data_seed: k``. By default it runs ``dvc repro lifelong@r<K>`` there (the
 sharing this repository's DVC cache). With ``--reuse DIR`` the stages before the loop are not run again: their
 outputs are linked from DIR/draw<k> (an attribution study's draws: the same profile's data, the same data seed) and
 the rounds run as ``graspaug lifelong-start`` and ``graspaug lifelong --round r<k>``, the commands the DVC stages
-run. A finished round is not run again. Then :func:`graspaug.experiments.lifelong.arm_contrasts` combines the draws
-per round and ``summary.json``, ``lifelong.md``, ``followed.csv``, ``curve.png`` (test AP) and ``gain.png`` (the
-gain over round 0) are written into ``--workdir``.
+run. A finished round is not run again. Then :func:`~graspaug.experiments.lifelong.numbers.arm_contrasts` combines
+the draws per round and ``summary.json``, ``lifelong.md``, ``followed.csv``, ``curve.png`` (test AP) and ``gain.png``
+(the gain over round 0) are written into ``--workdir``.
 
     python studies/lifelong.py [--draws 0 1 2] [--workdir ../lifelong] [--profile lifelong] [--reuse ../attribution]
         [--resamples 2000] [--combine-only]
@@ -27,15 +27,9 @@ from pathlib import Path
 import pandas as pd
 
 from graspaug.experiments.ap.numbers import test_labels
-from graspaug.experiments.lifelong import (
-    arm_contrasts,
-    arm_variant,
-    curve_rows,
-    curve_series,
-    interval_text,
-    round_networks,
-)
-from graspaug.experiments.settings import ARMS
+from graspaug.experiments.lifelong.figures import curve_series
+from graspaug.experiments.lifelong.numbers import ARMS, arm_contrasts, arm_variant, curve_rows, round_networks
+from graspaug.experiments.lifelong.words import interval_text
 from graspaug.io.tables import read_table
 from graspaug.pipeline.params.profiles import merge, params_yaml, read_overlay
 from graspaug.plots import lines

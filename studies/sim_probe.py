@@ -31,8 +31,8 @@ from pathlib import Path
 import pandas as pd
 from _cell import with_changes
 
-from graspaug.experiments.sim import object_jobs, prepare_objects, run_object, test_shape_ids
-from graspaug.experiments.sim_report import rate_summary, trial_contrast
+from graspaug.experiments.cell.numbers import rate_summary, trial_contrast
+from graspaug.experiments.cell.trials import object_jobs, prepare_objects, run_object, test_shape_ids
 from graspaug.io.tables import read_table
 from graspaug.parallel import parallel_map
 from graspaug.pipeline.params.model import Params

@@ -207,27 +207,56 @@ def test_a_folder_the_stage_does_not_run_is_caught():
     }
 
 
+WIDTH = 118  # dvc.yaml's lines, as ruff's for the code
+
+
+def flow_list(indent: str, key: str, items: list[tuple[str, str | None]]) -> list[str]:
+    """``key: [a, b, ...]`` at ``indent``, wrapped at :data:`WIDTH` with continuation lines two spaces deeper; each item
+    a (value, comment or None) pair, quoted where YAML's flow context needs it, a comment ending its line."""
+    lines, line = [], f"{indent}{key}: ["
+    for n, (value, comment) in enumerate(items):
+        text = f"'{value}'" if any(c in value for c in "{}[],#") else value
+        text += "]" if n == len(items) - 1 else ","
+        if len(line) + 1 + len(text) > WIDTH and not line.endswith("["):
+            lines.append(line)
+            line = f"{indent}  {text}"
+        else:
+            line += ("" if line.endswith("[") else " ") + text
+        if comment:
+            lines.append(f"{line}  # {comment}")
+            line = f"{indent}  "
+    if line.strip():
+        lines.append(line)
+    return lines
+
+
 def written_deps(text: str, deps: dict[str, set[str]]) -> str:
-    """dvc.yaml's ``text`` with each stage's ``src/`` deps replaced by ``deps[stage]`` (sorted, where its first
-    ``src/`` dep was); comments, other deps and every other line kept."""
-    out, stage, written = [], None, False
-    for line in text.splitlines(keepends=True):
+    """dvc.yaml's ``text`` with each stage's ``src/`` deps replaced by ``deps[stage]``: its ``deps: [...]`` list
+    rewritten as its other deps in their order, then ``deps[stage]`` sorted (:func:`flow_list`); every other line
+    kept."""
+    out, stage, lines, i = [], None, text.splitlines(), 0
+    while i < len(lines):
+        line = lines[i]
         if line.startswith("  ") and not line.startswith("   ") and line.split("#")[0].rstrip().endswith(":"):
-            stage, written = line.split(":")[0].strip(), False
-        if stage in deps and line.lstrip().startswith("- src/"):
-            if not written:
-                indent = line[: len(line) - len(line.lstrip())]
-                out += [f"{indent}- {d}\n" for d in sorted(deps[stage])]
-                written = True
+            stage = line.split(":")[0].strip()
+        if stage in deps and line.lstrip().startswith("deps: ["):
+            j = i
+            while "]" not in lines[j].split("#")[0]:
+                j += 1
+            listed = yaml.safe_load("\n".join(x.split("  # ")[0] for x in lines[i : j + 1]))["deps"]
+            others = [(d, None) for d in listed if not d.startswith("src/")]
+            out += flow_list(line[: len(line) - len(line.lstrip())], "deps", others + [(d, None) for d in sorted(deps[stage])])
+            i = j + 1
             continue
         out.append(line)
-    return "".join(out)
+        i += 1
+    return "\n".join(out) + "\n"
 
 
 def test_write_puts_back_what_the_check_expects():
     """`--write` on a dvc.yaml with a stage's src deps scrambled gives a file this test passes on."""
     text = DVC_YAML.read_text()
-    scrambled = text.replace("- src/graspaug/pipeline/stages/voxelize.py", "- src/graspaug/sim", 1)
+    scrambled = text.replace("src/graspaug/pipeline/stages/voxelize.py", "src/graspaug/sim", 1)
     assert scrambled != text
     expected = {name: dvc_deps(files) for name, files in expected_code_deps().items()}
     assert compare_code_deps(yaml.safe_load(written_deps(scrambled, expected))) == {}

@@ -313,7 +313,7 @@ def test_dvc_repro_render(tiny_repo):
 def test_dvc_repro_fidelity(tiny_repo):
     import json
 
-    from graspaug.experiments.fidelity import HEADLINE
+    from graspaug.experiments.fidelity.numbers import HEADLINE
 
     work, env = tiny_repo
     run(["dvc", "repro", "fidelity"], work, env)

@@ -8,8 +8,8 @@ import pytest
 from sklearn.metrics import roc_auc_score
 
 from graspaug.errors import DataError
-from graspaug.experiments.cell_ranking import cell_ranking
-from graspaug.experiments.sim_report import ranking_lines, sim_headline
+from graspaug.experiments.cell.numbers import cell_ranking, sim_headline
+from graspaug.experiments.cell.words import ranking_lines
 
 CHOSEN = {
     "before": ("targeted", 0.0, 50),

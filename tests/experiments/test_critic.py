@@ -2,23 +2,20 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from graspaug.experiments.critic import (
-    EXAMPLE_ALPHAS,
+from graspaug.experiments.critic.figures import EXAMPLE_ALPHAS, example_rows, outlier_columns, outlier_lines
+from graspaug.experiments.critic.numbers import (
     MODEL_LABELS,
-    contrast_text,
-    example_rows,
     finite_or_none,
     interpolant_contrast,
     interpolate,
-    outlier_columns,
     outlier_contrast,
-    outlier_lines,
     outlier_table,
     random_pairs,
     study_headline,
     study_metrics,
     summarize,
 )
+from graspaug.experiments.critic.words import contrast_text
 from graspaug.experiments.stats import PairBootstrap
 
 

@@ -7,20 +7,20 @@ import pandas as pd
 import pytest
 import trimesh
 
-from graspaug.experiments.fidelity import (
+from graspaug.experiments.fidelity.numbers import (
     FIGURES,
     HEADLINE,
     chamfer_matrix,
     coverage_mmd,
     distribution_distances,
     fidelity_headline,
-    fidelity_markdown,
     fidelity_table,
     one_nn_accuracy,
     pool_shapes,
     resampled_distances,
     surface_cloud,
 )
+from graspaug.experiments.fidelity.words import fidelity_markdown
 
 
 def test_chamfer_of_a_cloud_and_its_shift():

@@ -1,4 +1,4 @@
-"""The lifelong loop's choices (graspaug.experiments.lifelong, graspaug.augment.candidates.FailureStream) on
+"""The lifelong loop's choices (graspaug.experiments.lifelong.numbers, graspaug.augment.candidates.FailureStream) on
 hand-made data."""
 
 from collections import Counter
@@ -8,7 +8,7 @@ import pytest
 
 from graspaug.augment.candidates import EXTRA_ALPHAS, FailureStream, neighbour_pairs
 from graspaug.errors import DataError
-from graspaug.experiments.lifelong import disjoint, failure_anchors, object_errors, worst_objects
+from graspaug.experiments.lifelong.numbers import disjoint, failure_anchors, object_errors, worst_objects
 
 
 def test_object_errors_rank_the_object_the_network_gets_wrong_first():
@@ -80,7 +80,7 @@ def _seed_folders(tmp_path, predictions: dict[int, list[float]], rows=(0, 1, 2, 
 def test_validation_errors_average_the_seeds_predictions_and_rank_worst_first(tmp_path):
     import pandas as pd
 
-    from graspaug.experiments.lifelong import validation_errors
+    from graspaug.experiments.lifelong.numbers import validation_errors
 
     index = pd.DataFrame({"shape_id": ["a", "a", "b", "b", "t"], "label": [1, 0, 1, 0, 1]})
     folders = _seed_folders(tmp_path, {0: [0.9, 0.1, 0.1, 0.9], 1: [0.7, 0.3, 0.3, 0.5]})
@@ -141,7 +141,8 @@ def test_each_round_adds_new_shapes_to_each_arm_and_never_a_pair_and_weight_made
 
 
 def test_arm_contrasts_pair_the_arms_within_a_seed_and_say_when_the_real_data_gain_shows(tmp_path):
-    from graspaug.experiments.lifelong import arm_contrasts, arm_variant, curve_rows, curve_series
+    from graspaug.experiments.lifelong.figures import curve_series
+    from graspaug.experiments.lifelong.numbers import arm_contrasts, arm_variant, curve_rows
 
     rng = np.random.default_rng(1)
     objects = np.repeat([f"o{i}" for i in range(40)], 10)
@@ -176,7 +177,7 @@ def test_arm_contrasts_pair_the_arms_within_a_seed_and_say_when_the_real_data_ga
 def test_failure_history_counts_the_rounds_an_object_stays_a_failure():
     import pandas as pd
 
-    from graspaug.experiments.lifelong import failure_history, followed_failures, persistent_failures
+    from graspaug.experiments.lifelong.numbers import failure_history, followed_failures, persistent_failures
 
     history = failure_history(failure_history(failure_history(None, 0, ["a", "b"]), 1, ["b", "c"]), 2, ["b", "a"])
     top = persistent_failures(history)
@@ -191,7 +192,7 @@ def test_failure_history_counts_the_rounds_an_object_stays_a_failure():
 def test_a_rounds_verdicts_are_scoped_to_its_one_draw_of_the_data():
     import pandas as pd
 
-    from graspaug.experiments.lifelong import round_markdown
+    from graspaug.experiments.lifelong.words import round_markdown
 
     c = {"mean": -0.02, "ci_low": -0.03, "ci_high": -0.01}
     result = {"ap": {"failure": {"mean": 0.3, "ci_low": 0.2, "ci_high": 0.4}}, "contrasts": {"failure_vs_real": c}}

@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 
 from graspaug.errors import DataError
-from graspaug.experiments.sim import arms, model_path, trial_picture
+from graspaug.experiments.cell.figures import trial_picture
+from graspaug.experiments.cell.trials import arms, model_path
 
 
 def seed_dirs_with(tmp_path, networks: list[str], seeds=(0, 1)) -> dict:
@@ -54,7 +55,7 @@ def test_a_picture_shows_the_jaws_around_the_grasp_and_blanks_missing_pixels():
 
 
 def test_the_after_ratio_comes_from_the_report_or_is_the_largest():
-    from graspaug.experiments.sim import after_ratio
+    from graspaug.experiments.cell.trials import after_ratio
 
     assert after_ratio({"summary": {"50": {"best_ratio": 1.5}}}, 50, [0.0, 0.5, 2.0]) == (1.5, True)
     assert after_ratio({"summary": {"100": {"best_ratio": 1.5}}}, 50, [0.0, 0.5, 2.0]) == (2.0, False)
@@ -64,7 +65,7 @@ def test_the_after_ratio_comes_from_the_report_or_is_the_largest():
 def test_no_user_folder_gives_no_meshes_and_a_bad_one_is_a_data_error(tmp_path):
     from types import SimpleNamespace
 
-    from graspaug.experiments.sim import user_meshes
+    from graspaug.experiments.cell.trials import user_meshes
 
     ingest = SimpleNamespace(surface=None, max_faces=10, max_file_mb=1.0)
     assert user_meshes(None, ingest) == ([], {})
@@ -75,7 +76,7 @@ def test_no_user_folder_gives_no_meshes_and_a_bad_one_is_a_data_error(tmp_path):
 def test_the_plan_line_counts_objects_arms_and_seeds():
     from types import SimpleNamespace
 
-    from graspaug.experiments.sim import trials_plan
+    from graspaug.experiments.cell.trials import trials_plan
 
     chosen = {"before": ("targeted", 0.0, 50), "after": ("targeted", 1.5, 50), "antipodal": (None, None, None)}
     objects = [SimpleNamespace(name="a"), SimpleNamespace(name="b")]

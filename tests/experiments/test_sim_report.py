@@ -4,15 +4,9 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from graspaug.experiments.sim_report import (
-    calibration,
-    compare,
-    rate_summary,
-    report_text,
-    sim_headline,
-    success_bar_data,
-    trial_contrast,
-)
+from graspaug.experiments.cell.figures import success_bar_data
+from graspaug.experiments.cell.numbers import calibration, compare, rate_summary, sim_headline, trial_contrast
+from graspaug.experiments.cell.words import report_text
 
 
 def trials_table(outcomes: dict[tuple[str, int, str], list[bool]]) -> pd.DataFrame:
@@ -131,7 +125,7 @@ def test_calibration_correlates_sim_success_with_graspness():
 
 
 def test_the_outcome_line_gives_rates_contrasts_and_planning_time():
-    from graspaug.experiments.sim_report import outcome_words
+    from graspaug.experiments.cell.words import outcome_words
 
     metrics = {
         "arms": {"before": {"successes": 3, "attempts": 4}, "after": {"successes": 4, "attempts": 4}},
@@ -148,7 +142,7 @@ def test_the_outcome_line_gives_rates_contrasts_and_planning_time():
 
 
 def test_the_report_reads_augmentation_only_when_the_positive_control_shows():
-    from graspaug.experiments.sim_report import control_words
+    from graspaug.experiments.cell.words import control_words
 
     shows = {"real_data": {"mean": 0.08, "ci_low": 0.02, "ci_high": 0.14}}
     fails = {"real_data": {"mean": -0.02, "ci_low": -0.09, "ci_high": 0.05}}

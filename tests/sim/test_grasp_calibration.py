@@ -6,7 +6,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from graspaug.experiments.grasp_calibration import (
+from graspaug.experiments.cell.calibration import (
     ShapeGrasps,
     choose_grasps,
     grasp_on_body,

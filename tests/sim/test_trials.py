@@ -95,7 +95,7 @@ def test_user_folder_of_meshes_runs_through_the_trials(tmp_path, sim_cache):
     are scaled like the corpus's shapes, get drawn physics, and each runs one trial."""
     import trimesh
 
-    from graspaug.experiments.sim import ObjectJob, prepare_objects, run_object
+    from graspaug.experiments.cell.trials import ObjectJob, prepare_objects, run_object
     from graspaug.geometry.settings import SurfaceSettings
     from graspaug.sim.objects import folder_meshes
     from graspaug.sim.settings import ObjectPhysics

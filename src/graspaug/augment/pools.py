@@ -281,7 +281,7 @@ def failure_shapes(
     ----------
     pool : the training shapes (a :class:`BaseSet`) the anchors index
     anchors : indices into ``pool``, most failing first
-        (:func:`graspaug.experiments.lifelong.failure_anchors`)
+        (:func:`graspaug.experiments.lifelong.numbers.failure_anchors`)
     failures : (len(anchors),) — the name of the failure object each anchor is nearest to
     count : shapes to keep
     cfg : the ``generate`` params: neighbours (``first_neighbour``, ``extra_neighbours``) and ``alphas``

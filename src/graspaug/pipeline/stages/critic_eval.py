@@ -16,18 +16,15 @@ import numpy as np
 import pandas as pd
 
 from graspaug.device import resolve_device
-from graspaug.experiments.critic import (
-    EXAMPLE_ALPHAS,
-    contrast_text,
-    example_rows,
+from graspaug.experiments.critic.figures import EXAMPLE_ALPHAS, example_rows, outlier_columns, outlier_lines
+from graspaug.experiments.critic.numbers import (
     finite_or_none,
     model_interpolations,
-    outlier_columns,
-    outlier_lines,
     random_pairs,
     study_headline,
     study_metrics,
 )
+from graspaug.experiments.critic.words import contrast_text
 from graspaug.experiments.stats import PairBootstrap
 from graspaug.io.checkpoints import load_autoencoder
 from graspaug.io.tables import write_csv, write_json

@@ -4,11 +4,10 @@ Per pool of ``gqcnn.pools`` at base size B (the shapes of the 1:1 augmentation s
 and of the real pool, as the GQ-CNN experiment takes them), against B held-out real shapes (a seeded draw from the
 test split): graspness and the share of the parents' graspness a child keeps, the share of positive rendered
 datapoints, datapoints per shape, median extents, and coverage / MMD / 1-NNA on the Chamfer distance
-(:func:`graspaug.experiments.fidelity.fidelity_table`), each with a 95% bootstrap interval over shapes.
+(:func:`~graspaug.experiments.fidelity.numbers.fidelity_table`), each with a 95% bootstrap interval over shapes.
 
 Outputs: ``metrics/fidelity/<B>/<pool>_<figure>.json`` (``mean``, ``lo``, ``hi``: graspness kept, positive share,
-datapoints per shape, 1-NNA),
-``reports/fidelity/<B>/{fidelity.csv,fidelity.md}``.
+datapoints per shape, 1-NNA), ``reports/fidelity/<B>/{fidelity.csv,fidelity.md}``.
 """
 
 from __future__ import annotations
@@ -20,8 +19,14 @@ import numpy as np
 import pandas as pd
 
 from graspaug.augment.candidates import ratio_count
-from graspaug.experiments.fidelity import fidelity_headline, fidelity_markdown, fidelity_table, pool_shapes
-from graspaug.experiments.settings import FIDELITY_POINTS, FIDELITY_RESAMPLES
+from graspaug.experiments.fidelity.numbers import (
+    FIDELITY_POINTS,
+    FIDELITY_RESAMPLES,
+    fidelity_headline,
+    fidelity_table,
+    pool_shapes,
+)
+from graspaug.experiments.fidelity.words import fidelity_markdown
 from graspaug.io.atomic import atomic_path
 from graspaug.io.meshes import MESH_SUFFIX, mesh_path, read_mesh
 from graspaug.io.tables import read_table, write_csv, write_json_files
@@ -90,9 +95,5 @@ def run(params: Params, base_size: int) -> None:
         tmp.write_text(fidelity_markdown(table, b, len(reference)))
     write_json_files(fidelity_headline(table), fidelity_metrics(b))
     log.info(
-        "fidelity %d: %d pools against %d real shapes in %.1f s",
-        b,
-        len(pools),
-        len(reference),
-        time.perf_counter() - start,
+        "fidelity %d: %d pools, %d real shapes, %.1f s", b, len(pools), len(reference), time.perf_counter() - start
     )

@@ -22,7 +22,7 @@ from graspaug.augment.decode import mesh_batches
 from graspaug.augment.pools import base_set, failure_shapes, failure_summary, log_failure_summary
 from graspaug.device import resolve_device
 from graspaug.errors import DataError
-from graspaug.experiments.lifelong import failure_anchors, validation_errors
+from graspaug.experiments.lifelong.numbers import failure_anchors, validation_errors
 from graspaug.io.atomic import atomic_path
 from graspaug.io.checkpoints import load_autoencoder
 from graspaug.io.meshes import mesh_path, write_obj

@@ -2,7 +2,7 @@
 
 ``sim.calibration_grasps`` datapoints of the rendered test split (half labelled positive, spread over the test
 shapes) are executed in the ``sim`` stage's cell: each shape is put on the table in its datapoint's stable pose
-and the Panda executes that grasp (:mod:`graspaug.experiments.grasp_calibration`). Writes
+and the Panda executes that grasp (:mod:`graspaug.experiments.cell.calibration`). Writes
 ``metrics/grasp_calibration/<figure>.json`` (``mean``, ``lo``, ``hi``, bootstrap over shapes: success per label;
 ROC AUC of the robust ε over all grasps, over collision-free ones, of ε on collision-free grasps and 0 on colliding
 ones, and of the label) and ``reports/grasp_calibration/`` (``summary.json`` with the outcome counts,
@@ -15,9 +15,9 @@ from __future__ import annotations
 import logging
 import time
 
-from graspaug.experiments.grasp_calibration import (
+from graspaug.experiments.cell.calibration import (
+    calibration_headline,
     choose_grasps,
-    headline,
     run_calibration,
     shape_jobs,
     success_by_eps,
@@ -61,5 +61,5 @@ def run(params: Params) -> None:
         write_json(summary, out / "summary.json")
         title = f"{len(table)} labelled test grasps executed in the cell"
         label_calibration(by_eps, table, out / "calibration.png", title)
-    write_json_files(headline(summary), CALIBRATION_METRICS)
+    write_json_files(calibration_headline(summary), CALIBRATION_METRICS)
     log.info("grasp_calibration: %s; %.0f s", summary_line(summary), summary["seconds"])

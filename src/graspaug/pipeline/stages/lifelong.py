@@ -15,9 +15,8 @@ from graspaug.augment.decode import mesh_batches
 from graspaug.augment.pools import base_set, loop_shapes
 from graspaug.device import resolve_device
 from graspaug.experiments.ap.numbers import test_labels
-from graspaug.experiments.lifelong import arm_variant, disjoint, failure_anchors, round_networks
-from graspaug.experiments.lifelong_round import render_round, score_round, write_round
-from graspaug.experiments.settings import ARMS
+from graspaug.experiments.lifelong.numbers import ARMS, arm_variant, disjoint, failure_anchors, round_networks
+from graspaug.experiments.lifelong.round import render_round, score_round, write_round
 from graspaug.io.atomic import atomic_path
 from graspaug.io.checkpoints import load_autoencoder
 from graspaug.io.tables import read_table, write_table

@@ -13,8 +13,8 @@ import logging
 import numpy as np
 
 from graspaug.experiments.ap.numbers import test_labels
-from graspaug.experiments.lifelong import arm_variant, failure_history, validation_errors
-from graspaug.experiments.lifelong_round import write_round
+from graspaug.experiments.lifelong.numbers import arm_variant, failure_history, validation_errors
+from graspaug.experiments.lifelong.round import write_round
 from graspaug.io.atomic import atomic_path
 from graspaug.io.tables import read_table
 from graspaug.io.voxels import read_voxels

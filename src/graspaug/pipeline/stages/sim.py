@@ -1,11 +1,11 @@
 """Stage ``sim``: simulated Panda pick-and-place trials with the GQ-CNN before and after augmentation.
 
-Arms (:mod:`graspaug.experiments.sim`): ``before`` (B = ``sim.base_size``, ratio 0), ``after`` (the ratio chosen on
-validation AP), ``real`` (the ``real`` pool there), ``more_real`` (the largest B at ratio 0: the positive
+Arms (:mod:`~graspaug.experiments.cell.trials`): ``before`` (B = ``sim.base_size``, ratio 0), ``after`` (the ratio
+chosen on validation AP), ``real`` (the ``real`` pool there), ``more_real`` (the largest B at ratio 0: the positive
 control), each per training seed, and ``antipodal`` (no network). Every object (``sim.objects``, ``sim.n_test_objects``
 test shapes, ``sim.objects_path``) is dropped ``sim.attempts`` times, the same drops for every arm; the planner sees a
 D435-like noisy depth image. Each arm's networks also rank the grasps ``grasp_calibration`` executed in this cell
-(:mod:`graspaug.experiments.cell_ranking`). Writes ``metrics/sim/<contrast>.json`` (``mean``, ``lo``, ``hi``: paired
+(:mod:`graspaug.experiments.cell.numbers`). Writes ``metrics/sim/<contrast>.json`` (``mean``, ``lo``, ``hi``: paired
 difference in success, bootstrap over objects; ``ranking_<contrast>``: in ROC AUC against the executed grasps'
 outcomes) and ``reports/sim/`` (``summary.json``, ``report.md``, ``trials.csv``, ``success.{csv,png}``,
 ``objects.csv``, ``calibration.csv``, ``timing.json``, ``trials/<arm>-<object>.png``).
@@ -17,8 +17,16 @@ import json
 import logging
 import time
 
-from graspaug.experiments.cell_ranking import cell_ranking
-from graspaug.experiments.sim import (
+from graspaug.experiments.cell.figures import write_trials_report
+from graspaug.experiments.cell.numbers import (
+    calibration,
+    cell_ranking,
+    planning_timing,
+    sim_headline,
+    summarize,
+    trial_setup,
+)
+from graspaug.experiments.cell.trials import (
     after_ratio,
     arms,
     object_jobs,
@@ -27,15 +35,7 @@ from graspaug.experiments.sim import (
     trials_plan,
     trials_table,
 )
-from graspaug.experiments.sim_outputs import write_trials_report
-from graspaug.experiments.sim_report import (
-    calibration,
-    outcome_words,
-    planning_timing,
-    sim_headline,
-    summarize,
-    trial_setup,
-)
+from graspaug.experiments.cell.words import outcome_words
 from graspaug.io.atomic import atomic_path
 from graspaug.io.tables import read_table, write_json, write_json_files
 from graspaug.pipeline import paths

@@ -1,8 +1,5 @@
-"""A round of the lifelong loop's work on files, into folders the caller names: its new shapes' meshes and the
-union of every round's datapoints (:func:`render_round`), the failure arm's validation errors that choose the next
-round's failures (:func:`score_round`), and its metrics files (each arm's test AP and contrast: mean, lo, hi), report
-(``report.md``), curves over rounds (``curve.png``: test AP; ``gain.png``: the gain over round 0, paired) and the
-objects it keeps failing on (``failures.png``, :func:`write_round`)."""
+"""One round of the lifelong loop: grasp and render the round's new shapes, score the round's networks, write its
+files."""
 
 from __future__ import annotations
 
@@ -12,18 +9,21 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from graspaug.experiments.lifelong import (
+from graspaug.experiments.lifelong.figures import curve_series
+from graspaug.experiments.lifelong.numbers import (
+    ARMS,
     arm_contrasts,
     curve_rows,
-    curve_series,
     failure_history,
     followed_failures,
     persistent_failures,
-    round_markdown,
     validation_errors,
 )
-from graspaug.experiments.settings import ARMS
-from graspaug.experiments.stats import draw_scope, headline
+from graspaug.experiments.lifelong.words import round_markdown
+from graspaug.experiments.stats import (
+    draw_scope,
+    headline,
+)
 from graspaug.grasping.labelled import grasps_of_shapes
 from graspaug.io.atomic import atomic_path
 from graspaug.io.gqcnn import append_grasp_images
@@ -34,6 +34,8 @@ from graspaug.render.corpus_dataset import datapoints_table, render_corpus, with
 from graspaug.render.dataset import SHAPE_COLUMNS, datapoints_index
 
 log = logging.getLogger(__name__)
+
+
 PICTURED = 8  # objects in the picture of persistent failures
 
 
@@ -111,9 +113,9 @@ def write_round(
     report_dir: Path,
     followed: pd.DataFrame | None = None,
 ) -> pd.DataFrame:
-    """Round ``round_``'s figures (:func:`graspaug.experiments.lifelong.arm_contrasts` of ``networks``: draw → seed →
-    arm → folder, tested on ``labels`` / ``objects`` (N,)) as metrics files in ``metrics_dir`` and its report,
-    curve and failures picture (``history``: the failures chosen so far; ``voxels``: the corpus's VoxelSet;
+    """Round ``round_``'s figures (:func:`~graspaug.experiments.lifelong.numbers.arm_contrasts` of ``networks``: draw
+    → seed → arm → folder, tested on ``labels`` / ``objects`` (N,)) as metrics files in ``metrics_dir`` and its
+    report, curve and failures picture (``history``: the failures chosen so far; ``voxels``: the corpus's VoxelSet;
     ``followed``: the last round's failures before and now, None in round 0) in ``report_dir``; ``params`` the
     stage's (``lifelong``, ``gqcnn.seeds``, ``seed``, ``data_seed``). Returns ``curve`` (None in round 0) with this
     round's rows appended."""

@@ -1,33 +1,26 @@
-"""The critic study (paper Section IV-B) with uncertainty: outliers of decoded interpolations,
-per model and α, with bootstrap intervals over pairs, and paired contrasts between models.
-
-Every model decodes the *same* pairs at the same weights, so a contrast is a paired
-difference: pair p's outlier % under model A minus under model B, averaged over pairs.
-Intervals are percentile bootstraps that resample pairs (one
-:class:`~graspaug.experiments.stats.PairBootstrap` for every model, so the contrasts stay paired).
-"""
+"""The critic study's numbers: random interpolation pairs, their decodes, outlier percentages and the paired contrasts
+between models (bootstrap over pairs)."""
 
 from __future__ import annotations
 
 import numpy as np
-import pandas as pd
 import torch
 
 from graspaug.experiments.stats import PairBootstrap, headline, mean_interval, paired_contrast
-from graspaug.geometry.clusters import largest_cluster, outlier_percentage
+from graspaug.geometry.clusters import outlier_percentage
 from graspaug.nets.ae_critic import AutoEncoder
 from graspaug.training.autoencoder import decode, encode
 
 # the three models of the study, in the order they are decoded, tabled and drawn
 MODEL_LABELS = {"ae": "AE", "ae_extra": "AE + extra epochs (λ = 0)", "ae_critic": "AE-Critic"}
+
+
 # paired contrasts: name → (model A, model B), A − B
 CONTRASTS = {
     "critic_vs_control": ("ae_critic", "ae_extra"),
     "critic_vs_ae": ("ae_critic", "ae"),
     "control_vs_ae": ("ae_extra", "ae"),
 }
-# (S,) the interpolation weights of the example pairs' figure
-EXAMPLE_ALPHAS = np.linspace(0, 1, 7, dtype=np.float32)
 
 
 def random_pairs(n: int, n_shapes: int, n_pairs: int, rng: np.random.Generator) -> np.ndarray:
@@ -84,27 +77,6 @@ def interpolant_contrast(
     sums = np.where(finite, diff, 0.0).sum(axis=1)
     per_pair = np.divide(sums, counts, out=np.full(len(diff), np.nan), where=counts > 0)  # (P,)
     return mean_interval(per_pair, boot, level)
-
-
-def outlier_columns(summary: dict[str, dict[str, dict]], alphas, keys: list[str]) -> dict[str, list]:
-    """The outlier table, one row per α (``alphas``, named ``keys`` in ``summary``) and one column per
-    model and interval end: ``alpha``, ``<model>``, …, ``<model>_low``, ``<model>_high``, …
-    ``summary``: model → α key → :func:`~graspaug.experiments.stats.mean_interval` dict (outlier %)."""
-    columns = {m: [s[k]["mean"] for k in keys] for m, s in summary.items()}
-    bounds = {f"{m}_{end}": [s[k][f"ci_{end}"] for k in keys] for m, s in summary.items() for end in ("low", "high")}
-    return {"alpha": list(alphas), **columns, **bounds}
-
-
-def interpolation_rows(sequences: dict[str, np.ndarray], labels: dict[str, str]) -> tuple[list[list[tuple]], list[str]]:
-    """The cells of the interpolations figure: per example pair, one row per model of its decoded
-    grids (A, R, R, R) bool with their largest cluster; and the row labels (``pair <p> <label>``)."""
-    rows, row_labels = [], []
-    n_examples = len(next(iter(sequences.values()))) if sequences else 0
-    for p in range(n_examples):
-        for name, label in labels.items():
-            rows.append([(g, largest_cluster(g)) for g in sequences[name][p]])
-            row_labels.append(f"pair {p + 1} {label}")
-    return rows, row_labels
 
 
 def model_interpolations(
@@ -180,31 +152,3 @@ def study_headline(study: dict) -> dict[str, float | None]:
     interpolants (``mean``, 95% interval ``lo``, ``hi``; percentage points) and the critic's held-out ROC ``auc``."""
     auc = study["critic_auc"]
     return {**headline(study["critic_vs_control_interpolants"]), "auc": None if auc is None else round(auc, 5)}
-
-
-def outlier_lines(wide: pd.DataFrame) -> tuple[dict[str, np.ndarray], dict[str, tuple[np.ndarray, np.ndarray]]]:
-    """What :func:`graspaug.plots.lines` draws of the :func:`outlier_columns` table ``wide`` (one row per α):
-    per model label, its (A,) mean outlier % and its (low, high) interval ends, (A,) each."""
-    series = {label: wide[m].to_numpy(dtype=float) for m, label in MODEL_LABELS.items()}
-    intervals = {
-        label: (wide[f"{m}_low"].to_numpy(dtype=float), wide[f"{m}_high"].to_numpy(dtype=float))
-        for m, label in MODEL_LABELS.items()
-    }
-    return series, intervals
-
-
-def example_rows(sequences: dict[str, np.ndarray]) -> tuple[list[list[tuple]], list[str], list[str]]:
-    """What :func:`graspaug.plots.voxel_rows` draws of the example pairs' ``sequences`` (model → (E, S, R, R, R)
-    bool, decoded at :data:`EXAMPLE_ALPHAS`): the :func:`interpolation_rows` cells and row labels (the models'
-    short names: their label up to `` (``), and the column labels (``α=0.50``)."""
-    rows, row_labels = interpolation_rows(sequences, {m: label.split(" (")[0] for m, label in MODEL_LABELS.items()})
-    return rows, row_labels, [f"α={a:.2f}" for a in EXAMPLE_ALPHAS]
-
-
-def contrast_text(contrast: dict[str, dict], keys: list[str]) -> list[str | None]:
-    """Per α key, one contrast (α key → :func:`~graspaug.experiments.stats.paired_contrast` dict) as
-    ``"+1.23 [+0.45, +2.01]"`` (percentage points), or None where it has no mean."""
-    return [
-        None if d["mean"] is None else f"{d['mean']:+.2f} [{d['ci_low']:+.2f}, {d['ci_high']:+.2f}]"
-        for d in (contrast[k] for k in keys)
-    ]

@@ -1,15 +1,4 @@
-"""The simulated robot experiment (paper Section IV-E): arms (which network plans), the objects
-and their physics, one object's attempts in one arm, and the trials table.
-
-Every arm sees the same seeded drops, sensor noise and planner seeds (paired). Arms: ``before``
-= the targeted network of base size B at ratio 0, ``after`` = the same B at the ratio chosen on
-validation AP (by the GQ-CNN experiment's report), ``real`` = the ``real`` pool's network at that
-B and ratio (when it was trained), ``more_real`` = the network of the largest base size at
-ratio 0 (more real shapes, no augmentation: the cell's positive control for training data, when
-trained), each once per training seed, and ``antipodal`` = a random antipodal seed grasp without a
-network (once: it has no training seed). The numbers and the
-report's text are :mod:`graspaug.experiments.sim_report`.
-"""
+"""The robot trials: which networks each arm uses, the test objects, the pick attempts in pybullet and their table."""
 
 from __future__ import annotations
 
@@ -301,33 +290,3 @@ def trials_table(rows: list[dict], chosen: dict[str, ArmNetwork]) -> pd.DataFram
     trials = pd.DataFrame([{k: v for k, v in row.items() if not k.startswith("_")} for row in rows])
     trials["ratio"] = trials.arm.map({arm: network[1] for arm, network in chosen.items()})
     return trials
-
-
-def trial_picture(row: dict, ratio: float | None) -> dict:
-    """What :func:`graspaug.plots.pick_story` draws of a recorded attempt (a :func:`run_object`
-    row): ``depth`` (H, W) m, missing pixels NaN; ``jaw`` (2, 2) the jaw endpoints (u, v) px or
-    None; ``window`` (u0, v0, u1, v1) px around the grasp; ``frames``; ``title``. ``ratio``: the
-    arm's (None: no network)."""
-    from graspaug.planning.grasps import jaw_endpoints
-
-    depth = np.where(row["_depth"] > 0, row["_depth"], np.nan)  # missing pixels (0) left blank
-    h, w = depth.shape
-    jaw = None
-    if row["u"] is not None:
-        jaw = jaw_endpoints(np.array([[row["u"], row["v"]]]), np.array([row["angle"]]), np.array([row["width_px"]]))[0]
-        cu, cv = int(round(row["u"])), int(round(row["v"]))
-    else:
-        cu, cv = w // 2, h // 2
-    r = min(80, h // 2, w // 2)
-    u0, v0 = int(np.clip(cu - r, 0, w - 2 * r)), int(np.clip(cv - r, 0, h - 2 * r))
-    q = row["quality"]
-    quality = "no grasp found" if q is None else ("random" if np.isnan(q) else f"Q = {q:.3f}")
-    network = "random antipodal grasp, no network" if ratio is None else f"ratio {ratio:g}, training seed {row['seed']}"
-    title = f"{row['object']}, arm {row['arm']} ({network}), attempt 0: {quality} → {row['outcome']}"
-    return {
-        "depth": depth,
-        "jaw": jaw,
-        "window": (u0, v0, u0 + 2 * r, v0 + 2 * r),
-        "frames": row["_frames"],
-        "title": title,
-    }

@@ -1,11 +1,10 @@
-"""The lifelong loop's choices and figures: which objects the planner fails on, which training
+"""The lifelong loop's choices and numbers: which objects the planner fails on, which training
 shapes to generate from, and what each round's arms gain.
 
 A round scores every *validation* object by the round's networks (the test split never chooses
 anything), takes the worst ones and anchors generation at the training shapes nearest to them in
 latent space (:class:`graspaug.augment.candidates.FailureStream` pairs each anchor with its neighbours).
-The anchors are always training shapes: a validation or test object only points at them.
-"""
+The anchors are always training shapes: a validation or test object only points at them."""
 
 from __future__ import annotations
 
@@ -19,16 +18,17 @@ from sklearn.metrics import average_precision_score
 from sklearn.neighbors import NearestNeighbors
 
 from graspaug.errors import DataError
-from graspaug.experiments.settings import ARMS
 from graspaug.experiments.stats import (
     ObjectBootstrap,
-    draw_verdict,
     nested_indices,
     nested_interval,
     nested_means,
     percentile_interval,
 )
 from graspaug.training.variants import Variant
+
+ARMS = ("failure", "random", "real")  # what each round of the lifelong loop adds, at equal counts
+
 
 EPS = 1e-6  # probabilities are clipped to [EPS, 1 − EPS] for the log loss
 
@@ -266,74 +266,6 @@ def curve_rows(round_: int, result: dict) -> pd.DataFrame:
         if gain is not None:
             rows.append({"round": round_, "arm": arm, "figure": "gain", **{k: gain[k] for k in keys}})
     return pd.DataFrame(rows)
-
-
-def curve_series(curve: pd.DataFrame, arms: Sequence[str], figure: str = "ap") -> tuple[list[int], dict, dict]:
-    """(rounds, arm → ``figure`` per round, arm → (low, high) per round) of a curve (:func:`curve_rows` of every
-    round). The test AP of every arm starts at round 0's ``none`` (the base set alone, which every arm starts
-    from), the gain at 0."""
-    curve = curve.astype({"mean": float, "ci_low": float, "ci_high": float})  # a missing end: NaN
-    rounds = sorted(curve["round"].unique())
-    curve = curve[curve.figure == figure]
-    series, bands = {}, {}
-    for arm in arms:
-        rows = curve[curve.arm == arm].set_index("round")
-        start = curve[curve.arm == ("none" if figure == "ap" else arm)].set_index("round").loc[0]
-        pick = lambda col: [start[col]] + [rows[col].get(r, np.nan) for r in rounds[1:]]  # noqa: B023, E731
-        series[arm], bands[arm] = pick("mean"), (pick("ci_low"), pick("ci_high"))
-    return rounds, series, bands
-
-
-def _table(frame: pd.DataFrame) -> str:
-    """A markdown table of ``frame``'s columns (missing values: n/a)."""
-    cells = [[("n/a" if pd.isna(v) else str(v)) for v in row] for row in frame.itertuples(index=False)]
-    head = [f"| {' | '.join(map(str, frame.columns))} |", "|" + "---|" * len(frame.columns)]
-    return "\n".join(head + [f"| {' | '.join(row)} |" for row in cells])
-
-
-def interval_text(c: Mapping | None, spec: str = "+.4f") -> str:
-    """``mean [ci_low, ci_high]`` of an interval dict, n/a for what is missing."""
-    if not c or c.get("mean") is None:
-        return "n/a"
-    ends = [format(c[k], spec) if c.get(k) is not None else "n/a" for k in ("ci_low", "ci_high")]
-    return f"{format(c['mean'], spec)} [{ends[0]}, {ends[1]}]"
-
-
-def round_markdown(
-    round_: int, result: dict, followed: pd.DataFrame | None, persistent: pd.DataFrame, words: dict
-) -> str:
-    """A round's report: each arm's test AP, the contrasts with their verdicts (scoped to the draws of the data
-    in ``result``: :func:`~graspaug.experiments.stats.draw_verdict`), the share of the real shapes' gain,
-    the last round's failures before and after (``followed``; None in round 0), the objects chosen most often
-    (``persistent``: :func:`persistent_failures`) and ``words`` (``design``, ``command``)."""
-    lines = [f"# Lifelong loop, round {round_}", "", words["design"], ""]
-    lines += ["| arm | test AP |", "|---|---|"]
-    lines += [f"| {arm} | {interval_text(ap, '.4f')} |" for arm, ap in result["ap"].items()]
-    if result["contrasts"]:
-        lines += ["", "| contrast | mean [95% interval] | verdict |", "|---|---|---|"]
-        for name, c in result["contrasts"].items():
-            word = draw_verdict(c["ci_low"], c["ci_high"], len(result["draws"]))
-            lines.append(f"| `{name}@r{round_}` | {interval_text(c)} | {word} |")
-    if "share" in result:
-        lines += [
-            "",
-            "Share of the real shapes' gain that failure-targeted shapes give: "
-            f"{interval_text(result['share'], '+.2f')} (a ratio of two intervals: read it when `real_data` shows).",
-        ]
-    if followed is not None:
-        lines += [
-            "",
-            "The last round's failure objects (validation), before and now, per arm:",
-            "",
-            _table(followed.round(4).reset_index()),
-        ]
-    lines += [
-        "",
-        "Objects chosen as failures most often (validation):",
-        "",
-        _table(persistent.head(10)),
-    ]
-    return "\n".join(lines + ["", f"Command: `{words['command']}`", ""])
 
 
 def round_networks(start: Mapping[int, Path], seed_dirs: Mapping[int, Path], variants: Sequence[Variant]) -> dict:

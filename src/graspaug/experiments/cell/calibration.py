@@ -1,14 +1,5 @@
-"""Do the cell's outcomes follow the grasp labels? Labelled grasps of a rendered dataset, executed in the cell.
-
-A rendered datapoint is one antipodal grasp of one shape in one of its stable poses, with its
-label (robust Ferrari-Canny ε above the threshold and a collision-free approach from above). Here
-the shape is put on the cell's table in that same stable pose (as its convex hull rests, 1 mm
-above the table, then left to settle), and the Panda executes that grasp, straight down with the
-jaw across the grasp axis, lifts and carries the object to the bin as in every trial of the
-``sim`` stage. If the labels and the cell agree, labelled-positive grasps succeed far more often
-than negative ones, and the robust ε ranks outcomes well (ROC AUC). Which grasps are executed:
-:func:`choose_grasps`; one shape's grasps: :func:`run_shape`; the numbers: :func:`summarize`.
-"""
+"""Grasp calibration: does the cell hold what the labels call graspable? Executes chosen grasps with the Panda and
+summarizes success per label and the ROC AUC of ε and the label against the outcomes."""
 
 from __future__ import annotations
 
@@ -20,7 +11,13 @@ import numpy as np
 import pandas as pd
 from scipy.spatial.transform import Rotation
 
+from graspaug.experiments.stats import (
+    ObjectBootstrap,
+    percentile_interval,
+    wilson_interval,
+)
 from graspaug.rng import shape_rng
+from graspaug.sim.objects import prepare_objects
 
 #: Columns of the rendered dataset's index that a calibration row keeps (``datapoint``: the row in the index).
 INDEX_COLUMNS = (
@@ -149,7 +146,7 @@ def shape_jobs(chosen: pd.DataFrame, grasps: pd.DataFrame, shapes_dir, sim, seed
     numbered them."""
     from graspaug.io.meshes import mesh_path, read_mesh
     from graspaug.render.stable_poses import stable_poses
-    from graspaug.sim.objects import body_origin, prepare_objects
+    from graspaug.sim.objects import body_origin
 
     ids = sorted(chosen.shape_id.unique())
     meshes = {shape_id: read_mesh(mesh_path(shapes_dir, shape_id)) for shape_id in ids}
@@ -196,8 +193,6 @@ def summarize(table: pd.DataFrame, n_bootstrap: int, seed: int) -> dict:
     Intervals: percentile bootstrap over shapes (``n_bootstrap`` resamples; grasps of one shape
     share its physics and mesh); None where one outcome is missing."""
     from sklearn.metrics import roc_auc_score
-
-    from graspaug.experiments.stats import ObjectBootstrap, percentile_interval
 
     y = table.executed_success.to_numpy(bool)
     boot = ObjectBootstrap(table.shape_id.to_numpy(), n_bootstrap, shape_rng(seed, "sim", "calibration-bootstrap"))
@@ -252,7 +247,6 @@ def success_by_eps(table: pd.DataFrame, n_bins: int = 8) -> pd.DataFrame:
     labelled collision-free and colliding: ``collision_free``, ``eps_low``, ``eps_high`` (bin
     edges), ``eps_mid`` (median ε of the bin's grasps), ``grasps``, ``successes``, ``rate`` and its
     95% Wilson interval ``lo``, ``hi``."""
-    from graspaug.experiments.stats import wilson_interval
 
     edges = np.unique(np.quantile(table.eps, np.linspace(0, 1, n_bins + 1)))
     bins = np.clip(np.searchsorted(edges, table.eps, side="right") - 1, 0, len(edges) - 2)
@@ -276,7 +270,7 @@ def success_by_eps(table: pd.DataFrame, n_bins: int = 8) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
-def headline(summary: dict) -> dict[str, dict]:
+def calibration_headline(summary: dict) -> dict[str, dict]:
     """The metrics files: name → {mean, lo, hi} for the success rates per label and the ROC AUCs."""
     names = ("success_positive", "success_negative", "auc_eps", "auc_eps_collision_free", "auc_quality", "auc_label")
     return {name: {k: None if v is None else round(float(v), 5) for k, v in summary[name].items()} for name in names}

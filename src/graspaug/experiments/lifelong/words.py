@@ -1,0 +1,63 @@
+"""The lifelong loop in words: a round's report.md."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+import pandas as pd
+
+from graspaug.experiments.stats import (
+    draw_verdict,
+)
+
+
+def _table(frame: pd.DataFrame) -> str:
+    """A markdown table of ``frame``'s columns (missing values: n/a)."""
+    cells = [[("n/a" if pd.isna(v) else str(v)) for v in row] for row in frame.itertuples(index=False)]
+    head = [f"| {' | '.join(map(str, frame.columns))} |", "|" + "---|" * len(frame.columns)]
+    return "\n".join(head + [f"| {' | '.join(row)} |" for row in cells])
+
+
+def interval_text(c: Mapping | None, spec: str = "+.4f") -> str:
+    """``mean [ci_low, ci_high]`` of an interval dict, n/a for what is missing."""
+    if not c or c.get("mean") is None:
+        return "n/a"
+    ends = [format(c[k], spec) if c.get(k) is not None else "n/a" for k in ("ci_low", "ci_high")]
+    return f"{format(c['mean'], spec)} [{ends[0]}, {ends[1]}]"
+
+
+def round_markdown(
+    round_: int, result: dict, followed: pd.DataFrame | None, persistent: pd.DataFrame, words: dict
+) -> str:
+    """A round's report: each arm's test AP, the contrasts with their verdicts (scoped to the draws of the data
+    in ``result``: :func:`~graspaug.experiments.stats.draw_verdict`), the share of the real shapes' gain,
+    the last round's failures before and after (``followed``; None in round 0), the objects chosen most often
+    (``persistent``: :func:`persistent_failures`) and ``words`` (``design``, ``command``)."""
+    lines = [f"# Lifelong loop, round {round_}", "", words["design"], ""]
+    lines += ["| arm | test AP |", "|---|---|"]
+    lines += [f"| {arm} | {interval_text(ap, '.4f')} |" for arm, ap in result["ap"].items()]
+    if result["contrasts"]:
+        lines += ["", "| contrast | mean [95% interval] | verdict |", "|---|---|---|"]
+        for name, c in result["contrasts"].items():
+            word = draw_verdict(c["ci_low"], c["ci_high"], len(result["draws"]))
+            lines.append(f"| `{name}@r{round_}` | {interval_text(c)} | {word} |")
+    if "share" in result:
+        lines += [
+            "",
+            "Share of the real shapes' gain that failure-targeted shapes give: "
+            f"{interval_text(result['share'], '+.2f')} (a ratio of two intervals: read it when `real_data` shows).",
+        ]
+    if followed is not None:
+        lines += [
+            "",
+            "The last round's failure objects (validation), before and now, per arm:",
+            "",
+            _table(followed.round(4).reset_index()),
+        ]
+    lines += [
+        "",
+        "Objects chosen as failures most often (validation):",
+        "",
+        _table(persistent.head(10)),
+    ]
+    return "\n".join(lines + ["", f"Command: `{words['command']}`", ""])
