@@ -124,7 +124,7 @@ def main() -> None:
     table = pd.DataFrame(rows)
     args.out.mkdir(parents=True, exist_ok=True)
     table.to_csv(args.out / "ap_by_members.csv", index=False)
-    fmt = lambda t: f"{t['mean']:+.4f} [{t['ci_low']:+.4f}, {t['ci_high']:+.4f}]"  # noqa: E731
+    fmt = lambda t: f"{t['mean']:+.4f} [{t['low']:+.4f}, {t['high']:+.4f}]"  # noqa: E731
     print(f"\n{len(cfg.seeds)} seeds; contrast: mean [95% t over seeds], SD over seeds, for ensembles of k members")
     for k in range(1, args.members + 1):
         runs = table[table.members == k]

@@ -108,11 +108,7 @@ def main() -> None:
     default = next(iter(options))
 
     def fmt(t):
-        return (
-            f"{t['mean']:+.4f} [{t['ci_low']:+.4f}, {t['ci_high']:+.4f}]"
-            if t["ci_low"] is not None
-            else f"{t['mean']:+.4f}"
-        )  # noqa: E731
+        return f"{t['mean']:+.4f} [{t['low']:+.4f}, {t['high']:+.4f}]" if t["low"] is not None else f"{t['mean']:+.4f}"  # noqa: E731
 
     print(
         "\noption                                 B     validation AP (95% t)          vs default (paired, 95% t)    "

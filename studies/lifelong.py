@@ -29,7 +29,7 @@ import pandas as pd
 from graspaug.experiments.ap.numbers import test_labels
 from graspaug.experiments.lifelong.figures import curve_series
 from graspaug.experiments.lifelong.numbers import ARMS, arm_contrasts, arm_variant, curve_rows, round_networks
-from graspaug.experiments.lifelong.words import interval_text
+from graspaug.experiments.stats import interval_text
 from graspaug.io.tables import read_table
 from graspaug.pipeline.params.profiles import merge, params_yaml, read_overlay
 from graspaug.plots import lines

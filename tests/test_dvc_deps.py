@@ -245,7 +245,9 @@ def written_deps(text: str, deps: dict[str, set[str]]) -> str:
                 j += 1
             listed = yaml.safe_load("\n".join(x.split("  # ")[0] for x in lines[i : j + 1]))["deps"]
             others = [(d, None) for d in listed if not d.startswith("src/")]
-            out += flow_list(line[: len(line) - len(line.lstrip())], "deps", others + [(d, None) for d in sorted(deps[stage])])
+            out += flow_list(
+                line[: len(line) - len(line.lstrip())], "deps", others + [(d, None) for d in sorted(deps[stage])]
+            )
             i = j + 1
             continue
         out.append(line)

@@ -95,7 +95,7 @@ def test_dvc_repro_critic_eval_and_embed(tiny_repo):
     assert result["n_pairs"] == 3 and result["n_decoded_per_model"] == 18
     assert set(result["outlier_pct"]) == {"ae", "ae_extra", "ae_critic"}
     assert list(result["outlier_pct"]["ae"]) == ["0.00", "0.10", "0.20", "0.30", "0.40", "0.50"]
-    assert set(result["contrast"]["critic_vs_control"]["0.50"]) == {"mean", "ci_low", "ci_high"}
+    assert result["contrast"]["critic_vs_control"]["0.50"]["over"] == "objects"  # the pairs, resampled
     assert result["critic_auc"] is None or 0 <= result["critic_auc"] <= 1
     headline = json.loads((work / "metrics/critic_eval.json").read_text())
     assert set(headline) == {"mean", "lo", "hi", "auc"}  # the study's headline; its tables are in the report
@@ -430,9 +430,9 @@ def test_dvc_repro_gqcnn_matrix_and_report(tiny_repo):
     }
     assert ("targeted_vs_none_chosen@6" in ap["contrasts"]) == ("6" in ap["chosen_ratio"])
     for c in ap["contrasts"].values():
-        assert {"mean", "ci_low", "ci_high", "n_seeds", "boot_low", "boot_high"} <= set(c)
+        assert c["over"] == "seeds" and c["draws_low"] is None
         if c["mean"] is not None:
-            assert c["n_seeds"] == 2 and c["ci_low"] <= c["mean"] <= c["ci_high"]
+            assert c["n_seeds"] == 2 and c["seeds_low"] <= c["mean"] <= c["seeds_high"]
     assert set(ap["networks"]["targeted"]["6"]) == {"0", "0.5", "1"} and ap["seeds"] == [0, 1]
     assert (
         "| targeted | 4 | 1:0 |" in report
@@ -448,7 +448,7 @@ def test_dvc_repro_gqcnn_matrix_and_report(tiny_repo):
     step = steps["contrasts"]["blend_vs_recon@6"]
     assert step["n_draws"] == 1 and step["n_seeds"] == 2
     assert (
-        step["ci_low"] is None or step["ci_low"] <= step["ci_high"]
+        step["draws_low"] is None or step["draws_low"] <= step["draws_high"]
     )  # None: a resample of the few tiny objects lacks a class
     same = ap["contrasts"]["blend_vs_recon@6"]["mean"]  # None: a network of the few tiny shapes had no test AP
     assert step["mean"] == pytest.approx(same, abs=1e-4) if same is not None else step["mean"] is None
@@ -603,17 +603,18 @@ def test_dvc_repro_sim(tiny_repo, tmp_path):
         c = metrics["contrasts"][name]
         # against the antipodal arm (one run per drop) each of the 4 drops counts once; network arms: 2 seeds × 4 drops
         assert (
-            c["n_trials"] == (4 if name == "network_vs_antipodal" else 8) and c["ci_low"] <= c["mean"] <= c["ci_high"]
+            c["n_trials"] == (4 if name == "network_vs_antipodal" else 8)
+            and c["objects_low"] <= c["mean"] <= c["objects_high"]
         )
-        assert c["n_seeds"] == 2 and c["t_ci_low"] <= c["mean"] <= c["t_ci_high"]
+        assert c["n_seeds"] == 2 and c["seeds_low"] <= c["mean"] <= c["seeds_high"]
         headline = json.loads((work / f"metrics/sim/{name}.json").read_text())
-        assert headline == {"mean": round(c["mean"], 5), "lo": c["ci_low"], "hi": c["ci_high"]}
+        assert headline == {"mean": round(c["mean"], 5), "lo": c["objects_low"], "hi": c["objects_high"]}
     ranking, executed = metrics["ranking"], pd.read_csv(work / "reports/grasp_calibration/grasps.csv")
     assert ranking["n_grasps"] == len(executed) == 6  # every arm's networks rank the executed calibration grasps
     assert list(ranking["arms"]) == (network_arms if executed.executed_success.nunique() == 2 else [])
     for name, c in ranking["contrasts"].items():
         headline = json.loads((work / f"metrics/sim/ranking_{name}.json").read_text())
-        assert headline == {"mean": c["mean"], "lo": c["ci_low"], "hi": c["ci_high"]}
+        assert headline == {"mean": c["mean"], "lo": c["objects_low"], "hi": c["objects_high"]}
     trials = pd.read_csv(work / "reports/sim/trials.csv")
     assert len(trials) == 4 * len(network_arms) * 2 + 4 and set(trials.object) == {
         "cube",
@@ -704,6 +705,44 @@ def test_metrics_hold_few_scalars_and_fit_a_terminal(tiny_repo):
     table = run(["dvc", "metrics", "show"], work, env).stdout.splitlines()
     # 203 characters on the tiny run since its test APs are defined (a test_ap column, negative contrast means)
     assert len(table) == len(files) + 1 and max(map(len, table)) <= 210, max(table, key=len)
+
+
+def test_every_contrast_has_one_set_of_interval_keys(tiny_repo):
+    """One result type: in every report a contrast's intervals are keyed by what they cover (``seeds_*``,
+    ``objects_*``, ``draws_*``) with the ``over`` its verdict reads, and every metrics file holds an interval as
+    ``mean``, ``lo``, ``hi``; no file of the run uses another interval key (``ci_low``, ``boot_low``, ...)."""
+    import json
+    import re
+
+    from graspaug.experiments.stats import INTERVALS
+
+    work, env = tiny_repo
+    run(["dvc", "repro"], work, env)  # a no-op after the tests above
+    contrast_keys = {f"{name}_{end}" for name in INTERVALS for end in ("low", "high")}
+    other = re.compile(r"^(ci|boot|t_ci)_(low|high)$")
+    seen = {"metrics": 0, "reports": 0}
+
+    def walk(value, path, where):
+        if isinstance(value, list):
+            for v in value:
+                walk(v, path, where)
+        if not isinstance(value, dict):
+            return
+        assert not [k for k in value if other.match(str(k))], f"{path}: {sorted(value)}"
+        assert not {"low", "high"} & set(value) or "share" in value, f"{path}: {sorted(value)}"  # a ratio's interval
+        if where == "metrics" and {"lo", "hi"} & set(value):
+            assert {"mean", "lo", "hi"} <= set(value), f"{path}: {sorted(value)}"
+            seen[where] += 1
+        if where == "reports" and contrast_keys & set(value):
+            assert contrast_keys <= set(value) and value["over"] in INTERVALS, f"{path}: {sorted(value)}"
+            seen[where] += 1
+        for k, v in value.items():
+            walk(v, f"{path}.{k}", where)
+
+    for where in seen:
+        for path in sorted((work / where).rglob("*.json")):
+            walk(json.loads(path.read_text()), str(path.relative_to(work)), where)
+    assert seen["metrics"] >= 50 and seen["reports"] >= 50, seen  # ap, sim, lifelong, critic, fidelity, calibration
 
 
 DATA_PLOT_SUFFIXES = (".csv", ".tsv", ".json", ".yaml", ".yml")

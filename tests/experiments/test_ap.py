@@ -9,6 +9,7 @@ import pytest
 from graspaug.errors import DataError
 from graspaug.experiments.ap import figures, numbers, words
 from graspaug.experiments.ap.numbers import collect, declared_contrasts
+from graspaug.experiments.stats import contrast
 from graspaug.training.settings import POOLS
 from graspaug.training.variants import seed_variants
 
@@ -79,7 +80,7 @@ def test_gain_sentences_give_shares_and_call_a_gap_within_the_ceilings_interval_
     lines = gain_sentences(results, table, {50: 1.0, 200: 1.0}, [50], ceiling_shapes=600)
     assert "give 25% of the gain of the same number of real shapes" in lines[0]
     share = fieller_interval(np.array([0.01, 0.03, 0.02, 0.02]), np.array([0.07, 0.09, 0.08, 0.08]))
-    assert f"95% Fieller interval over seeds [{share['ci_low']:.0%}, {share['ci_high']:.0%}]" in lines[0]
+    assert f"95% Fieller interval over seeds [{share['low']:.0%}, {share['high']:.0%}]" in lines[0]
     noisy = {**results, "targeted_vs_real@50": {"mean": -0.01, "per_seed": [-0.1, 0.1, -0.06, 0.02]}}
     assert "Fieller interval is unbounded" in gain_sentences(noisy, table, {}, [50], ceiling_shapes=None)[0]
     assert "1:1 closes 20% of the gap" in lines[1]  # (0.42 - 0.40) / (0.50 - 0.40)
@@ -231,8 +232,7 @@ def test_datapoint_matched_contrasts_interpolate_the_real_shape_curve_in_datapoi
 def test_the_report_scopes_its_verdicts_to_its_one_draw_of_the_data():
     """One run's intervals cover its draw of the data and its training seeds: report.md says which, that
     other draws are not covered and where they are combined, and calls a loss a loss in this draw."""
-    loss = {"mean": -0.034, "ci_low": -0.055, "ci_high": -0.014, "n_seeds": 4, "sd": 0.013}
-    loss |= {"boot_low": -0.05, "boot_high": -0.02, "meaning": "m"}
+    loss = contrast(-0.034, "seeds", 4, seeds=(-0.055, -0.014), objects=(-0.05, -0.02), sd=0.013, meaning="m")
     table = pd.DataFrame(
         [("targeted", 50, 0.0, 0.3, 0.01, 0.3, 0.3, 0.8, 4)],
         columns=["pool", "base_size", "ratio", "test_ap", "test_ap_ci", "per_object_ap", "val_ap", "test_roc_auc", "n"],
@@ -242,4 +242,4 @@ def test_the_report_scopes_its_verdicts_to_its_one_draw_of_the_data():
     assert "does not cover other draws" in text and "`python studies/attribution.py --draws 0 1 2`" in text
     assert "Over three draws of the data" in text
     assert "a loss in this draw of the data" in text and "a real loss" not in text
-    assert "a real gain" not in words.verdict("x", loss | {"mean": 0.03, "ci_low": 0.01, "ci_high": 0.05})
+    assert "a real gain" not in words.verdict("x", loss | {"mean": 0.03, "seeds_low": 0.01, "seeds_high": 0.05})

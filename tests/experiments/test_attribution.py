@@ -50,7 +50,7 @@ def test_combine_draws_gives_every_contrast_one_interval_over_draws_seeds_and_ob
     assert "targeted_vs_none_chosen@10" not in contrasts  # the chosen ratio may differ between draws
     assert {"targeted_vs_real_datapoints@10", "recon_vs_real_datapoints@10"} <= set(contrasts)
     same = contrasts["recon_vs_real@10"]  # recon predicts as real in every draw and seed: exactly zero
-    assert same["mean"] == 0 and same["ci_low"] == same["ci_high"] == 0 and same["per_draw"] == [0, 0]
+    assert same["mean"] == 0 and same["draws_low"] == same["draws_high"] == 0 and same["per_draw"] == [0, 0]
     ap = {  # targeted_vs_blend by hand, from the summaries
         (d, s): json.loads((draws[d][s] / "targeted/10-1/summary.json").read_text())["test"]["ap"]
         - json.loads((draws[d][s] / "blend/10-1/summary.json").read_text())["test"]["ap"]
@@ -60,7 +60,7 @@ def test_combine_draws_gives_every_contrast_one_interval_over_draws_seeds_and_ob
     step = contrasts["targeted_vs_blend@10"]
     assert step["mean"] == pytest.approx(np.mean(list(ap.values())))
     assert step["per_draw"] == pytest.approx([(ap[d, 0] + ap[d, 1]) / 2 for d in draws], abs=1e-5)
-    assert step["n_draws"] == 2 and step["n_seeds"] == 2 and step["ci_low"] < step["ci_high"]
+    assert step["n_draws"] == 2 and step["n_seeds"] == 2 and step["draws_low"] < step["draws_high"]
     assert set(result["share"]) == {"10"} and result["draws"] == [0, 1] and result["seeds"] == [0, 1]
     text = decomposition_markdown(result, [10], "python studies/attribution.py")
     assert "| `targeted_vs_blend@10` |" in text and "B = 10" in text
@@ -75,8 +75,22 @@ def test_every_draw_needs_the_same_training_seeds(tmp_path):
 
 def test_the_losing_step_is_the_most_negative_with_its_interval_below_zero():
     c = {
-        "recon_vs_real@50": {"mean": -0.03, "ci_low": -0.05, "ci_high": -0.01, "n_draws": 3, "n_seeds": 4},
-        "targeted_vs_blend@50": {"mean": -0.05, "ci_low": -0.09, "ci_high": 0.01, "n_draws": 3, "n_seeds": 4},
+        "recon_vs_real@50": {
+            "mean": -0.03,
+            "draws_low": -0.05,
+            "draws_high": -0.01,
+            "over": "draws",
+            "n_draws": 3,
+            "n_seeds": 4,
+        },
+        "targeted_vs_blend@50": {
+            "mean": -0.05,
+            "draws_low": -0.09,
+            "draws_high": 0.01,
+            "over": "draws",
+            "n_draws": 3,
+            "n_seeds": 4,
+        },
     }
     assert "`recon_vs_real`: -0.0300 AP [-0.0500, -0.0100] over 3 draws × 4 seeds" in losing_step(c, 50)
     assert losing_step(c, 50).endswith("a loss over 3 draws of the data.")
@@ -88,11 +102,20 @@ def test_one_draw_gives_intervals_over_seeds_and_objects_and_says_they_miss_othe
     draws = make_draws(tmp_path, draws=(0,), seeds=(0, 1, 2))
     result = combine_draws(draws, LABELS, OBJECTS, GENERATE, GQCNN, n_resamples=300, seed=0)
     step = result["contrasts"]["targeted_vs_blend@10"]
-    assert step["n_draws"] == 1 and step["n_seeds"] == 3 and step["ci_low"] < step["mean"] < step["ci_high"]
+    assert step["n_draws"] == 1 and step["n_seeds"] == 3 and step["draws_low"] < step["mean"] < step["draws_high"]
     text = decomposition_markdown(result, [10], "dvc repro report")
     assert "One draw of the data" in text and "does not cover other draws" in text and "Draws (data_seed)" not in text
     assert "`data_seed` = 0 and training seeds [0, 1, 2]" in text and "studies/attribution.py --draws 0 1 2" in text
-    c = {"recon_vs_real@50": {"mean": -0.03, "ci_low": -0.05, "ci_high": -0.01, "n_draws": 1, "n_seeds": 4}}
+    c = {
+        "recon_vs_real@50": {
+            "mean": -0.03,
+            "draws_low": -0.05,
+            "draws_high": -0.01,
+            "over": "draws",
+            "n_draws": 1,
+            "n_seeds": 4,
+        }
+    }
     assert "over 4 seeds of one draw and the test objects, a loss in this draw of the data." in losing_step(c, 50)
 
 

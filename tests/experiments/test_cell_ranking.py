@@ -69,11 +69,11 @@ def test_networks_are_scored_on_the_executed_grasps_and_paired_by_seed(tmp_path)
         want = roc_auc_score(grasps.executed_success, p)
         assert ranking["arms"]["more_real"]["per_seed"][str(seed)] == pytest.approx(want, abs=1e-5)
     real, same = ranking["contrasts"]["real_data"], ranking["contrasts"]["after_vs_before"]
-    assert real["ci_low"] > 0 and real["t_ci_low"] > 0 and real["n_seeds"] == 3
+    assert real["objects_low"] > 0 and real["seeds_low"] > 0 and real["n_seeds"] == 3
     assert real["mean"] == pytest.approx(
         ranking["arms"]["more_real"]["auc"] - ranking["arms"]["before"]["auc"], abs=1e-4
     )
-    assert same["mean"] == same["ci_low"] == same["ci_high"] == 0  # the same network: no difference, no width
+    assert same["mean"] == same["objects_low"] == same["objects_high"] == 0  # the same network: no difference, no width
     assert ranking["reference"]["label"] == pytest.approx(
         roc_auc_score(grasps.executed_success, grasps.label), abs=1e-5
     )
@@ -84,7 +84,11 @@ def test_networks_are_scored_on_the_executed_grasps_and_paired_by_seed(tmp_path)
     assert "- Augmentation shows no change in the networks' ranking of the cell's outcomes (+0.000" in text
     headline = sim_headline({"contrasts": {}, "ranking": ranking})
     assert set(headline) == {"ranking_real_data", "ranking_after_vs_before"}
-    assert headline["ranking_real_data"] == {"mean": real["mean"], "lo": real["ci_low"], "hi": real["ci_high"]}
+    assert headline["ranking_real_data"] == {
+        "mean": real["mean"],
+        "lo": real["objects_low"],
+        "hi": real["objects_high"],
+    }
 
 
 def test_a_grasp_that_is_not_a_test_datapoint_of_a_seed_is_named(tmp_path):

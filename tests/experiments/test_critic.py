@@ -16,7 +16,7 @@ from graspaug.experiments.critic.numbers import (
     summarize,
 )
 from graspaug.experiments.critic.words import contrast_text
-from graspaug.experiments.stats import PairBootstrap
+from graspaug.experiments.stats import PairBootstrap, contrast
 
 
 def test_random_pairs_are_distinct_shapes():
@@ -46,8 +46,8 @@ def test_intervals_bracket_the_mean_and_shrink_with_more_pairs():
     narrow = summarize(many, PairBootstrap(400, 2000, rng))[0]
     wide = summarize(few, PairBootstrap(20, 2000, rng))[0]
     for s in (narrow, wide):
-        assert s["ci_low"] < s["mean"] < s["ci_high"]
-    assert narrow["ci_high"] - narrow["ci_low"] < wide["ci_high"] - wide["ci_low"]
+        assert s["objects_low"] < s["mean"] < s["objects_high"]
+    assert narrow["objects_high"] - narrow["objects_low"] < wide["objects_high"] - wide["objects_low"]
     assert abs(narrow["mean"] - 2.0) < 0.3
 
 
@@ -61,18 +61,20 @@ def test_paired_contrast_is_exact_for_a_constant_shift_and_skips_empty_pairs():
     diff = outlier_contrast(a, b, PairBootstrap(30, 500, rng))
     for d in diff:
         assert (
-            d["mean"] == pytest.approx(1.0) and d["ci_low"] == pytest.approx(1.0) and d["ci_high"] == pytest.approx(1.0)
+            d["mean"] == pytest.approx(1.0)
+            and d["objects_low"] == pytest.approx(1.0)
+            and d["objects_high"] == pytest.approx(1.0)
         )
     unpaired = summarize(a, PairBootstrap(30, 500, rng))[0]
-    assert unpaired["ci_high"] - unpaired["ci_low"] > 0.5  # the per-model interval carries the pair-to-pair spread
+    assert (
+        unpaired["objects_high"] - unpaired["objects_low"] > 0.5
+    )  # the per-model interval carries the pair-to-pair spread
 
 
 def test_all_empty_column_gives_nulls():
-    assert summarize(np.full((5, 1), np.nan), PairBootstrap(5, 100, np.random.default_rng(0)))[0] == {
-        "mean": None,
-        "ci_low": None,
-        "ci_high": None,
-    }
+    assert summarize(np.full((5, 1), np.nan), PairBootstrap(5, 100, np.random.default_rng(0)))[0] == contrast(
+        None, "objects"
+    )
 
 
 def test_study_metrics_tables_every_model_and_contrast():
@@ -90,7 +92,7 @@ def test_study_metrics_tables_every_model_and_contrast():
     assert metrics["empty_grids"] == {"ae": 1, "ae_extra": 0, "ae_critic": 0}
     assert list(metrics["outlier_pct"]) == list(MODEL_LABELS)
     gap = metrics["contrast"]["critic_vs_control"]
-    assert all(gap[k]["mean"] == pytest.approx(2.0) == gap[k]["ci_low"] for k in keys)
+    assert all(gap[k]["mean"] == pytest.approx(2.0) == gap[k]["objects_low"] for k in keys)
     assert contrast_text(gap, keys) == ["+2.00 [+2.00, +2.00]"] * 2
     assert contrast_text({"0.00": {"mean": None}}, ["0.00"]) == [None]
 
@@ -120,7 +122,11 @@ def test_the_headline_averages_the_interpolants_per_pair_and_leaves_reconstructi
     critic = control + np.array([5.0, 1.0, 3.0])
     boot = PairBootstrap(8, 200, rng)
     c = interpolant_contrast(critic, control, keys, boot)
-    assert c["mean"] == pytest.approx(2.0) and c["ci_low"] == pytest.approx(2.0) and c["ci_high"] == pytest.approx(2.0)
+    assert (
+        c["mean"] == pytest.approx(2.0)
+        and c["objects_low"] == pytest.approx(2.0)
+        and c["objects_high"] == pytest.approx(2.0)
+    )
     critic[0, 2] = np.nan  # pair 0 keeps α = 0.25 alone: 1.0
     assert interpolant_contrast(critic, control, keys, boot)["mean"] == pytest.approx((7 * 2.0 + 1.0) / 8)
     pct = {"ae": control, "ae_extra": control, "ae_critic": control + np.array([5.0, 1.0, 3.0])}

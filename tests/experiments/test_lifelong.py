@@ -9,6 +9,7 @@ import pytest
 from graspaug.augment.candidates import EXTRA_ALPHAS, FailureStream, neighbour_pairs
 from graspaug.errors import DataError
 from graspaug.experiments.lifelong.numbers import disjoint, failure_anchors, object_errors, worst_objects
+from graspaug.experiments.stats import contrast
 
 
 def test_object_errors_rank_the_object_the_network_gets_wrong_first():
@@ -158,9 +159,9 @@ def test_arm_contrasts_pair_the_arms_within_a_seed_and_say_when_the_real_data_ga
             networks.setdefault(s, {})[arm] = folder
     out = arm_contrasts({0: networks}, labels, objects, 300, 0)
     c = out["contrasts"]
-    assert c["real_data"]["ci_low"] > 0 and c["failure_vs_real"]["ci_high"] < 0  # the control shows
+    assert c["real_data"]["draws_low"] > 0 and c["failure_vs_real"]["draws_high"] < 0  # the control shows
     assert c["failure_vs_random"]["mean"] == pytest.approx(0.0, abs=1e-12)  # the same network: nothing, exactly
-    assert c["failure_vs_random"]["ci_low"] <= 0 <= c["failure_vs_random"]["ci_high"]
+    assert c["failure_vs_random"]["draws_low"] <= 0 <= c["failure_vs_random"]["draws_high"]
     assert out["ap"]["real"]["mean"] > out["ap"]["none"]["mean"] and 0 < out["share"]["mean"] < 0.5
     assert arm_variant("none", 50, 0).name == "targeted/50-0"
     assert arm_variant("failure", 50, 25).name == "failure/50-0.5"
@@ -169,9 +170,11 @@ def test_arm_contrasts_pair_the_arms_within_a_seed_and_say_when_the_real_data_ga
     curve = pd.concat([curve_rows(0, {"ap": {"none": out["ap"]["none"]}, "contrasts": {}}), curve_rows(1, out)])
     rounds, series, bands = curve_series(curve, ["failure", "real"])
     assert rounds == [0, 1] and series["real"] == [out["ap"]["none"]["mean"], out["ap"]["real"]["mean"]]
-    assert bands["failure"][0][0] == out["ap"]["none"]["ci_low"]  # every arm starts from the base set alone
+    assert bands["failure"][0][0] == out["ap"]["none"]["draws_low"]  # every arm starts from the base set alone
     rounds, series, bands = curve_series(curve, ["failure", "real"], "gain")  # paired: from 0, real_data for real
-    assert series["real"] == [0.0, c["real_data"]["mean"]] and bands["failure"][1][1] == c["failure_vs_none"]["ci_high"]
+    assert (
+        series["real"] == [0.0, c["real_data"]["mean"]] and bands["failure"][1][1] == c["failure_vs_none"]["draws_high"]
+    )
 
 
 def test_failure_history_counts_the_rounds_an_object_stays_a_failure():
@@ -194,10 +197,11 @@ def test_a_rounds_verdicts_are_scoped_to_its_one_draw_of_the_data():
 
     from graspaug.experiments.lifelong.words import round_markdown
 
-    c = {"mean": -0.02, "ci_low": -0.03, "ci_high": -0.01}
-    result = {"ap": {"failure": {"mean": 0.3, "ci_low": 0.2, "ci_high": 0.4}}, "contrasts": {"failure_vs_real": c}}
+    c = contrast(-0.02, "draws", 4, 1, draws=(-0.03, -0.01))
+    result = {"ap": {"failure": contrast(0.3, "draws", 4, 1, draws=(0.2, 0.4))}, "contrasts": {"failure_vs_real": c}}
     persistent = pd.DataFrame({"object": ["o1"], "rounds": [1]})
     text = round_markdown(1, result | {"draws": [0]}, None, persistent, {"design": "D.", "command": "c"})
     assert "| `failure_vs_real@r1` | -0.0200 [-0.0300, -0.0100] | a loss in this draw of the data |" in text
+    result["contrasts"]["failure_vs_real"] = c | {"n_draws": 3}
     text = round_markdown(1, result | {"draws": [0, 1, 2]}, None, persistent, {"design": "D.", "command": "c"})
     assert "| a loss over 3 draws of the data |" in text

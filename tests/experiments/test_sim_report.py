@@ -36,7 +36,7 @@ def test_antipodal_pairs_with_every_training_seed():
     assert c["n_trials"] == 2 and c["n_objects"] == 1 and c["mean"] == 0.75
     assert c["only_before"] is None and "mcnemar_p" not in c  # a drop of the antipodal arm counts once
     assert c["n_seeds"] == 2 and c["per_seed"] == {"0": 1.0, "1": 0.5}
-    assert c["t_ci_low"] < 0.75 < c["t_ci_high"]  # t(0.975, 1) = 12.7 × 0.25 / √2 on each side
+    assert c["seeds_low"] < 0.75 < c["seeds_high"]  # t(0.975, 1) = 12.7 × 0.25 / √2 on each side
 
 
 def test_contrast_between_network_arms_counts_discordant_picks_and_gives_a_t_interval_over_seeds():
@@ -49,7 +49,7 @@ def test_contrast_between_network_arms_counts_discordant_picks_and_gives_a_t_int
     assert c["n_trials"] == 60 and c["only_after"] == 20 and c["only_before"] == 0 and "mcnemar_p" not in c
     assert c["per_seed"] == {"0": 0.25, "1": 0.5, "2": 0.25} and c["mean"] == pytest.approx(1 / 3, abs=1e-4)
     half = 4.302653 * np.std([0.25, 0.5, 0.25], ddof=1) / np.sqrt(3)
-    assert c["t_ci_low"] == pytest.approx(1 / 3 - half, abs=1e-4) and c["t_ci_high"] == pytest.approx(
+    assert c["seeds_low"] == pytest.approx(1 / 3 - half, abs=1e-4) and c["seeds_high"] == pytest.approx(
         1 / 3 + half, abs=1e-4
     )
 
@@ -63,7 +63,7 @@ def test_contrast_interval_excludes_zero_for_a_clear_effect_and_report_says_so()
         outcomes[("antipodal", -1, obj)] = [False, k % 4 == 0, False]
     trials = trials_table(outcomes)
     c = trial_contrast(trials, "before", "antipodal", n_boot=1000)
-    assert c["ci_low"] > 0 and c["mean"] == pytest.approx(np.mean([1, 1, 2 / 3]) - 1 / 12, abs=1e-4)
+    assert c["objects_low"] > 0 and c["mean"] == pytest.approx(np.mean([1, 1, 2 / 3]) - 1 / 12, abs=1e-4)
     chosen = {"before": ("targeted", 0.0, 50), "after": ("targeted", 1.0, 50), "antipodal": (None, None, None)}
     metrics = {
         "setup": {
@@ -111,7 +111,11 @@ def test_contrast_interval_excludes_zero_for_a_clear_effect_and_report_says_so()
     assert "Grip 20 N, the object shaken at 5 g after the lift." in text
     headline = sim_headline(metrics)  # the metrics files: one per contrast, its mean and bootstrap interval
     assert list(headline) == ["after_vs_before", "network_vs_antipodal"]
-    assert headline["network_vs_antipodal"] == {"mean": round(c["mean"], 5), "lo": c["ci_low"], "hi": c["ci_high"]}
+    assert headline["network_vs_antipodal"] == {
+        "mean": round(c["mean"], 5),
+        "lo": c["objects_low"],
+        "hi": c["objects_high"],
+    }
 
 
 def test_calibration_correlates_sim_success_with_graspness():
@@ -129,13 +133,13 @@ def test_the_outcome_line_gives_rates_contrasts_and_planning_time():
 
     metrics = {
         "arms": {"before": {"successes": 3, "attempts": 4}, "after": {"successes": 4, "attempts": 4}},
-        "contrasts": {"after_vs_before": {"mean": 0.25, "ci_low": -0.125, "ci_high": 0.5}},
+        "contrasts": {"after_vs_before": {"mean": 0.25, "objects_low": -0.125, "objects_high": 0.5}},
     }
     timing = {"planning_time_mean": 0.01234, "planning_time_max": None}
     assert outcome_words(metrics, timing) == (
         "before 3/4, after 4/4; after_vs_before +0.250 [-0.125, +0.500]; planning 0.012 s per grasp (max 0.000)"
     )
-    metrics["ranking"] = {"contrasts": {"real_data": {"mean": 0.0104, "ci_low": 0.0024, "ci_high": 0.0186}}}
+    metrics["ranking"] = {"contrasts": {"real_data": {"mean": 0.0104, "objects_low": 0.0024, "objects_high": 0.0186}}}
     assert "after_vs_before +0.250 [-0.125, +0.500], ranking_real_data +0.010 [+0.002, +0.019];" in outcome_words(
         metrics, timing
     )
@@ -144,8 +148,8 @@ def test_the_outcome_line_gives_rates_contrasts_and_planning_time():
 def test_the_report_reads_augmentation_only_when_the_positive_control_shows():
     from graspaug.experiments.cell.words import control_words
 
-    shows = {"real_data": {"mean": 0.08, "ci_low": 0.02, "ci_high": 0.14}}
-    fails = {"real_data": {"mean": -0.02, "ci_low": -0.09, "ci_high": 0.05}}
+    shows = {"real_data": {"mean": 0.08, "objects_low": 0.02, "objects_high": 0.14}}
+    fails = {"real_data": {"mean": -0.02, "objects_low": -0.09, "objects_high": 0.05}}
     assert control_words(shows).startswith("The positive control shows") and "test of augmentation" in control_words(
         shows
     )

@@ -21,12 +21,12 @@ def test_t_interval_on_a_hand_made_table():
     result = t_interval([0.01, 0.03, 0.02])  # mean 0.02, SD 0.01, t(0.975, 2) = 4.3027
     assert result["mean"] == pytest.approx(0.02) and result["n_seeds"] == 3
     half = 4.302653 * 0.01 / np.sqrt(3)
-    assert (result["ci_low"], result["ci_high"]) == pytest.approx((0.02 - half, 0.02 + half), abs=1e-6)
+    assert (result["low"], result["high"]) == pytest.approx((0.02 - half, 0.02 + half), abs=1e-6)
     five = t_interval([0.1, 0.2, 0.3, 0.4, 0.5])
-    assert five["ci_high"] - five["mean"] == pytest.approx(
+    assert five["high"] - five["mean"] == pytest.approx(
         scipy_stats.t.ppf(0.975, 4) * np.std([0.1, 0.2, 0.3, 0.4, 0.5], ddof=1) / np.sqrt(5)
     )
-    assert t_interval([0.05])["ci_low"] is None and t_interval([None, 0.05, float("nan")])["n_seeds"] == 1
+    assert t_interval([0.05])["low"] is None and t_interval([None, 0.05, float("nan")])["n_seeds"] == 1
 
 
 def test_the_bootstrap_resamples_objects_not_datapoints():
@@ -71,10 +71,11 @@ def test_wilson_interval_known_values():
 
 
 def test_a_contrasts_headline_is_its_mean_and_interval_ends_rounded():
-    from graspaug.experiments.stats import headline
+    from graspaug.experiments.stats import contrast, headline
 
-    c = {"mean": 0.0123456, "ci_low": -0.001, "ci_high": None, "n_seeds": 4, "per_seed": [0.1, 0.2]}
-    assert headline(c) == {"mean": 0.01235, "lo": -0.001, "hi": None}
+    c = contrast(0.0123456, "seeds", 4, seeds=(-0.001, None), objects=(0.5, 0.6), per_seed=[0.1, 0.2])
+    assert headline(c) == {"mean": 0.01235, "lo": -0.001, "hi": None}  # its `over` interval, not the other
+    assert headline({**c, "over": "objects"}) == {"mean": 0.01235, "lo": 0.5, "hi": 0.6}
 
 
 def test_the_nested_interval_covers_each_source_of_variance_on_hand_made_tables():
@@ -82,23 +83,23 @@ def test_the_nested_interval_covers_each_source_of_variance_on_hand_made_tables(
 
     rng = np.random.default_rng(0)
     flat = nested_interval(np.full((3, 4), 0.02), np.full((3, 4, 500), 0.02), rng)
-    assert flat == pytest.approx({"mean": 0.02, "ci_low": 0.02, "ci_high": 0.02, "n_draws": 3, "n_seeds": 4})
+    assert flat == pytest.approx({"mean": 0.02, "low": 0.02, "high": 0.02, "n_draws": 3, "n_seeds": 4})
     # draws alone vary: the bootstrap of the mean of 60 draw effects, SE = SD / sqrt(60)
     effects = rng.normal(0.1, 0.05, size=60)
     full = np.repeat(effects[:, None], 4, axis=1)
     out = nested_interval(full, np.repeat(full[:, :, None], 4000, axis=2), np.random.default_rng(1))
     se = effects.std() / np.sqrt(60)
     assert out["mean"] == pytest.approx(effects.mean())
-    assert out["ci_low"] == pytest.approx(effects.mean() - 1.96 * se, abs=0.25 * se)
-    assert out["ci_high"] == pytest.approx(effects.mean() + 1.96 * se, abs=0.25 * se)
+    assert out["low"] == pytest.approx(effects.mean() - 1.96 * se, abs=0.25 * se)
+    assert out["high"] == pytest.approx(effects.mean() + 1.96 * se, abs=0.25 * se)
     # test objects alone vary (the same object resample in every cell): the object bootstrap's interval
     objects = rng.normal(0.0, 0.01, size=3000)
     alone = nested_interval(np.zeros((3, 4)), np.broadcast_to(objects, (3, 4, 3000)), np.random.default_rng(2))
-    assert (alone["ci_low"], alone["ci_high"]) == pytest.approx(percentile_interval(objects))
+    assert (alone["low"], alone["high"]) == pytest.approx(percentile_interval(objects))
     # seeds on top of objects: wider than objects alone
     seeds = rng.normal(0.0, 0.02, size=(3, 4))
     both = nested_interval(seeds, seeds[:, :, None] + objects, np.random.default_rng(3))
-    assert both["ci_high"] - both["ci_low"] > alone["ci_high"] - alone["ci_low"]
+    assert both["high"] - both["low"] > alone["high"] - alone["low"]
 
 
 def test_the_fieller_interval_inverts_the_t_test_of_the_paired_difference():
@@ -108,14 +109,14 @@ def test_the_fieller_interval_inverts_the_t_test_of_the_paired_difference():
 
     gain, real_gain = np.array([0.010, 0.020, 0.015, 0.012]), np.array([0.040, 0.035, 0.045, 0.041])
     out = fieller_interval(gain, real_gain)
-    assert out["bounded"] and out["ci_low"] < out["ratio"] < out["ci_high"]
+    assert out["bounded"] and out["low"] < out["ratio"] < out["high"]
     assert out["ratio"] == pytest.approx(gain.mean() / real_gain.mean())
     critical = stats.t.ppf(0.975, 3)
-    for theta in (out["ci_low"], out["ci_high"]):  # at either end x - θ y is exactly on the edge of significance
+    for theta in (out["low"], out["high"]):  # at either end x - θ y is exactly on the edge of significance
         d = gain - theta * real_gain
         assert abs(d.mean() / (d.std(ddof=1) / 2)) == pytest.approx(critical)
     noisy = fieller_interval(gain, np.array([0.03, -0.02, 0.01, -0.015]))  # the real gain is not clearly nonzero
-    assert not noisy["bounded"] and noisy["ci_low"] is None and noisy["ci_high"] is None
+    assert not noisy["bounded"] and noisy["low"] is None and noisy["high"] is None
 
 
 def test_weighted_roc_auc_is_sklearns_with_ties_and_weights():
@@ -147,3 +148,23 @@ def test_a_one_draw_interval_is_a_gain_or_loss_in_this_draw_only_and_says_where_
     assert "does not cover other draws" in scope
     assert "`python studies/attribution.py --draws 0 1 2`" in scope and '"Over three draws of the data"' in scope
     assert "studies/lifelong.py --draws 0 1 2" in draw_scope(0, [0], "lifelong")
+
+
+def test_one_contrast_type_names_each_interval_by_what_it_covers():
+    """Every experiment's contrast has the same keys; its verdict, text and metrics read the interval it names."""
+    from graspaug.experiments.stats import contrast, interval_text, verdict
+
+    c = contrast(0.02, "objects", 4, objects=(0.01, 0.03), seeds=(-0.01, 0.05), n_trials=8)
+    assert list(c)[:10] == [
+        "mean", "seeds_low", "seeds_high", "objects_low", "objects_high", "draws_low", "draws_high", "over", "n_seeds",
+        "n_draws",
+    ]  # fmt: skip
+    assert c["draws_low"] is None and c["n_trials"] == 8
+    assert verdict(c) == "a gain in this draw of the data"
+    assert verdict({**c, "over": "seeds"}) == "no effect we can claim in this draw of the data"
+    assert interval_text(c, "+.2f") == "+0.02 [+0.01, +0.03]"
+    assert interval_text(c, "+.2f", over="draws") == "+0.02 [n/a, n/a]" and interval_text(None) == "n/a"
+    over_draws = contrast(-0.02, "draws", 4, 3, draws=(-0.03, -0.01))
+    assert verdict(over_draws) == "a loss over 3 draws of the data"
+    with pytest.raises(ValueError, match="over must be one of"):
+        contrast(0.0, "t")

@@ -14,6 +14,9 @@
   hierarchical bootstrap); :func:`fieller_interval`: a ratio of paired means (a share of a gain);
 * :func:`wilson_interval` (a success rate). No McNemar test: the robot trials' picks cluster by
   object and training seed, so they are compared with the object bootstrap and the t-interval;
+* :func:`contrast`: the one result type of every experiment (a mean and its intervals, each keyed by what it
+  covers: ``seeds_*``, ``objects_*``, ``draws_*``), with one :func:`verdict`, one :func:`interval_text` and one
+  :func:`headline` (a metrics file's ``mean``, ``lo``, ``hi``);
 * :func:`draw_scope`, :func:`draw_verdict`: the words every report uses for intervals over one draw
   of the data (``data_seed``), which do not cover other draws.
 """
@@ -31,12 +34,12 @@ def t_interval(values, level: float = 0.95) -> dict:
     x = np.asarray([v for v in values if v is not None and np.isfinite(v)], dtype=float)
     n = len(x)
     if n == 0:
-        return {"mean": None, "ci_low": None, "ci_high": None, "n_seeds": 0}
+        return {"mean": None, "low": None, "high": None, "n_seeds": 0}
     mean = float(x.mean())
     if n < 2:
-        return {"mean": mean, "ci_low": None, "ci_high": None, "n_seeds": 1}
+        return {"mean": mean, "low": None, "high": None, "n_seeds": 1}
     half = float(stats.t.ppf(0.5 + level / 2, n - 1) * x.std(ddof=1) / np.sqrt(n))
-    return {"mean": mean, "ci_low": mean - half, "ci_high": mean + half, "n_seeds": n}
+    return {"mean": mean, "low": mean - half, "high": mean + half, "n_seeds": n}
 
 
 class ObjectBootstrap:
@@ -152,13 +155,12 @@ def percentile_interval(samples: np.ndarray, level: float = 0.95) -> tuple[float
 
 def mean_interval(values: np.ndarray, boot: ObjectBootstrap, level: float = 0.95) -> dict[str, float | None]:
     """Mean of the finite ``values`` (N,) and the two-sided ``level`` percentile interval of
-    their mean over the resamples of ``boot`` (:meth:`ObjectBootstrap.means`); all None when
-    no value is finite."""
+    their mean over the resamples of ``boot`` (:meth:`ObjectBootstrap.means`), as a :func:`contrast` over
+    ``objects``; all None when no value is finite."""
     finite = np.isfinite(values)
     if not finite.any():
-        return {"mean": None, "ci_low": None, "ci_high": None}
-    low, high = percentile_interval(boot.means(values), level)
-    return {"mean": float(np.mean(values[finite])), "ci_low": low, "ci_high": high}
+        return contrast(None, "objects")
+    return contrast(float(np.mean(values[finite])), "objects", objects=percentile_interval(boot.means(values), level))
 
 
 def paired_contrast(
@@ -170,12 +172,59 @@ def paired_contrast(
     return mean_interval(a - b, boot, level)
 
 
-def headline(contrast: dict) -> dict[str, float | None]:
-    """A contrast as a metrics file holds it: ``mean`` and its interval ends ``lo``, ``hi`` (from ``ci_low``,
-    ``ci_high``), rounded to 5 decimals; None stays None. The same three keys in every metrics file, so
-    ``dvc metrics show`` lines every experiment's contrasts up in three columns."""
-    keys = {"mean": "mean", "lo": "ci_low", "hi": "ci_high"}
-    return {k: None if contrast.get(v) is None else round(float(contrast[v]), 5) for k, v in keys.items()}
+INTERVALS = ("seeds", "objects", "draws")
+"""What a contrast's intervals cover, the prefix of their keys: ``seeds`` the 95% t-interval over paired training
+seeds; ``objects`` the 95% cluster bootstrap over test objects (shapes; the critic study's interpolation pairs);
+``draws`` the 95% nested bootstrap over data draws × training seeds × test objects."""
+
+
+def contrast(mean: float | None, over: str, n_seeds: int | None = None, n_draws: int = 1, **intervals) -> dict:
+    """The one result type of every experiment: a paired difference (or one figure) ``mean`` with its 95% intervals,
+    each keyed by what it covers (:data:`INTERVALS`): ``seeds_low``, ``seeds_high``, ``objects_low``,
+    ``objects_high``, ``draws_low``, ``draws_high`` (None where not measured). ``over`` names the interval that its
+    verdict (:func:`verdict`), its text (:func:`interval_text`) and its metrics file (:func:`headline`) read;
+    ``n_seeds``, ``n_draws``. ``intervals``: ``seeds=(low, high)`` and the like, then any other keys the experiment
+    keeps (``sd``, ``per_seed``, ``n_trials``…), in that order after the fixed ones."""
+    if over not in INTERVALS:
+        raise ValueError(f"over must be one of {INTERVALS}, not {over!r}")
+    out = {"mean": mean}
+    for name in INTERVALS:
+        low, high = intervals.pop(name, None) or (None, None)
+        out |= {f"{name}_low": low, f"{name}_high": high}
+    return out | {"over": over, "n_seeds": n_seeds, "n_draws": n_draws} | intervals
+
+
+def nested_contrast(nested: dict, **extra) -> dict:
+    """A :func:`nested_interval` result as a :func:`contrast` over ``draws``; ``extra`` keys kept after its own."""
+    draws = (nested["low"], nested["high"])
+    return contrast(nested["mean"], "draws", nested["n_seeds"], nested["n_draws"], draws=draws, **extra)
+
+
+def interval(c: dict) -> tuple[float | None, float | None]:
+    """The (low, high) of the interval a :func:`contrast` is judged by (its ``over``)."""
+    return c[f"{c['over']}_low"], c[f"{c['over']}_high"]
+
+
+def verdict(c: dict) -> str:
+    """A :func:`contrast` in words (:func:`draw_verdict` of its :func:`interval` and ``n_draws``)."""
+    return draw_verdict(*interval(c), c["n_draws"])
+
+
+def interval_text(c: dict | None, spec: str = "+.4f", over: str | None = None) -> str:
+    """``mean [low, high]`` of a :func:`contrast` (its ``over`` interval, or ``over``'s), "n/a" for what is missing."""
+    if c is None or c.get("mean") is None:
+        return "n/a"
+    low, high = interval(c if over is None else {**c, "over": over})
+    ends = [format(v, spec) if v is not None else "n/a" for v in (low, high)]
+    return f"{format(c['mean'], spec)} [{ends[0]}, {ends[1]}]"
+
+
+def headline(c: dict) -> dict[str, float | None]:
+    """A :func:`contrast` as a metrics file holds it: ``mean`` and its :func:`interval` as ``lo``, ``hi``, rounded to 5
+    decimals; None stays None. The same three keys in every metrics file, so ``dvc metrics show`` lines every
+    experiment's contrasts up in three columns; the report beside it says what the interval covers (``over``)."""
+    values = {"mean": c.get("mean"), "lo": interval(c)[0], "hi": interval(c)[1]}
+    return {k: None if v is None else round(float(v), 5) for k, v in values.items()}
 
 
 #: Where each experiment is run over several draws of the data: (command, section of docs/results.md).
@@ -260,13 +309,13 @@ def nested_interval(full: np.ndarray, resampled: np.ndarray, rng: np.random.Gene
 
     Returns
     -------
-    dict — ``mean`` (of ``full``; None if a cell is not finite), ``ci_low``, ``ci_high``, ``n_draws``, ``n_seeds``
+    dict — ``mean`` (of ``full``; None if a cell is not finite), ``low``, ``high``, ``n_draws``, ``n_seeds``
     """
     full, resampled = np.asarray(full, dtype=float), np.asarray(resampled, dtype=float)
     n_draws, n_seeds, n_resamples = resampled.shape
     low, high = percentile_interval(nested_means(resampled, nested_indices(n_draws, n_seeds, n_resamples, rng)), level)
     mean = float(full.mean()) if np.isfinite(full).all() else None  # a network without a test AP: no mean
-    return {"mean": mean, "ci_low": low, "ci_high": high, "n_draws": n_draws, "n_seeds": n_seeds}
+    return {"mean": mean, "low": low, "high": high, "n_draws": n_draws, "n_seeds": n_seeds}
 
 
 def fieller_interval(x, y, level: float = 0.95) -> dict:
@@ -280,12 +329,12 @@ def fieller_interval(x, y, level: float = 0.95) -> dict:
 
     Returns
     -------
-    dict — ``ratio`` (x̄ / ȳ), ``ci_low``, ``ci_high``, ``bounded``
+    dict — ``ratio`` (x̄ / ȳ), ``low``, ``high``, ``bounded``
     """
     x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
     n = len(x)
     if n < 2 or not np.any(y):
-        return {"ratio": None, "ci_low": None, "ci_high": None, "bounded": False}
+        return {"ratio": None, "low": None, "high": None, "bounded": False}
     mx, my = x.mean(), y.mean()
     cov = np.cov(x, y, ddof=1)
     t2 = stats.t.ppf(0.5 + level / 2, n - 1) ** 2 / n
@@ -295,6 +344,6 @@ def fieller_interval(x, y, level: float = 0.95) -> dict:
     ratio = float(mx / my) if my else None
     disc = b * b - a * c
     if a <= 0 or disc < 0:
-        return {"ratio": ratio, "ci_low": None, "ci_high": None, "bounded": False}
+        return {"ratio": ratio, "low": None, "high": None, "bounded": False}
     root = np.sqrt(disc)
-    return {"ratio": ratio, "ci_low": float((b - root) / a), "ci_high": float((b + root) / a), "bounded": True}
+    return {"ratio": ratio, "low": float((b - root) / a), "high": float((b + root) / a), "bounded": True}

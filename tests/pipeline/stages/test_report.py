@@ -10,16 +10,14 @@ from graspaug.experiments.ap.words import verdict
 
 
 def contrast(values, boot=(0.01, 0.03)):
+    from graspaug.experiments.stats import contrast as stats_contrast
     from graspaug.experiments.stats import t_interval
 
     t = t_interval(values)
-    return {
-        **t,
-        "sd": float(np.std(values, ddof=1)) if len(values) > 1 else None,
-        "boot_low": boot[0],
-        "boot_high": boot[1],
-        "meaning": "m",
-    }
+    sd = float(np.std(values, ddof=1)) if len(values) > 1 else None
+    return stats_contrast(
+        t["mean"], "seeds", t["n_seeds"], seeds=(t["low"], t["high"]), objects=boot, sd=sd, meaning="m"
+    )
 
 
 def test_a_consistent_gain_is_claimed_and_a_noisy_one_is_not():

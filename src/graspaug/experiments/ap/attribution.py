@@ -31,11 +31,12 @@ from graspaug.experiments.ap.numbers import (
 from graspaug.experiments.stats import (
     ObjectBootstrap,
     draw_scope,
-    draw_verdict,
+    nested_contrast,
     nested_indices,
     nested_interval,
     nested_means,
     percentile_interval,
+    verdict,
 )
 from graspaug.training.variants import seed_variants
 
@@ -75,10 +76,10 @@ def combine_draws(
 
     Returns
     -------
-    dict — ``contrasts``: name → ``mean``, ``ci_low``, ``ci_high`` (:func:`nested_interval`),
-    ``n_draws``, ``n_seeds``, ``per_draw`` (mean over seeds per draw), ``meaning``; ``share``: the
-    share of the real-shape gain that targeted shapes give per augmented base size (ratio of the
-    nested means, its percentile interval); ``draws``, ``seeds``
+    dict — ``contrasts``: name → a :func:`~graspaug.experiments.stats.contrast` over ``draws``
+    (:func:`nested_interval`) with ``per_draw`` (mean over seeds per draw) and ``meaning``; ``share``: the share of
+    the real-shape gain that targeted shapes give per augmented base size (ratio of the nested means, its percentile
+    interval: ``share``, ``low``, ``high``); ``draws``, ``seeds``
     """
     seeds = sorted({s for d in draws.values() for s in d})
     if any(sorted(d) != seeds for d in draws.values()):
@@ -108,11 +109,11 @@ def combine_draws(
         full[name], resampled[name] = f, r
     rng = np.random.default_rng([seed, 0xA77])
     out = {
-        name: {
-            **nested_interval(full[name], resampled[name], rng),
-            "per_draw": [round(float(v), 5) if np.isfinite(v) else None for v in full[name].mean(axis=1)],
-            "meaning": per_draw[next(iter(per_draw))][1][name].meaning,
-        }
+        name: nested_contrast(
+            nested_interval(full[name], resampled[name], rng),
+            per_draw=[round(float(v), 5) if np.isfinite(v) else None for v in full[name].mean(axis=1)],
+            meaning=per_draw[next(iter(per_draw))][1][name].meaning,
+        )
         for name in names
     }
     shares = {}
@@ -124,7 +125,7 @@ def combine_draws(
             ratio = nested_means(x, indices) / nested_means(y, indices)
             low, high = percentile_interval(ratio)
             mean = float(full[gain].mean() / (full[gain] - full[versus_real]).mean())
-            shares[str(b)] = {"share": mean if np.isfinite(mean) else None, "ci_low": low, "ci_high": high}
+            shares[str(b)] = {"share": mean if np.isfinite(mean) else None, "low": low, "high": high}
     return {"contrasts": out, "share": shares, "draws": list(draws), "seeds": seeds}
 
 
@@ -133,7 +134,9 @@ def losing_step(contrasts: Mapping[str, dict], base_size: int) -> str:
     of the real-shape gain, if any step's interval lies below zero."""
     steps = {s: contrasts.get(f"{s}@{base_size}") for s in STEPS}
     below = {
-        s: c for s, c in steps.items() if c and c["mean"] is not None and c["ci_high"] is not None and c["ci_high"] < 0
+        s: c
+        for s, c in steps.items()
+        if c and c["mean"] is not None and c["draws_high"] is not None and c["draws_high"] < 0
     }
     if not below:
         shown = [s for s, c in steps.items() if c]
@@ -145,8 +148,7 @@ def losing_step(contrasts: Mapping[str, dict], base_size: int) -> str:
     over = f"{c['n_draws']} draws × {c['n_seeds']} seeds" if c["n_draws"] > 1 else f"{c['n_seeds']} seeds of one draw"
     return (
         f"At B = {base_size} the step that loses most is `{worst}`: {c['mean']:+.4f} AP "
-        f"[{c['ci_low']:+.4f}, {c['ci_high']:+.4f}] over {over} and the test objects, "
-        f"{draw_verdict(c['ci_low'], c['ci_high'], c['n_draws'])}."
+        f"[{c['draws_low']:+.4f}, {c['draws_high']:+.4f}] over {over} and the test objects, {verdict(c)}."
     )
 
 
@@ -174,13 +176,13 @@ def decomposition_markdown(result: dict, augment_base_sizes: Sequence[int], comm
         "|---|---|---|---|---|",
     ]
     for name, c in result["contrasts"].items():
-        interval = "-" if c["ci_low"] is None else f"[{c['ci_low']:+.4f}, {c['ci_high']:+.4f}]"
+        interval = "-" if c["draws_low"] is None else f"[{c['draws_low']:+.4f}, {c['draws_high']:+.4f}]"
         per_draw = ", ".join("-" if v is None else f"{v:+.4f}" for v in c["per_draw"])
         mean = "-" if c["mean"] is None else f"{c['mean']:+.4f}"
         lines.append(f"| `{name}` | {mean} | {interval} | {per_draw} | {c['meaning']} |")
     lines += ["", "## What it says", ""]
     for b, s in result["share"].items():
-        interval = "unbounded" if s["ci_low"] is None else f"[{s['ci_low']:.0%}, {s['ci_high']:.0%}]"
+        interval = "unbounded" if s["low"] is None else f"[{s['low']:.0%}, {s['high']:.0%}]"
         share = "an undefined share" if s["share"] is None else f"{s['share']:.0%}"
         lines.append(f"- B = {b}: targeted shapes give {share} of the real-shape gain, 95% interval {interval}.")
     lines += [f"- {losing_step(result['contrasts'], b)}" for b in augment_base_sizes]

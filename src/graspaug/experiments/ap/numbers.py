@@ -38,6 +38,7 @@ from sklearn.metrics import average_precision_score
 from graspaug.errors import DataError
 from graspaug.experiments.stats import (
     ObjectBootstrap,
+    contrast,
     headline,
     percentile_interval,
     t_interval,
@@ -301,14 +302,17 @@ def evaluate_contrasts(
         resampled = np.mean([sum(w * boot_ap(k, s) for w, k in c.terms) for s in seeds], axis=0)
         low, high = percentile_interval(resampled)
         finite = [v for v in per_seed if np.isfinite(v)]
-        out[c.name] = {
-            **{k: (round(v, 5) if isinstance(v, float) else v) for k, v in summary.items()},
-            "sd": round(float(np.std(finite, ddof=1)), 5) if len(finite) > 1 else None,
-            "boot_low": None if low is None else round(low, 5),
-            "boot_high": None if high is None else round(high, 5),
-            "per_seed": [round(float(v), 5) if np.isfinite(v) else None for v in per_seed],
-            "meaning": c.meaning,
-        }
+        r5 = lambda v: None if v is None else round(float(v), 5)  # noqa: E731
+        out[c.name] = contrast(
+            r5(summary["mean"]),
+            "seeds",
+            summary["n_seeds"],
+            seeds=(r5(summary["low"]), r5(summary["high"])),
+            objects=(r5(low), r5(high)),
+            sd=round(float(np.std(finite, ddof=1)), 5) if len(finite) > 1 else None,
+            per_seed=[round(float(v), 5) if np.isfinite(v) else None for v in per_seed],
+            meaning=c.meaning,
+        )
     return out
 
 
@@ -347,7 +351,7 @@ def network_table(runs: pd.DataFrame, per_object: pd.DataFrame) -> pd.DataFrame:
     merged = runs.merge(per_object, on=["pool", "base_size", "ratio", "seed"], how="left")
     for (pool, base, ratio), g in merged.groupby(["pool", "base_size", "ratio"], sort=False):
         t = t_interval(g.test_ap.astype(float))
-        half = np.nan if t["ci_high"] is None else t["ci_high"] - t["mean"]
+        half = np.nan if t["high"] is None else t["high"] - t["mean"]
         rows.append(
             {
                 "pool": pool,

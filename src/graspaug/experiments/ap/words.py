@@ -7,8 +7,10 @@ import pandas as pd
 
 from graspaug.experiments.stats import (
     draw_scope,
-    draw_verdict,
     fieller_interval,
+)
+from graspaug.experiments.stats import (
+    verdict as contrast_verdict,
 )
 
 
@@ -33,7 +35,7 @@ def gain_sentences(
             ok = np.isfinite(gain) & np.isfinite(real)
             share = fieller_interval(gain[ok], real[ok])
             interval = (
-                f"95% Fieller interval over seeds [{share['ci_low']:.0%}, {share['ci_high']:.0%}]"
+                f"95% Fieller interval over seeds [{share['low']:.0%}, {share['high']:.0%}]"
                 if share["bounded"]
                 else "the real-shape gain is not clearly nonzero over seeds, so its Fieller interval is unbounded"
             )
@@ -72,17 +74,20 @@ def verdict(name: str, c: dict) -> str:
     the run's one draw of the data (:func:`~graspaug.experiments.stats.draw_verdict`)."""
     if c["mean"] is None:
         return f"`{name}` ({c['meaning']}): no value (a test set with one class?)."
-    if c["ci_low"] is None:
+    if c["seeds_low"] is None:
         return f"`{name}` ({c['meaning']}): {c['mean']:+.4f} with one seed, no interval; not evidence either way."
-    t_side = "above zero" if c["ci_low"] > 0 else ("below zero" if c["ci_high"] < 0 else "includes zero")
+    t_side = "above zero" if c["seeds_low"] > 0 else ("below zero" if c["seeds_high"] < 0 else "includes zero")
     b_side = (
-        "above zero" if (c["boot_low"] or 0) > 0 else ("below zero" if (c["boot_high"] or 0) < 0 else "includes zero")
+        "above zero"
+        if (c["objects_low"] or 0) > 0
+        else ("below zero" if (c["objects_high"] or 0) < 0 else "includes zero")
     )
-    word = draw_verdict(c["ci_low"], c["ci_high"])
+    word = contrast_verdict(c)
     return (
         f"`{name}` ({c['meaning']}): {c['mean']:+.4f} AP, 95% t-interval over {c['n_seeds']} seeds "
-        f"[{c['ci_low']:+.4f}, {c['ci_high']:+.4f}] "
-        f"({t_side}), bootstrap over test objects [{c['boot_low']:+.4f}, {c['boot_high']:+.4f}] ({b_side}): {word}."
+        f"[{c['seeds_low']:+.4f}, {c['seeds_high']:+.4f}] "
+        f"({t_side}), bootstrap over test objects [{c['objects_low']:+.4f}, {c['objects_high']:+.4f}] ({b_side}): "
+        f"{word}."
     )
 
 
@@ -147,10 +152,10 @@ def report_markdown(
     ]
     for name, c in contrasts.items():
         lines.append(
-            f"| `{name}` | {_fmt(c['mean'])} | [{_fmt(c['ci_low'])}, {_fmt(c['ci_high'])}] | {_fmt(c['sd'])} | "
-            f"[{_fmt(c['boot_low'])}, {_fmt(c['boot_high'])}] |"
+            f"| `{name}` | {_fmt(c['mean'])} | [{_fmt(c['seeds_low'])}, {_fmt(c['seeds_high'])}] | {_fmt(c['sd'])} | "
+            f"[{_fmt(c['objects_low'])}, {_fmt(c['objects_high'])}] |"
         )
-    excluding = [n for n, c in contrasts.items() if c["ci_low"] is not None and (c["ci_low"] > 0 or c["ci_high"] < 0)]
+    excluding = [n for n, c in contrasts.items() if contrast_verdict(c).startswith(("a gain", "a loss"))]
     lines += [
         "",
         "## What the numbers say",

@@ -13,6 +13,7 @@ from graspaug.errors import DataError
 from graspaug.experiments.ap.numbers import test_predictions, test_rows
 from graspaug.experiments.stats import (
     ObjectBootstrap,
+    contrast,
     headline,
     paired_contrast,
     percentile_interval,
@@ -70,9 +71,9 @@ def paired_outcomes(trials: pd.DataFrame, arm: str, reference: str) -> pd.DataFr
 
 def trial_contrast(trials: pd.DataFrame, arm: str, reference: str, n_boot: int = 2000, seed: int = 0) -> dict:
     """success(arm) − success(reference) on the paired attempts: ``mean``; the 95 % bootstrap
-    interval over objects (``ci_low``, ``ci_high``; each resampled object brings all its
-    attempts); ``n_trials`` (paired drops), ``n_objects``; the 95 % t-interval over training
-    seeds of the per-seed differences (``t_ci_low``, ``t_ci_high``, ``n_seeds``, ``per_seed``);
+    interval over objects (``objects_low``, ``objects_high``; each resampled object brings all its
+    attempts; the verdict's); ``n_trials`` (paired drops), ``n_objects``; the 95 % t-interval over training
+    seeds of the per-seed differences (``seeds_low``, ``seeds_high``, ``n_seeds``, ``per_seed``);
     and, when both arms ran once per training seed, the discordant counts (``only_<arm>``,
     ``only_<reference>``). No McNemar test: the picks cluster by object and seed, so they are not
     independent pairs; the two intervals above are the inference.
@@ -94,20 +95,19 @@ def trial_contrast(trials: pd.DataFrame, arm: str, reference: str, n_boot: int =
             f"only_{arm}": int((paired.a & ~paired.b).sum()),
             f"only_{reference}": int((paired.b & ~paired.a).sum()),
         }
-    contrast = paired_contrast(a, b, ObjectBootstrap(objects, n_boot, seed))
+    difference = paired_contrast(a, b, ObjectBootstrap(objects, n_boot, seed))
     rounded = lambda x: None if x is None else round(float(x), 5)  # noqa: E731
-    return {
-        "mean": rounded(contrast["mean"]),
-        "ci_low": rounded(contrast["ci_low"]),
-        "ci_high": rounded(contrast["ci_high"]),
-        "n_trials": int(len(a)),
-        "n_objects": int(len(set(objects))),
-        "t_ci_low": rounded(over_seeds["ci_low"]),
-        "t_ci_high": rounded(over_seeds["ci_high"]),
-        "n_seeds": over_seeds["n_seeds"],
-        "per_seed": {str(k): round(v, 5) for k, v in per_seed.items()},
+    return contrast(
+        rounded(difference["mean"]),
+        "objects",
+        over_seeds["n_seeds"],
+        objects=(rounded(difference["objects_low"]), rounded(difference["objects_high"])),
+        seeds=(rounded(over_seeds["low"]), rounded(over_seeds["high"])),
+        n_trials=int(len(a)),
+        n_objects=int(len(set(objects))),
+        per_seed={str(k): round(v, 5) for k, v in per_seed.items()},
         **counts,
-    }
+    )
 
 
 def compare(trials: pd.DataFrame) -> dict:
@@ -290,9 +290,9 @@ def cell_ranking(grasps: pd.DataFrame, seed_dirs: Mapping[int, Path], chosen: Ma
     Returns ``{"n_grasps", "n_objects", "reference": {"eps", "label"}, "arms": {arm: {"auc", "per_seed",
     "auc_label"}}, "contrasts": {name: {...}}}``: ``auc`` the mean over training seeds (``auc_label``:
     the same networks' ROC AUC against the grasps' labels instead; None when the grasps hold one label
-    only); a contrast's ``mean`` is the mean over seeds of the AUC difference, ``ci_low``, ``ci_high``
+    only); a contrast's ``mean`` is the mean over seeds of the AUC difference, ``objects_low``, ``objects_high``
     its 95 % bootstrap interval over the grasps' objects (shapes; one resample for every network),
-    ``t_ci_low``, ``t_ci_high`` the t-interval over seeds, ``per_seed``. The robust ε and the label,
+    ``seeds_low``, ``seeds_high`` the t-interval over seeds, ``per_seed``. The robust ε and the label,
     scored the same way, are the reference. When every grasp had the same outcome there is nothing to
     rank: no arms, no contrasts, reference None."""
     y = grasps.executed_success.to_numpy(bool)
@@ -318,15 +318,14 @@ def ranking_summary(grasps: pd.DataFrame, seeds: list, scores: dict, full: dict,
         per_seed = full[arm] - full[reference]
         lo, hi = percentile_interval((resampled[arm] - resampled[reference]).mean(axis=0))
         over_seeds = t_interval(per_seed)
-        contrasts[name] = {
-            "mean": rounded(per_seed.mean()),
-            "ci_low": rounded(lo),
-            "ci_high": rounded(hi),
-            "t_ci_low": rounded(over_seeds["ci_low"]),
-            "t_ci_high": rounded(over_seeds["ci_high"]),
-            "n_seeds": over_seeds["n_seeds"],
-            "per_seed": dict(zip(seeds, map(rounded, per_seed))),
-        }
+        contrasts[name] = contrast(
+            rounded(per_seed.mean()),
+            "objects",
+            over_seeds["n_seeds"],
+            objects=(rounded(lo), rounded(hi)),
+            seeds=(rounded(over_seeds["low"]), rounded(over_seeds["high"])),
+            per_seed=dict(zip(seeds, map(rounded, per_seed))),
+        )
     return {
         "reference": {k: rounded(boot_auc(y, grasps[k].to_numpy(float), None)) for k in ("eps", "label")},
         "arms": {

@@ -8,7 +8,7 @@ import pandas as pd
 from graspaug.experiments.cell.numbers import CONTRASTS
 from graspaug.experiments.stats import (
     draw_scope,
-    draw_verdict,
+    verdict,
 )
 
 
@@ -18,21 +18,21 @@ def _number(x) -> str:
 
 def _t(c: dict) -> str:
     """A contrast's t-interval over seeds as a table cell ("–" with one seed)."""
-    return "–" if c["t_ci_low"] is None else f"[{c['t_ci_low']:+.3f}, {c['t_ci_high']:+.3f}]"
+    return "–" if c["seeds_low"] is None else f"[{c['seeds_low']:+.3f}, {c['seeds_high']:+.3f}]"
 
 
 def _interval(c: dict) -> str:
-    return f"{c['mean']:+.3f} [{c['ci_low']:+.3f}, {c['ci_high']:+.3f}]"
+    return f"{c['mean']:+.3f} [{c['objects_low']:+.3f}, {c['objects_high']:+.3f}]"
 
 
 def _verdict(name: str, c: dict) -> str:
     """One sentence on a pick contrast's bootstrap interval, scoped to the run's one draw of the data
     (:func:`~graspaug.experiments.stats.draw_verdict`)."""
     arm, reference = CONTRASTS[name]
-    evidence = f"({_interval(c)}, {c['n_trials']} paired drops): {draw_verdict(c['ci_low'], c['ci_high'])}."
-    if c["ci_low"] > 0:
+    evidence = f"({_interval(c)}, {c['n_trials']} paired drops): {verdict(c)}."
+    if c["objects_low"] > 0:
         return f"`{name}` excludes zero: {arm} succeeds more often than {reference} {evidence}"
-    if c["ci_high"] < 0:
+    if c["objects_high"] < 0:
         return f"`{name}` excludes zero: {arm} succeeds less often than {reference} {evidence}"
     return f"`{name}` includes zero: no difference shown between {arm} and {reference} {evidence}"
 
@@ -47,7 +47,7 @@ def control_words(contrasts: dict) -> str:
             "No positive control (no network of a larger base size): whether these picks can tell better training "
             "data is unknown, so after_vs_before is not read as a test of augmentation."
         )
-    if c["ci_low"] > 0:
+    if c["objects_low"] > 0:
         return (
             f"The positive control shows: more real training shapes raise pick success ({_interval(c)}), so these "
             "picks can judge training data and after_vs_before is read as a test of augmentation."
@@ -66,7 +66,7 @@ def ranking_words(ranking: dict) -> str:
     c, n = ranking["contrasts"].get("real_data"), ranking["n_grasps"]
     if c is None:
         return "No network of a larger base size: the ranking has no positive control, so after_vs_before is not read."
-    if c["ci_low"] > 0:
+    if c["objects_low"] > 0:
         return (
             f"The positive control shows on the {n} executed grasps: the networks trained on more real shapes rank "
             f"the cell's outcomes better (ROC AUC {_interval(c)}), so this readout can judge training data and its "
@@ -108,11 +108,11 @@ def ranking_lines(ranking: dict) -> list[str]:
         "|---|---|---|---|",
     ]
     for name, c in ranking["contrasts"].items():
-        lines.append(f"| {name} | {c['mean']:+.3f} | [{c['ci_low']:+.3f}, {c['ci_high']:+.3f}] | {_t(c)} |")
+        lines.append(f"| {name} | {c['mean']:+.3f} | [{c['objects_low']:+.3f}, {c['objects_high']:+.3f}] | {_t(c)} |")
     lines += ["", f"**{ranking_words(ranking)}**", ""]
     c = ranking["contrasts"].get("after_vs_before")
-    if c is not None and ranking["contrasts"].get("real_data", {}).get("ci_low", 0) > 0:
-        shown = "raises" if c["ci_low"] > 0 else "lowers" if c["ci_high"] < 0 else "shows no change in"
+    if c is not None and ranking["contrasts"].get("real_data", {}).get("objects_low", 0) > 0:
+        shown = "raises" if c["objects_low"] > 0 else "lowers" if c["objects_high"] < 0 else "shows no change in"
         lines.append(f"- Augmentation {shown} the networks' ranking of the cell's outcomes ({_interval(c)}).")
     return lines
 
@@ -165,7 +165,7 @@ def report_text(metrics: dict, trials: pd.DataFrame, calibration_table: pd.DataF
     ]
     for name, c in metrics["contrasts"].items():
         lines.append(
-            f"| {name} | {c['mean']:+.3f} | [{c['ci_low']:+.3f}, {c['ci_high']:+.3f}] | {_t(c)} | "
+            f"| {name} | {c['mean']:+.3f} | [{c['objects_low']:+.3f}, {c['objects_high']:+.3f}] | {_t(c)} | "
             f"{c['n_trials']} | {c['n_objects']} |"
         )
     lines += ["", f"**{control_words(metrics['contrasts'])}**", ""]
@@ -248,7 +248,7 @@ def outcome_words(metrics: dict, timing: dict) -> str:
     rates = ", ".join(f"{arm} {a['successes']}/{a['attempts']}" for arm, a in metrics["arms"].items())
     ranked = {f"ranking_{n}": c for n, c in (metrics.get("ranking") or {}).get("contrasts", {}).items()}
     contrasts = ", ".join(
-        f"{n} {c['mean']:+.3f} [{c['ci_low']:+.3f}, {c['ci_high']:+.3f}]"
+        f"{n} {c['mean']:+.3f} [{c['objects_low']:+.3f}, {c['objects_high']:+.3f}]"
         for n, c in {**metrics["contrasts"], **ranked}.items()
     )
     return "%s; %s; planning %.3f s per grasp (max %.3f)" % (

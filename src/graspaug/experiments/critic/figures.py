@@ -17,7 +17,9 @@ def outlier_columns(summary: dict[str, dict[str, dict]], alphas, keys: list[str]
     model and interval end: ``alpha``, ``<model>``, …, ``<model>_low``, ``<model>_high``, …
     ``summary``: model → α key → :func:`~graspaug.experiments.stats.mean_interval` dict (outlier %)."""
     columns = {m: [s[k]["mean"] for k in keys] for m, s in summary.items()}
-    bounds = {f"{m}_{end}": [s[k][f"ci_{end}"] for k in keys] for m, s in summary.items() for end in ("low", "high")}
+    bounds = {
+        f"{m}_{end}": [s[k][f"objects_{end}"] for k in keys] for m, s in summary.items() for end in ("low", "high")
+    }
     return {"alpha": list(alphas), **columns, **bounds}
 
 

@@ -12,7 +12,7 @@ def curve_series(curve: pd.DataFrame, arms: Sequence[str], figure: str = "ap") -
     """(rounds, arm → ``figure`` per round, arm → (low, high) per round) of a curve (:func:`curve_rows` of every
     round). The test AP of every arm starts at round 0's ``none`` (the base set alone, which every arm starts
     from), the gain at 0."""
-    curve = curve.astype({"mean": float, "ci_low": float, "ci_high": float})  # a missing end: NaN
+    curve = curve.astype({"mean": float, "draws_low": float, "draws_high": float})  # a missing end: NaN
     rounds = sorted(curve["round"].unique())
     curve = curve[curve.figure == figure]
     series, bands = {}, {}
@@ -20,5 +20,5 @@ def curve_series(curve: pd.DataFrame, arms: Sequence[str], figure: str = "ap") -
         rows = curve[curve.arm == arm].set_index("round")
         start = curve[curve.arm == ("none" if figure == "ap" else arm)].set_index("round").loc[0]
         pick = lambda col: [start[col]] + [rows[col].get(r, np.nan) for r in rounds[1:]]  # noqa: B023, E731
-        series[arm], bands[arm] = pick("mean"), (pick("ci_low"), pick("ci_high"))
+        series[arm], bands[arm] = pick("mean"), (pick("draws_low"), pick("draws_high"))
     return rounds, series, bands

@@ -20,6 +20,8 @@ from sklearn.neighbors import NearestNeighbors
 from graspaug.errors import DataError
 from graspaug.experiments.stats import (
     ObjectBootstrap,
+    contrast,
+    nested_contrast,
     nested_indices,
     nested_interval,
     nested_means,
@@ -183,9 +185,9 @@ def arm_contrasts(
 
     Returns
     -------
-    dict — ``ap``: arm → ``mean``, ``ci_low``, ``ci_high``; ``contrasts``: name → the same; ``share``: the share of
-    the real shapes' gain that failure-targeted shapes give (ratio of nested means, percentile interval), ``draws``,
-    ``seeds``
+    dict — ``ap``: arm → a :func:`~graspaug.experiments.stats.contrast` over ``draws``; ``contrasts``: name → the
+    same; ``share``: the share of the real shapes' gain that failure-targeted shapes give (ratio of nested means,
+    percentile interval; the same type), ``draws``, ``seeds``
     """
     draws = list(networks)
     seeds = sorted(networks[draws[0]])
@@ -205,9 +207,11 @@ def arm_contrasts(
     at = {arm: a for a, arm in enumerate(arms)}
     rounded = lambda d: {k: (round(v, 5) if isinstance(v, float) else v) for k, v in d.items()}  # noqa: E731
     out = {
-        "ap": {arm: rounded(nested_interval(full[a], resampled[a], rng)) for arm, a in at.items()},
+        "ap": {arm: rounded(nested_contrast(nested_interval(full[a], resampled[a], rng))) for arm, a in at.items()},
         "contrasts": {
-            name: rounded(nested_interval(full[at[a]] - full[at[b]], resampled[at[a]] - resampled[at[b]], rng))
+            name: rounded(
+                nested_contrast(nested_interval(full[at[a]] - full[at[b]], resampled[at[a]] - resampled[at[b]], rng))
+            )
             for name, (a, b) in ARM_CONTRASTS.items()
             if a in at and b in at
         },
@@ -221,7 +225,7 @@ def arm_contrasts(
         low, high = percentile_interval(nested_means(x, indices) / nested_means(y, indices))
         gain = (full[at["real"]] - full[at["none"]]).mean()
         mean = float((full[at["failure"]] - full[at["none"]]).mean() / gain) if gain else None
-        out["share"] = rounded({"mean": mean, "ci_low": low, "ci_high": high})
+        out["share"] = rounded(contrast(mean, "draws", len(seeds), len(draws), draws=(low, high)))
     return out
 
 
@@ -258,8 +262,8 @@ GAINS = {"failure": "failure_vs_none", "random": "random_vs_none", "real": "real
 def curve_rows(round_: int, result: dict) -> pd.DataFrame:
     """The rows a round appends to the loop's curve, from :func:`arm_contrasts`'s ``result`` at ``round_``: per arm
     its test AP (``figure`` ``ap``) and its paired gain over round 0 (``figure`` ``gain``, :data:`GAINS`; 0 at
-    round 0), each as ``round``, ``arm``, ``figure``, ``mean``, ``ci_low``, ``ci_high``."""
-    keys = ("mean", "ci_low", "ci_high")
+    round 0), each as ``round``, ``arm``, ``figure``, ``mean``, ``draws_low``, ``draws_high``."""
+    keys = ("mean", "draws_low", "draws_high")
     rows = [{"round": round_, "arm": arm, "figure": "ap", **{k: c[k] for k in keys}} for arm, c in result["ap"].items()]
     for arm, name in GAINS.items():
         gain = {k: 0.0 for k in keys} if round_ == 0 else result["contrasts"].get(name)

@@ -2,12 +2,11 @@
 
 from __future__ import annotations
 
-from collections.abc import Mapping
-
 import pandas as pd
 
 from graspaug.experiments.stats import (
-    draw_verdict,
+    interval_text,
+    verdict,
 )
 
 
@@ -16,14 +15,6 @@ def _table(frame: pd.DataFrame) -> str:
     cells = [[("n/a" if pd.isna(v) else str(v)) for v in row] for row in frame.itertuples(index=False)]
     head = [f"| {' | '.join(map(str, frame.columns))} |", "|" + "---|" * len(frame.columns)]
     return "\n".join(head + [f"| {' | '.join(row)} |" for row in cells])
-
-
-def interval_text(c: Mapping | None, spec: str = "+.4f") -> str:
-    """``mean [ci_low, ci_high]`` of an interval dict, n/a for what is missing."""
-    if not c or c.get("mean") is None:
-        return "n/a"
-    ends = [format(c[k], spec) if c.get(k) is not None else "n/a" for k in ("ci_low", "ci_high")]
-    return f"{format(c['mean'], spec)} [{ends[0]}, {ends[1]}]"
 
 
 def round_markdown(
@@ -39,7 +30,7 @@ def round_markdown(
     if result["contrasts"]:
         lines += ["", "| contrast | mean [95% interval] | verdict |", "|---|---|---|"]
         for name, c in result["contrasts"].items():
-            word = draw_verdict(c["ci_low"], c["ci_high"], len(result["draws"]))
+            word = verdict(c)
             lines.append(f"| `{name}@r{round_}` | {interval_text(c)} | {word} |")
     if "share" in result:
         lines += [

@@ -1,11 +1,12 @@
 """Stage ``report``: the paper's GQ-CNN experiment in one table, declared contrasts with intervals, figures, words.
 
 Reads every network of every seed (``models/gqcnn/s<seed>/``). Writes ``metrics/ap/<contrast>.json`` (``mean``,
-``lo``, ``hi``: 95% t over seeds) and, in ``reports/gqcnn/``: ``ap.json`` (per declared contrast ``mean``,
-``ci_low``/``ci_high``, ``n_seeds``, ``sd``, ``boot_low``/``boot_high`` (95% bootstrap over test objects); test,
-validation and per-object AP per network; ``chosen_ratio`` per base size, picked on validation AP), ``ap_table.csv``,
-``report.md``, ``decomposition.{md,json}`` (the gap to real shapes step by step, real → recon → blend → targeted /
-random, intervals over the seeds and test objects of this run's one draw of the data), ``ap_vs_ratio.png`` (Fig. 7),
+``lo``, ``hi``: 95% t over seeds) and, in ``reports/gqcnn/``: ``ap.json`` (per declared contrast a
+:func:`~graspaug.experiments.stats.contrast`: ``mean``, ``seeds_low``/``seeds_high``, ``objects_low``/``objects_high``,
+``over``, ``n_seeds``, ``sd``; test, validation and per-object AP per network; ``chosen_ratio`` per base size, picked
+on validation AP), ``ap_table.csv``, ``report.md``, ``decomposition.{md,json}`` (the gap to real shapes step by step,
+real → recon → blend → targeted / random, intervals over the seeds and test objects of this run's one draw of the
+data), ``ap_vs_ratio.png`` (Fig. 7),
 ``improvement_by_score.png`` (Fig. 8: per-object AP change of the chosen ratio over 1:0 at the largest base size, by
 rarity and graspness interval) and ``tsne_graspness.png`` (Fig. 1).
 """
