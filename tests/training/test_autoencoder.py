@@ -195,3 +195,71 @@ def test_checkpoint_roundtrip_and_mismatch(tmp_path):
     assert (tmp_path / "m.pt").read_bytes() == (tmp_path / "again.pt").read_bytes()  # same weights, same bytes
     with pytest.raises(CheckpointMismatch, match=r"trained with resolution=16 \(params: 32\)"):
         load_autoencoder(tmp_path / "m.pt", AEConfig(resolution=32, z_dim=16, base_width=4, top_width=16))
+
+
+def primitive_fields(resolution: int, truncation: float = 3.0) -> torch.Tensor:
+    """The eight shapes of :func:`primitive_grids` as the voxelize stage grids them for a decoder of signed distances:
+    (8, 1, R, R, R) float32 truncated signed distance / truncation."""
+    from graspaug.geometry.sdf import truncated_distance_grid
+
+    c = trimesh.creation
+    meshes = [
+        c.box(extents=(0.1, 0.06, 0.03)),
+        c.icosphere(radius=0.05),
+        c.cylinder(radius=0.03, height=0.1),
+        c.capsule(height=0.06, radius=0.02),
+        c.torus(major_radius=0.04, minor_radius=0.015),
+        c.cone(radius=0.04, height=0.09),
+        c.box(extents=(0.05, 0.05, 0.05)),
+        c.annulus(r_min=0.02, r_max=0.045, height=0.03),
+    ]
+    fields = [truncated_distance_grid(m.vertices, m.faces, fit_grid(m.bounds, resolution), truncation) for m in meshes]
+    return torch.from_numpy(np.stack(fields)[:, None] / np.float32(truncation))
+
+
+def test_a_decoder_of_signed_distances_learns_eight_shapes_and_meshes_them():
+    """``output: sdf``: the same network learns signed distances (tanh out, L1 near the surface) to within half a voxel
+    near the surfaces; its decodes mesh by marching cubes at 0 with no opening or smoothing."""
+    from graspaug.geometry.sdf import mesh_decoded_field
+    from graspaug.geometry.settings import DecodeSettings
+    from graspaug.training.autoencoder import decode
+
+    torch.manual_seed(0)
+    x = primitive_fields(16)
+    assert x.dtype == torch.float32 and x.min() >= -1 and x.max() <= 1
+    cfg = AEConfig(resolution=16, z_dim=32, base_width=8, top_width=32, output="sdf")
+    ae = AutoEncoder(cfg)
+    losses = []
+    tcfg = train_settings(batch_size=8, epochs_ae=150, epochs_critic=0, lr_ae=3e-3, flips=False)
+    train_autoencoder(ae, x, tcfg, CPU, torch.Generator().manual_seed(0), lambda e, m: losses.append(m["loss_recon"]))
+    assert losses[-1] < 0.25 * losses[0]
+    assert reconstruction_iou(ae, x, CPU) > 0.85  # the inside: a negative distance
+    z = encode(ae, x, CPU)
+    fields = decode(ae, z, CPU)
+    assert fields.shape == (8, 16, 16, 16) and np.abs(fields).max() <= 1
+    grid, mesh, reason = mesh_decoded_field(fields[0], 0.01, cfg.truncation, DecodeSettings())
+    assert reason is None and mesh.is_watertight and mesh.volume > 0
+    assert np.array_equal(grid.occupancy, fields[0] < 0)
+    near = np.abs(x[:, 0].numpy()) < 1  # within the truncation of a surface
+    error = np.abs(fields - x[:, 0].numpy())[near].mean() * cfg.truncation  # voxels
+    assert error < 0.5, error  # the surface placed between voxel centres, not on them
+
+    # the phase-2 losses take the same grids (the critic sees tanh decodes and normalized distances)
+    seen = []
+    tcfg = train_settings(batch_size=8, epochs_ae=0, epochs_critic=2, critic_warmup=1)
+    train_ae_critic(ae, Critic(cfg), x, tcfg, CPU, torch.Generator().manual_seed(0), lambda e, m: seen.append(m))
+    assert all(np.isfinite(v) for m in seen for v in m.values())
+
+
+def test_an_occupancy_checkpoint_keeps_its_old_layout_and_a_decoder_of_distances_says_what_it_is(tmp_path):
+    from graspaug.io.checkpoints import SDF_KEYS
+
+    cfg = AEConfig(resolution=16, z_dim=16, base_width=4, top_width=16)
+    save_autoencoder(tmp_path / "occupancy.pt", AutoEncoder(cfg), None, {})
+    state = torch.load(tmp_path / "occupancy.pt", weights_only=True)
+    assert not set(SDF_KEYS) & set(state["config"])  # the file as before signed distances existed
+    sdf = AEConfig(resolution=16, z_dim=16, base_width=4, top_width=16, output="sdf")
+    save_autoencoder(tmp_path / "sdf.pt", AutoEncoder(sdf), None, {})
+    assert load_autoencoder(tmp_path / "sdf.pt", sdf)[0].cfg.output == "sdf"
+    with pytest.raises(CheckpointMismatch, match=r"output=occupancy \(params: sdf\)"):
+        load_autoencoder(tmp_path / "occupancy.pt", sdf)

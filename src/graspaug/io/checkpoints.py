@@ -20,15 +20,21 @@ from graspaug.io.atomic import atomic_path
 from graspaug.nets.ae_critic import AEConfig, AutoEncoder, Critic
 
 FORMAT = "graspaug.autoencoder/2"  # /2: the critic has no normalization layers
+SDF_KEYS = ("output", "truncation")  # in a checkpoint's config only for a decoder of signed distances
 
 
 def save_autoencoder(
     path: str | os.PathLike, ae: AutoEncoder, critic: Critic | None, train_params: dict[str, Any]
 ) -> None:
-    """Write the AE (and critic) weights with the network config and training params (atomic)."""
+    """Write the AE (and critic) weights with the network config and training params (atomic). An occupancy
+    network's config leaves out ``output`` and ``truncation`` (both read back as their defaults), so its file is
+    the same, byte for byte, as before a decoder of signed distances existed."""
+    config = dataclasses.asdict(ae.cfg)
+    if ae.cfg.output == "occupancy":
+        config = {k: v for k, v in config.items() if k not in SDF_KEYS}
     state = {
         "format": FORMAT,
-        "config": dataclasses.asdict(ae.cfg),
+        "config": config,
         "train_params": dict(train_params),
         "autoencoder": {k: v.detach().cpu() for k, v in ae.state_dict().items()},
     }
@@ -59,7 +65,7 @@ def load_autoencoder(path: str | os.PathLike, expected: AEConfig) -> tuple[AutoE
     if saved != expected:
         diffs = [
             f"{k}={getattr(saved, k)} (params: {getattr(expected, k)})"
-            for k in state["config"]
+            for k in dataclasses.asdict(saved)
             if getattr(saved, k) != getattr(expected, k)
         ]
         raise CheckpointMismatch(f"{path} was trained with {', '.join(diffs)}; retrain it with `dvc repro train_ae`")

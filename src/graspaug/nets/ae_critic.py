@@ -14,6 +14,11 @@ padding, which keeps the paper's five layers, 4³ kernels and the 512×4×4×4 m
 (flattened 32768 → FC 128) at R = 64. The decoder mirrors it: FC → top×4³, one
 stride-1 conv, then log2(R/4) stride-2 transposed convs back to R³.
 
+Grids: ``cfg.output`` says what a grid holds. ``occupancy``: 0/1 in, the decoder's logits out
+(sigmoid: the probability); ``sdf``: the truncated signed distance divided by its truncation, in
+[-1, 1] and negative inside, in and out (tanh of the decoder's output). :meth:`AutoEncoder.grid` turns
+the decoder's output into a grid of the input's kind; the critic always sees such grids.
+
 Widths: layer i of the down path has ``min(base_width * 2**i, top_width)``
 channels and the stride-1 layer ``top_width``. Paper profile (R = 64): base 64 →
 64, 128, 256, 512, then 512. The CPU default (R = 32) is narrower.
@@ -124,6 +129,11 @@ class AutoEncoder(nn.Module):
     def forward(self, x: torch.Tensor) -> torch.Tensor:
         return self.decoder(self.encoder(x))
 
+    def grid(self, out: torch.Tensor) -> torch.Tensor:
+        """The decoder's raw output as a grid of the input's kind: occupancy probabilities (sigmoid) or signed
+        distances / truncation in [-1, 1] (tanh)."""
+        return torch.tanh(out) if self.cfg.output == "sdf" else torch.sigmoid(out)
+
     def interpolate(self, z_a: torch.Tensor, z_b: torch.Tensor, alpha: torch.Tensor) -> torch.Tensor:
         """Logits of the shape at ``(1 − α) z_a + α z_b``: α = 0 gives a, α = 1 gives b.
 
@@ -168,15 +178,38 @@ def critic_loss(
     return (c_interp - alpha).pow(2).mean() + c_real.pow(2).mean()  # eq. (1)
 
 
-def autoencoder_loss(
-    recon_logits: torch.Tensor, x: torch.Tensor, critic_on_interp: torch.Tensor | None, lam: float
-) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
-    """Eq. (2): L_B(x̂, x) + λ‖C(x̂_α)‖². Returns (total, reconstruction BCE, regularizer).
+SURFACE_WEIGHT = 10.0
+"""With output ``sdf``: the L1 weight of a voxel whose target lies within the truncation (a distance the surface
+is made of) against 1 for a clamped voxel."""
 
-    With λ = 0 (or no critic output) the total is the BCE alone: the critic term sends no
-    gradient to the autoencoder, not even a zero-weighted one.
+
+def reconstruction_loss(out: torch.Tensor, x: torch.Tensor, output: str = "occupancy") -> torch.Tensor:
+    """L_B of eq. (2) for the decoder's raw output ``out`` and the target grids ``x`` (B, 1, R, R, R).
+
+    ``occupancy``: binary cross-entropy on the logits. ``sdf``: L1 between tanh(out) and the normalized signed
+    distance, voxels whose target lies within the truncation (|x| < 1) weighted :data:`SURFACE_WEIGHT`, the
+    weighted mean over the batch.
     """
-    bce = F.binary_cross_entropy_with_logits(recon_logits, x)
+    if output == "occupancy":
+        return F.binary_cross_entropy_with_logits(out, x)
+    weight = torch.where(x.abs() < 1.0, SURFACE_WEIGHT, 1.0)
+    return (weight * (torch.tanh(out) - x).abs()).sum() / weight.sum()
+
+
+def autoencoder_loss(
+    recon_out: torch.Tensor,
+    x: torch.Tensor,
+    critic_on_interp: torch.Tensor | None,
+    lam: float,
+    output: str = "occupancy",
+) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+    """Eq. (2): L_B(x̂, x) + λ‖C(x̂_α)‖². Returns (total, reconstruction loss, regularizer).
+
+    ``recon_out``: the decoder's raw output; L_B is :func:`reconstruction_loss` for ``output``. With λ = 0 (or no
+    critic output) the total is L_B alone: the critic term sends no gradient to the autoencoder, not even a
+    zero-weighted one.
+    """
+    bce = reconstruction_loss(recon_out, x, output)
     if critic_on_interp is None:
         return bce, bce, torch.zeros((), device=bce.device)
     reg = critic_on_interp.pow(2).mean()

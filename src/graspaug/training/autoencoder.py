@@ -1,8 +1,8 @@
 """Training the AutoEncoder (phase 1) and the AE-Critic (phase 2), and using them.
 
-Voxel grids travel as ``(N, 1, R, R, R)`` uint8 tensors (0/1) and are turned into
-float batches on the device. Every random choice (batch order, flips, α) comes from one
-``torch.Generator``.
+Grids travel as ``(N, 1, R, R, R)`` tensors, uint8 occupancy (0/1) or float32 signed distance / truncation
+(``ae.net.output``: :mod:`graspaug.nets.ae_critic`), and are turned into float batches on the device. Every
+random choice (batch order, flips, α) comes from one ``torch.Generator``.
 """
 
 from __future__ import annotations
@@ -14,7 +14,15 @@ import numpy as np
 import torch
 from tqdm import tqdm
 
-from graspaug.nets.ae_critic import AutoEncoder, Critic, autoencoder_loss, critic_loss, folded_alpha, reversed_partners
+from graspaug.nets.ae_critic import (
+    AutoEncoder,
+    Critic,
+    autoencoder_loss,
+    critic_loss,
+    folded_alpha,
+    reconstruction_loss,
+    reversed_partners,
+)
 from graspaug.training.settings import AETrainConfig
 
 EpochCallback = Callable[[int, dict[str, float]], None]
@@ -43,7 +51,8 @@ def train_autoencoder(
     gen: torch.Generator,
     on_epoch: EpochCallback | None = None,
 ) -> float:
-    """Phase 1: minimize the reconstruction BCE with Adam(lr_ae). Returns shapes/s."""
+    """Phase 1: minimize the reconstruction loss (:func:`~graspaug.nets.ae_critic.reconstruction_loss`: BCE of
+    occupancy, or the weighted L1 of signed distances) with Adam(lr_ae). Returns shapes/s."""
     ae.to(device)
     opt = torch.optim.Adam(ae.parameters(), lr=cfg.lr_ae)
     seen, elapsed = 0, 0.0
@@ -55,7 +64,7 @@ def train_autoencoder(
             x = _as_float(voxels[idx], device)
             if cfg.flips:
                 x = _flip(x, gen)
-            loss = torch.nn.functional.binary_cross_entropy_with_logits(ae(x), x)
+            loss = reconstruction_loss(ae(x), x, ae.cfg.output)
             opt.zero_grad(set_to_none=True)
             loss.backward()
             opt.step()
@@ -121,16 +130,16 @@ def train_ae_critic(
                 c_interp = None
                 if critic is not None:
                     with torch.set_grad_enabled(train_ae and lam > 0):
-                        x_alpha = torch.sigmoid(ae.interpolate(z, z[partner], alpha))
+                        x_alpha = ae.grid(ae.interpolate(z, z[partner], alpha))
                         c_interp = critic(x_alpha)
-                loss_ae, bce, reg = autoencoder_loss(recon, x, c_interp, lam)  # eq. (2)
+                loss_ae, bce, reg = autoencoder_loss(recon, x, c_interp, lam, ae.cfg.output)  # eq. (2)
             if train_ae:
                 opt_ae.zero_grad(set_to_none=True)
                 loss_ae.backward()
                 opt_ae.step()
 
             if critic is not None:
-                loss_c = critic_loss(critic, x, torch.sigmoid(recon), x_alpha, alpha, cfg.gamma)  # eq. (1)
+                loss_c = critic_loss(critic, x, ae.grid(recon), x_alpha, alpha, cfg.gamma)  # eq. (1)
                 opt_c.zero_grad(set_to_none=True)
                 loss_c.backward()
                 opt_c.step()
@@ -206,56 +215,82 @@ def encode(ae: AutoEncoder, voxels: torch.Tensor, device: torch.device, batch_si
     return torch.cat(out).numpy() if out else np.zeros((0, ae.cfg.z_dim), np.float32)
 
 
-@torch.no_grad()
-def encode_meshes(ae: AutoEncoder, meshes, resolution: int, margin: int, device: torch.device) -> np.ndarray:
-    """(N, z_dim) float32 latents of N meshes (trimesh, m), each voxelized as the ``voxelize`` stage
-    does (a solid ``resolution``³ grid fitted to its bounds with ``margin`` empty cells)."""
+def mesh_grid(mesh, resolution: int, margin: int, output: str = "occupancy", truncation: float = 3.0) -> np.ndarray:
+    """One mesh (trimesh, m) as the ``voxelize`` stage grids it (a ``resolution``³ grid fitted to its bounds with
+    ``margin`` empty cells): (R, R, R) occupancy bool, or with ``output`` ``sdf`` its truncated signed distance /
+    ``truncation`` (voxels), float32 in [-1, 1]."""
+    from graspaug.geometry.sdf import truncated_distance_grid
     from graspaug.geometry.voxelize import fit_grid, voxelize_solid
 
-    grids = [voxelize_solid(m.vertices, m.faces, fit_grid(m.bounds, resolution, margin)) for m in meshes]
+    grid = fit_grid(mesh.bounds, resolution, margin)
+    if output == "sdf":
+        return truncated_distance_grid(mesh.vertices, mesh.faces, grid, truncation) / np.float32(truncation)
+    return voxelize_solid(mesh.vertices, mesh.faces, grid)
+
+
+@torch.no_grad()
+def encode_meshes(ae: AutoEncoder, meshes, resolution: int, margin: int, device: torch.device) -> np.ndarray:
+    """(N, z_dim) float32 latents of N meshes (trimesh, m), each gridded as the ``voxelize`` stage does
+    (:func:`mesh_grid` of the autoencoder's ``output``)."""
+    cfg = ae.cfg
+    grids = [mesh_grid(m, resolution, margin, cfg.output, cfg.truncation) for m in meshes]
     if not grids:
-        return np.zeros((0, ae.cfg.z_dim), np.float32)
-    return encode(ae, torch.from_numpy(np.stack(grids)[:, None].astype(np.uint8)), device)
+        return np.zeros((0, cfg.z_dim), np.float32)
+    kind = np.float32 if cfg.output == "sdf" else np.uint8
+    return encode(ae, torch.from_numpy(np.stack(grids)[:, None].astype(kind)), device)
 
 
 @torch.no_grad()
 def decode(ae: AutoEncoder, z: np.ndarray, device: torch.device, batch_size: int = 64) -> np.ndarray:
-    """(N, R, R, R) float32 occupancy probabilities of (N, z_dim) latents (eval mode)."""
+    """(N, R, R, R) float32 grids of (N, z_dim) latents (eval mode), of the input's kind (:meth:`AutoEncoder.grid`):
+    occupancy probabilities, or signed distances / truncation in [-1, 1]."""
     ae.eval().to(device)
     zt = torch.as_tensor(np.asarray(z, dtype=np.float32))
     if len(zt) == 0:
         r = ae.cfg.resolution
         return np.zeros((0, r, r, r), np.float32)
-    out = [torch.sigmoid(ae.decoder(zt[i : i + batch_size].to(device))).cpu() for i in range(0, len(zt), batch_size)]
+    out = [ae.grid(ae.decoder(zt[i : i + batch_size].to(device))).cpu() for i in range(0, len(zt), batch_size)]
     return torch.cat(out)[:, 0].numpy()
 
 
+def occupied(grids: np.ndarray, output: str = "occupancy", threshold: float = 0.5) -> np.ndarray:
+    """Which voxels of grids of ``output``'s kind are inside: occupancy above ``threshold``, or a negative signed
+    distance (the surface's side; ``threshold`` unused)."""
+    grids = np.asarray(grids)
+    return grids < 0 if output == "sdf" else grids > threshold
+
+
 def reconstruction_iou(ae: AutoEncoder, voxels: torch.Tensor, device: torch.device, threshold: float = 0.5) -> float:
-    """Mean over shapes of IoU(decode(encode(x)) > threshold, x)."""
+    """Mean over shapes of IoU(inside of decode(encode(x)), inside of x) (:func:`occupied`)."""
     if len(voxels) == 0:
         return float("nan")
-    recon = decode(ae, encode(ae, voxels, device), device) > threshold
-    x = voxels[:, 0].numpy().astype(bool)
+    output = ae.cfg.output
+    recon = occupied(decode(ae, encode(ae, voxels, device), device), output, threshold)
+    x = occupied(voxels[:, 0].numpy(), output, threshold)
     inter = (recon & x).sum(axis=(1, 2, 3))
     union = (recon | x).sum(axis=(1, 2, 3))
     return float(np.mean(np.where(union > 0, inter / np.maximum(union, 1), 1.0)))
 
 
-def voxel_grids(voxels_path, shapes_path) -> tuple[np.ndarray, np.ndarray, torch.Tensor]:
-    """Every shape's ``shape_id``, ``split`` and (N, 1, R, R, R) uint8 grid, in the voxel file's order."""
+def voxel_grids(voxels_path, shapes_path, output: str = "occupancy") -> tuple[np.ndarray, np.ndarray, torch.Tensor]:
+    """Every shape's ``shape_id``, ``split`` and (N, 1, R, R, R) grid of ``output``'s kind (uint8 occupancy, or
+    float32 signed distance / truncation: the voxel file must hold them), in the voxel file's order."""
+    from graspaug.errors import DataError
     from graspaug.io.tables import read_table
     from graspaug.io.voxels import read_voxels
 
     voxels = read_voxels(voxels_path)
     split = read_table(shapes_path).set_index("shape_id")["split"]
-    return (
-        voxels.shape_id,
-        split.reindex(voxels.shape_id).to_numpy(),
-        torch.from_numpy(voxels.occupancy[:, None].astype(np.uint8)),
-    )
+    if output == "sdf":
+        if voxels.sdf is None:
+            raise DataError(f"{voxels_path} holds no signed distances: run the voxelize stage with ae.net.output: sdf")
+        grids = torch.from_numpy(np.ascontiguousarray(voxels.sdf[:, None], dtype=np.float32))
+    else:
+        grids = torch.from_numpy(voxels.occupancy[:, None].astype(np.uint8))
+    return voxels.shape_id, split.reindex(voxels.shape_id).to_numpy(), grids
 
 
-def grids_by_split(voxels_path, shapes_path) -> dict[str, torch.Tensor]:
-    """(N, 1, R, R, R) uint8 grids of the ``train`` and ``test`` splits, in the voxel file's order."""
-    _, labels, grids = voxel_grids(voxels_path, shapes_path)
+def grids_by_split(voxels_path, shapes_path, output: str = "occupancy") -> dict[str, torch.Tensor]:
+    """(N, 1, R, R, R) grids (:func:`voxel_grids`) of the ``train`` and ``test`` splits, in the voxel file's order."""
+    _, labels, grids = voxel_grids(voxels_path, shapes_path, output)
     return {name: grids[labels == name] for name in ("train", "test")}

@@ -9,7 +9,7 @@ import torch
 from graspaug.experiments.stats import PairBootstrap, headline, mean_interval, paired_contrast
 from graspaug.geometry.clusters import outlier_percentage
 from graspaug.nets.ae_critic import AutoEncoder
-from graspaug.training.autoencoder import decode, encode
+from graspaug.training.autoencoder import decode, encode, occupied
 
 # the three models of the study, in the order they are decoded, tabled and drawn
 MODEL_LABELS = {"ae": "AE", "ae_extra": "AE + extra epochs (λ = 0)", "ae_critic": "AE-Critic"}
@@ -39,9 +39,10 @@ def interpolate(z: np.ndarray, pairs: np.ndarray, alphas: np.ndarray) -> np.ndar
 def decoded_interpolations(
     ae: AutoEncoder, z: np.ndarray, pairs: np.ndarray, alphas: np.ndarray, threshold: float, device: torch.device
 ) -> np.ndarray:
-    """(P, A, R, R, R) bool: the pairs of latents ``z`` (N, d) interpolated at ``alphas`` (A,), decoded, thresholded."""
-    probs = decode(ae, interpolate(z, pairs, alphas).reshape(-1, z.shape[1]), device)
-    return (probs > threshold).reshape(len(pairs), len(alphas), *probs.shape[1:])
+    """(P, A, R, R, R) bool: the pairs of latents ``z`` (N, d) interpolated at ``alphas`` (A,), decoded, their inside
+    (:func:`~graspaug.training.autoencoder.occupied`: occupancy above ``threshold``, or a negative signed distance)."""
+    grids = decode(ae, interpolate(z, pairs, alphas).reshape(-1, z.shape[1]), device)
+    return occupied(grids, ae.cfg.output, threshold).reshape(len(pairs), len(alphas), *grids.shape[1:])
 
 
 def outlier_table(decoded: np.ndarray) -> np.ndarray:

@@ -57,7 +57,7 @@ MODEL_FILES = {"ae": AE_MODEL, "ae_extra": AE_EXTRA_MODEL, "ae_critic": AE_CRITI
 def run(params: Params) -> None:
     cfg = params.critic_eval
     device = resolve_device(params.device)
-    grids = grids_by_split(VOXELS, SHAPES_TABLE)
+    grids = grids_by_split(VOXELS, SHAPES_TABLE, params.ae.net.output)
     rng = np.random.default_rng(params.seed)
     pairs = random_pairs(len(grids["train"]), cfg.n_shapes, cfg.n_pairs, rng)
     if len(pairs) == 0:

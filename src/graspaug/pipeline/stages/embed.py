@@ -30,7 +30,7 @@ Params = params_model("The params the `embed` stage reads.", ae=AEParams, embed=
 def run(params: Params) -> None:
     device = resolve_device(params.device)
     ae, _, _ = load_autoencoder(AE_CRITIC_MODEL, params.ae.net)
-    shape_ids, split, grids = voxel_grids(VOXELS, SHAPES_TABLE)
+    shape_ids, split, grids = voxel_grids(VOXELS, SHAPES_TABLE, params.ae.net.output)
     z = encode(ae, grids, device)
 
     latents = pd.DataFrame({"shape_id": shape_ids, "split": split, "z": list(z.astype(np.float32))})

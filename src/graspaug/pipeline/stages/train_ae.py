@@ -48,7 +48,7 @@ def run(params: Params) -> None:
     gen = torch.Generator().manual_seed(params.seed)
     device = resolve_device(params.device)
     cfg, tcfg = params.ae.net, params.ae.train
-    data = grids_by_split(VOXELS, SHAPES_TABLE)
+    data = grids_by_split(VOXELS, SHAPES_TABLE, cfg.output)
     train, test = data["train"], data["test"]
     if len(train) < 2:
         raise StageError(f"train_ae needs at least 2 train shapes, the split has {len(train)}")

@@ -1,0 +1,210 @@
+"""What could a perfect decoder hand over? Graspness kept when a shape goes through a grid and back to a mesh.
+
+For ``--shapes`` random train shapes of a project (``--seed`` picks them), each shape's grasps are labelled as
+the ``grasps`` stage labels them (:func:`graspaug.grasping.labelled.grasps_of_shape`, the project's ``grasps``
+params and ``seed``, the shape's own random stream) on
+
+- ``original``: its ingested mesh;
+- ``occupancy R``: its solid occupancy at R³ (fit_grid with ``voxelize.margin`` + voxelize_solid, as the
+  ``voxelize`` stage makes it) meshed by :func:`graspaug.geometry.from_voxels.mesh_decoded` with the project's
+  ``generate.decode`` settings, as if the grid were a perfect decode;
+- ``tsdf R``: its exact truncated signed distance at R³ on the same grid
+  (:func:`graspaug.geometry.sdf.truncated_distance_grid`, ``--truncation`` voxels) meshed by
+  :func:`graspaug.geometry.sdf.mesh_from_sdf` (marching cubes at 0, no opening, no smoothing; the same
+  ``min_voxels`` and ``min_main_share`` rejections), centred on its centre of mass as a decode would be;
+
+for R = 32 and 64. Each reconstruction is written as a generated shape is (OBJ) and read back before labelling.
+Graspness is a shape's share of positive grasps (:func:`graspaug.augment.scores.graspness`; 0 without grasps).
+Per row, over the shapes that meshed: graspness kept = mean after / mean before (Fieller 95% interval of the
+ratio of paired means), the paired difference after − before with its 95% t-interval over shapes, and how
+many meshed. Prints a markdown table and writes ``rows.csv``, ``per_shape.csv``, ``summary.json`` (the rows and
+the run's settings) and ``timing.json`` (seconds per shape of each grid and mesh step) into ``--out``.
+
+Run it on a project where ``ingest`` has run (``data/shapes.parquet``, ``data/shapes/``)::
+
+    .venv/bin/python studies/roundtrip_ceiling.py --project PROJECT [--shapes 80] [--seed 0] [--workers 2]
+                                                  [--truncation 3] [--out studies/out/roundtrip_ceiling]
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import logging
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from graspaug.augment.scores import graspness
+from graspaug.experiments.stats import fieller_interval, t_interval
+from graspaug.geometry.from_voxels import mesh_decoded
+from graspaug.geometry.sdf import mesh_from_sdf, truncated_distance_grid
+from graspaug.geometry.voxelize import fit_grid, voxelize_solid
+from graspaug.grasping.labelled import grasps_of_shape
+from graspaug.io.meshes import mesh_path, read_mesh, write_obj
+from graspaug.io.tables import read_table, write_json
+from graspaug.parallel import parallel_map
+from graspaug.pipeline.params.model import load_params
+from graspaug.pipeline.paths import GENERATED_SUFFIX, corpus_files
+
+log = logging.getLogger("roundtrip_ceiling")
+
+HERE = Path(__file__).resolve().parent
+OUT = HERE / "out" / "roundtrip_ceiling"
+RESOLUTIONS = (32, 64)
+VARIANTS = ("original", *(f"{recipe} {r}" for recipe in ("occupancy", "tsdf") for r in RESOLUTIONS))
+
+
+def reconstructions(mesh, margin: int, decode, truncation: float) -> tuple[dict, dict]:
+    """Every variant's mesh of ``mesh`` (or the reason it has none), and the seconds each step took."""
+    meshes, seconds = {"original": (mesh, None)}, {}
+    for resolution in RESOLUTIONS:
+        grid = fit_grid(mesh.bounds, resolution, margin)
+        start = time.perf_counter()
+        occupancy = voxelize_solid(mesh.vertices, mesh.faces, grid)
+        _, decoded, reason = mesh_decoded(occupancy.astype(np.float32), grid.pitch, decode)
+        seconds[f"occupancy {resolution}"] = time.perf_counter() - start
+        meshes[f"occupancy {resolution}"] = (decoded, reason)
+
+        start = time.perf_counter()
+        sdf = truncated_distance_grid(mesh.vertices, mesh.faces, grid, truncation)
+        seconds[f"tsdf {resolution} field"] = time.perf_counter() - start
+        start = time.perf_counter()
+        surface = mesh_from_sdf(sdf, grid, 0.0, decode.min_voxels, decode.min_main_share)
+        seconds[f"tsdf {resolution} mesh"] = time.perf_counter() - start
+        if surface.reason is None:
+            surface.mesh.apply_translation(-surface.mesh.center_mass)  # as mesh_decoded places a decode
+        meshes[f"tsdf {resolution}"] = (surface.mesh if surface.reason is None else None, surface.reason)
+    return meshes, seconds
+
+
+def shape_rows(job: tuple[Path, str], margin: int, decode, grasps, seed: int, truncation: float) -> tuple[list, dict]:
+    """One shape's per-variant rows (graspness, grasps, why no mesh) and the seconds of its grid steps."""
+    path, shape_id = job
+    meshes, seconds = reconstructions(read_mesh(path), margin, decode, truncation)
+    rows = []
+    with tempfile.TemporaryDirectory() as folder:
+        for variant, (mesh, reason) in meshes.items():
+            row = {"shape_id": shape_id, "variant": variant, "meshed": mesh is not None, "reason": reason}
+            if mesh is not None:
+                file = path
+                if variant != "original":
+                    file = mesh_path(folder, f"{shape_id}_{variant.replace(' ', '_')}", GENERATED_SUFFIX)
+                    write_obj(mesh, file)
+                table, _ = grasps_of_shape(file, shape_id, grasps, seed)
+                score, count = graspness(table.success.to_numpy(), np.zeros(len(table), dtype=np.int64), 1)
+                row |= {"graspness": float(score[0]), "grasps": int(count[0]), "faces": len(mesh.faces)}
+            rows.append(row)
+    return rows, seconds
+
+
+def summarize(per_shape: pd.DataFrame) -> pd.DataFrame:
+    """One row per variant: its paired comparison with the original over the shapes that meshed."""
+    before = per_shape[per_shape.variant == "original"].set_index("shape_id").graspness
+    rows = []
+    for variant in VARIANTS:
+        part = per_shape[per_shape.variant == variant].set_index("shape_id")
+        after = part.graspness[part.meshed]
+        x, y = after.to_numpy(), before[after.index].to_numpy()
+        ratio = fieller_interval(x, y)
+        diff = t_interval(x - y)
+        rows.append(
+            {
+                "variant": variant,
+                "shapes": len(part),
+                "meshed": int(part.meshed.sum()),
+                "graspness_before": float(y.mean()),
+                "graspness_after": float(x.mean()),
+                "kept": ratio["ratio"],
+                "kept_low": ratio["low"],
+                "kept_high": ratio["high"],
+                "difference": diff["mean"],
+                "difference_half_width": None if diff["high"] is None else diff["high"] - diff["mean"],
+                "grasps_after_mean": float(part.grasps[part.meshed].mean()),
+            }
+        )
+    return pd.DataFrame(rows)
+
+
+def markdown(rows: pd.DataFrame) -> str:
+    def number(value, spec):
+        return "n/a" if value is None or not np.isfinite(value) else format(value, spec)
+
+    lines = [
+        "| variant | shapes | meshed | graspness before → after | kept [95% Fieller] | after − before ± 95% t |",
+        "|---|---:|---:|---|---|---|",
+    ]
+    for r in rows.itertuples():
+        kept = f"{number(r.kept, '.1%')} [{number(r.kept_low, '.1%')}, {number(r.kept_high, '.1%')}]"
+        diff = f"{number(r.difference, '+.3f')} ± {number(r.difference_half_width, '.3f')}"
+        graspness_text = f"{r.graspness_before:.3f} → {r.graspness_after:.3f}"
+        lines.append(f"| {r.variant} | {r.shapes} | {r.meshed} | {graspness_text} | {kept} | {diff} |")
+    return "\n".join(lines)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--project", type=Path, default=Path("."), help="a project where ingest has run")
+    parser.add_argument("--shapes", type=int, default=80, help="train shapes drawn (%(default)s)")
+    parser.add_argument("--seed", type=int, default=0, help="which shapes are drawn (%(default)s)")
+    parser.add_argument("--workers", type=int, default=None, help="processes (default: the project's n_jobs)")
+    parser.add_argument("--truncation", type=float, default=3.0, help="TSDF truncation, voxels (%(default)s)")
+    parser.add_argument("--out", type=Path, default=OUT, help="where the results go (%(default)s)")
+    args = parser.parse_args()
+    logging.basicConfig(level=logging.INFO, format="%(message)s")
+
+    project = args.project.resolve()
+    params = load_params(project / "params.yaml")
+    table_path, mesh_dir, suffix = corpus_files("original")
+    shapes = read_table(project / table_path)
+    train = shapes.shape_id[shapes.split == "train"].to_numpy()
+    chosen = sorted(np.random.default_rng(args.seed).choice(train, size=min(args.shapes, len(train)), replace=False))
+    jobs = [(mesh_path(project / mesh_dir, shape_id, suffix), shape_id) for shape_id in chosen]
+    margin, decode = params.voxelize.margin, params.generate.decode
+
+    start = time.perf_counter()
+    results = parallel_map(
+        lambda job: shape_rows(job, margin, decode, params.grasps, params.seed, args.truncation),
+        jobs,
+        args.workers or params.workers,
+        "round trips",
+    )
+    seconds = time.perf_counter() - start
+    per_shape = pd.DataFrame([row for rows, _ in results for row in rows])
+    rows = summarize(per_shape)
+    steps = pd.DataFrame([s for _, s in results])
+
+    args.out.mkdir(parents=True, exist_ok=True)
+    per_shape.to_csv(args.out / "per_shape.csv", index=False)
+    rows.to_csv(args.out / "rows.csv", index=False)
+    settings = {
+        "project": str(project),
+        "shapes": len(chosen),
+        "seed": args.seed,
+        "truncation_voxels": args.truncation,
+        "margin": margin,
+        "decode": dataclasses.asdict(decode),
+        "grasps_seed": params.seed,
+        "n_grasps": params.grasps.sampler.n_grasps,
+    }
+    write_json(
+        {"settings": settings, "rows": rows.replace({np.nan: None}).to_dict("records")}, args.out / "summary.json"
+    )
+    timing = {
+        "seconds": round(seconds, 1),
+        "per_shape_mean": {step: round(float(steps[step].mean()), 3) for step in steps},
+        "per_shape_median": {step: round(float(steps[step].median()), 3) for step in steps},
+    }
+    write_json(timing, args.out / "timing.json")
+    reasons = per_shape[~per_shape.meshed].groupby("variant").reason.value_counts()
+    if len(reasons):
+        log.info("not meshed:\n%s", reasons.to_string())
+    log.info("%d shapes in %.0f s; seconds per shape (mean): %s", len(chosen), seconds, timing["per_shape_mean"])
+    print(markdown(rows))
+
+
+if __name__ == "__main__":
+    main()
