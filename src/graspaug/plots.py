@@ -1,4 +1,8 @@
-"""Figures as PNG files (matplotlib, Agg backend): what the stages show a person."""
+"""Figures as PNG files (matplotlib, Agg backend): what the stages show a person.
+
+The shared primitives (lines with bands, bars, scatter maps, voxel and mesh rows, depth crops, pick stories): over
+400 lines because each is a small function that several stages' figures call; what an experiment draws is decided in
+its own ``figures`` module (``experiments/<name>/figures.py``)."""
 
 from __future__ import annotations
 

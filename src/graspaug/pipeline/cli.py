@@ -3,6 +3,11 @@
 A stage command imports its stage module, and through it only the params sections that stage
 reads, when it runs (``tests/test_dvc_deps.py`` derives each stage's code deps from that); the
 params tables in ``--help`` are filled in when help is shown.
+
+Over 400 lines because it is a table: 25 commands (one per stage, and ``plan``, ``from-failures``,
+``export-model``, ``profile``, ``schema``), each a few lines of options with the help text a user reads; the work
+is elsewhere (``pipeline/stages/``, ``planning/report.py``) and errors go through one handler
+(:mod:`graspaug.pipeline.command`).
 """
 
 from __future__ import annotations
