@@ -848,20 +848,14 @@ def test_queued_two_point_sweep_lines_up_metrics(tiny_repo):
             work,
             env,
         )
-    # a decoder of signed distances, as far as the shapes it generates (voxelize, train_ae, embed, score, generate)
-    sdf = ["ae.net.output=sdf", "ae.net.z_dim=32", "ae.net.base_width=8", "ae.net.top_width=32"]  # the tiny widths
-    sdf += ["ae.train.epochs_ae=60", "ae.train.lr_ae=0.003"]  # and epochs learn too little for a decode with an inside
-    run(
-        ["dvc", "exp", "run", "--queue", *[a for k in sdf for a in ("-S", k)], "--name", "sdf", "generate@6"], work, env
-    )
-    run(["dvc", "queue", "start", "-j", "2"], work, env)  # two at once: the suite's other tests are done
+    run(["dvc", "queue", "start", "-j", "2"], work, env)  # both points at once: the suite's other tests are done
     deadline = time.time() + 600
     while time.time() < deadline:
         status = run(["dvc", "queue", "status"], work, env).stdout
         if "Queued" not in status and "Running" not in status:
             break
         time.sleep(3)
-    assert status.count("Success") == 3, status
+    assert status.count("Success") == 2, status
     shown = json.loads(run(["dvc", "exp", "show", "--json"], work, env).stdout)
     experiments = {}
     for commit in shown:
@@ -869,12 +863,7 @@ def test_queued_two_point_sweep_lines_up_metrics(tiny_repo):
             for rev in exp.get("revs") or []:
                 data = rev["data"]
                 experiments[rev.get("name") or data.get("name")] = data
-    assert {"grip-10", "grip-40", "sdf"} <= set(experiments), list(experiments)
-    sdf = experiments["sdf"]
-    assert sdf["params"]["params.yaml"]["data"]["ae"]["net"]["output"] == "sdf"
-    generated = sdf["metrics"]["metrics/generate/6.json"]["data"]
-    assert generated["shapes"] > 0, generated  # decoded distances meshed into kept shapes
-    assert sdf["metrics"]["metrics/train_ae.json"]["data"]["iou_ae"] > 0.1  # the inside of the decoded distances
+    assert {"grip-10", "grip-40"} <= set(experiments), list(experiments)
     for name, force in (("grip-10", 10.0), ("grip-40", 40.0)):
         data = experiments[name]
         assert data["params"]["params.yaml"]["data"]["sim"]["hand"]["grip_force"] == force

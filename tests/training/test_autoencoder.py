@@ -244,6 +244,17 @@ def test_a_decoder_of_signed_distances_learns_eight_shapes_and_meshes_them():
     error = np.abs(fields - x[:, 0].numpy())[near].mean() * cfg.truncation  # voxels
     assert error < 0.5, error  # the surface placed between voxel centres, not on them
 
+    # generate's batch runner meshes interpolated decodes of distances the same way
+    from graspaug.augment.candidates import Candidate
+    from graspaug.augment.decode import mesh_batches
+    from graspaug.augment.pools import BaseSet
+
+    base = BaseSet(np.arange(8).astype(str), z, np.zeros(8), np.zeros(8), np.full(8, 0.01))
+    run_batch = mesh_batches(ae, CPU, base, DecodeSettings(), 1, "test")
+    decoded = run_batch([Candidate(1, 6, 0.3, "random"), Candidate(0, 6, 0.5, "random")])
+    meshes = [d for d in decoded if d.mesh is not None]
+    assert meshes and all(d.mesh.is_watertight for d in meshes), [d.reason for d in decoded]
+
     # the phase-2 losses take the same grids (the critic sees tanh decodes and normalized distances)
     seen = []
     tcfg = train_settings(batch_size=8, epochs_ae=0, epochs_critic=2, critic_warmup=1)
