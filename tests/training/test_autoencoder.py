@@ -27,10 +27,10 @@ def train_settings(**overrides) -> AETrainConfig:
     return replace(Params().ae.train, **overrides)
 
 
-def primitive_grids(resolution: int) -> torch.Tensor:
-    """Eight real solid shapes voxelized with the project's voxelizer: (8, 1, R, R, R) uint8."""
+def primitive_meshes() -> list[trimesh.Trimesh]:
+    """Eight real solid shapes (trimesh primitives), m."""
     c = trimesh.creation
-    meshes = [
+    return [
         c.box(extents=(0.1, 0.06, 0.03)),
         c.icosphere(radius=0.05),
         c.cylinder(radius=0.03, height=0.1),
@@ -40,7 +40,11 @@ def primitive_grids(resolution: int) -> torch.Tensor:
         c.box(extents=(0.05, 0.05, 0.05)),
         c.annulus(r_min=0.02, r_max=0.045, height=0.03),
     ]
-    grids = [voxelize_solid(m.vertices, m.faces, fit_grid(m.bounds, resolution)) for m in meshes]
+
+
+def primitive_grids(resolution: int) -> torch.Tensor:
+    """The eight :func:`primitive_meshes` voxelized with the project's voxelizer: (8, 1, R, R, R) uint8."""
+    grids = [voxelize_solid(m.vertices, m.faces, fit_grid(m.bounds, resolution)) for m in primitive_meshes()]
     return torch.from_numpy(np.stack(grids)[:, None].astype(np.uint8))
 
 
@@ -198,23 +202,12 @@ def test_checkpoint_roundtrip_and_mismatch(tmp_path):
 
 
 def primitive_fields(resolution: int, truncation: float = 3.0) -> torch.Tensor:
-    """The eight shapes of :func:`primitive_grids` as the voxelize stage grids them for a decoder of signed distances:
+    """The eight :func:`primitive_meshes` as the voxelize stage grids them for a decoder of signed distances:
     (8, 1, R, R, R) float32 truncated signed distance / truncation."""
     from graspaug.geometry.sdf import truncated_distance_grid
 
-    c = trimesh.creation
-    meshes = [
-        c.box(extents=(0.1, 0.06, 0.03)),
-        c.icosphere(radius=0.05),
-        c.cylinder(radius=0.03, height=0.1),
-        c.capsule(height=0.06, radius=0.02),
-        c.torus(major_radius=0.04, minor_radius=0.015),
-        c.cone(radius=0.04, height=0.09),
-        c.box(extents=(0.05, 0.05, 0.05)),
-        c.annulus(r_min=0.02, r_max=0.045, height=0.03),
-    ]
-    fields = [truncated_distance_grid(m.vertices, m.faces, fit_grid(m.bounds, resolution), truncation) for m in meshes]
-    return torch.from_numpy(np.stack(fields)[:, None] / np.float32(truncation))
+    grid = lambda m: truncated_distance_grid(m.vertices, m.faces, fit_grid(m.bounds, resolution), truncation)  # noqa: E731
+    return torch.from_numpy(np.stack([grid(m) for m in primitive_meshes()])[:, None] / np.float32(truncation))
 
 
 def test_a_decoder_of_signed_distances_learns_eight_shapes_and_meshes_them():
