@@ -9,6 +9,7 @@ from sklearn.metrics import average_precision_score
 
 from graspaug.errors import DataError
 from graspaug.experiments.ap.attribution import combine_draws, decomposition_markdown, losing_step
+from graspaug.experiments.stats import contrast
 from graspaug.training.variants import seed_variants
 
 GENERATE = SimpleNamespace(base_sizes=[10, 20], ratios=[0.0, 1.0])
@@ -75,22 +76,8 @@ def test_every_draw_needs_the_same_training_seeds(tmp_path):
 
 def test_the_losing_step_is_the_most_negative_with_its_interval_below_zero():
     c = {
-        "recon_vs_real@50": {
-            "mean": -0.03,
-            "draws_low": -0.05,
-            "draws_high": -0.01,
-            "over": "draws",
-            "n_draws": 3,
-            "n_seeds": 4,
-        },
-        "targeted_vs_blend@50": {
-            "mean": -0.05,
-            "draws_low": -0.09,
-            "draws_high": 0.01,
-            "over": "draws",
-            "n_draws": 3,
-            "n_seeds": 4,
-        },
+        "recon_vs_real@50": contrast(-0.03, "draws", 4, 3, draws=(-0.05, -0.01)),
+        "targeted_vs_blend@50": contrast(-0.05, "draws", 4, 3, draws=(-0.09, 0.01)),
     }
     assert "`recon_vs_real`: -0.0300 AP [-0.0500, -0.0100] over 3 draws × 4 seeds" in losing_step(c, 50)
     assert losing_step(c, 50).endswith("a loss over 3 draws of the data.")
@@ -106,16 +93,7 @@ def test_one_draw_gives_intervals_over_seeds_and_objects_and_says_they_miss_othe
     text = decomposition_markdown(result, [10], "dvc repro report")
     assert "One draw of the data" in text and "does not cover other draws" in text and "Draws (data_seed)" not in text
     assert "`data_seed` = 0 and training seeds [0, 1, 2]" in text and "studies/attribution.py --draws 0 1 2" in text
-    c = {
-        "recon_vs_real@50": {
-            "mean": -0.03,
-            "draws_low": -0.05,
-            "draws_high": -0.01,
-            "over": "draws",
-            "n_draws": 1,
-            "n_seeds": 4,
-        }
-    }
+    c = {"recon_vs_real@50": contrast(-0.03, "draws", 4, 1, draws=(-0.05, -0.01))}
     assert "over 4 seeds of one draw and the test objects, a loss in this draw of the data." in losing_step(c, 50)
 
 
