@@ -129,7 +129,7 @@ def test_the_blend_pool_takes_the_targeted_pools_pairs_and_weights_and_replaces_
 
     plain = generate_pools(base, cfg, 0, some_rejected, 3, ("targeted",))
     out_targeted = [d.candidate for d in plain.kept]
-    out = generate_pools(base, cfg, 0, some_rejected, 3, ("targeted", "blend"), blend=first_fails)
+    out = generate_pools(base, cfg, 0, some_rejected, 3, ("targeted", "blend"), controls={"blend": first_fails})
     targeted, blend = (out.index[out.index.pool == p] for p in ("targeted", "blend"))
     key = lambda rows: list(zip(rows.parent_a, rows.parent_b, rows.alpha))  # noqa: E731
     assert key(blend)[: len(blend) - 1] == key(targeted)[1:]  # the same pairs and weights, in order
@@ -138,7 +138,7 @@ def test_the_blend_pool_takes_the_targeted_pools_pairs_and_weights_and_replaces_
     assert (
         len(blend) == len(targeted) == out.summary["blend"]["kept"] and out.summary["blend"]["tried"] == len(blend) + 1
     )
-    with pytest.raises(DataError, match="the blend pool needs the base set's meshes"):
+    with pytest.raises(DataError, match="the blend pool needs its runner"):
         generate_pools(base, cfg, 0, some_rejected, 3, ("targeted", "blend"))
 
 
@@ -155,3 +155,32 @@ def test_blend_batches_mix_the_parents_meshes_at_each_weight():
         grids = [voxelize_solid(v, m.faces, grid) for v, m in ((child, d.mesh), (parent.vertices, parent))]
         assert d.reason is None and iou(*grids) >= 0.95
     assert ends[2].reason is None and ends[2].mesh.is_watertight
+
+
+def test_the_warp_and_primitives_pools_are_the_data_seeds_and_warp_only_base_shapes():
+    """A warp's parent is a targeted candidate's nearer parent, a base (train) shape, never a held-out one; an
+    assembly has no real parent and no latent; both pools are the same for one data seed, another for the next."""
+    from graspaug.augment.decode import control_runners
+    from graspaug.geometry.settings import SurfaceSettings
+
+    base, cfg = make_base(4), GenerateParams(base_sizes=(4,), ratios=(0.0, 1.0))
+    meshes = [trimesh.creation.box(extents=(0.02 + 0.01 * i, 0.03, 0.05)) for i in range(4)]
+    pools = ("targeted", "warp", "primitives")
+
+    def made(seed):
+        controls = control_runners(pools, meshes, cfg, SurfaceSettings(), seed, 4, 1)
+        return generate_pools(base, cfg, seed, some_rejected, 2, pools, controls=controls)
+
+    out, again, other = made(0), made(0), made(1)
+    targeted, warp, prims = (out.index[out.index.pool == p] for p in pools)
+    assert len(warp) == len(prims) == len(targeted) == 4
+    assert list(warp.parent_a) == list(warp.parent_b) and set(warp.parent_a) <= set(base.ids)
+    assert list(warp.parent_a) == [base.ids[d.candidate.a] for d in out.kept[:4]]  # the targeted pool's order
+    assert prims.parent_a.str.startswith("assembly_").all() and prims.rarity_vs_base.isna().all()
+    assert warp.rarity_vs_base.notna().all() and (out.index.watertight & out.index.one_piece).all()
+    for a, b in zip(out.kept, again.kept):
+        assert np.array_equal(a.mesh.vertices, b.mesh.vertices)
+    assert not np.allclose(out.kept[-1].mesh.extents, other.kept[-1].mesh.extents)
+    assert np.isclose(np.sort(out.kept[-1].mesh.extents)[1], SurfaceSettings().size_m)  # the ingest size rule
+    xy, groups = tsne_groups(base, out.index, 2.0, 0)
+    assert len(xy) == 4 + 8 and "generated (primitives)" not in groups  # an assembly has no latent to place

@@ -20,16 +20,29 @@ def test_the_declared_contrasts():
         "real_data",
         "targeted_vs_none@50",
         "targeted_vs_none_chosen@50",
+        "warp_vs_none@50",
+        "primitives_vs_none@50",
         "targeted_vs_random@50",
         "targeted_vs_real@50",
         "recon_vs_real@50",
         "targeted_vs_recon@50",
         "blend_vs_recon@50",
         "targeted_vs_blend@50",
+        "warp_vs_real@50",
+        "targeted_vs_warp@50",
+        "primitives_vs_real@50",
+        "targeted_vs_primitives@50",
     ]
+    baseline = {c.name: c for c in declared_contrasts([50, 200], [0.0, 0.5, 1.0], [50], {})}["warp_vs_none@50"]
+    assert dict((k, w) for w, k in baseline.terms) == {
+        ("warp", 50, 0.5): 0.5,
+        ("warp", 50, 1.0): 0.5,
+        ("targeted", 50, 0.0): -1.0,
+    }
     three_pools = declared_contrasts([50, 200], [0.0, 1.0], [50], {}, ("targeted", "random", "real"))
     assert [c.name for c in three_pools][-2:] == ["targeted_vs_random@50", "targeted_vs_real@50"]
-    decoding = {k: w for w, k in declared_contrasts([50, 200], [0.0, 0.5, 1.0], [50], {})[-4].terms}
+    declared = {c.name: c for c in declared_contrasts([50, 200], [0.0, 0.5, 1.0], [50], {})}
+    decoding = {k: w for w, k in declared["recon_vs_real@50"].terms}
     assert decoding == {
         ("recon", 50, 0.5): 0.5,
         ("recon", 50, 1.0): 0.5,
@@ -52,6 +65,8 @@ def test_the_declared_contrasts():
         "real/50-1",
         "recon/50-1",
         "blend/50-1",
+        "warp/50-1",
+        "primitives/50-1",
         "ceiling",
     ]
     assert "recon/50-1" not in [v.name for v in seed_variants([50], [0.0, 1.0], [50], False, ("targeted", "real"))]

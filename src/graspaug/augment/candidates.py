@@ -266,6 +266,15 @@ class ReconStream(CandidateStream):
         self._append([Candidate(k, k, 0.0, "recon") for k in range(n_shapes)])
 
 
+class PrimitiveStream(CandidateStream):
+    """The ``primitives`` pool's stream: assembly k of ``n_shapes`` (parents k and k, weight 0), in order, so a
+    rejected assembly is replaced by the next one. No real shape is its parent."""
+
+    def __init__(self, n_shapes: int) -> None:
+        super().__init__()
+        self._append([Candidate(k, k, 0.0, "primitives") for k in range(n_shapes)])
+
+
 class FollowStream(CandidateStream):
     """Another pool's candidates for a control pool (the ``blend`` pool follows the targeted one):
     ``first`` (that pool's kept candidates, in order: the same pairs and weights) then the rest of

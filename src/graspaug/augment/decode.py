@@ -1,7 +1,8 @@
 """Decode to mesh: the batch runners that turn a pool's candidates into meshes, with the AutoEncoder-Critic
 (:func:`mesh_batches`: decode the interpolated latent, then fill, open, marching cubes and smoothing; a decoder of
 signed distances: marching cubes at 0 alone) or with no
-network (:func:`blend_batches`: the parents' signed distance fields mixed). Each is what
+network (:func:`blend_batches`: the parents' signed distance fields mixed; :func:`warp_batches`: one parent under a
+random smooth deformation; :func:`primitive_batches`: random assemblies of primitives, no parent). Each is what
 :func:`graspaug.augment.candidates.fill_pool` calls on a batch of candidates."""
 
 from __future__ import annotations
@@ -71,3 +72,76 @@ def blend_batches(
         return [Decoded(c, np.zeros(0, np.uint8), mesh, reason) for c, (mesh, reason) in zip(candidates, out)]
 
     return run_batch
+
+
+def warp_batches(
+    meshes: Sequence, settings, surface, key: Sequence[int], workers: int, label: str
+) -> Callable[[list[Candidate]], list[Decoded]]:
+    """A batch runner that makes each candidate with no network: a random warp
+    (:func:`graspaug.geometry.warp.random_warp` within ``settings``, a
+    :class:`~graspaug.geometry.settings.WarpSettings`) of its nearer parent ``a`` among ``meshes`` (the base set's
+    meshes, m, in base-set order), sized by the ingest rule of ``surface``
+    (:class:`~graspaug.geometry.settings.SurfaceSettings`: size rule, size, face budget). Each warp is drawn from its
+    own stream ``[*key, a, b, round(1e6 α)]``, so it depends on the candidate alone. The outcome names ``a`` as both
+    parents at weight 0 (the shape is ``a``'s alone); on ``workers`` processes."""
+    from graspaug.geometry.warp import random_warp, warp_mesh
+    from graspaug.parallel import parallel_map
+
+    def one(c: Candidate):
+        rng = np.random.default_rng([*key, c.a, c.b, round(1e6 * c.alpha)])
+        return warp_mesh(
+            meshes[c.a], random_warp(rng, settings), surface.size_rule, surface.size_m, surface.face_budget
+        )
+
+    def run_batch(candidates: list[Candidate]) -> list[Decoded]:
+        out = parallel_map(one, candidates, workers, label)
+        return [
+            Decoded(Candidate(c.a, c.a, 0.0, "warp"), np.zeros(0, np.uint8), mesh, reason)
+            for c, (mesh, reason) in zip(candidates, out)
+        ]
+
+    return run_batch
+
+
+def primitive_batches(
+    settings, surface, key: Sequence[int], workers: int, label: str
+) -> Callable[[list[Candidate]], list[Decoded]]:
+    """A batch runner for the ``primitives`` pool: candidate k (:class:`~graspaug.augment.candidates.PrimitiveStream`)
+    becomes the random assembly of primitives drawn from the stream ``[*key, k]``
+    (:func:`graspaug.geometry.primitives.random_assembly` within ``settings``, a
+    :class:`~graspaug.geometry.settings.PrimitiveSettings`), sized by ``surface``'s ingest rule; on ``workers``
+    processes."""
+    from graspaug.geometry.primitives import assembly_mesh, random_assembly
+    from graspaug.parallel import parallel_map
+
+    def one(c: Candidate):
+        parts = random_assembly(np.random.default_rng([*key, c.a]), settings)
+        return assembly_mesh(parts, settings.resolution, surface.size_rule, surface.size_m, surface.face_budget)
+
+    def run_batch(candidates: list[Candidate]) -> list[Decoded]:
+        out = parallel_map(one, candidates, workers, label)
+        return [Decoded(c, np.zeros(0, np.uint8), mesh, reason) for c, (mesh, reason) in zip(candidates, out)]
+
+    return run_batch
+
+
+WARP_SEED, PRIMITIVE_SEED = 0x3A2B, 0x9817  # the warp and primitives pools' own streams of the data seed
+
+
+def control_runners(
+    pools: Sequence[str], meshes: Sequence, cfg, surface, seed: int, base_size: int, workers: int
+) -> dict[str, Callable[[list[Candidate]], list[Decoded]]]:
+    """The runners of the no-network pools among ``pools`` for base size ``base_size``: ``blend``, ``warp`` (both on
+    ``meshes``, the base set's meshes, m) and ``primitives``, with ``cfg`` (a
+    :class:`~graspaug.augment.settings.GenerateSettings`), ``surface`` (the ingest sizing rule) and the data
+    ``seed``."""
+    runners = {
+        "blend": lambda: blend_batches(meshes, cfg.blend.resolution, cfg.blend.margin, workers, f"blend {base_size}"),
+        "warp": lambda: warp_batches(
+            meshes, cfg.warp, surface, [seed, WARP_SEED, base_size], workers, f"warp {base_size}"
+        ),
+        "primitives": lambda: primitive_batches(
+            cfg.primitives, surface, [seed, PRIMITIVE_SEED, base_size], workers, f"primitives {base_size}"
+        ),
+    }
+    return {name: make() for name, make in runners.items() if name in pools}

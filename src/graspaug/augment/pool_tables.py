@@ -8,7 +8,15 @@ import pandas as pd
 
 from graspaug.augment.candidates import Decoded, TargetedStream, above_percentile
 
-ID_LETTERS = {"targeted": "t", "random": "r", "recon": "c", "blend": "b", "failure": "f"}  # gen_<B>_<letter><order>
+ID_LETTERS = {
+    "targeted": "t",
+    "random": "r",
+    "recon": "c",
+    "blend": "b",
+    "warp": "w",
+    "primitives": "p",
+    "failure": "f",
+}  # gen_<B>_<letter><order>
 
 
 def pool_tables(

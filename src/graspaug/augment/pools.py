@@ -22,6 +22,7 @@ from graspaug.augment.candidates import (
     FailureStream,
     FollowStream,
     PoolExhausted,
+    PrimitiveStream,
     RandomStream,
     ReconStream,
     TargetedStream,
@@ -85,7 +86,10 @@ def base_set(ids: np.ndarray, latents: pd.DataFrame, scores: pd.DataFrame, voxel
 
 
 Pools = dict[str, tuple[list[Decoded], list[Decoded]]]
-GENERATED_POOLS = ("targeted", "random", "recon", "blend")  # the pools generate can make, in index order
+GENERATED_POOLS = ("targeted", "random", "recon", "blend", "warp", "primitives")  # what generate makes, in index order
+FOLLOWERS = ("blend", "warp")  # the controls that follow the targeted pool's candidates (its parents and weights)
+PRIMITIVE_TRIES = 20  # the primitives stream holds this many assemblies per shape needed
+Runner = Callable[[list[Candidate]], list[Decoded]]
 
 
 @dataclass(frozen=True)
@@ -101,21 +105,23 @@ def fill_pools(
     base: BaseSet,
     cfg: GenerateSettings,
     seed: int,
-    run_batch: Callable[[list[Candidate]], list[Decoded]],
+    run_batch: Runner,
     pools: Sequence[str] = ("targeted", "random"),
     recon: ReconSource | None = None,
-    blend: Callable[[list[Candidate]], list[Decoded]] | None = None,
+    controls: dict[str, Runner] | None = None,
 ) -> tuple[Pools, TargetedStream, int]:
     """Fill each of ``pools`` (of :data:`GENERATED_POOLS`; the targeted one always) to
     ``pool_size(cfg.ratios, B)`` kept shapes: ``targeted`` and ``random`` (seeded by
     ``[seed, BASE_SEED, B]``) with ``run_batch`` (:func:`.decode.mesh_batches` over the base set),
-    ``recon`` from ``recon`` (the real pool's shapes, each decoded from its own latent),
-    ``blend`` with the runner ``blend`` (:func:`.decode.blend_batches`) on the targeted pool's candidates
-    (its kept ones first: the same pairs and weights).
+    ``recon`` from ``recon`` (the real pool's shapes, each decoded from its own latent), and the
+    no-network pools with their runner in ``controls``: ``blend`` (:func:`.decode.blend_batches`) and
+    ``warp`` (:func:`.decode.warp_batches`) on the targeted pool's candidates (its kept ones first: the same
+    parents and weights), ``primitives`` (:func:`.decode.primitive_batches`) on assemblies 0, 1, … of
+    :class:`PrimitiveStream` (:data:`PRIMITIVE_TRIES` per shape needed).
 
     Returns (pools: name → (kept, rejected) Decoded lists, in :data:`GENERATED_POOLS` order, the
     targeted stream as widened, shapes per pool); a :class:`graspaug.errors.DataError` if a pool's
-    candidates run out first, or ``recon`` is asked for without its source.
+    candidates run out first, or a pool is asked for without its source or runner.
     """
     base_size = len(base.ids)
     needed = pool_size(cfg.ratios, base_size)
@@ -124,17 +130,20 @@ def fill_pools(
     )
     if "recon" in pools and recon is None:
         raise DataError(f"generate {base_size}: the recon pool needs the real pool's shapes")
-    if "blend" in pools and blend is None:
-        raise DataError(f"generate {base_size}: the blend pool needs the base set's meshes")
+    controls = controls or {}
+    for name in ("blend", "warp", "primitives"):
+        if name in pools and name not in controls:
+            raise DataError(f"generate {base_size}: the {name} pool needs its runner (the base set's meshes)")
     streams = {
         "targeted": (targeted_stream, run_batch),
         "random": (RandomStream(base_size, cfg.alphas, np.random.default_rng([seed, BASE_SEED, base_size])), run_batch),
         "recon": (ReconStream(len(recon.shapes.ids)), recon.run_batch) if recon else None,
+        "primitives": (PrimitiveStream(PRIMITIVE_TRIES * needed), controls.get("primitives")),
     }
     out = {}
     for name in (p for p in GENERATED_POOLS if p == "targeted" or p in pools):
-        if name == "blend":
-            streams[name] = (FollowStream([d.candidate for d in out["targeted"][0]], targeted_stream), blend)
+        if name in FOLLOWERS:
+            streams[name] = (FollowStream([d.candidate for d in out["targeted"][0]], targeted_stream), controls[name])
         stream, runner = streams[name]
         try:
             out[name] = fill_pool(stream, needed, runner)
@@ -186,9 +195,15 @@ def generated_set(
     sources = {name: (base.ids, base.z) for name in pools}
     if recon_shapes is not None:
         sources["recon"] = (recon_shapes.ids, recon_shapes.z)
+    if "primitives" in pools:  # assembly k of the stream: no real parent, no latent
+        n = PRIMITIVE_TRIES * needed
+        sources["primitives"] = (
+            np.array([f"assembly_{i:04d}" for i in range(n)]),
+            np.full((n, base.z.shape[1]), np.nan),
+        )
     rows, reject_rows = pool_tables(sources, pools, base_size)
     index = pd.DataFrame(rows)
-    index["rarity_vs_base"] = rarity(base.z, k, query=np.stack(index.z.to_numpy()))
+    index["rarity_vs_base"] = latent_rarity(base.z, k, np.stack(index.z.to_numpy()))
     base_table = base_scores_table(base.ids, base.rarity, base.graspness, targeted.percentile)
     summary, kept_share = pool_summary(base_size, needed, pools, targeted, index, reject_rows)
     return GeneratedSet(
@@ -212,15 +227,25 @@ def generate_pools(
     base: BaseSet,
     cfg: GenerateSettings,
     seed: int,
-    run_batch: Callable[[list[Candidate]], list[Decoded]],
+    run_batch: Runner,
     k: int,
     pools: Sequence[str] = ("targeted", "random"),
     recon: ReconSource | None = None,
-    blend: Callable[[list[Candidate]], list[Decoded]] | None = None,
+    controls: dict[str, Runner] | None = None,
 ) -> GeneratedSet:
     """:func:`fill_pools` then :func:`generated_set` (``k``: the rarity's neighbours)."""
-    filled, targeted, needed = fill_pools(base, cfg, seed, run_batch, pools, recon, blend)
+    filled, targeted, needed = fill_pools(base, cfg, seed, run_batch, pools, recon, controls)
     return generated_set(base, filled, targeted, needed, k, cfg.n_examples, recon.shapes if recon else None)
+
+
+def latent_rarity(z_base: np.ndarray, k: int, z: np.ndarray) -> np.ndarray:
+    """Rarity (G,) of latents ``z`` (G, d) against the base latents ``z_base`` (B, d) with ``k`` neighbours; NaN for
+    a row with no latent (NaN)."""
+    out = np.full(len(z), np.nan)
+    known = np.isfinite(z).all(axis=1)
+    if known.any():
+        out[known] = rarity(z_base, k, query=z[known])
+    return out
 
 
 def example_decodes(pools: Pools, n_examples: int) -> list[Decoded]:
@@ -231,8 +256,10 @@ def example_decodes(pools: Pools, n_examples: int) -> list[Decoded]:
 def tsne_groups(base: BaseSet, index: pd.DataFrame, perplexity: float, seed: int) -> tuple[np.ndarray, list[str]]:
     """(xy (B + G, 2), groups (B + G,)): the t-SNE of the base latents followed by the G generated
     ones (``index.z``), and each point's group (``base`` or ``generated (<selected_by>)``)."""
-    xy = tsne_2d(np.concatenate([base.z, np.stack(index.z.to_numpy())]), perplexity, seed)
-    groups = ["base"] * len(base.ids) + [f"generated ({s})" for s in index.selected_by]
+    z = np.stack(index.z.to_numpy())
+    known = np.isfinite(z).all(axis=1)  # a primitive assembly has no latent
+    xy = tsne_2d(np.concatenate([base.z, z[known]]), perplexity, seed)
+    groups = ["base"] * len(base.ids) + [f"generated ({s})" for s in index.selected_by[known]]
     return xy, groups
 
 

@@ -6,7 +6,7 @@ from typing import Any
 
 from pydantic import model_validator
 
-from graspaug.geometry.settings import BlendSettings, DecodeSettings
+from graspaug.geometry.settings import BlendSettings, DecodeSettings, PrimitiveSettings, WarpSettings
 from graspaug.settings import Field, settings
 
 
@@ -62,6 +62,16 @@ class GenerateSettings:
     blend: BlendSettings = Field(
         default_factory=BlendSettings,
         description="The blend pool (gqcnn.pools): the targeted pool's pairs interpolated with no network.",
+    )
+    warp: WarpSettings = Field(
+        default_factory=WarpSettings,
+        description="The warp pool (gqcnn.pools): each of the targeted pool's pairs becomes a random smooth "
+        "deformation of its nearer parent, sized by the ingest rule.",
+    )
+    primitives: PrimitiveSettings = Field(
+        default_factory=PrimitiveSettings,
+        description="The primitives pool (gqcnn.pools): random assemblies of 1-5 primitives, no real parent, sized by "
+        "the ingest rule.",
     )
 
     @model_validator(mode="before")

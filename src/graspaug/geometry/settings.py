@@ -98,3 +98,48 @@ class BlendSettings:
         ge=1,
         description="Empty cells around each parent along its largest extent (one voxel of a 32³ grid at 96 cells).",
     )
+
+
+@settings
+class WarpSettings:
+    """Ranges of the random smooth deformation that makes a ``warp`` shape from a real one (params section
+    ``generate.warp``; :mod:`graspaug.geometry.warp`)."""
+
+    scale: float = Field(
+        1.5,
+        ge=1,
+        le=4,
+        description="Anisotropic scale: each axis of a random frame scaled by a factor log-uniform in [1/scale, "
+        "scale] (1: none), before the shape is sized by the ingest rule.",
+    )
+    shear: float = Field(0.3, ge=0, le=1, description="Shear: x and y move by k z, k uniform in [-shear, shear].")
+    taper: float = Field(
+        0.3, ge=0, lt=1, description="Taper: x and y scale by 1 + t z / h (h: half the z extent), t in [-taper, taper]."
+    )
+    bend_deg: float = Field(
+        30.0,
+        ge=0,
+        le=45,
+        description="Bend: the z axis bends through an angle uniform in [-bend_deg, bend_deg] degrees over the "
+        "shape's largest extent (≤ 45: the bending radius stays above that extent, so no fold).",
+    )
+
+
+@settings
+class PrimitiveSettings:
+    """Random assemblies of primitives, the ``primitives`` pool's shapes (params section ``generate.primitives``;
+    :mod:`graspaug.geometry.primitives`)."""
+
+    max_parts: int = Field(5, ge=1, le=10, description="Parts per assembly: uniform in 1 … max_parts.")
+    kinds: tuple[Literal["box", "cylinder", "sphere", "capsule", "ring"], ...] = Field(
+        ("box", "cylinder", "sphere", "capsule", "ring"),
+        min_length=1,
+        description="The kinds a part is drawn from, uniformly.",
+    )
+    resolution: int = Field(
+        64,
+        ge=16,
+        le=256,
+        description="Field samples along an assembly's largest extent before marching cubes (exact distances: faces "
+        "land between samples, so 64 keeps a box's faces flat).",
+    )

@@ -12,11 +12,13 @@ network is read:
   shapes must help);
 * ``targeted_vs_none@B``: mean over R > 0 of AP(targeted, B, R) − AP(B, 1:0);
 * ``targeted_vs_none_chosen@B``: the same at the ratio chosen on mean validation AP;
+* ``warp_vs_none@B``, ``primitives_vs_none@B``: the same for the no-network baselines when trained;
 * ``<a>_vs_<b>@B`` for the pool pairs of :data:`PAIRS` whose pools are trained: mean over R > 0 of
   AP(a, B, R) − AP(b, B, R), equal shape counts (``targeted_vs_random``, ``targeted_vs_real``,
   ``recon_vs_real``: what decoding alone costs, ``targeted_vs_recon``: what interpolation and
   selection add to a decoded shape, ``blend_vs_recon``, ``targeted_vs_blend``: what the latent
-  space adds over mixing the same parents' signed distance fields);
+  space adds over mixing the same parents' signed distance fields; ``warp_vs_real``, ``targeted_vs_warp``,
+  ``primitives_vs_real``, ``targeted_vs_primitives``: the baselines a researcher tries first);
 * ``<pool>_vs_real_datapoints@B``: the same pools against real shapes at as many training
   datapoints (:func:`datapoint_matched_contrasts`), since a generated shape yields fewer.
 
@@ -55,7 +57,12 @@ PAIRS = {  # pool a vs pool b at equal shape counts: what the difference measure
     ("targeted", "recon"): "what interpolation and selection add to a decoded shape",
     ("blend", "recon"): "interpolants made with no network vs decoded real shapes",
     ("targeted", "blend"): "what the learned latent space adds over geometric interpolation of the same pairs",
+    ("warp", "real"): "randomly deformed real shapes vs as many more real shapes",
+    ("targeted", "warp"): "the paper's method vs deforming the same parents by hand",
+    ("primitives", "real"): "random assemblies of primitives vs as many more real shapes",
+    ("targeted", "primitives"): "the paper's method vs procedural objects",
 }
+NONE_CONTRASTS = ("warp", "primitives")  # pools whose own `<pool>_vs_none@B` is declared beside targeted's
 
 
 def _key(pool: str, base: int, ratio: float) -> Key:
@@ -105,6 +112,10 @@ def declared_contrasts(base_sizes, ratios, augment_base_sizes, chosen: dict[int,
                 )
             )
     for b in augment_base_sizes:
+        for pool in (p for p in NONE_CONTRASTS if p in pools and nonzero):
+            terms = tuple((1 / len(nonzero), _key(pool, b, r)) for r in nonzero) + ((-1.0, _key("targeted", b, 0)),)
+            words = f"{pool} augmentation vs none at B = {b}, mean over ratios {', '.join(f'1:{r:g}' for r in nonzero)}"
+            out.append(Contrast(f"{pool}_vs_none@{b}", terms, words))
         for one, other in PAIRS:
             if nonzero and one in pools and other in pools:
                 terms = tuple(

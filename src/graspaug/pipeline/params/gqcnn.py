@@ -50,8 +50,9 @@ class GQCNNParams:
         "(interpolants of rare and graspable neighbours), `random` (interpolants of random pairs), `real` (more real "
         "train shapes, the positive control), `recon` (the real pool's shapes passed through the AutoEncoder alone: "
         "what decoding and meshing cost), `blend` (the targeted pool's pairs and weights interpolated with no "
-        "network, by mixing the parents' signed distance fields); `generate` makes the generated ones. `targeted` is "
-        "always trained.",
+        "network, by mixing the parents' signed distance fields), `warp` (each targeted pair's nearer parent under a "
+        "random smooth deformation: scale, shear, taper, bend), `primitives` (random assemblies of 1-5 boxes, "
+        "cylinders, spheres, capsules and rings); `generate` makes the generated ones. `targeted` is always trained.",
     )
     members: int = Field(
         2,

@@ -3,7 +3,8 @@
 Targeted: the base set's rare, and separately graspable, shapes with their N-th … (N+K)-th latent
 neighbours, ``(1 - α) z_a + α z_b`` decoded by the AE-Critic and meshed (paper Section III-C);
 random: random pairs; recon: the real pool's shapes (the GQ-CNN experiment's order) from their own
-latents; blend: the targeted pairs with no network. ``gqcnn.pools`` says which; each holds
+latents; blend: the targeted pairs with no network; warp: each targeted pair's nearer parent randomly deformed;
+primitives: random assemblies of primitives. ``gqcnn.pools`` says which; each holds
 ``ceil(max ratio × B)`` kept shapes, the first ``round(R × B)`` ratio R's set; a failed shape is
 replaced by the next candidate. Writes ``data/generated/<B>/`` (``meshes/``, ``index``, ``rejects``
 and ``base.parquet``), ``metrics/generate/<B>.json``, ``reports/generate/<B>/`` (summary, pictures)."""
@@ -16,7 +17,7 @@ from functools import partial
 
 import numpy as np
 
-from graspaug.augment.decode import blend_batches, mesh_batches
+from graspaug.augment.decode import control_runners, mesh_batches
 from graspaug.augment.pool_tables import generate_headline
 from graspaug.augment.pools import GENERATED_POOLS, ReconSource, base_ids, base_set, generate_pools, tsne_groups
 from graspaug.device import resolve_device
@@ -31,6 +32,7 @@ from graspaug.pipeline.params.base import params_model
 from graspaug.pipeline.params.embed import EmbedParams
 from graspaug.pipeline.params.generate import GenerateParams
 from graspaug.pipeline.params.gqcnn import GQCNNParams
+from graspaug.pipeline.params.ingest import IngestParams
 from graspaug.pipeline.params.score import ScoreParams
 from graspaug.plots import generated_pairs, scatter_2d
 from graspaug.training.gqcnn_data import load_split
@@ -39,6 +41,7 @@ log = logging.getLogger(__name__)
 
 Params = params_model(
     "The params the `generate` stage reads.",
+    ingest=IngestParams,
     ae=AEParams,
     embed=EmbedParams,
     score=ScoreParams,
@@ -58,16 +61,16 @@ def run(params: Params, base_size: int) -> None:
     ae, _, _ = load_autoencoder(paths.AE_CRITIC_MODEL, params.ae.net)
     meshes = partial(mesh_batches, ae, resolve_device(params.device), settings=cfg.decode, workers=params.workers)
     gq = params.gqcnn
-    pools, recon, blend = [p for p in GENERATED_POOLS if p in gq.pools], None, None
+    pools, recon = [p for p in GENERATED_POOLS if p in gq.pools], None
     if "recon" in pools:  # the real pool as the GQ-CNN experiment draws it
         split = load_split(paths.gqcnn_dir("original"), shapes, list(cfg.base_sizes), gq.val_shapes, params.data_seed)
         real = base_set(np.array(split.real_pool), latents, scores, voxels, params.score.k)
         recon = ReconSource(real, meshes(real, label=f"generate {base_size} recon"))
-    if "blend" in pools:  # the base shapes' own surfaces
-        solids = [read_mesh(mesh_path(paths.SHAPES_DIR, s)) for s in ids]
-        blend = blend_batches(solids, cfg.blend.resolution, cfg.blend.margin, params.workers, f"blend {base_size}")
+    solids = [read_mesh(mesh_path(paths.SHAPES_DIR, s)) for s in ids] if {"blend", "warp"} & set(pools) else []
+    surface = params.ingest.surface  # the warp and primitives pools' shapes are sized as ingest sizes a shape
+    controls = control_runners(pools, solids, cfg, surface, params.data_seed, base_size, params.workers)
     run_batch = meshes(base, label=f"generate {base_size}")
-    out = generate_pools(base, cfg, params.data_seed, run_batch, params.score.k, pools, recon, blend)
+    out = generate_pools(base, cfg, params.data_seed, run_batch, params.score.k, pools, recon, controls)
     for level, message in [(logging.INFO, n) for n in out.notes] + [(logging.WARNING, w) for w in out.warnings]:
         log.log(level, "generate %d: %s", base_size, message)
 
