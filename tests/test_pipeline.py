@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
+import yaml
 
 from graspaug.io.checkpoints import read_gqcnn
 from graspaug.io.voxels import read_voxels
@@ -317,9 +318,11 @@ def test_dvc_repro_fidelity(tiny_repo):
 
     work, env = tiny_repo
     run(["dvc", "repro", "fidelity"], work, env)
-    pools = ("targeted", "random", "real", "recon", "blend")
+    pools = yaml.safe_load((work / "params.yaml").read_text())["gqcnn"]["pools"]
     files = {p.stem: json.loads(p.read_text()) for p in (work / "metrics/fidelity/6").glob("*.json")}
-    assert set(files) == {f"{p}_{f}" for p in pools for f in HEADLINE} - {"real_graspness_kept"}
+    no_parent = {f"{p}_{f}" for p in ("real", "primitives") for f in ("graspness_kept", "datapoints_kept")}
+    assert set(files) == {f"{p}_{f}" for p in pools for f in HEADLINE} - no_parent
+    assert 0 < files["recon_datapoints_kept"]["mean"] and 0 < files["targeted_graspness_kept"]["mean"]
     for pool in pools:
         one_nna = files[f"{pool}_one_nna"]
         assert 0 <= one_nna["lo"] <= one_nna["mean"] <= one_nna["hi"] <= 1, pool

@@ -95,6 +95,11 @@ def test_pool_shapes_reads_graspness_datapoints_and_the_parents_mix():
     assert np.array_equal(again.clouds[1], pool.clouds[1])
     real = pool_shapes(meshes, graspness, rendered, 64, 0)
     assert np.isnan(real.parents).all() and real.distinct_parents is None and real.alphas == {}
+    assert np.isnan(real.parent_datapoints).all() and np.isnan(pool.parent_datapoints).all()  # no counts given
+    counted = pool_shapes(meshes, graspness, rendered, 64, 0, parents, {"a": 6, "b": 2})
+    assert counted.parent_datapoints == pytest.approx([6, 0.75 * 6 + 0.25 * 2])  # mixed as the child mixes them
+    kept = fidelity_table({"c": counted}, counted.clouds, 50, np.random.default_rng(0)).iloc[0]
+    assert kept.datapoints_kept == pytest.approx(4 / (6 + 5)) and kept.datapoints_kept_lo <= kept.datapoints_kept
 
 
 def test_fidelity_table_gives_intervals_that_hold_the_values_and_tell_a_far_pool_from_a_near_one():
@@ -108,14 +113,16 @@ def test_fidelity_table_gives_intervals_that_hold_the_values_and_tell_a_far_pool
     pools = {name: pool_shapes(m, graspness, rendered, 128, 0) for name, m in (("near", near), ("far", far))}
     table = fidelity_table(pools, reference, 200, np.random.default_rng(0)).set_index("pool")
     for figure in FIGURES:
-        if figure != "graspness_kept":  # real shapes keep no parents' graspness
+        if figure not in ("graspness_kept", "datapoints_kept"):  # real shapes keep no parents' figures
             assert (table[f"{figure}_lo"] <= table[figure] + 1e-12).all() and (
                 table[figure] <= table[f"{figure}_hi"] + 1e-12
             ).all()
-    assert table.graspness_kept.isna().all() and table.datapoints_per_shape.tolist() == [4.5, 4.5]
+    assert table.graspness_kept.isna().all() and table.datapoints_kept.isna().all()
+    assert table.datapoints_per_shape.tolist() == [4.5, 4.5]
     assert table.loc["near", "one_nna_hi"] < table.loc["far", "one_nna_lo"]
     assert table.loc["far", "one_nna"] == 1.0 and table.loc["near", "coverage"] > table.loc["far", "coverage"]
     headline = fidelity_headline(table.reset_index())  # one metrics file per pool and figure; real shapes keep none
-    assert set(headline) == {f"{p}_{f}" for p in ("near", "far") for f in HEADLINE if f != "graspness_kept"}
+    kept = ("graspness_kept", "datapoints_kept")
+    assert set(headline) == {f"{p}_{f}" for p in ("near", "far") for f in HEADLINE if f not in kept}
     assert headline["far_one_nna"] == {"mean": 1.0, "lo": 1.0, "hi": 1.0}
     assert "| near | 8 | - |" in fidelity_markdown(table.reset_index(), 8, len(reference))

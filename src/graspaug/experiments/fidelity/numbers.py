@@ -102,6 +102,8 @@ class PoolShapes:
     parents : (n,) — the parents' graspness mixed as the child mixes them, (1 − α) g_a + α g_b
         (NaN for a real shape)
     datapoints, positives : (n,) int — the shape's rendered datapoints and its positive ones
+    parent_datapoints : (n,) — the parents' rendered datapoints mixed as the child mixes them (NaN for a real
+        shape or one with no real parent)
     distinct_parents : int or None — parents of the pool's shapes, counted once (None: real shapes)
     alphas : dict — α → how many shapes (empty for real shapes)
     """
@@ -113,6 +115,7 @@ class PoolShapes:
     parents: np.ndarray
     datapoints: np.ndarray
     positives: np.ndarray
+    parent_datapoints: np.ndarray | None = None
     distinct_parents: int | None = None
     alphas: dict = field(default_factory=dict)
 
@@ -124,6 +127,7 @@ def pool_shapes(
     n_points: int,
     seed: int,
     parents: pd.DataFrame | None = None,
+    parent_counts: Mapping[str, int] | None = None,
 ) -> PoolShapes:
     """A pool's :class:`PoolShapes` from its meshes.
 
@@ -135,14 +139,19 @@ def pool_shapes(
     n_points : surface points per shape; each shape's points come from its own stream of ``seed``
     parents : for generated shapes, their rows of the generated index (``shape_id``, ``parent_a``,
         ``parent_b``, ``alpha``), the parents' graspness looked up in ``graspness``
+    parent_counts : real shape id → its rendered datapoints, the parents' looked up here
     """
     ids = list(meshes)
     counts = rendered.groupby("shape_id").label.agg(["size", "sum"]).reindex(ids, fill_value=0)
-    mixed, distinct, alphas = np.full(len(ids), np.nan), None, {}
+    mixed, mixed_counts, distinct, alphas = np.full(len(ids), np.nan), np.full(len(ids), np.nan), None, {}
     if parents is not None:
         p = parents.set_index("shape_id").loc[ids]
+        alpha = p.alpha.to_numpy(float)
         g_a, g_b = (p[c].map(lambda s: graspness.get(s, 0.0)).to_numpy(float) for c in ("parent_a", "parent_b"))
-        mixed = (1 - p.alpha.to_numpy(float)) * g_a + p.alpha.to_numpy(float) * g_b
+        mixed = (1 - alpha) * g_a + alpha * g_b
+        if parent_counts is not None:
+            n_a, n_b = (p[c].map(lambda s: parent_counts.get(s, 0)).to_numpy(float) for c in ("parent_a", "parent_b"))
+            mixed_counts = (1 - alpha) * n_a + alpha * n_b
         distinct = len(set(p.parent_a) | set(p.parent_b))
         alphas = {f"{a:g}": int(n) for a, n in p.alpha.value_counts().sort_index().items()}
     return PoolShapes(
@@ -153,6 +162,7 @@ def pool_shapes(
         parents=mixed,
         datapoints=counts["size"].to_numpy(int),
         positives=counts["sum"].to_numpy(int),
+        parent_datapoints=mixed_counts,
         distinct_parents=distinct,
         alphas=alphas,
     )
@@ -177,18 +187,30 @@ def resampled_distances(pp: np.ndarray, rr: np.ndarray, pr: np.ndarray, i: np.nd
     }
 
 
-FIGURES = ("graspness", "graspness_kept", "positive_share", "datapoints_per_shape", "coverage", "mmd", "one_nna")
+FIGURES = (
+    "graspness",
+    "graspness_kept",
+    "positive_share",
+    "datapoints_per_shape",
+    "datapoints_kept",
+    "coverage",
+    "mmd",
+    "one_nna",
+)
 """The figures of :func:`fidelity_table`, each with its interval."""
 
 
 def _shape_figures(pool: PoolShapes, i: np.ndarray) -> dict:
     graspness = float(pool.graspness[i].mean())
     kept = graspness / float(np.mean(pool.parents[i])) if np.isfinite(pool.parents).all() else np.nan
+    counts = pool.parent_datapoints
+    known = counts is not None and np.isfinite(counts).all() and counts[i].sum() > 0
     return {
         "graspness": graspness,
         "graspness_kept": kept,
         "positive_share": float(pool.positives[i].sum() / max(pool.datapoints[i].sum(), 1)),
         "datapoints_per_shape": float(pool.datapoints[i].mean()),
+        "datapoints_kept": float(pool.datapoints[i].sum() / counts[i].sum()) if known else np.nan,
     }
 
 
@@ -198,7 +220,9 @@ def fidelity_table(
     """How close each pool is to real shapes, before any training, with 95% intervals.
 
     Each pool gets :data:`FIGURES`: its graspness and (generated pools) the share of its parents'
-    graspness it keeps, the share of positive rendered datapoints, datapoints per shape, and
+    graspness it keeps, the share of positive rendered datapoints, datapoints per shape and (pools with real
+    parents) the share of its parents' datapoints it keeps (both ratios of paired means over the same
+    resampled shapes), and
     coverage / MMD / 1-NNA against the ``reference`` clouds (held-out real shapes) on the first m
     shapes of each (m: the smaller count). Intervals: percentile bootstrap, ``n_resamples`` times
     drawing the pool's shapes and (for the distances) m pool and m reference shapes with
@@ -231,7 +255,7 @@ def fidelity_table(
     return pd.DataFrame(rows)
 
 
-HEADLINE = ("graspness_kept", "positive_share", "datapoints_per_shape", "one_nna")
+HEADLINE = ("graspness_kept", "positive_share", "datapoints_per_shape", "datapoints_kept", "one_nna")
 """The figures of :func:`fidelity_table` that go to metrics files (the rest: the report's table)."""
 
 

@@ -20,11 +20,13 @@ def fidelity_markdown(table: pd.DataFrame, base_size: int, reference_count: int)
         "",
         f"Each pool against {reference_count} held-out real shapes (test split; Chamfer distance on surface points). "
         "Intervals: 95% percentile bootstrap over the pool's shapes and the reference shapes. 1-NNA 0.5 is "
-        "indistinguishable from real shapes, 1.0 fully separable; the `real` pool is the control.",
+        "indistinguishable from real shapes, 1.0 fully separable; the `real` pool is the control. Kept of parents: "
+        "the pool's mean over its parents' (mixed by α as the child mixes them; a recon shape's parent is itself), "
+        "graspness and rendered datapoints.",
         "",
         "| pool | shapes | parents | graspness | kept of parents | positive share | datapoints / shape "
-        "| COV | MMD (mm) | 1-NNA | median extents (cm) |",
-        "|---|---|---|---|---|---|---|---|---|---|---|",
+        "| datapoints kept of parents | COV | MMD (mm) | 1-NNA | median extents (cm) |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for _, row in table.iterrows():
         mmd = "-" if pd.isna(row.mmd) else f"{1e3 * row.mmd:.2f} [{1e3 * row.mmd_lo:.2f}, {1e3 * row.mmd_hi:.2f}]"
@@ -32,7 +34,8 @@ def fidelity_markdown(table: pd.DataFrame, base_size: int, reference_count: int)
         parents = "-" if row.distinct_parents is None or pd.isna(row.distinct_parents) else int(row.distinct_parents)
         lines.append(
             f"| {row.pool} | {row.shapes} | {parents} | {cell(row, 'graspness', 3)} | {cell(row, 'graspness_kept', 2)} "
-            f"| {cell(row, 'positive_share', 3)} | {cell(row, 'datapoints_per_shape', 1)} | {cell(row, 'coverage', 2)} "
+            f"| {cell(row, 'positive_share', 3)} | {cell(row, 'datapoints_per_shape', 1)} "
+            f"| {cell(row, 'datapoints_kept', 2)} | {cell(row, 'coverage', 2)} "
             f"| {mmd} | {cell(row, 'one_nna', 2)} | {extents} |"
         )
     return "\n".join(lines) + "\n"

@@ -3,11 +3,12 @@
 Per pool of ``gqcnn.pools`` at base size B (the shapes of the 1:1 augmentation set: the first B of each generated pool
 and of the real pool, as the GQ-CNN experiment takes them), against B held-out real shapes (a seeded draw from the
 test split): graspness and the share of the parents' graspness a child keeps, the share of positive rendered
-datapoints, datapoints per shape, median extents, and coverage / MMD / 1-NNA on the Chamfer distance
-(:func:`~graspaug.experiments.fidelity.numbers.fidelity_table`), each with a 95% bootstrap interval over shapes.
+datapoints, datapoints per shape and the share of the parents' a child keeps, median extents, and coverage / MMD /
+1-NNA on the Chamfer distance (:func:`~graspaug.experiments.fidelity.numbers.fidelity_table`), each with a 95%
+bootstrap interval over shapes.
 
 Outputs: ``metrics/fidelity/<B>/<pool>_<figure>.json`` (``mean``, ``lo``, ``hi``: graspness kept, positive share,
-datapoints per shape, 1-NNA), ``reports/fidelity/<B>/{fidelity.csv,fidelity.md}``.
+datapoints per shape and kept, 1-NNA), ``reports/fidelity/<B>/{fidelity.csv,fidelity.md}``.
 """
 
 from __future__ import annotations
@@ -64,7 +65,7 @@ def run(params: Params, base_size: int) -> None:
     generated = read_table(generated_index(b)).sort_values("order")
     graspness = read_table(SCORES).set_index("shape_id").graspness.to_dict()
     graspness |= read_table(grasps_table(f"gen_{b}")).groupby("shape_id").success.mean().to_dict()
-    pools = {}
+    pools, parent_counts = {}, original.groupby("shape_id").size().to_dict()  # a real shape's datapoints
     for pool in cfg.pools:
         if pool == "real":  # the real pool as the GQ-CNN experiment draws it
             split = load_split(
@@ -77,17 +78,12 @@ def run(params: Params, base_size: int) -> None:
             ids, folder, suffix = list(rows.shape_id), generated_meshes(b), GENERATED_SUFFIX
         meshes = {s: read_mesh(mesh_path(folder, s, suffix)) for s in ids}
         rows = rendered[rendered.shape_id.isin(ids)]
-        pools[pool] = pool_shapes(meshes, graspness, rows, FIDELITY_POINTS, params.seed, parents)
+        pools[pool] = pool_shapes(meshes, graspness, rows, FIDELITY_POINTS, params.seed, parents, parent_counts)
     test_ids = sorted(original.shape_id[original.split == "test"].unique())
     rng = shape_rng(params.seed, "fidelity", f"reference-{b}")
     reference_ids = [test_ids[i] for i in sorted(rng.choice(len(test_ids), size=min(b, len(test_ids)), replace=False))]
-    reference = pool_shapes(
-        {s: read_mesh(mesh_path(SHAPES_DIR, s)) for s in reference_ids},
-        graspness,
-        original.iloc[:0],
-        FIDELITY_POINTS,
-        params.seed,
-    ).clouds
+    reference_meshes = {s: read_mesh(mesh_path(SHAPES_DIR, s)) for s in reference_ids}
+    reference = pool_shapes(reference_meshes, graspness, original.iloc[:0], FIDELITY_POINTS, params.seed).clouds
     table = fidelity_table(pools, reference, FIDELITY_RESAMPLES, np.random.default_rng([params.seed, b]))
     folder = fidelity_reports(b)
     folder.mkdir(parents=True, exist_ok=True)
