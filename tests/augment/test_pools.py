@@ -163,7 +163,7 @@ def test_the_warp_and_primitives_pools_are_the_data_seeds_and_warp_only_base_sha
     from graspaug.augment.decode import control_runners
     from graspaug.geometry.settings import SurfaceSettings
 
-    base, cfg = make_base(4), GenerateParams(base_sizes=(4,), ratios=(0.0, 1.0))
+    base, cfg = make_base(4), GenerateParams(base_sizes=(4,), ratios=(0.0, 1.0), primitives={"resolution": 24})
     meshes = [trimesh.creation.box(extents=(0.02 + 0.01 * i, 0.03, 0.05)) for i in range(4)]
     pools = ("targeted", "warp", "primitives")
 
@@ -182,5 +182,5 @@ def test_the_warp_and_primitives_pools_are_the_data_seeds_and_warp_only_base_sha
         assert np.array_equal(a.mesh.vertices, b.mesh.vertices)
     assert not np.allclose(out.kept[-1].mesh.extents, other.kept[-1].mesh.extents)
     assert np.isclose(np.sort(out.kept[-1].mesh.extents)[1], SurfaceSettings().size_m)  # the ingest size rule
-    xy, groups = tsne_groups(base, out.index, 2.0, 0)
+    xy, groups = tsne_groups(base, out.index, 5.0, 0)
     assert len(xy) == 4 + 8 and "generated (primitives)" not in groups  # an assembly has no latent to place

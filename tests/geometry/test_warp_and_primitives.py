@@ -79,13 +79,14 @@ def test_a_primitives_distance_is_signed_and_exact_on_its_axes(kind):
 
 def test_assemblies_are_closed_solids_that_pass_ingest_and_keep_a_boxs_faces_flat(tmp_path):
     settings = PrimitiveSettings()
-    for k in range(4):
+    for k in range(2):
         parts = random_assembly(np.random.default_rng([3, k]), settings)
         assert 1 <= len(parts) <= settings.max_parts
         out, reason = assembly_mesh(parts, settings.resolution, "mid", 0.06, 5000)
-        again, _ = assembly_mesh(random_assembly(np.random.default_rng([3, k]), settings), 64, "mid", 0.06, 5000)
-        assert reason is None and out.is_watertight and np.array_equal(out.vertices, again.vertices)
-        assert np.sort(out.extents)[1] == pytest.approx(0.06) and passes_ingest(out, tmp_path, f"asm{k}")["ok"]
+        assert reason is None and out.is_watertight and np.sort(out.extents)[1] == pytest.approx(0.06)
+        assert passes_ingest(out, tmp_path, f"asm{k}")["ok"]
+    again, _ = assembly_mesh(random_assembly(np.random.default_rng([3, 1]), settings), 64, "mid", 0.06, 5000)
+    assert np.array_equal(out.vertices, again.vertices)  # the same stream, the same assembly
     box = Primitive("box", np.array([0.2, 0.3, 0.5]), np.eye(3), np.zeros(3))
     mesh, _ = assembly_mesh([box], 64, "mid", 0.06, 100000)
     # a field sample, m: 64 across the box's bounding sphere (radius |size|), scaled by 0.06 / 0.6 m
