@@ -65,6 +65,22 @@ def test_combine_draws_gives_every_contrast_one_interval_over_draws_seeds_and_ob
     assert set(result["share"]) == {"10"} and result["draws"] == [0, 1] and result["seeds"] == [0, 1]
     text = decomposition_markdown(result, [10], "python studies/attribution.py")
     assert "| `targeted_vs_blend@10` |" in text and "B = 10" in text
+    shares = result["shares"]  # every pool but real, as a share of the real pool's gain over no augmentation
+    assert set(shares) == {"targeted", "random", "recon", "blend"} and shares["targeted"] == result["share"]
+    assert shares["recon"]["10"] == {"share": pytest.approx(1.0), "low": pytest.approx(1.0), "high": pytest.approx(1.0)}
+    gain = {  # the blend pool's share by hand: its gain over 1:0 over the real pool's, mean over draws and seeds
+        pool: np.mean(
+            [
+                json.loads((draws[d][s] / f"{pool}/10-1/summary.json").read_text())["test"]["ap"]
+                - json.loads((draws[d][s] / "targeted/10-0/summary.json").read_text())["test"]["ap"]
+                for d in draws
+                for s in (0, 1)
+            ]
+        )
+        for pool in ("blend", "real")
+    }
+    assert shares["blend"]["10"]["share"] == pytest.approx(gain["blend"] / gain["real"])
+    assert "## What to add" in text and "| recon | +100% [+100%, +100%] |" in text
 
 
 def test_every_draw_needs_the_same_training_seeds(tmp_path):

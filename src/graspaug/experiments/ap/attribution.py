@@ -77,9 +77,10 @@ def combine_draws(
     Returns
     -------
     dict — ``contrasts``: name → a :func:`~graspaug.experiments.stats.contrast` over ``draws``
-    (:func:`nested_interval`) with ``per_draw`` (mean over seeds per draw) and ``meaning``; ``share``: the share of
-    the real-shape gain that targeted shapes give per augmented base size (ratio of the nested means, its percentile
-    interval: ``share``, ``low``, ``high``); ``draws``, ``seeds``
+    (:func:`nested_interval`) with ``per_draw`` (mean over seeds per draw) and ``meaning``; ``shares``: pool →
+    augmented base size → the share of the real-shape gain that the pool gives (its mean gain over no augmentation,
+    mean over ratios, divided by the real pool's; the ratio of the nested means and its percentile interval:
+    ``share``, ``low``, ``high``), ``share``: the targeted pool's; ``draws``, ``seeds``
     """
     seeds = sorted({s for d in draws.values() for s in d})
     if any(sorted(d) != seeds for d in draws.values()):
@@ -98,15 +99,19 @@ def combine_draws(
             cache[d, s, key] = boot.average_precision(labels, test_predictions(draws[d][s], key))
         return cache[d, s, key]
 
-    full, resampled = {}, {}
-    for name in names:
+    def arrays(terms_of) -> tuple[np.ndarray, np.ndarray]:
+        """(draws, seeds) and (draws, seeds, resamples) of Σ weight × AP over ``terms_of(contrasts of a draw)``."""
         f, r = np.zeros((len(draws), len(seeds))), np.zeros((len(draws), len(seeds), n_resamples))
         for i, (d, (runs, contrasts)) in enumerate(per_draw.items()):
             ap = runs.set_index(["pool", "base_size", "ratio", "seed"]).test_ap.astype(float)
             for j, s in enumerate(seeds):
-                f[i, j] = sum(w * ap.get((*k, s), np.nan) for w, k in contrasts[name].terms)
-                r[i, j] = sum(w * boot_ap(d, s, k) for w, k in contrasts[name].terms)
-        full[name], resampled[name] = f, r
+                f[i, j] = sum(w * ap.get((*k, s), np.nan) for w, k in terms_of(contrasts))
+                r[i, j] = sum(w * boot_ap(d, s, k) for w, k in terms_of(contrasts))
+        return f, r
+
+    full, resampled = {}, {}
+    for name in names:
+        full[name], resampled[name] = arrays(lambda contrasts, name=name: contrasts[name].terms)
     rng = np.random.default_rng([seed, 0xA77])
     out = {
         name: nested_contrast(
@@ -116,17 +121,37 @@ def combine_draws(
         )
         for name in names
     }
-    shares = {}
     indices = nested_indices(len(draws), len(seeds), n_resamples, rng)
-    for b in gqcnn.augment_base_sizes:
-        gain, versus_real = f"targeted_vs_none@{b}", f"targeted_vs_real@{b}"
-        if gain in full and versus_real in full:
-            x, y = resampled[gain], resampled[gain] - resampled[versus_real]  # y: the real shapes' gain
-            ratio = nested_means(x, indices) / nested_means(y, indices)
+    shares: dict[str, dict[str, dict]] = {}  # pool → base size → the share of the real-shape gain
+    nonzero = [float(r) for r in generate.ratios if r > 0]
+    for b in gqcnn.augment_base_sizes if "real" in gqcnn.pools and nonzero else ():
+        gains = {  # a pool's gain over no augmentation, mean over ratios, from the same networks as the contrasts
+            pool: arrays(
+                lambda _, pool=pool: (
+                    [(1 / len(nonzero), (pool, b, r)) for r in nonzero] + [(-1.0, ("targeted", b, 0.0))]
+                )
+            )
+            for pool in gqcnn.pools
+        }
+        real_full, real_resampled = gains["real"]
+        for pool, (f, r) in gains.items():
+            if pool == "real":
+                continue
+            ratio = nested_means(r, indices) / nested_means(real_resampled, indices)
             low, high = percentile_interval(ratio)
-            mean = float(full[gain].mean() / (full[gain] - full[versus_real]).mean())
-            shares[str(b)] = {"share": mean if np.isfinite(mean) else None, "low": low, "high": high}
-    return {"contrasts": out, "share": shares, "draws": list(draws), "seeds": seeds}
+            mean = float(f.mean() / real_full.mean())
+            shares.setdefault(pool, {})[str(b)] = {
+                "share": mean if np.isfinite(mean) else None,
+                "low": low,
+                "high": high,
+            }
+    return {
+        "contrasts": out,
+        "share": shares.get("targeted", {}),
+        "shares": shares,
+        "draws": list(draws),
+        "seeds": seeds,
+    }
 
 
 def losing_step(contrasts: Mapping[str, dict], base_size: int) -> str:
@@ -186,4 +211,54 @@ def decomposition_markdown(result: dict, augment_base_sizes: Sequence[int], comm
         share = "an undefined share" if s["share"] is None else f"{s['share']:.0%}"
         lines.append(f"- B = {b}: targeted shapes give {share} of the real-shape gain, 95% interval {interval}.")
     lines += [f"- {losing_step(result['contrasts'], b)}" for b in augment_base_sizes]
+    if result.get("shares"):
+        lines += ["", "## What to add: each pool's share of the real-shape gain", "", *recommendation(result)]
     return "\n".join(lines) + "\n"
+
+
+def recommendation(result: dict) -> list[str]:
+    """A markdown table (one line each): per pool of ``result["shares"]`` (:func:`combine_draws`), its share of the
+    real-shape gain at every augmented base size with its 95% interval, ordered by the share at the smallest base
+    size, and what it says: worth it (the interval above 0), harmful (below 0) or no detectable gain; then a
+    sentence a user can act on."""
+
+    def text(s: dict | None) -> str:
+        if not s or s["share"] is None:
+            return "-"
+        return f"{s['share']:+.0%} " + ("[unbounded]" if s["low"] is None else f"[{s['low']:+.0%}, {s['high']:+.0%}]")
+
+    def says(s: dict | None) -> str:
+        if not s or s["low"] is None:
+            return "cannot tell"
+        return "a gain" if s["low"] > 0 else "a loss" if s["high"] < 0 else "no detectable gain"
+
+    shares = result["shares"]
+    sizes = sorted({b for by_size in shares.values() for b in by_size}, key=int)
+    first = sizes[0]
+
+    def at_first(pool: str) -> float:
+        share = shares[pool].get(first, {}).get("share")
+        return -np.inf if share is None else share
+
+    order = sorted(shares, key=at_first, reverse=True)
+    lines = [
+        "| pool | " + " | ".join(f"B = {b}: share [95%]" for b in sizes) + " | says (smallest B) |",
+        "|---|" + "---|" * len(sizes) + "---|",
+    ]
+    lines += [
+        f"| {p} | " + " | ".join(text(shares[p].get(b)) for b in sizes) + f" | {says(shares[p].get(first))} |"
+        for p in order
+    ]
+    gaining = [p for p in order if says(shares[p].get(first)) == "a gain"]
+    if gaining:
+        best = shares[gaining[0]][first]
+        advice = (
+            f"At B = {first} the pools that add AP with an interval above zero: {', '.join(gaining)}; "
+            f"{gaining[0]} adds the most, {best['share']:.0%} of as many real shapes' gain."
+        )
+    else:
+        advice = "Add real shapes: no generated or procedural pool tried here adds AP with an interval above zero."
+    return lines + [
+        "",
+        f"A share is the pool's AP gain over no augmentation divided by as many real shapes' gain. {advice}",
+    ]
