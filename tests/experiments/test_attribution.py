@@ -67,7 +67,10 @@ def test_combine_draws_gives_every_contrast_one_interval_over_draws_seeds_and_ob
     assert "| `targeted_vs_blend@10` |" in text and "B = 10" in text
     shares = result["shares"]  # every pool but real, as a share of the real pool's gain over no augmentation
     assert set(shares) == {"targeted", "random", "recon", "blend"} and shares["targeted"] == result["share"]
-    assert shares["recon"]["10"] == {"share": pytest.approx(1.0), "low": pytest.approx(1.0), "high": pytest.approx(1.0)}
+    recon, contrasts = shares["recon"]["10"], result["contrasts"]
+    assert (recon["share"], recon["low"], recon["high"]) == pytest.approx((1.0, 1.0, 1.0))
+    real_gain = contrasts["targeted_vs_none@10"]["mean"] - contrasts["targeted_vs_real@10"]["mean"]
+    assert recon["gain"]["mean"] == pytest.approx(real_gain) and recon["gain"]["over"] == "draws"
     gain = {  # the blend pool's share by hand: its gain over 1:0 over the real pool's, mean over draws and seeds
         pool: np.mean(
             [
@@ -80,7 +83,7 @@ def test_combine_draws_gives_every_contrast_one_interval_over_draws_seeds_and_ob
         for pool in ("blend", "real")
     }
     assert shares["blend"]["10"]["share"] == pytest.approx(gain["blend"] / gain["real"])
-    assert "## What to add" in text and "| recon | +100% [+100%, +100%] |" in text
+    assert "## What to add" in text and "| recon | +100% [+100%, +100%] |" in text  # as real shapes: the same gain
 
 
 def test_every_draw_needs_the_same_training_seeds(tmp_path):

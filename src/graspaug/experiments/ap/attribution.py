@@ -31,6 +31,7 @@ from graspaug.experiments.ap.numbers import (
 from graspaug.experiments.stats import (
     ObjectBootstrap,
     draw_scope,
+    interval,
     nested_contrast,
     nested_indices,
     nested_interval,
@@ -80,7 +81,8 @@ def combine_draws(
     (:func:`nested_interval`) with ``per_draw`` (mean over seeds per draw) and ``meaning``; ``shares``: pool →
     augmented base size → the share of the real-shape gain that the pool gives (its mean gain over no augmentation,
     mean over ratios, divided by the real pool's; the ratio of the nested means and its percentile interval:
-    ``share``, ``low``, ``high``), ``share``: the targeted pool's; ``draws``, ``seeds``
+    ``share``, ``low``, ``high``) and ``gain``, that gain as a contrast over draws; ``share``: the targeted pool's;
+    ``draws``, ``seeds``
     """
     seeds = sorted({s for d in draws.values() for s in d})
     if any(sorted(d) != seeds for d in draws.values()):
@@ -140,10 +142,12 @@ def combine_draws(
             ratio = nested_means(r, indices) / nested_means(real_resampled, indices)
             low, high = percentile_interval(ratio)
             mean = float(f.mean() / real_full.mean())
+            gain = nested_contrast(nested_interval(f, r, rng))  # the pool's own gain: is it above zero?
             shares.setdefault(pool, {})[str(b)] = {
                 "share": mean if np.isfinite(mean) else None,
                 "low": low,
                 "high": high,
+                "gain": gain,
             }
     return {
         "contrasts": out,
@@ -219,18 +223,19 @@ def decomposition_markdown(result: dict, augment_base_sizes: Sequence[int], comm
 def recommendation(result: dict) -> list[str]:
     """A markdown table (one line each): per pool of ``result["shares"]`` (:func:`combine_draws`), its share of the
     real-shape gain at every augmented base size with its 95% interval, ordered by the share at the smallest base
-    size, and what it says: worth it (the interval above 0), harmful (below 0) or no detectable gain; then a
-    sentence a user can act on."""
+    size, and what the pool's own gain over no augmentation says (``gain``, a contrast over draws): a gain (its
+    interval above 0), a loss (below 0) or no detectable gain; then a sentence a user can act on."""
 
     def text(s: dict | None) -> str:
         if not s or s["share"] is None:
             return "-"
         return f"{s['share']:+.0%} " + ("[unbounded]" if s["low"] is None else f"[{s['low']:+.0%}, {s['high']:+.0%}]")
 
-    def says(s: dict | None) -> str:
-        if not s or s["low"] is None:
+    def says(s: dict | None) -> str:  # the pool's own gain over no augmentation, by its interval
+        low, high = (None, None) if not s else interval(s["gain"])
+        if low is None:
             return "cannot tell"
-        return "a gain" if s["low"] > 0 else "a loss" if s["high"] < 0 else "no detectable gain"
+        return "a gain" if low > 0 else "a loss" if high < 0 else "no detectable gain"
 
     shares = result["shares"]
     sizes = sorted({b for by_size in shares.values() for b in by_size}, key=int)
@@ -242,7 +247,7 @@ def recommendation(result: dict) -> list[str]:
 
     order = sorted(shares, key=at_first, reverse=True)
     lines = [
-        "| pool | " + " | ".join(f"B = {b}: share [95%]" for b in sizes) + " | says (smallest B) |",
+        "| pool | " + " | ".join(f"B = {b}: share [95%]" for b in sizes) + " | its own gain at the smallest B |",
         "|---|" + "---|" * len(sizes) + "---|",
     ]
     lines += [
