@@ -267,3 +267,33 @@ def test_an_occupancy_checkpoint_keeps_its_old_layout_and_a_decoder_of_distances
     assert load_autoencoder(tmp_path / "sdf.pt", sdf)[0].cfg.output == "sdf"
     with pytest.raises(CheckpointMismatch, match=r"output=occupancy \(params: sdf\)"):
         load_autoencoder(tmp_path / "occupancy.pt", sdf)
+
+
+def test_the_paper_profiles_critic_does_not_diverge_at_64():
+    """The paper profile's AE-Critic warm-up at its own sizes (64³, widths 64…512), three critic steps on the CPU
+    through the training loop: the critic loss stays finite and within 10× of its first step. With a critic learning
+    rate of 1e-3 it went 0.06 → 555 → 1.7e6: Adam moves every weight by about the learning rate on its first steps,
+    and a unit summing 32,768 inputs (the paper's 512 × 4³ map) moves by thousands of times that."""
+    import dataclasses
+
+    import trimesh
+
+    from graspaug.geometry.voxelize import fit_grid, voxelize_solid
+    from graspaug.nets.ae_critic import AutoEncoder, Critic
+    from graspaug.pipeline.params.profiles import profile_params
+    from graspaug.training.autoencoder import train_ae_critic
+
+    params = profile_params("paper")
+    net = params.ae.net
+    assert (net.resolution, net.widths[-1]) == (64, 512)
+    meshes = [trimesh.creation.box((0.03, 0.05, 0.08)), trimesh.creation.capsule(height=0.05, radius=0.02)]
+    grids = [voxelize_solid(m.vertices, m.faces, fit_grid(m.bounds, 64, 1)) for m in meshes]
+    voxels = torch.from_numpy(np.stack(grids)[:, None])
+    train = dataclasses.replace(params.ae.train, epochs_critic=3, critic_warmup=3, batch_size=2)  # 3 critic steps
+    torch.manual_seed(0)
+    losses = []
+    train_ae_critic(
+        AutoEncoder(net), Critic(net), voxels, train, torch.device("cpu"), torch.Generator().manual_seed(0),
+        lambda epoch, logs: losses.append(logs["loss_critic"]),
+    )
+    assert len(losses) == 3 and np.isfinite(losses).all() and max(losses) <= 10 * losses[0], losses
