@@ -293,7 +293,12 @@ def test_the_paper_profiles_critic_does_not_diverge_at_64():
     torch.manual_seed(0)
     losses = []
     train_ae_critic(
-        AutoEncoder(net), Critic(net), voxels, train, torch.device("cpu"), torch.Generator().manual_seed(0),
+        AutoEncoder(net),
+        Critic(net),
+        voxels,
+        train,
+        torch.device("cpu"),
+        torch.Generator().manual_seed(0),
         lambda epoch, logs: losses.append(logs["loss_critic"]),
     )
     assert len(losses) == 3 and np.isfinite(losses).all() and max(losses) <= 10 * losses[0], losses
