@@ -5,7 +5,7 @@ with the ``paper`` profile's networks and learning rates (``profiles/paper.yaml`
 Dex-Net's GQ-CNN widths):
 
 1. voxelizes ``--train-shapes`` random train shapes and ``--test-shapes`` random test shapes at the profile's
-   resolution (solid occupancy, as the ``voxelize`` stage makes it);
+   resolution (solid occupancy, the profile's decoder output, as the ``voxelize`` stage makes it);
 2. phase 1, the plain AutoEncoder, ``--epochs-ae`` epochs: the loss per epoch, shapes/s, held-out voxel IoU;
 3. phase 2, the AE-Critic (eqs. 1–2), ``--epochs-critic`` epochs with the profile's warm-up (at most all but one of
    them): the critic loss per epoch (finite? its largest against its first), the critic's separation AUC on held-out

@@ -103,7 +103,8 @@ def pool_summary(
 
 def pool_makeup(rows) -> dict:
     """What a pool's kept shapes (their ``index.parquet`` rows: ``parent_a``, ``parent_b``, ``alpha``) are
-    made of: ``distinct_parents`` (base shapes that parent at least one) and ``alphas`` (weight → shapes)."""
+    made of: ``distinct_parents`` (base shapes that parent at least one; for ``primitives``, its assemblies) and
+    ``alphas`` (weight → shapes)."""
     parents = set(rows.parent_a) | set(rows.parent_b)
     counts = rows.alpha.value_counts().sort_index()
     return {"distinct_parents": len(parents), "alphas": {f"{a:g}": int(n) for a, n in counts.items()}}

@@ -157,7 +157,8 @@ class GeneratedSet:
     """A base set's generated shapes, ready to write.
 
     index : one row per kept shape in pool order (:func:`graspaug.augment.pool_tables.pool_tables` columns
-        plus ``rarity_vs_base``, the rarity of its latent against the base set)
+        plus ``rarity_vs_base``, the rarity of its latent against the base set; NaN for the warp and primitives
+        pools, whose shapes have no latent)
     rejects : one row per rejected decode (:data:`REJECT_COLUMNS`)
     base_table : the base set with its scores (:func:`graspaug.augment.pool_tables.base_scores_table`)
     kept : the kept decodes (Decoded, with their meshes in m), in ``index`` order
@@ -195,6 +196,8 @@ def generated_set(
     sources = {name: (base.ids, base.z) for name in pools}
     if recon_shapes is not None:
         sources["recon"] = (recon_shapes.ids, recon_shapes.z)
+    if "warp" in pools:  # a warp is its parent deformed: the parent's latent is not the warp's
+        sources["warp"] = (base.ids, np.full_like(base.z, np.nan))
     if "primitives" in pools:  # assembly k of the stream: no real parent, no latent
         n = PRIMITIVE_TRIES * needed
         sources["primitives"] = (
@@ -255,7 +258,8 @@ def example_decodes(pools: Pools, n_examples: int) -> list[Decoded]:
 
 def tsne_groups(base: BaseSet, index: pd.DataFrame, perplexity: float, seed: int) -> tuple[np.ndarray, list[str]]:
     """(xy (B + G, 2), groups (B + G,)): the t-SNE of the base latents followed by the G generated
-    ones (``index.z``), and each point's group (``base`` or ``generated (<selected_by>)``)."""
+    ones that have a latent (``index.z`` not NaN: not the warp and primitives pools), and each point's group
+    (``base`` or ``generated (<selected_by>)``)."""
     z = np.stack(index.z.to_numpy())
     known = np.isfinite(z).all(axis=1)  # a primitive assembly has no latent
     xy = tsne_2d(np.concatenate([base.z, z[known]]), perplexity, seed)

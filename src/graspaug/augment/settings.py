@@ -70,8 +70,8 @@ class GenerateSettings:
     )
     primitives: PrimitiveSettings = Field(
         default_factory=PrimitiveSettings,
-        description="The primitives pool (gqcnn.pools): random assemblies of 1-5 primitives, no real parent, sized by "
-        "the ingest rule.",
+        description="The primitives pool (gqcnn.pools): random assemblies of 1 to max_parts (5) primitives, no real "
+        "parent, sized by the ingest rule.",
     )
 
     @model_validator(mode="before")

@@ -2,10 +2,12 @@
 
 The ``primitives`` pool's shapes, independent of any real shape: the kind of training object procedural
 grasping datasets use. An assembly is 1 … ``max_parts`` primitives, each at a random orientation, the first at
-the origin and each next one centred inside the bounding sphere of an earlier one (so they overlap). Its solid
-is the union of the parts, ``min`` of their exact signed distances sampled on a grid of ``resolution`` cells
-along the assembly's largest extent, meshed by marching cubes at 0 (faces at sub-cell positions, so a box's
-faces stay flat), decimated towards a face budget and sized by the ingest rule.
+the origin and each next one centred within 0.6 of the bounding radius of an earlier one (usually touching it;
+a ring's hole or a thin part can leave it detached). Its solid is the union of the parts, ``min`` of their exact
+signed distances sampled on a grid of ``resolution`` cells along the largest side of the box around the parts'
+bounding spheres, meshed by marching cubes at 0 (faces at sub-cell positions, so a box's faces stay flat), cut to
+its largest piece (a detached part holding under 10% of the volume is dropped, more rejects the assembly),
+decimated towards a face budget and sized by the ingest rule.
 
 Each part's size is drawn in units of the assembly (the sizing fixes metres afterwards):
 
@@ -124,8 +126,9 @@ def assembly_field(parts: list[Primitive], resolution: int) -> tuple[np.ndarray,
 def assembly_mesh(
     parts: list[Primitive], resolution: int, size_rule: str, size_m: float, face_budget: int
 ) -> tuple[trimesh.Trimesh | None, str | None]:
-    """The closed surface of ``parts``' union (``resolution`` cells along its largest extent), at most
-    ``face_budget`` faces, sized so its ``size_rule`` extent is ``size_m`` m, centred on its centre of mass.
+    """The closed surface of ``parts``' union (``resolution`` cells along the largest side of the box around the
+    parts' bounding spheres), decimated towards ``face_budget`` faces, sized so its ``size_rule`` extent is
+    ``size_m`` m, centred on its centre of mass.
 
     Returns (mesh, None), or (None, reason) when the union is not one closed solid."""
     field, origin, pitch = assembly_field(parts, resolution)

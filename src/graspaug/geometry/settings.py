@@ -114,7 +114,11 @@ class WarpSettings:
     )
     shear: float = Field(0.3, ge=0, le=1, description="Shear: x and y move by k z, k uniform in [-shear, shear].")
     taper: float = Field(
-        0.3, ge=0, lt=1, description="Taper: x and y scale by 1 + t z / h (h: half the z extent), t in [-taper, taper]."
+        0.3,
+        ge=0,
+        lt=1,
+        description="Taper: x and y scale by 1 + t z / h (z from the middle of the z range, h: half that range), t in "
+        "[-taper, taper].",
     )
     bend_deg: float = Field(
         30.0,
@@ -140,6 +144,6 @@ class PrimitiveSettings:
         64,
         ge=16,
         le=256,
-        description="Field samples along an assembly's largest extent before marching cubes (exact distances: faces "
-        "land between samples, so 64 keeps a box's faces flat).",
+        description="Field samples along the largest side of the box around the parts' bounding spheres before "
+        "marching cubes (exact distances: faces land between samples, so 64 keeps a box's faces flat).",
     )

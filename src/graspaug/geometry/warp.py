@@ -6,7 +6,8 @@ The ``warp`` pool's augmentation, the handcrafted kind a researcher tries before
 
 1. an anisotropic scale ``diag(s)``, each ``s_i`` log-uniform in ``[1 / scale, scale]``;
 2. a shear ``x += k_x z``, ``y += k_y z``, each ``k`` uniform in ``[-shear, shear]``;
-3. a taper along z: ``x, y *= 1 + t z / h`` with ``h`` half the z extent, ``t`` uniform in ``[-taper, taper]``;
+3. a taper along z: ``x, y *= 1 + t z' / h`` with ``z'`` measured from the middle of the z range and ``h`` half
+   that range, ``t`` uniform in ``[-taper, taper]``;
 4. a bend of the z axis in the xz plane through ``φ`` uniform in ``[-bend, bend]`` degrees over the shape's
    largest extent ``L`` (curvature ``κ = φ / L``; with φ ≤ 45° the bending radius stays above ``L``, so no fold).
 
@@ -37,7 +38,7 @@ class Warp:
 
     scale : (3,) — factors along the frame's axes
     shear : (2,) — ``k_x``, ``k_y``: x and y move by ``k z``
-    taper : float — ``t``: x and y scale by ``1 + t z / h`` (h: half the z extent)
+    taper : float — ``t``: x and y scale by ``1 + t z' / h`` (z' from the middle of the z range, h half of it)
     bend_deg : float — ``φ``: the z axis bends through this angle over the largest extent, degrees
     """
 
@@ -90,7 +91,8 @@ def warp_mesh(
     mesh: trimesh.Trimesh, warp: Warp, size_rule: str, size_m: float, face_budget: int
 ) -> tuple[trimesh.Trimesh | None, str | None]:
     """``mesh`` (closed, m) under ``warp``, sized so its ``size_rule`` extent is ``size_m`` m and centred on its
-    centre of mass; at most ``face_budget`` faces after a smooth warp's subdivision.
+    centre of mass; after a smooth warp's subdivision, decimated towards ``face_budget`` faces (:func:`decimate`
+    keeps the finer mesh when no decimation stays closed).
 
     Returns (mesh, None), or (None, reason) when the result is not a closed solid in one piece.
     """

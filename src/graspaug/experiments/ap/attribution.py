@@ -31,7 +31,6 @@ from graspaug.experiments.ap.numbers import (
 from graspaug.experiments.stats import (
     ObjectBootstrap,
     draw_scope,
-    interval,
     nested_contrast,
     nested_indices,
     nested_interval,
@@ -81,7 +80,8 @@ def combine_draws(
     (:func:`nested_interval`) with ``per_draw`` (mean over seeds per draw) and ``meaning``; ``shares``: pool →
     augmented base size → the share of the real-shape gain that the pool gives (its mean gain over no augmentation,
     mean over ratios, divided by the real pool's; the ratio of the nested means and its percentile interval:
-    ``share``, ``low``, ``high``) and ``gain``, that gain as a contrast over draws; ``share``: the targeted pool's;
+    ``share``, ``low``, ``high``) and ``gain``, that gain as a contrast over draws (the declared
+    ``<pool>_vs_none@B`` where there is one); ``share``: the targeted pool's;
     ``draws``, ``seeds``
     """
     seeds = sorted({s for d in draws.values() for s in d})
@@ -142,7 +142,8 @@ def combine_draws(
             ratio = nested_means(r, indices) / nested_means(real_resampled, indices)
             low, high = percentile_interval(ratio)
             mean = float(f.mean() / real_full.mean())
-            gain = nested_contrast(nested_interval(f, r, rng))  # the pool's own gain: is it above zero?
+            declared = out.get(f"{pool}_vs_none@{b}")  # the same terms: one interval for one gain
+            gain = declared if declared is not None else nested_contrast(nested_interval(f, r, rng))
             shares.setdefault(pool, {})[str(b)] = {
                 "share": mean if np.isfinite(mean) else None,
                 "low": low,
@@ -223,19 +224,16 @@ def decomposition_markdown(result: dict, augment_base_sizes: Sequence[int], comm
 def recommendation(result: dict) -> list[str]:
     """A markdown table (one line each): per pool of ``result["shares"]`` (:func:`combine_draws`), its share of the
     real-shape gain at every augmented base size with its 95% interval, ordered by the share at the smallest base
-    size, and what the pool's own gain over no augmentation says (``gain``, a contrast over draws): a gain (its
-    interval above 0), a loss (below 0) or no detectable gain; then a sentence a user can act on."""
+    size, and what the pool's own gain over no augmentation says (``gain``, a contrast over draws, in
+    :func:`~graspaug.experiments.stats.verdict`'s words); then a sentence a user can act on."""
 
     def text(s: dict | None) -> str:
         if not s or s["share"] is None:
             return "-"
         return f"{s['share']:+.0%} " + ("[unbounded]" if s["low"] is None else f"[{s['low']:+.0%}, {s['high']:+.0%}]")
 
-    def says(s: dict | None) -> str:  # the pool's own gain over no augmentation, by its interval
-        low, high = (None, None) if not s else interval(s["gain"])
-        if low is None:
-            return "cannot tell"
-        return "a gain" if low > 0 else "a loss" if high < 0 else "no detectable gain"
+    def says(s: dict | None) -> str:  # the pool's own gain over no augmentation, in the one verdict's words
+        return "n/a" if not s or s["gain"]["mean"] is None else verdict(s["gain"])
 
     shares = result["shares"]
     sizes = sorted({b for by_size in shares.values() for b in by_size}, key=int)
@@ -254,13 +252,11 @@ def recommendation(result: dict) -> list[str]:
         f"| {p} | " + " | ".join(text(shares[p].get(b)) for b in sizes) + f" | {says(shares[p].get(first))} |"
         for p in order
     ]
-    gaining = [p for p in order if says(shares[p].get(first)) == "a gain"]
+    gaining = [p for p in order if says(shares[p].get(first)).startswith("a gain")]
     if gaining:
-        best = shares[gaining[0]][first]
-        advice = (
-            f"At B = {first} the pools that add AP with an interval above zero: {', '.join(gaining)}; "
-            f"{gaining[0]} adds the most, {best['share']:.0%} of as many real shapes' gain."
-        )
+        best = shares[gaining[0]][first]["share"]
+        most = "" if best is None else f"; {gaining[0]} adds the most, {best:.0%} of as many real shapes' gain"
+        advice = f"At B = {first} the pools that add AP with an interval above zero: {', '.join(gaining)}{most}."
     else:
         advice = "Add real shapes: no generated or procedural pool tried here adds AP with an interval above zero."
     return lines + [

@@ -261,7 +261,8 @@ HEADLINE = ("graspness_kept", "positive_share", "datapoints_per_shape", "datapoi
 
 def fidelity_headline(table: pd.DataFrame) -> dict[str, dict]:
     """Metrics files from :func:`fidelity_table`: ``<pool>_<figure>`` → ``mean``, ``lo``, ``hi`` (its
-    95% interval) for each figure of :data:`HEADLINE` a pool has (real shapes keep no parents' graspness)."""
+    95% interval) for each figure of :data:`HEADLINE` a pool has (real and primitive shapes have no parents, so no
+    graspness or datapoints kept)."""
 
     def value(v):
         return None if v is None or not np.isfinite(v) else round(float(v), 4)

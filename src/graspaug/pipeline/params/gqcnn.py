@@ -51,8 +51,9 @@ class GQCNNParams:
         "train shapes, the positive control), `recon` (the real pool's shapes passed through the AutoEncoder alone: "
         "what decoding and meshing cost), `blend` (the targeted pool's pairs and weights interpolated with no "
         "network, by mixing the parents' signed distance fields), `warp` (each targeted pair's nearer parent under a "
-        "random smooth deformation: scale, shear, taper, bend), `primitives` (random assemblies of 1-5 boxes, "
-        "cylinders, spheres, capsules and rings); `generate` makes the generated ones. `targeted` is always trained.",
+        "random smooth deformation: scale, shear, taper, bend), `primitives` (random assemblies of 1 to "
+        "generate.primitives.max_parts boxes, cylinders, spheres, capsules and rings); `generate` makes the generated "
+        "ones. `targeted` is always trained.",
     )
     members: int = Field(
         2,
