@@ -7,7 +7,8 @@ import sys as _sys
 
 def _import_pybullet_quietly() -> None:
     """Import pybullet with its C-level "pybullet build time: ..." banner on stderr silenced, so a command's output
-    is its own lines (the module is then cached for every ``import pybullet`` of this package)."""
+    is its own lines (the module is then cached for every ``import pybullet`` of this package). Without pybullet
+    (a GPU machine that trains networks only) the settings still import; a trial fails where it needs pybullet."""
     if "pybullet" in _sys.modules:
         return
     _sys.stderr.flush()
@@ -15,6 +16,8 @@ def _import_pybullet_quietly() -> None:
     try:
         _os.dup2(devnull, 2)
         import pybullet  # noqa: F401
+    except ImportError:
+        pass
     finally:
         _os.dup2(saved, 2)
         _os.close(saved)
