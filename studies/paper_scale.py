@@ -15,11 +15,19 @@ Dex-Net's GQ-CNN widths):
 5. writes each held-out shape's reconstruction before and after phase 2 as a mesh (``generate``'s recipe, OBJ, in
    ``meshes/``) so the fidelity figures (graspness kept, datapoints per shape) can be computed elsewhere.
 
-Everything goes to ``--out``: ``summary.json`` (settings, per-phase figures, seconds) and ``meshes/``. On a CPU keep
+Everything goes to ``--out``: ``summary.json`` (settings, per-phase figures, seconds), ``reconstructions.npz`` (the
+held-out ids, pitches and both reconstructions at 0.5, bit-packed) and, from a project, ``meshes/``. On a CPU keep
 it small (the defaults take about 15 minutes on 2 cores); on a GPU raise every count::
 
     python studies/paper_scale.py --project PROJECT [--device auto] [--train-shapes 24] [--test-shapes 12]
         [--epochs-ae 6] [--epochs-critic 3] [--gqcnn-steps 20] [--batch-size B] [--out studies/out/paper_scale]
+
+A GPU machine with no project (and no pybullet or trimesh) takes the inputs packed on the CPU side: ``--pack FILE``
+writes the chosen shapes' grids bit-packed and ``--crops`` rendered train crops in float16 into one .npz (700 + 260
+shapes at 64³ and 8,000 crops: a few MB compressed), and ``--packed FILE`` trains from it::
+
+    python studies/paper_scale.py --project PROJECT --train-shapes 700 --test-shapes 260 --pack inputs.npz
+    python studies/paper_scale.py --packed inputs.npz --device cuda --epochs-ae 150 --epochs-critic 20 ...
 """
 
 from __future__ import annotations
@@ -35,10 +43,7 @@ import numpy as np
 import torch
 
 from graspaug.device import resolve_device
-from graspaug.geometry.from_voxels import mesh_decoded
-from graspaug.geometry.voxelize import fit_grid, voxelize_solid
-from graspaug.io.meshes import mesh_path, read_mesh, write_obj
-from graspaug.io.tables import read_table
+from graspaug.geometry.voxelize import fit_grid, pack_bits, unpack_bits, voxelize_solid
 from graspaug.nets.ae_critic import AutoEncoder, Critic
 from graspaug.nets.gqcnn import GQCNN
 from graspaug.parallel import parallel_map
@@ -47,12 +52,12 @@ from graspaug.training.autoencoder import (
     critic_separation,
     decode,
     encode,
+    occupied,
     reconstruction_iou,
     train_ae_critic,
     train_autoencoder,
 )
-from graspaug.training.gqcnn import train_gqcnn
-from graspaug.training.gqcnn_data import shapes_datapoints
+from graspaug.training.gqcnn import GraspArrays, train_gqcnn
 
 log = logging.getLogger("paper_scale")
 OUT = Path(__file__).resolve().parent / "out" / "paper_scale"
@@ -60,19 +65,68 @@ OUT = Path(__file__).resolve().parent / "out" / "paper_scale"
 
 def grid_of(job: tuple[Path, int, int]) -> tuple[np.ndarray, float]:
     """A shape file's solid occupancy (R, R, R) bool and its voxel pitch, m."""
+    from graspaug.io.meshes import read_mesh
+
     path, resolution, margin = job
     mesh = read_mesh(path)
     grid = fit_grid(mesh.bounds, resolution, margin)
     return voxelize_solid(mesh.vertices, mesh.faces, grid), grid.pitch
 
 
-def write_reconstructions(ae, voxels, pitches, ids, decode_settings, device, folder: Path) -> int:
-    """Each grid's reconstruction meshed by ``generate``'s recipe into ``folder``/<id>.obj; how many meshed."""
+def project_inputs(args, resolution: int, margin: int) -> dict:
+    """The chosen shapes' grids (bool) and pitches, and the train shapes' rendered crops (``--crops`` at most)."""
+    from graspaug.io.meshes import mesh_path
+    from graspaug.io.tables import read_table
+    from graspaug.training.gqcnn_data import shapes_datapoints
+
+    shapes = read_table(args.project / "data/shapes.parquet")
+    rng = np.random.default_rng(args.seed)
+    out = {}
+    for split, n in (("train", args.train_shapes), ("test", args.test_shapes)):
+        ids = sorted(rng.choice(shapes.shape_id[shapes.split == split].to_numpy(), size=n, replace=False))
+        jobs = [(mesh_path(args.project / "data/shapes", s), resolution, margin) for s in ids]
+        got = parallel_map(grid_of, jobs, args.workers, f"voxelize {split} at {resolution}³")
+        out |= {f"{split}_ids": np.array(ids), f"{split}_grids": np.stack([g for g, _ in got])}
+        out[f"{split}_pitches"] = np.array([p for _, p in got])
+    crops, _ = shapes_datapoints(args.project / "data/gqcnn/original", list(out["train_ids"]))
+    keep = np.sort(rng.permutation(len(crops))[: args.crops])
+    out["crops"] = GraspArrays(crops.images[keep], crops.z[keep], crops.labels[keep])
+    return out
+
+
+def write_pack(inputs: dict, path: Path) -> None:
+    """``inputs`` (:func:`project_inputs`) as one compressed .npz: grids bit-packed, crops in float16."""
+    crops = inputs["crops"]
+    arrays = {k: v for k, v in inputs.items() if k != "crops" and not k.endswith("_grids")}
+    arrays |= {f"{s}_grids": pack_bits(inputs[f"{s}_grids"]) for s in ("train", "test")}
+    arrays |= {"resolution": inputs["train_grids"].shape[1], "crop_images": crops.images.astype(np.float16)}
+    np.savez_compressed(path, crop_z=crops.z, crop_labels=crops.labels, **arrays)
+
+
+def read_pack(path: Path) -> dict:
+    """The inputs a :func:`write_pack` file holds, as :func:`project_inputs` gives them."""
+    f = np.load(path)
+    r = int(f["resolution"])
+    out = {k: f[k] for k in f.files if k.endswith(("_ids", "_pitches"))}
+    out |= {f"{s}_grids": unpack_bits(f[f"{s}_grids"], r) for s in ("train", "test")}
+    out["crops"] = GraspArrays(f["crop_images"].astype(np.float32), f["crop_z"], f["crop_labels"])
+    return out
+
+
+def decoded_grids(ae, voxels: torch.Tensor, device) -> np.ndarray:
+    """Each grid's reconstruction by ``ae`` (N, R, R, R), occupied where the decoder says so."""
+    return occupied(decode(ae, encode(ae, voxels, device), device), ae.cfg.output)
+
+
+def write_meshes(grids: np.ndarray, inputs: dict, decode_settings, folder: Path) -> int:
+    """Each reconstruction meshed by ``generate``'s recipe into ``folder``/<id>.obj; how many meshed."""
+    from graspaug.geometry.from_voxels import mesh_decoded
+    from graspaug.io.meshes import write_obj
+
     folder.mkdir(parents=True, exist_ok=True)
-    grids = decode(ae, encode(ae, voxels, device), device)
     meshed = 0
-    for grid, pitch, shape_id in zip(grids, pitches, ids):
-        _, mesh, reason = mesh_decoded(grid, pitch, decode_settings)
+    for grid, pitch, shape_id in zip(grids, inputs["test_pitches"], inputs["test_ids"]):
+        _, mesh, reason = mesh_decoded(grid.astype(np.float32), float(pitch), decode_settings)
         if reason is None:
             write_obj(mesh, folder / f"{shape_id}.obj")
             meshed += 1
@@ -81,7 +135,10 @@ def write_reconstructions(ae, voxels, pitches, ids, decode_settings, device, fol
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--project", type=Path, required=True, help="a project where render@original has run")
+    parser.add_argument("--project", type=Path, help="a project where render@original has run")
+    parser.add_argument("--pack", type=Path, help="only write the chosen inputs to this .npz (to carry to a GPU)")
+    parser.add_argument("--packed", type=Path, help="read the inputs from a --pack file instead of a project")
+    parser.add_argument("--crops", type=int, default=8000, help="rendered train crops packed (%(default)s)")
     parser.add_argument("--device", default="auto", help="auto, cpu or cuda (%(default)s)")
     parser.add_argument("--train-shapes", type=int, default=24)
     parser.add_argument("--test-shapes", type=int, default=12)
@@ -104,24 +161,15 @@ def main() -> None:
         batch_size=args.batch_size or params.ae.train.batch_size,
     )
 
-    shapes = read_table(args.project / "data/shapes.parquet")
-    rng = np.random.default_rng(args.seed)
-    chosen = {
-        split: sorted(rng.choice(shapes.shape_id[shapes.split == split].to_numpy(), size=n, replace=False))
-        for split, n in (("train", args.train_shapes), ("test", args.test_shapes))
-    }
-    margin = params.voxelize.margin
-    grids = {
-        split: parallel_map(
-            grid_of,
-            [(mesh_path(args.project / "data/shapes", s), net.resolution, margin) for s in ids],
-            args.workers,
-            f"voxelize {split} at {net.resolution}³",
-        )
-        for split, ids in chosen.items()
-    }
-    voxels = {split: torch.from_numpy(np.stack([g for g, _ in got])[:, None]) for split, got in grids.items()}
-    seconds = {"voxelize": time.perf_counter() - start}
+    if (args.project is None) == (args.packed is None):
+        parser.error("give --project (a project where render@original has run) or --packed (a --pack file)")
+    inputs = read_pack(args.packed) if args.packed else project_inputs(args, net.resolution, params.voxelize.margin)
+    if args.pack:
+        write_pack(inputs, args.pack)
+        log.info("packed %s (%.1f MB)", args.pack, args.pack.stat().st_size / 1e6)
+        return
+    voxels = {split: torch.from_numpy(inputs[f"{split}_grids"][:, None]) for split in ("train", "test")}
+    seconds = {"inputs": time.perf_counter() - start}
 
     torch.manual_seed(args.seed)
     ae, critic, gen = AutoEncoder(net), Critic(net), torch.Generator().manual_seed(args.seed)
@@ -130,10 +178,7 @@ def main() -> None:
     ae_rate = train_autoencoder(ae, voxels["train"], train_cfg, device, gen, lambda e, m: logs["ae"].append(m))
     seconds["phase_1"] = time.perf_counter() - t
     iou_before = reconstruction_iou(ae, voxels["test"], device)
-    pitches = [p for _, p in grids["test"]]
-    before = write_reconstructions(
-        ae, voxels["test"], pitches, chosen["test"], params.generate.decode, device, args.out / "meshes" / "ae"
-    )
+    decoded = {"ae": decoded_grids(ae, voxels["test"], device)}
     t = time.perf_counter()
     critic_rate = train_ae_critic(
         ae, critic, voxels["train"], train_cfg, device, gen, lambda e, m: logs["ae_critic"].append(m)
@@ -141,14 +186,23 @@ def main() -> None:
     seconds["phase_2"] = time.perf_counter() - t
     separation = critic_separation(ae, critic, voxels["test"], device, n_shapes=len(voxels["test"]))
     iou_after = reconstruction_iou(ae, voxels["test"], device)
-    after = write_reconstructions(
-        ae, voxels["test"], pitches, chosen["test"], params.generate.decode, device, args.out / "meshes" / "ae_critic"
+    decoded["ae_critic"] = decoded_grids(ae, voxels["test"], device)
+    args.out.mkdir(parents=True, exist_ok=True)
+    np.savez_compressed(  # held-out reconstructions at 0.5, bit-packed, for the fidelity figures elsewhere
+        args.out / "reconstructions.npz",
+        ids=inputs["test_ids"],
+        pitches=inputs["test_pitches"],
+        **{name: pack_bits(grids) for name, grids in decoded.items()},
     )
+    meshed = {}
+    if args.project is not None:  # meshes need trimesh and the corpus' decode settings: on the CPU side
+        for name, grids in decoded.items():
+            meshed[name] = write_meshes(grids, inputs, params.generate.decode, args.out / "meshes" / name)
     critic_losses = [m["loss_critic"] for m in logs["ae_critic"]]
 
     gq_rate = None
     if args.gqcnn_steps > 0:
-        data, _ = shapes_datapoints(args.project / "data/gqcnn/original", chosen["train"])
+        data = inputs["crops"]
         gq_cfg = dataclasses.replace(
             params.gqcnn.train, min_steps=args.gqcnn_steps, max_steps=args.gqcnn_steps, evals=1
         )
@@ -158,10 +212,10 @@ def main() -> None:
         gq_rate = args.gqcnn_steps * gq_cfg.batch_size / seconds["gqcnn"]
 
     summary = {
-        "settings": vars(args) | {"project": str(args.project), "out": str(args.out), "device": str(device)},
+        "settings": {k: str(v) if isinstance(v, Path) else v for k, v in vars(args).items()} | {"device": str(device)},
         "net": {"resolution": net.resolution, "widths": net.widths, "z_dim": net.z_dim},
         "train": dataclasses.asdict(train_cfg),
-        "phase_1": {"shapes_per_s": ae_rate, "loss": logs["ae"], "test_iou": iou_before, "meshed": before},
+        "phase_1": {"shapes_per_s": ae_rate, "loss": logs["ae"], "test_iou": iou_before, "meshed": meshed.get("ae")},
         "phase_2": {
             "shapes_per_s": critic_rate,
             "loss": logs["ae_critic"],
@@ -169,12 +223,11 @@ def main() -> None:
             "critic_loss_growth": max(critic_losses) / critic_losses[0] if critic_losses else None,
             "separation": separation,
             "test_iou": iou_after,
-            "meshed": after,
+            "meshed": meshed.get("ae_critic"),
         },
         "gqcnn": {"samples_per_s": gq_rate, "filters": params.gqcnn.net.filters, "fc": params.gqcnn.net.fc},
         "seconds": seconds | {"all": time.perf_counter() - start},
     }
-    args.out.mkdir(parents=True, exist_ok=True)
     (args.out / "summary.json").write_text(json.dumps(summary, indent=1, default=float))
     log.info(
         "phase 1: IoU %.3f, %.1f shapes/s; phase 2: critic loss %s, AUC %.3f, IoU %.3f, %.1f shapes/s; GQ-CNN %s "
