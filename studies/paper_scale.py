@@ -43,7 +43,7 @@ import numpy as np
 import torch
 
 from graspaug.device import resolve_device
-from graspaug.geometry.voxelize import fit_grid, pack_bits, unpack_bits, voxelize_solid
+from graspaug.geometry.voxelize import pack_bits, unpack_bits
 from graspaug.nets.ae_critic import AutoEncoder, Critic
 from graspaug.nets.gqcnn import GQCNN
 from graspaug.parallel import parallel_map
@@ -63,20 +63,11 @@ log = logging.getLogger("paper_scale")
 OUT = Path(__file__).resolve().parent / "out" / "paper_scale"
 
 
-def grid_of(job: tuple[Path, int, int]) -> tuple[np.ndarray, float]:
-    """A shape file's solid occupancy (R, R, R) bool and its voxel pitch, m."""
-    from graspaug.io.meshes import read_mesh
-
-    path, resolution, margin = job
-    mesh = read_mesh(path)
-    grid = fit_grid(mesh.bounds, resolution, margin)
-    return voxelize_solid(mesh.vertices, mesh.faces, grid), grid.pitch
-
-
 def project_inputs(args, resolution: int, margin: int) -> dict:
     """The chosen shapes' grids (bool) and pitches, and the train shapes' rendered crops (``--crops`` at most)."""
     from graspaug.io.meshes import mesh_path
     from graspaug.io.tables import read_table
+    from graspaug.pipeline.stages.voxelize import voxelize_file  # the voxelize stage's own grid of one file
     from graspaug.training.gqcnn_data import shapes_datapoints
 
     shapes = read_table(args.project / "data/shapes.parquet")
@@ -85,7 +76,9 @@ def project_inputs(args, resolution: int, margin: int) -> dict:
     for split, n in (("train", args.train_shapes), ("test", args.test_shapes)):
         ids = sorted(rng.choice(shapes.shape_id[shapes.split == split].to_numpy(), size=n, replace=False))
         jobs = [(mesh_path(args.project / "data/shapes", s), resolution, margin) for s in ids]
-        got = parallel_map(grid_of, jobs, args.workers, f"voxelize {split} at {resolution}³")
+        got = parallel_map(
+            lambda job: voxelize_file(*job)[:2], jobs, args.workers, f"voxelize {split} at {resolution}³"
+        )
         out |= {f"{split}_ids": np.array(ids), f"{split}_grids": np.stack([g for g, _ in got])}
         out[f"{split}_pitches"] = np.array([p for _, p in got])
     crops, _ = shapes_datapoints(args.project / "data/gqcnn/original", list(out["train_ids"]))

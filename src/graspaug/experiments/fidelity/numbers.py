@@ -147,11 +147,14 @@ def pool_shapes(
     if parents is not None:
         p = parents.set_index("shape_id").loc[ids]
         alpha = p.alpha.to_numpy(float)
-        g_a, g_b = (p[c].map(lambda s: graspness.get(s, 0.0)).to_numpy(float) for c in ("parent_a", "parent_b"))
-        mixed = (1 - alpha) * g_a + alpha * g_b
+
+        def mix(of: Mapping[str, float]) -> np.ndarray:  # a parent figure mixed as the child mixes its parents
+            a, b = (p[c].map(lambda s: of.get(s, 0.0)).to_numpy(float) for c in ("parent_a", "parent_b"))
+            return (1 - alpha) * a + alpha * b
+
+        mixed = mix(graspness)
         if parent_counts is not None:
-            n_a, n_b = (p[c].map(lambda s: parent_counts.get(s, 0)).to_numpy(float) for c in ("parent_a", "parent_b"))
-            mixed_counts = (1 - alpha) * n_a + alpha * n_b
+            mixed_counts = mix(parent_counts)
         distinct = len(set(p.parent_a) | set(p.parent_b))
         alphas = {f"{a:g}": int(n) for a, n in p.alpha.value_counts().sort_index().items()}
     return PoolShapes(
