@@ -28,6 +28,13 @@ shapes at 64³ and 8,000 crops: a few MB compressed), and ``--packed FILE`` trai
 
     python studies/paper_scale.py --project PROJECT --train-shapes 700 --test-shapes 260 --pack inputs.npz
     python studies/paper_scale.py --packed inputs.npz --device cuda --epochs-ae 150 --epochs-critic 20 ...
+
+Back on the CPU, ``--label reconstructions.npz --project PROJECT`` (the project the pack came from) meshes each
+held-out reconstruction by ``generate``'s recipe (the profile's ``generate.decode``), labels its grasps and the
+original's as the ``grasps`` stage does (the project's ``grasps`` params and ``seed``) and writes, per phase,
+the graspness kept (after / before over the shapes that meshed, Fieller 95%) to ``--out``/``label.json``::
+
+    python studies/paper_scale.py --label OUT/reconstructions.npz --project PROJECT [--workers 2]
 """
 
 from __future__ import annotations
@@ -36,6 +43,7 @@ import argparse
 import dataclasses
 import json
 import logging
+import tempfile
 import time
 from pathlib import Path
 
@@ -126,6 +134,58 @@ def write_meshes(grids: np.ndarray, inputs: dict, decode_settings, folder: Path)
     return meshed
 
 
+def label_shape(job: tuple, project: Path, phases: tuple[str, ...], decode, grasps: tuple) -> dict:
+    """One held-out shape's graspness, original and per phase's reconstruction (NaN where it did not mesh)."""
+    from roundtrip_ceiling import mesh_graspness  # a study beside this one (studies/ is on the path)
+
+    from graspaug.geometry.from_voxels import mesh_decoded
+    from graspaug.io.meshes import mesh_path, write_obj
+    from graspaug.pipeline.paths import GENERATED_SUFFIX
+
+    shape_id, pitch, grids = job
+    original = mesh_graspness(mesh_path(project / "data/shapes", shape_id), shape_id, *grasps)
+    row = {"shape_id": shape_id, "original": original}
+    with tempfile.TemporaryDirectory() as folder:
+        for phase, grid in zip(phases, grids):
+            _, mesh, reason = mesh_decoded(grid.astype(np.float32), float(pitch), decode)
+            row[phase] = (float("nan"), 0)
+            if reason is None:
+                file = mesh_path(folder, f"{shape_id}_{phase}", GENERATED_SUFFIX)
+                write_obj(mesh, file)
+                row[phase] = mesh_graspness(file, shape_id, *grasps)
+    return row
+
+
+def label_reconstructions(path: Path, project: Path, decode, workers: int, out: Path) -> None:
+    """Graspness kept by the held-out reconstructions in ``path`` (a ``reconstructions.npz``), per phase: the
+    table printed and written to ``out``/``label.json``."""
+    import pandas as pd
+    from roundtrip_ceiling import kept, markdown
+
+    from graspaug.pipeline.params.model import load_params
+
+    f = np.load(path)
+    phases = tuple(k for k in ("ae", "ae_critic") if k in f.files)
+    grids = {k: unpack_bits(f[k], round((8 * f[k].shape[1]) ** (1 / 3))) for k in phases}  # bit-packed R³
+    params = load_params(project / "params.yaml")
+    grasps = (params.grasps, params.seed)
+    jobs = [(s, p, [grids[k][i] for k in phases]) for i, (s, p) in enumerate(zip(f["ids"], f["pitches"]))]
+    start = time.perf_counter()
+    rows = parallel_map(lambda job: label_shape(job, project, phases, decode, grasps), jobs, workers, "label")
+    before = np.array([r["original"][0] for r in rows])
+    table = []
+    for phase in phases:
+        after = np.array([r[phase][0] for r in rows])
+        meshed = np.isfinite(after)
+        table.append({"variant": phase, "shapes": len(rows), "meshed": int(meshed.sum())})
+        table[-1] |= kept(after[meshed], before[meshed])
+    out.mkdir(parents=True, exist_ok=True)
+    summary = {"reconstructions": str(path), "project": str(project), "decode": dataclasses.asdict(decode)}
+    summary |= {"n_grasps": params.grasps.sampler.n_grasps, "rows": table, "seconds": time.perf_counter() - start}
+    (out / "label.json").write_text(json.dumps(summary, indent=1, default=float))
+    print(markdown(pd.DataFrame(table)))
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--project", type=Path, help="a project where render@original has run")
@@ -141,10 +201,15 @@ def main() -> None:
     parser.add_argument("--batch-size", type=int, default=None, help="AE batch (default: the profile's)")
     parser.add_argument("--workers", type=int, default=2, help="processes for voxelizing (%(default)s)")
     parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--label", type=Path, help="a reconstructions.npz to mesh and label (needs --project)")
     parser.add_argument("--out", type=Path, default=OUT)
     args = parser.parse_args()
     logging.basicConfig(level=logging.INFO, format="%(message)s")
     params = profile_params("paper")
+    if args.label:
+        if args.project is None:
+            parser.error("--label needs --project: the project whose shapes the reconstructions are")
+        return label_reconstructions(args.label, args.project, params.generate.decode, args.workers, args.out)
     net, device, start = params.ae.net, resolve_device(args.device), time.perf_counter()
     train_cfg = dataclasses.replace(
         params.ae.train,
@@ -157,6 +222,7 @@ def main() -> None:
     if (args.project is None) == (args.packed is None):
         parser.error("give --project (a project where render@original has run) or --packed (a --pack file)")
     inputs = read_pack(args.packed) if args.packed else project_inputs(args, net.resolution, params.voxelize.margin)
+    args.train_shapes, args.test_shapes = len(inputs["train_ids"]), len(inputs["test_ids"])  # as read (--packed)
     if args.pack:
         write_pack(inputs, args.pack)
         log.info("packed %s (%.1f MB)", args.pack, args.pack.stat().st_size / 1e6)

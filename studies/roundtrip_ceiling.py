@@ -81,6 +81,29 @@ def reconstructions(mesh, margin: int, decode, truncation: float) -> tuple[dict,
     return meshes, seconds
 
 
+def mesh_graspness(file: Path, shape_id: str, grasps, seed: int) -> tuple[float, int]:
+    """The share of positive grasps of the mesh in ``file`` and how many were labelled, as the ``grasps`` stage
+    labels shape ``shape_id`` (its ``grasps`` params and ``seed``)."""
+    table, _ = grasps_of_shape(file, shape_id, grasps, seed)
+    score, count = graspness(table.success.to_numpy(), np.zeros(len(table), dtype=np.int64), 1)
+    return float(score[0]), int(count[0])
+
+
+def kept(after: np.ndarray, before: np.ndarray) -> dict:
+    """Paired graspness after / before over shapes: the ratio of means with its Fieller 95% interval and the mean
+    difference with its 95% t half-width."""
+    ratio, diff = fieller_interval(after, before), t_interval(after - before)
+    return {
+        "graspness_before": float(before.mean()),
+        "graspness_after": float(after.mean()),
+        "kept": ratio["ratio"],
+        "kept_low": ratio["low"],
+        "kept_high": ratio["high"],
+        "difference": diff["mean"],
+        "difference_half_width": None if diff["high"] is None else diff["high"] - diff["mean"],
+    }
+
+
 def shape_rows(job: tuple[Path, str], margin: int, decode, grasps, seed: int, truncation: float) -> tuple[list, dict]:
     """One shape's per-variant rows (graspness, grasps, why no mesh) and the seconds of its grid steps."""
     path, shape_id = job
@@ -94,9 +117,8 @@ def shape_rows(job: tuple[Path, str], margin: int, decode, grasps, seed: int, tr
                 if variant != "original":
                     file = mesh_path(folder, f"{shape_id}_{variant.replace(' ', '_')}", GENERATED_SUFFIX)
                     write_obj(mesh, file)
-                table, _ = grasps_of_shape(file, shape_id, grasps, seed)
-                score, count = graspness(table.success.to_numpy(), np.zeros(len(table), dtype=np.int64), 1)
-                row |= {"graspness": float(score[0]), "grasps": int(count[0]), "faces": len(mesh.faces)}
+                score, count = mesh_graspness(file, shape_id, grasps, seed)
+                row |= {"graspness": score, "grasps": count, "faces": len(mesh.faces)}
             rows.append(row)
     return rows, seconds
 
@@ -108,23 +130,10 @@ def summarize(per_shape: pd.DataFrame) -> pd.DataFrame:
     for variant in VARIANTS:
         part = per_shape[per_shape.variant == variant].set_index("shape_id")
         after = part.graspness[part.meshed]
-        x, y = after.to_numpy(), before[after.index].to_numpy()
-        ratio = fieller_interval(x, y)
-        diff = t_interval(x - y)
         rows.append(
-            {
-                "variant": variant,
-                "shapes": len(part),
-                "meshed": int(part.meshed.sum()),
-                "graspness_before": float(y.mean()),
-                "graspness_after": float(x.mean()),
-                "kept": ratio["ratio"],
-                "kept_low": ratio["low"],
-                "kept_high": ratio["high"],
-                "difference": diff["mean"],
-                "difference_half_width": None if diff["high"] is None else diff["high"] - diff["mean"],
-                "grasps_after_mean": float(part.grasps[part.meshed].mean()),
-            }
+            {"variant": variant, "shapes": len(part), "meshed": int(part.meshed.sum())}
+            | kept(after.to_numpy(), before[after.index].to_numpy())
+            | {"grasps_after_mean": float(part.grasps[part.meshed].mean())}
         )
     return pd.DataFrame(rows)
 
