@@ -10,6 +10,7 @@ from graspaug.training.autoencoder import (
     AETrainConfig,
     critic_separation,
     encode,
+    phase_1_lr,
     reconstruction_iou,
     train_ae_critic,
     train_autoencoder,
@@ -81,6 +82,13 @@ def _train_twice_state(seed: int) -> dict[str, torch.Tensor]:
         **{f"ae.{k}": v for k, v in ae.state_dict().items()},
         **{f"c.{k}": v for k, v in critic.state_dict().items()},
     }
+
+
+def test_the_cosine_schedule_falls_from_lr_ae_to_half_at_mid_training_and_constant_stays():
+    cosine = train_settings(epochs_ae=10, lr_ae=1e-3, lr_schedule="cosine")
+    assert [phase_1_lr(cosine, e) for e in (0, 5)] == pytest.approx([1e-3, 5e-4])
+    assert phase_1_lr(cosine, 9) == pytest.approx(1e-3 * 0.5 * (1 + np.cos(np.pi * 0.9)))
+    assert {phase_1_lr(train_settings(epochs_ae=10, lr_ae=1e-3), e) for e in range(10)} == {1e-3}
 
 
 def test_same_seed_gives_identical_weights():

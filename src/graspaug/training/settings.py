@@ -25,6 +25,13 @@ class AETrainConfig:
         ),
     )
     lr_ae: float = Field(1e-3, gt=0, description="Phase 1 Adam learning rate (paper: 1e-3).")
+    lr_schedule: Literal["constant", "cosine"] = Field(
+        "constant",
+        description=(
+            "Phase 1 learning rate over the epochs: `constant` (lr_ae throughout, the paper's) or `cosine` "
+            "(lr_ae · ½(1 + cos(π e / epochs_ae)) in epoch e, from lr_ae down towards 0)."
+        ),
+    )
     lr_ae_critic: float = Field(1e-4, gt=0, description="Phase 2 Adam learning rate of the AutoEncoder (paper: 1e-4).")
     lr_critic: float = Field(1e-3, gt=0, description="Phase 2 Adam learning rate of the Critic (paper: 1e-3).")
     gamma: float = Field(
