@@ -1,13 +1,14 @@
 """How many phase-1 epochs, with which learning-rate schedule, does the default AutoEncoder need?
 
-The default network (``ae.net`` of the default params: 32³, the decoder of ``ae.net.output``) is trained on a
+The default network (``ae.net`` of the default params: 32³; its decoder of the packed grids' kind) is trained on a
 project's train shapes less ``--val-shapes`` of them held out for validation (never the test split), once per
 entry of ``--runs`` (``SCHEDULE:EPOCHS``: ``constant:90``, ``cosine:45`` ...; ``ae.train.lr_schedule``), from the
 same initial weights and batches' seed. Every ``--every`` epochs (and the last) it logs the validation voxel IoU
 (insides: :func:`graspaug.training.autoencoder.reconstruction_iou`) and reconstruction loss, and the seconds spent.
 
 A GPU machine with no project takes the grids packed here (``--pack FILE``: the train split's grids of the
-project's ``data/voxels.npz``, int8 signed distances or bit-packed occupancy, and the validation choice)::
+project's ``data/voxels.npz`` of its own ``ae.net.output``, int8 signed distances or bit-packed occupancy, and the
+validation choice)::
 
     python studies/ae_schedule.py --project PROJECT --pack studies/out/ae_schedule_inputs.npz
     python studies/ae_schedule.py --packed studies/out/ae_schedule_inputs.npz --device cuda \\
@@ -29,25 +30,28 @@ import numpy as np
 import torch
 
 from graspaug.device import resolve_device
+from graspaug.geometry.voxelize import pack_bits, unpack_bits
 from graspaug.nets.ae_critic import AutoEncoder, reconstruction_loss
+from graspaug.pipeline.params.model import load_params
 from graspaug.pipeline.params.profiles import profile_params
-from graspaug.training.autoencoder import reconstruction_iou, train_autoencoder
+from graspaug.training.autoencoder import reconstruction_iou, train_autoencoder, voxel_grids
 
 log = logging.getLogger("ae_schedule")
 OUT = Path(__file__).resolve().parent / "out" / "ae_schedule"
 
 
-def pack(project: Path, val_shapes: int, seed: int, output: str, path: Path) -> None:
-    """The project's train-split grids (int8 distances × 127 / truncation, or occupancy bits) and which are held out."""
-    from graspaug.training.autoencoder import voxel_grids
-
+def pack(project: Path, val_shapes: int, seed: int, path: Path) -> str:
+    """The project's train-split grids of its own ``ae.net.output`` (int8 distances × 127 / truncation, or
+    bit-packed occupancy) and which are held out; returns that output."""
+    output = load_params(project / "params.yaml").ae.net.output
     ids, split, grids = voxel_grids(project / "data/voxels.npz", project / "data/shapes.parquet", output)
     train = split == "train"
     val = np.zeros(int(train.sum()), dtype=bool)
     val[np.random.default_rng(seed).choice(len(val), size=val_shapes, replace=False)] = True
     grids = grids[torch.from_numpy(train)].numpy()[:, 0]
-    stored = np.rint(grids * 127).astype(np.int8) if output == "sdf" else np.packbits(grids.astype(bool), axis=1)
+    stored = np.rint(grids * 127).astype(np.int8) if output == "sdf" else pack_bits(grids.astype(bool))
     np.savez_compressed(path, ids=ids[train], val=val, grids=stored, output=output, resolution=grids.shape[-1])
+    return output
 
 
 def unpack(path: Path) -> tuple[str, np.ndarray, torch.Tensor]:
@@ -57,7 +61,7 @@ def unpack(path: Path) -> tuple[str, np.ndarray, torch.Tensor]:
     if output == "sdf":
         grids = torch.from_numpy(f["grids"].astype(np.float32) / 127)
     else:
-        grids = torch.from_numpy(np.unpackbits(f["grids"], axis=1)[:, : r**3].reshape(-1, r, r, r))
+        grids = torch.from_numpy(unpack_bits(f["grids"], r).astype(np.uint8))
     return output, f["val"], grids[:, None]
 
 
@@ -78,8 +82,8 @@ def main() -> None:
     if args.pack:
         if args.project is None:
             parser.error("--pack needs --project")
-        pack(args.project, args.val_shapes, args.seed, params.ae.net.output, args.pack)
-        log.info("packed %s (%.1f MB)", args.pack, args.pack.stat().st_size / 1e6)
+        output = pack(args.project, args.val_shapes, args.seed, args.pack)
+        log.info("packed %s (%s, %.1f MB)", args.pack, output, args.pack.stat().st_size / 1e6)
         return
     if args.packed is None:
         parser.error("give --packed (a --pack file), or --project with --pack")
@@ -93,7 +97,7 @@ def main() -> None:
         torch.manual_seed(args.seed)
         ae, logs, start = AutoEncoder(net), [], time.perf_counter()
 
-        def validate(epoch: int, metrics: dict, ae=ae, logs=logs, start=start, cfg=cfg) -> None:
+        def validate(epoch: int, metrics: dict) -> None:  # called within this run's training
             if (epoch + 1) % args.every and epoch + 1 != cfg.epochs_ae:
                 return
             with torch.no_grad():
@@ -108,7 +112,8 @@ def main() -> None:
         runs.append({"run": run, "shapes_per_s": rate, "log": logs})
     args.out.mkdir(parents=True, exist_ok=True)
     settings = {k: str(v) if isinstance(v, Path) else v for k, v in vars(args).items()}
-    summary = {"settings": settings | {"device": str(device), "train": len(train_x), "val": len(val_x)}, "runs": runs}
+    settings |= {"device": str(device), "output": output, "train": len(train_x), "val": len(val_x)}
+    summary = {"settings": settings, "runs": runs}
     (args.out / "summary.json").write_text(json.dumps(summary, indent=1))
     for r in runs:
         print(f"{r['run']:>14}: val IoU {r['log'][-1]['val_iou']:.4f}, {r['shapes_per_s']:.0f} shapes/s")

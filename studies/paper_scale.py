@@ -119,27 +119,30 @@ def decoded_grids(ae, voxels: torch.Tensor, device) -> np.ndarray:
     return occupied(decode(ae, encode(ae, voxels, device), device), ae.cfg.output)
 
 
-def write_meshes(grids: np.ndarray, inputs: dict, decode_settings, folder: Path) -> int:
-    """Each reconstruction meshed by ``generate``'s recipe into ``folder``/<id>.obj; how many meshed."""
+def write_mesh(grid: np.ndarray, pitch: float, decode_settings, path: Path) -> bool:
+    """One reconstruction (R, R, R) bool meshed by ``generate``'s recipe and written to ``path`` (OBJ); whether it
+    meshed."""
     from graspaug.geometry.from_voxels import mesh_decoded
     from graspaug.io.meshes import write_obj
 
+    _, mesh, reason = mesh_decoded(grid.astype(np.float32), float(pitch), decode_settings)
+    if reason is None:
+        write_obj(mesh, path)
+    return reason is None
+
+
+def write_meshes(grids: np.ndarray, inputs: dict, decode_settings, folder: Path) -> int:
+    """Each reconstruction meshed by ``generate``'s recipe into ``folder``/<id>.obj; how many meshed."""
     folder.mkdir(parents=True, exist_ok=True)
-    meshed = 0
-    for grid, pitch, shape_id in zip(grids, inputs["test_pitches"], inputs["test_ids"]):
-        _, mesh, reason = mesh_decoded(grid.astype(np.float32), float(pitch), decode_settings)
-        if reason is None:
-            write_obj(mesh, folder / f"{shape_id}.obj")
-            meshed += 1
-    return meshed
+    jobs = zip(grids, inputs["test_pitches"], inputs["test_ids"])
+    return sum(write_mesh(grid, pitch, decode_settings, folder / f"{shape_id}.obj") for grid, pitch, shape_id in jobs)
 
 
 def label_shape(job: tuple, project: Path, phases: tuple[str, ...], decode, grasps: tuple) -> dict:
     """One held-out shape's graspness, original and per phase's reconstruction (NaN where it did not mesh)."""
     from roundtrip_ceiling import mesh_graspness  # a study beside this one (studies/ is on the path)
 
-    from graspaug.geometry.from_voxels import mesh_decoded
-    from graspaug.io.meshes import mesh_path, write_obj
+    from graspaug.io.meshes import mesh_path
     from graspaug.pipeline.paths import GENERATED_SUFFIX
 
     shape_id, pitch, grids = job
@@ -147,12 +150,9 @@ def label_shape(job: tuple, project: Path, phases: tuple[str, ...], decode, gras
     row = {"shape_id": shape_id, "original": original}
     with tempfile.TemporaryDirectory() as folder:
         for phase, grid in zip(phases, grids):
-            _, mesh, reason = mesh_decoded(grid.astype(np.float32), float(pitch), decode)
-            row[phase] = (float("nan"), 0)
-            if reason is None:
-                file = mesh_path(folder, f"{shape_id}_{phase}", GENERATED_SUFFIX)
-                write_obj(mesh, file)
-                row[phase] = mesh_graspness(file, shape_id, *grasps)
+            file = mesh_path(folder, f"{shape_id}_{phase}", GENERATED_SUFFIX)
+            meshed = write_mesh(grid, pitch, decode, file)
+            row[phase] = mesh_graspness(file, shape_id, *grasps) if meshed else (float("nan"), 0)
     return row
 
 
@@ -166,7 +166,8 @@ def label_reconstructions(path: Path, project: Path, decode, workers: int, out: 
 
     f = np.load(path)
     phases = tuple(k for k in ("ae", "ae_critic") if k in f.files)
-    grids = {k: unpack_bits(f[k], round((8 * f[k].shape[1]) ** (1 / 3))) for k in phases}  # bit-packed R³
+    resolution = int(f["resolution"]) if "resolution" in f.files else round((8 * f["ae"].shape[1]) ** (1 / 3))
+    grids = {k: unpack_bits(f[k], resolution) for k in phases}  # bit-packed R³ (files before 2026-11-27: no R)
     params = load_params(project / "params.yaml")
     grasps = (params.grasps, params.seed)
     jobs = [(s, p, [grids[k][i] for k in phases]) for i, (s, p) in enumerate(zip(f["ids"], f["pitches"]))]
@@ -209,7 +210,8 @@ def main() -> None:
     if args.label:
         if args.project is None:
             parser.error("--label needs --project: the project whose shapes the reconstructions are")
-        return label_reconstructions(args.label, args.project, params.generate.decode, args.workers, args.out)
+        label_reconstructions(args.label, args.project, params.generate.decode, args.workers, args.out)
+        return
     net, device, start = params.ae.net, resolve_device(args.device), time.perf_counter()
     train_cfg = dataclasses.replace(
         params.ae.train,
@@ -251,6 +253,7 @@ def main() -> None:
         args.out / "reconstructions.npz",
         ids=inputs["test_ids"],
         pitches=inputs["test_pitches"],
+        resolution=net.resolution,
         **{name: pack_bits(grids) for name, grids in decoded.items()},
     )
     meshed = {}

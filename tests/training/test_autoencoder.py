@@ -91,6 +91,22 @@ def test_the_cosine_schedule_falls_from_lr_ae_to_half_at_mid_training_and_consta
     assert {phase_1_lr(train_settings(epochs_ae=10, lr_ae=1e-3), e) for e in range(10)} == {1e-3}
 
 
+def _phase_1_weights(epochs: int, schedule: str) -> dict[str, torch.Tensor]:
+    torch.manual_seed(0)
+    ae = AutoEncoder(AEConfig(resolution=16, z_dim=16, base_width=4, top_width=16))
+    tcfg = train_settings(batch_size=4, epochs_ae=epochs, lr_schedule=schedule)
+    train_autoencoder(ae, primitive_grids(16), tcfg, CPU, torch.Generator().manual_seed(0))
+    return ae.state_dict()
+
+
+def test_training_follows_the_schedule():
+    """Epoch 0 runs at lr_ae under both schedules (the same weights after one epoch); later epochs differ."""
+    one = _phase_1_weights(1, "constant"), _phase_1_weights(1, "cosine")
+    assert all(torch.equal(one[0][k], one[1][k]) for k in one[0])
+    three = _phase_1_weights(3, "constant"), _phase_1_weights(3, "cosine")
+    assert not all(torch.equal(three[0][k], three[1][k]) for k in three[0])
+
+
 def test_same_seed_gives_identical_weights():
     a, b = _train_twice_state(7), _train_twice_state(7)
     assert a.keys() == b.keys()
