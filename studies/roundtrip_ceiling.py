@@ -37,13 +37,13 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
+from _fidelity import mesh_graspness  # a helper beside this study (studies/ is on the path)
 
-from graspaug.augment.scores import graspness
-from graspaug.experiments.stats import fieller_interval, t_interval
+from graspaug.experiments.fidelity.numbers import graspness_kept
+from graspaug.experiments.fidelity.words import graspness_kept_markdown
 from graspaug.geometry.from_voxels import mesh_decoded
 from graspaug.geometry.sdf import mesh_from_sdf, truncated_distance_grid
 from graspaug.geometry.voxelize import fit_grid, voxelize_solid
-from graspaug.grasping.labelled import grasps_of_shape
 from graspaug.io.meshes import mesh_path, read_mesh, write_obj
 from graspaug.io.tables import read_table, write_json
 from graspaug.parallel import parallel_map
@@ -81,29 +81,6 @@ def reconstructions(mesh, margin: int, decode, truncation: float) -> tuple[dict,
     return meshes, seconds
 
 
-def mesh_graspness(file: Path, shape_id: str, grasps, seed: int) -> tuple[float, int]:
-    """The share of positive grasps of the mesh in ``file`` and how many were labelled, as the ``grasps`` stage
-    labels shape ``shape_id`` (its ``grasps`` params and ``seed``)."""
-    table, _ = grasps_of_shape(file, shape_id, grasps, seed)
-    score, count = graspness(table.success.to_numpy(), np.zeros(len(table), dtype=np.int64), 1)
-    return float(score[0]), int(count[0])
-
-
-def kept(after: np.ndarray, before: np.ndarray) -> dict:
-    """Paired graspness after / before over shapes: the ratio of means with its Fieller 95% interval and the mean
-    difference with its 95% t half-width."""
-    ratio, diff = fieller_interval(after, before), t_interval(after - before)
-    return {
-        "graspness_before": float(before.mean()),
-        "graspness_after": float(after.mean()),
-        "kept": ratio["ratio"],
-        "kept_low": ratio["low"],
-        "kept_high": ratio["high"],
-        "difference": diff["mean"],
-        "difference_half_width": None if diff["high"] is None else diff["high"] - diff["mean"],
-    }
-
-
 def shape_rows(job: tuple[Path, str], margin: int, decode, grasps, seed: int, truncation: float) -> tuple[list, dict]:
     """One shape's per-variant rows (graspness, grasps, why no mesh) and the seconds of its grid steps."""
     path, shape_id = job
@@ -132,26 +109,10 @@ def summarize(per_shape: pd.DataFrame) -> pd.DataFrame:
         after = part.graspness[part.meshed]
         rows.append(
             {"variant": variant, "shapes": len(part), "meshed": int(part.meshed.sum())}
-            | kept(after.to_numpy(), before[after.index].to_numpy())
+            | graspness_kept(after.to_numpy(), before[after.index].to_numpy())
             | {"grasps_after_mean": float(part.grasps[part.meshed].mean())}
         )
     return pd.DataFrame(rows)
-
-
-def markdown(rows: pd.DataFrame) -> str:
-    def number(value, spec):
-        return "n/a" if value is None or not np.isfinite(value) else format(value, spec)
-
-    lines = [
-        "| variant | shapes | meshed | graspness before → after | kept [95% Fieller] | after − before ± 95% t |",
-        "|---|---:|---:|---|---|---|",
-    ]
-    for r in rows.itertuples():
-        kept = f"{number(r.kept, '.1%')} [{number(r.kept_low, '.1%')}, {number(r.kept_high, '.1%')}]"
-        diff = f"{number(r.difference, '+.3f')} ± {number(r.difference_half_width, '.3f')}"
-        graspness_text = f"{r.graspness_before:.3f} → {r.graspness_after:.3f}"
-        lines.append(f"| {r.variant} | {r.shapes} | {r.meshed} | {graspness_text} | {kept} | {diff} |")
-    return "\n".join(lines)
 
 
 def main() -> None:
@@ -212,7 +173,7 @@ def main() -> None:
     if len(reasons):
         log.info("not meshed:\n%s", reasons.to_string())
     log.info("%d shapes in %.0f s; seconds per shape (mean): %s", len(chosen), seconds, timing["per_shape_mean"])
-    print(markdown(rows))
+    print(graspness_kept_markdown(rows))
 
 
 if __name__ == "__main__":

@@ -15,12 +15,13 @@ from graspaug.experiments.fidelity.numbers import (
     distribution_distances,
     fidelity_headline,
     fidelity_table,
+    graspness_kept,
     one_nn_accuracy,
     pool_shapes,
     resampled_distances,
     surface_cloud,
 )
-from graspaug.experiments.fidelity.words import fidelity_markdown
+from graspaug.experiments.fidelity.words import fidelity_markdown, graspness_kept_markdown
 
 
 def test_chamfer_of_a_cloud_and_its_shift():
@@ -126,3 +127,15 @@ def test_fidelity_table_gives_intervals_that_hold_the_values_and_tell_a_far_pool
     assert set(headline) == {f"{p}_{f}" for p in ("near", "far") for f in HEADLINE if f not in kept}
     assert headline["far_one_nna"] == {"mean": 1.0, "lo": 1.0, "hi": 1.0}
     assert "| near | 8 | - |" in fidelity_markdown(table.reset_index(), 8, len(reference))
+
+
+def test_graspness_kept_is_the_ratio_of_paired_means_with_an_interval_around_it():
+    before = np.array([0.4, 0.5, 0.6, 0.3, 0.5])
+    same = graspness_kept(before.copy(), before)
+    assert same["kept"] == pytest.approx(1.0) and same["difference"] == pytest.approx(0.0)
+    halved = graspness_kept(before / 2 + np.array([0.01, -0.01, 0.0, 0.01, -0.01]), before)
+    assert halved["kept"] == pytest.approx(0.5, abs=0.01)
+    assert halved["kept_low"] < halved["kept"] < halved["kept_high"] < 1.0
+    assert halved["difference"] == pytest.approx(-before.mean() / 2, abs=0.01)
+    table = graspness_kept_markdown(pd.DataFrame([{"variant": "half", "shapes": 5, "meshed": 5} | halved]))
+    assert "| half | 5 | 5 | 0.460 → 0.230 | 50.0% [" in table

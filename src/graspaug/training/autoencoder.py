@@ -7,7 +7,6 @@ random choice (batch order, flips, α) comes from one ``torch.Generator``.
 
 from __future__ import annotations
 
-import math
 import time
 from collections.abc import Callable
 
@@ -53,13 +52,13 @@ def train_autoencoder(
     on_epoch: EpochCallback | None = None,
 ) -> float:
     """Phase 1: minimize the reconstruction loss (:func:`~graspaug.nets.ae_critic.reconstruction_loss`: BCE of
-    occupancy, or the weighted L1 of signed distances) with Adam at :func:`phase_1_lr` per epoch. Returns shapes/s."""
+    occupancy, or the weighted L1 of signed distances) with Adam, its rate set per epoch by :func:`phase_1_schedule`.
+    Returns shapes/s."""
     ae.to(device)
     opt = torch.optim.Adam(ae.parameters(), lr=cfg.lr_ae)
+    schedule = phase_1_schedule(opt, cfg)
     seen, elapsed = 0, 0.0
     for epoch in tqdm(range(cfg.epochs_ae), desc="train AE", unit="epoch"):
-        for group in opt.param_groups:
-            group["lr"] = phase_1_lr(cfg, epoch)
         ae.train()
         start, total = time.perf_counter(), 0.0
         batches = _batches(len(voxels), cfg.batch_size, gen)
@@ -74,17 +73,19 @@ def train_autoencoder(
             total += loss.item() * len(idx)
             seen += len(idx)
         elapsed += time.perf_counter() - start
+        schedule.step()
         if on_epoch:
             on_epoch(epoch, {"loss_recon": total / max(1, sum(len(b) for b in batches))})
     return seen / max(elapsed, 1e-9)
 
 
-def phase_1_lr(cfg: AETrainConfig, epoch: int) -> float:
-    """Phase 1's learning rate in ``epoch`` (0-based): ``lr_ae``, or with ``lr_schedule: cosine``
-    lr_ae · ½(1 + cos(π · epoch / epochs_ae))."""
+def phase_1_schedule(opt: torch.optim.Optimizer, cfg: AETrainConfig) -> torch.optim.lr_scheduler.LRScheduler:
+    """Phase 1's learning rate, stepped once per epoch: ``lr_ae`` throughout (``lr_schedule: constant``), or
+    torch's cosine annealing from ``lr_ae`` towards 0 over ``epochs_ae`` (``cosine``: lr_ae · ½(1 + cos(π · epoch /
+    epochs_ae)) in epoch ``epoch``, 0-based)."""
     if cfg.lr_schedule == "constant":
-        return cfg.lr_ae
-    return cfg.lr_ae * 0.5 * (1.0 + math.cos(math.pi * epoch / max(cfg.epochs_ae, 1)))
+        return torch.optim.lr_scheduler.ConstantLR(opt, factor=1.0, total_iters=0)
+    return torch.optim.lr_scheduler.CosineAnnealingLR(opt, T_max=max(cfg.epochs_ae, 1))
 
 
 def train_ae_critic(

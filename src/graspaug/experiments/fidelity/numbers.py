@@ -28,7 +28,7 @@ import pandas as pd
 from scipy.spatial import cKDTree
 
 from graspaug.errors import DataError
-from graspaug.experiments.stats import percentile_interval
+from graspaug.experiments.stats import fieller_interval, percentile_interval, t_interval
 from graspaug.rng import shape_rng
 
 FIDELITY_POINTS = 512
@@ -275,4 +275,19 @@ def fidelity_headline(table: pd.DataFrame) -> dict[str, dict]:
         for _, row in table.iterrows()
         for f in HEADLINE
         if value(row[f]) is not None
+    }
+
+
+def graspness_kept(after: np.ndarray, before: np.ndarray) -> dict:
+    """Paired graspness ``after`` / ``before`` (n,) over the same shapes: the ratio of means ``kept`` with its
+    Fieller 95% interval (``kept_low``, ``kept_high``) and the mean ``difference`` with its 95% t half-width."""
+    ratio, diff = fieller_interval(after, before), t_interval(after - before)
+    return {
+        "graspness_before": float(before.mean()),
+        "graspness_after": float(after.mean()),
+        "kept": ratio["ratio"],
+        "kept_low": ratio["low"],
+        "kept_high": ratio["high"],
+        "difference": diff["mean"],
+        "difference_half_width": None if diff["high"] is None else diff["high"] - diff["mean"],
     }

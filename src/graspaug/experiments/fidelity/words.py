@@ -39,3 +39,22 @@ def fidelity_markdown(table: pd.DataFrame, base_size: int, reference_count: int)
             f"| {mmd} | {cell(row, 'one_nna', 2)} | {extents} |"
         )
     return "\n".join(lines) + "\n"
+
+
+def graspness_kept_markdown(rows: pd.DataFrame) -> str:
+    """A table of graspness kept, one row per ``variant``, from rows of
+    :func:`~graspaug.experiments.fidelity.numbers.graspness_kept` with ``variant``, ``shapes`` and ``meshed``."""
+
+    def number(value, spec):
+        return "n/a" if value is None or not np.isfinite(value) else format(value, spec)
+
+    lines = [
+        "| variant | shapes | meshed | graspness before → after | kept [95% Fieller] | after − before ± 95% t |",
+        "|---|---:|---:|---|---|---|",
+    ]
+    for r in rows.itertuples():
+        kept = f"{number(r.kept, '.1%')} [{number(r.kept_low, '.1%')}, {number(r.kept_high, '.1%')}]"
+        diff = f"{number(r.difference, '+.3f')} ± {number(r.difference_half_width, '.3f')}"
+        graspness_text = f"{r.graspness_before:.3f} → {r.graspness_after:.3f}"
+        lines.append(f"| {r.variant} | {r.shapes} | {r.meshed} | {graspness_text} | {kept} | {diff} |")
+    return "\n".join(lines)
