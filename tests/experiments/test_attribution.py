@@ -83,7 +83,10 @@ def test_combine_draws_gives_every_contrast_one_interval_over_draws_seeds_and_ob
         for pool in ("blend", "real")
     }
     assert shares["blend"]["10"]["share"] == pytest.approx(gain["blend"] / gain["real"])
-    assert "## What to add" in text and "| recon | +100% [+100%, +100%] |" in text  # as real shapes: the same gain
+    assert "## What to add" in text  # recon gains as real shapes do, but it is a control: never the advice
+    assert "| recon (control: the new real shapes themselves, decoded) | +100% [+100%, +100%] |" in text
+    advice = text.split("## What to add")[1].strip().splitlines()[-1]
+    assert "recon" not in advice and advice.startswith("A share is")
 
 
 def test_every_draw_needs_the_same_training_seeds(tmp_path):

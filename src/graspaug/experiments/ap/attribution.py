@@ -221,11 +221,16 @@ def decomposition_markdown(result: dict, augment_base_sizes: Sequence[int], comm
     return "\n".join(lines) + "\n"
 
 
+CONTROLS = {"recon": "control: the new real shapes themselves, decoded"}
+"""Pools that need the very real shapes they stand in for: measured, never recommended."""
+
+
 def recommendation(result: dict) -> list[str]:
     """A markdown table (one line each): per pool of ``result["shares"]`` (:func:`combine_draws`), its share of the
     real-shape gain at every augmented base size with its 95% interval, ordered by the share at the smallest base
     size, and what the pool's own gain over no augmentation says (``gain``, a contrast over draws, in
-    :func:`~graspaug.experiments.stats.verdict`'s words); then a sentence a user can act on."""
+    :func:`~graspaug.experiments.stats.verdict`'s words); then a sentence a user can act on, naming no pool of
+    :data:`CONTROLS`."""
 
     def text(s: dict | None) -> str:
         if not s or s["share"] is None:
@@ -249,10 +254,12 @@ def recommendation(result: dict) -> list[str]:
         "|---|" + "---|" * len(sizes) + "---|",
     ]
     lines += [
-        f"| {p} | " + " | ".join(text(shares[p].get(b)) for b in sizes) + f" | {says(shares[p].get(first))} |"
+        f"| {p}{f' ({CONTROLS[p]})' if p in CONTROLS else ''} | "
+        + " | ".join(text(shares[p].get(b)) for b in sizes)
+        + f" | {says(shares[p].get(first))} |"
         for p in order
     ]
-    gaining = [p for p in order if says(shares[p].get(first)).startswith("a gain")]
+    gaining = [p for p in order if p not in CONTROLS and says(shares[p].get(first)).startswith("a gain")]
     if gaining:
         best = shares[gaining[0]][first]["share"]
         most = "" if best is None else f"; {gaining[0]} adds the most, {best:.0%} of as many real shapes' gain"
