@@ -140,8 +140,7 @@ def write_meshes(grids: np.ndarray, inputs: dict, decode_settings, folder: Path)
 
 def label_shape(job: tuple, project: Path, phases: tuple[str, ...], decode, grasps: tuple) -> dict:
     """One held-out shape's graspness, original and per phase's reconstruction (NaN where it did not mesh)."""
-    from _fidelity import mesh_graspness  # a helper beside this study (studies/ is on the path)
-
+    from graspaug.experiments.fidelity.numbers import mesh_graspness
     from graspaug.io.meshes import mesh_path
     from graspaug.pipeline.paths import GENERATED_SUFFIX
 
@@ -161,8 +160,8 @@ def label_reconstructions(path: Path, project: Path, decode, workers: int, out: 
     table printed and written to ``out``/``label.json``."""
     import pandas as pd
 
-    from graspaug.experiments.fidelity.numbers import graspness_kept
-    from graspaug.experiments.fidelity.words import graspness_kept_markdown
+    from graspaug.experiments.fidelity.numbers import paired_graspness_kept
+    from graspaug.experiments.fidelity.words import paired_graspness_kept_markdown
     from graspaug.pipeline.params.model import load_params
 
     f = np.load(path)
@@ -180,12 +179,12 @@ def label_reconstructions(path: Path, project: Path, decode, workers: int, out: 
         after = np.array([r[phase][0] for r in rows])
         meshed = np.isfinite(after)
         table.append({"variant": phase, "shapes": len(rows), "meshed": int(meshed.sum())})
-        table[-1] |= graspness_kept(after[meshed], before[meshed])
+        table[-1] |= paired_graspness_kept(after[meshed], before[meshed])
     out.mkdir(parents=True, exist_ok=True)
     summary = {"reconstructions": str(path), "project": str(project), "decode": dataclasses.asdict(decode)}
     summary |= {"n_grasps": params.grasps.sampler.n_grasps, "rows": table, "seconds": time.perf_counter() - start}
     (out / "label.json").write_text(json.dumps(summary, indent=1, default=float))
-    print(graspness_kept_markdown(pd.DataFrame(table)))
+    print(paired_graspness_kept_markdown(pd.DataFrame(table)))
 
 
 def main() -> None:

@@ -37,10 +37,9 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
-from _fidelity import mesh_graspness  # a helper beside this study (studies/ is on the path)
 
-from graspaug.experiments.fidelity.numbers import graspness_kept
-from graspaug.experiments.fidelity.words import graspness_kept_markdown
+from graspaug.experiments.fidelity.numbers import mesh_graspness, paired_graspness_kept
+from graspaug.experiments.fidelity.words import paired_graspness_kept_markdown
 from graspaug.geometry.from_voxels import mesh_decoded
 from graspaug.geometry.sdf import mesh_from_sdf, truncated_distance_grid
 from graspaug.geometry.voxelize import fit_grid, voxelize_solid
@@ -109,7 +108,7 @@ def summarize(per_shape: pd.DataFrame) -> pd.DataFrame:
         after = part.graspness[part.meshed]
         rows.append(
             {"variant": variant, "shapes": len(part), "meshed": int(part.meshed.sum())}
-            | graspness_kept(after.to_numpy(), before[after.index].to_numpy())
+            | paired_graspness_kept(after.to_numpy(), before[after.index].to_numpy())
             | {"grasps_after_mean": float(part.grasps[part.meshed].mean())}
         )
     return pd.DataFrame(rows)
@@ -173,7 +172,7 @@ def main() -> None:
     if len(reasons):
         log.info("not meshed:\n%s", reasons.to_string())
     log.info("%d shapes in %.0f s; seconds per shape (mean): %s", len(chosen), seconds, timing["per_shape_mean"])
-    print(graspness_kept_markdown(rows))
+    print(paired_graspness_kept_markdown(rows))
 
 
 if __name__ == "__main__":

@@ -15,13 +15,16 @@ from graspaug.experiments.fidelity.numbers import (
     distribution_distances,
     fidelity_headline,
     fidelity_table,
-    graspness_kept,
+    mesh_graspness,
     one_nn_accuracy,
+    paired_graspness_kept,
     pool_shapes,
     resampled_distances,
     surface_cloud,
 )
-from graspaug.experiments.fidelity.words import fidelity_markdown, graspness_kept_markdown
+from graspaug.experiments.fidelity.words import fidelity_markdown, paired_graspness_kept_markdown
+from graspaug.grasping.labelled import grasps_of_shape
+from graspaug.grasping.settings import GraspsSettings
 
 
 def test_chamfer_of_a_cloud_and_its_shift():
@@ -131,11 +134,20 @@ def test_fidelity_table_gives_intervals_that_hold_the_values_and_tell_a_far_pool
 
 def test_graspness_kept_is_the_ratio_of_paired_means_with_an_interval_around_it():
     before = np.array([0.4, 0.5, 0.6, 0.3, 0.5])
-    same = graspness_kept(before.copy(), before)
+    same = paired_graspness_kept(before.copy(), before)
     assert same["kept"] == pytest.approx(1.0) and same["difference"] == pytest.approx(0.0)
-    halved = graspness_kept(before / 2 + np.array([0.01, -0.01, 0.0, 0.01, -0.01]), before)
+    halved = paired_graspness_kept(before / 2 + np.array([0.01, -0.01, 0.0, 0.01, -0.01]), before)
     assert halved["kept"] == pytest.approx(0.5, abs=0.01)
     assert halved["kept_low"] < halved["kept"] < halved["kept_high"] < 1.0
     assert halved["difference"] == pytest.approx(-before.mean() / 2, abs=0.01)
-    table = graspness_kept_markdown(pd.DataFrame([{"variant": "half", "shapes": 5, "meshed": 5} | halved]))
+    table = paired_graspness_kept_markdown(pd.DataFrame([{"variant": "half", "shapes": 5, "meshed": 5} | halved]))
     assert "| half | 5 | 5 | 0.460 → 0.230 | 50.0% [" in table
+
+
+def test_mesh_graspness_is_the_grasps_stages_share_of_positive_grasps(tmp_path):
+    path = tmp_path / "box.obj"
+    trimesh.creation.box((0.04, 0.05, 0.06)).export(path)
+    settings = GraspsSettings()
+    score, count = mesh_graspness(path, "box", settings, 3)
+    table, _ = grasps_of_shape(path, "box", settings, 3)
+    assert count == len(table) > 0 and score == pytest.approx(table.success.mean())

@@ -7,6 +7,7 @@ random choice (batch order, flips, α) comes from one ``torch.Generator``.
 
 from __future__ import annotations
 
+import math
 import time
 from collections.abc import Callable
 
@@ -73,19 +74,22 @@ def train_autoencoder(
             total += loss.item() * len(idx)
             seen += len(idx)
         elapsed += time.perf_counter() - start
-        schedule.step()
+        if batches:  # an epoch without a batch (fewer than 2 shapes) steps no optimizer, so no schedule either
+            schedule.step()
         if on_epoch:
             on_epoch(epoch, {"loss_recon": total / max(1, sum(len(b) for b in batches))})
     return seen / max(elapsed, 1e-9)
 
 
-def phase_1_schedule(opt: torch.optim.Optimizer, cfg: AETrainConfig) -> torch.optim.lr_scheduler.LRScheduler:
-    """Phase 1's learning rate, stepped once per epoch: ``lr_ae`` throughout (``lr_schedule: constant``), or
-    torch's cosine annealing from ``lr_ae`` towards 0 over ``epochs_ae`` (``cosine``: lr_ae · ½(1 + cos(π · epoch /
-    epochs_ae)) in epoch ``epoch``, 0-based)."""
+def phase_1_schedule(opt: torch.optim.Optimizer, cfg: AETrainConfig) -> torch.optim.lr_scheduler.LambdaLR:
+    """Phase 1's learning rate, stepped once per epoch: ``lr_ae`` throughout (``lr_schedule: constant``), or a
+    cosine from ``lr_ae`` towards 0 over ``epochs_ae`` (``cosine``: lr_ae · ½(1 + cos(π · epoch / epochs_ae)) in
+    epoch ``epoch``, 0-based; the closed form each epoch, so a rate never carries the last one's rounding)."""
     if cfg.lr_schedule == "constant":
-        return torch.optim.lr_scheduler.ConstantLR(opt, factor=1.0, total_iters=0)
-    return torch.optim.lr_scheduler.CosineAnnealingLR(opt, T_max=max(cfg.epochs_ae, 1))
+        return torch.optim.lr_scheduler.LambdaLR(opt, lambda epoch: 1.0)
+    return torch.optim.lr_scheduler.LambdaLR(
+        opt, lambda epoch: 0.5 * (1.0 + math.cos(math.pi * epoch / max(cfg.epochs_ae, 1)))
+    )
 
 
 def train_ae_critic(

@@ -259,13 +259,16 @@ def recommendation(result: dict) -> list[str]:
         + f" | {says(shares[p].get(first))} |"
         for p in order
     ]
-    gaining = [p for p in order if p not in CONTROLS and says(shares[p].get(first)).startswith("a gain")]
-    if gaining:
-        best = shares[gaining[0]][first]["share"]
-        most = "" if best is None else f"; {gaining[0]} adds the most, {best:.0%} of as many real shapes' gain"
-        advice = f"At B = {first} the pools that add AP with an interval above zero: {', '.join(gaining)}{most}."
+    gaining = [p for p in order if says(shares[p].get(first)).startswith("a gain")]
+    pools, controls = [p for p in gaining if p not in CONTROLS], [f"`{p}`" for p in gaining if p in CONTROLS]
+    if pools:
+        best = shares[pools[0]][first]["share"]
+        most = "" if best is None else f"; {pools[0]} adds the most, {best:.0%} of as many real shapes' gain"
+        advice = f"At B = {first} the pools that add AP with an interval above zero: {', '.join(pools)}{most}."
     else:
-        advice = "Add real shapes: no generated or procedural pool tried here adds AP with an interval above zero."
+        but = f" (only the control {', '.join(controls)} does, and it needs the new real shapes)" if controls else ""
+        none = "no generated or procedural pool tried here adds AP with an interval above zero"
+        advice = f"Add real shapes: {none}{but}."
     return lines + [
         "",
         f"A share is the pool's AP gain over no augmentation divided by as many real shapes' gain. {advice}",

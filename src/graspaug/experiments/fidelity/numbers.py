@@ -15,6 +15,10 @@ point clouds sampled from the meshes' surfaces:
 
 Chamfer distance here: the mean, over both clouds' points, of the distance to the nearest point
 of the other cloud (m, not squared), the clouds centered on their centroids.
+
+Also the round trip's figure (``studies/roundtrip_ceiling.py``, ``studies/paper_scale.py``): how much of each shape's
+graspness its reconstruction keeps, labelled as the ``grasps`` stage labels it (:func:`mesh_graspness`,
+:func:`paired_graspness_kept`).
 """
 
 from __future__ import annotations
@@ -22,13 +26,17 @@ from __future__ import annotations
 import json
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
 from scipy.spatial import cKDTree
 
+from graspaug.augment.scores import graspness
 from graspaug.errors import DataError
 from graspaug.experiments.stats import fieller_interval, percentile_interval, t_interval
+from graspaug.grasping.labelled import grasps_of_shape
+from graspaug.grasping.settings import GraspsSettings
 from graspaug.rng import shape_rng
 
 FIDELITY_POINTS = 512
@@ -278,9 +286,20 @@ def fidelity_headline(table: pd.DataFrame) -> dict[str, dict]:
     }
 
 
-def graspness_kept(after: np.ndarray, before: np.ndarray) -> dict:
-    """Paired graspness ``after`` / ``before`` (n,) over the same shapes: the ratio of means ``kept`` with its
-    Fieller 95% interval (``kept_low``, ``kept_high``) and the mean ``difference`` with its 95% t half-width."""
+def mesh_graspness(path: Path, shape_id: str, grasps: GraspsSettings, seed: int) -> tuple[float, int]:
+    """The share of positive grasps (0–1) of the mesh file ``path`` and how many grasps were labelled, as the
+    ``grasps`` stage labels shape ``shape_id`` (:func:`~graspaug.grasping.labelled.grasps_of_shape` with its settings
+    ``grasps`` and ``seed``); 0 where no grasp was found."""
+    table, _ = grasps_of_shape(path, shape_id, grasps, seed)
+    score, count = graspness(table.success.to_numpy(), np.zeros(len(table), dtype=np.int64), 1)
+    return float(score[0]), int(count[0])
+
+
+def paired_graspness_kept(after: np.ndarray, before: np.ndarray) -> dict:
+    """Paired graspness (shares of positive grasps, finite, 0–1) ``after`` / ``before`` (n,) of the same n shapes: the
+    ratio of means ``kept`` with its Fieller 95% interval (``kept_low``, ``kept_high``; None when unbounded) and the
+    mean ``difference`` with its 95% t half-width. Unlike the pools' ``graspness_kept`` figure (a child against its
+    mixed parents, bootstrapped), a shape here is compared with itself."""
     ratio, diff = fieller_interval(after, before), t_interval(after - before)
     return {
         "graspness_before": float(before.mean()),

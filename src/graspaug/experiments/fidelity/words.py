@@ -1,4 +1,5 @@
-"""The fidelity experiment in words: report.md's table of every pool's figures with their intervals."""
+"""The fidelity experiment in words: report.md's table of every pool's figures with their intervals, and the round
+trip's table of graspness kept."""
 
 from __future__ import annotations
 
@@ -41,9 +42,9 @@ def fidelity_markdown(table: pd.DataFrame, base_size: int, reference_count: int)
     return "\n".join(lines) + "\n"
 
 
-def graspness_kept_markdown(rows: pd.DataFrame) -> str:
+def paired_graspness_kept_markdown(rows: pd.DataFrame) -> str:
     """A table of graspness kept, one row per ``variant``, from rows of
-    :func:`~graspaug.experiments.fidelity.numbers.graspness_kept` with ``variant``, ``shapes`` and ``meshed``."""
+    :func:`~graspaug.experiments.fidelity.numbers.paired_graspness_kept` with ``variant``, ``shapes`` and ``meshed``."""
 
     def number(value, spec):
         return "n/a" if value is None or not np.isfinite(value) else format(value, spec)
