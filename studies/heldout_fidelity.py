@@ -1,0 +1,163 @@
+"""What a trained AutoEncoder keeps of real shapes it never trained on: the recon pool's fidelity, on the test split.
+
+The ``fidelity`` stage measures the ``recon`` pool: train-split shapes (the AutoEncoder learns every train shape)
+decoded from their own latents. This study asks the same of held-out shapes. On a project where ``embed`` and
+``render@original`` have run, for ``--shapes`` random test-split shapes (``--seed``), it
+
+1. decodes each shape's latent (``data/latents.parquet``, from ``models/ae_critic.pt``, the network ``generate``
+   decodes with) and meshes it by ``generate``'s recipe (``generate.decode``; a decoder of signed distances: marching
+   cubes at 0 alone) at the shape's own pitch (``data/voxels.npz``), as the recon pool is made;
+2. labels the grasps of the original and of its reconstruction as the ``grasps`` stage does (the same ``grasps``
+   params and ``seed``, each shape's own generator) and renders their datapoints as the ``render`` stage does;
+3. gives, over the shapes that meshed, the graspness kept and the datapoints kept (after / before, ratios of paired
+   means, Fieller 95%), the positive share of each, and how many meshed.
+
+It prints a table and writes ``summary.json`` and ``per_shape.csv`` to ``--out``::
+
+    python studies/heldout_fidelity.py --project PROJECT [--shapes 100] [--seed 0] [--workers 2] [--out DIR]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import logging
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from graspaug.augment.scores import graspness
+from graspaug.experiments.fidelity.numbers import paired_graspness_kept
+from graspaug.experiments.fidelity.words import paired_graspness_kept_markdown
+from graspaug.experiments.stats import fieller_interval
+from graspaug.geometry.from_voxels import mesh_decoded
+from graspaug.geometry.sdf import mesh_decoded_field
+from graspaug.grasping.labelled import grasps_of_shapes
+from graspaug.io.checkpoints import load_autoencoder
+from graspaug.io.meshes import mesh_path, write_obj
+from graspaug.io.tables import read_table
+from graspaug.io.voxels import read_voxels
+from graspaug.parallel import parallel_map
+from graspaug.pipeline.params.model import load_params
+from graspaug.pipeline.paths import AE_CRITIC_MODEL, GENERATED_SUFFIX, LATENTS, VOXELS, corpus_files
+from graspaug.render.corpus_dataset import render_corpus
+from graspaug.training.autoencoder import decode
+
+
+def reconstruct(project: Path, ids: list[str], params, folder: Path, workers: int) -> dict[str, str | None]:
+    """Each shape of ``ids`` decoded from its latent and meshed as the recon pool is, written to
+    ``folder``/<id>.obj; shape id → why it did not mesh (None where it did)."""
+    import torch
+
+    ae, _, _ = load_autoencoder(project / AE_CRITIC_MODEL, params.ae.net)
+    latents = read_table(project / LATENTS).set_index("shape_id")
+    voxels = read_voxels(project / VOXELS)
+    pitch = dict(zip(voxels.shape_id, voxels.pitch))
+    grids = decode(ae, np.stack(latents.loc[ids, "z"].to_numpy()), torch.device("cpu"))
+    settings, truncation = params.generate.decode, ae.cfg.truncation
+    if ae.cfg.output == "sdf":
+        mesh_grid = lambda job: mesh_decoded_field(job[0], job[1], truncation, settings)  # noqa: E731
+    else:
+        mesh_grid = lambda job: mesh_decoded(job[0], job[1], settings)  # noqa: E731
+    out = parallel_map(mesh_grid, [(g, pitch[s]) for g, s in zip(grids, ids)], workers, "mesh decodes")
+    for shape_id, (_, mesh, _) in zip(ids, out):
+        if mesh is not None:
+            write_obj(mesh, mesh_path(folder, shape_id, GENERATED_SUFFIX))
+    return {shape_id: reason for shape_id, (_, _, reason) in zip(ids, out)}
+
+
+def label_and_render(ids: list[str], folder: Path, suffix: str, params, workers: int, label: str) -> pd.DataFrame:
+    """Per shape of ``ids`` (meshes ``folder``/<id><suffix>): graspness, grasps labelled, datapoints rendered and
+    their positive share, as the ``grasps`` and ``render`` stages make them."""
+    grasps, _ = grasps_of_shapes(folder, ids, suffix, params.grasps, params.seed, workers, f"grasps ({label})")
+    index = {s: i for i, s in enumerate(ids)}
+    score, count = graspness(grasps.success.to_numpy(), grasps.shape_id.map(index).to_numpy(), len(ids))
+    shapes = pd.DataFrame({"shape_id": ids})
+    hand = params.grasps.gripper
+    by_shape, results = render_corpus(
+        shapes, grasps, folder, suffix, params.render, hand, params.seed, workers, f"render ({label})"
+    )
+    datapoints, positive = [], []
+    for shape_id, (data, _) in zip(ids, results):
+        n = 0 if data is None else len(data)
+        datapoints.append(n)
+        if n:
+            rows = by_shape[shape_id].success.to_numpy()[data.columns["grasp_index"]]
+            positive.append(float(rows.mean()))
+        else:
+            positive.append(np.nan)
+    return pd.DataFrame(
+        {"shape_id": ids, "graspness": score, "grasps": count, "datapoints": datapoints, "positive": positive}
+    )
+
+
+def summarize(per_shape: pd.DataFrame) -> dict:
+    """Paired figures over the shapes whose reconstruction meshed: graspness kept (Fieller 95%), datapoints kept
+    (Fieller 95%), mean datapoints and positive shares before and after."""
+    meshed = per_shape[per_shape.meshed]
+    before, after = meshed.datapoints_before.to_numpy(float), meshed.datapoints_after.to_numpy(float)
+    dp = fieller_interval(after, before)
+    return {
+        "shapes": len(per_shape),
+        "meshed": len(meshed),
+        **paired_graspness_kept(meshed.graspness_after.to_numpy(), meshed.graspness_before.to_numpy()),
+        "datapoints_before": float(before.mean()),
+        "datapoints_after": float(after.mean()),
+        "datapoints_kept": dp["ratio"],
+        "datapoints_kept_low": dp["low"],
+        "datapoints_kept_high": dp["high"],
+        "positive_before": float(np.nanmean(meshed.positive_before)),
+        "positive_after": float(np.nanmean(meshed.positive_after)),
+    }
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--project", type=Path, default=Path("."), help="a project where embed and render ran")
+    parser.add_argument("--shapes", type=int, default=100, help="random test shapes (%(default)s)")
+    parser.add_argument("--seed", type=int, default=0, help="which test shapes (%(default)s)")
+    parser.add_argument("--workers", type=int, default=2)
+    parser.add_argument("--out", type=Path, default=Path("studies/out/heldout_fidelity"))
+    args = parser.parse_args()
+    logging.basicConfig(level=logging.WARNING)
+    project = args.project.resolve()
+    params = load_params(project / "params.yaml")
+    table, mesh_dir, suffix = corpus_files("original")
+    shapes = read_table(project / table)
+    test = shapes.shape_id[shapes.split == "test"].to_numpy()
+    rng = np.random.default_rng(args.seed)
+    ids = sorted(rng.choice(test, size=min(args.shapes, len(test)), replace=False).tolist())
+    start = time.perf_counter()
+    with tempfile.TemporaryDirectory() as tmp:
+        folder = Path(tmp)
+        reasons = reconstruct(project, ids, params, folder, args.workers)
+        made = [s for s in ids if reasons[s] is None]
+        before = label_and_render(ids, project / mesh_dir, suffix, params, args.workers, "originals")
+        after = label_and_render(made, folder, GENERATED_SUFFIX, params, args.workers, "reconstructions")
+    per_shape = before.merge(after, on="shape_id", how="left", suffixes=("_before", "_after"))
+    per_shape["meshed"] = per_shape.shape_id.map(lambda s: reasons[s] is None)
+    per_shape["reason"] = per_shape.shape_id.map(reasons)
+    summary = summarize(per_shape) | {
+        "decoder": params.ae.net.output,
+        "project": str(project),
+        "shape_seed": args.seed,
+        "seconds": round(time.perf_counter() - start, 1),
+    }
+    args.out.mkdir(parents=True, exist_ok=True)
+    per_shape.to_csv(args.out / "per_shape.csv", index=False)
+    (args.out / "summary.json").write_text(json.dumps(summary, indent=1, default=float) + "\n")
+    print(paired_graspness_kept_markdown(pd.DataFrame([{"variant": f"{summary['decoder']} recon, test"} | summary])))
+    ends = (summary[f"datapoints_kept{e}"] for e in ("", "_low", "_high"))
+    kept = ["n/a" if v is None else f"{v:.1%}" for v in ends]
+    print(
+        f"datapoints / shape {summary['datapoints_before']:.1f} -> {summary['datapoints_after']:.1f}: kept {kept[0]} "
+        f"[{kept[1]}, {kept[2]}]; positive share {summary['positive_before']:.3f} -> {summary['positive_after']:.3f}; "
+        f"{summary['seconds']} s"
+    )
+
+
+if __name__ == "__main__":
+    main()
