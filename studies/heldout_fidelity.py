@@ -71,7 +71,8 @@ def reconstruct(project: Path, ids: list[str], params, folder: Path, workers: in
 
 def label_and_render(ids: list[str], folder: Path, suffix: str, params, workers: int, label: str) -> pd.DataFrame:
     """Per shape of ``ids`` (meshes ``folder``/<id><suffix>): graspness, grasps labelled, datapoints rendered and
-    their positive share, as the ``grasps`` and ``render`` stages make them."""
+    their positive share, the stable poses rendered and the grasps with at least one datapoint, as the ``grasps`` and
+    ``render`` stages make them."""
     grasps, _ = grasps_of_shapes(folder, ids, suffix, params.grasps, params.seed, workers, f"grasps ({label})")
     index = {s: i for i, s in enumerate(ids)}
     score, count = graspness(grasps.success.to_numpy(), grasps.shape_id.map(index).to_numpy(), len(ids))
@@ -80,23 +81,36 @@ def label_and_render(ids: list[str], folder: Path, suffix: str, params, workers:
     by_shape, results = render_corpus(
         shapes, grasps, folder, suffix, params.render, hand, params.seed, workers, f"render ({label})"
     )
-    datapoints, positive = [], []
+    datapoints, positive, poses, grasps_seen = [], [], [], []
     for shape_id, (data, _) in zip(ids, results):
         n = 0 if data is None else len(data)
         datapoints.append(n)
+        poses.append(0 if data is None else data.n_poses)
+        grasps_seen.append(0 if data is None else len(np.unique(data.columns["grasp_index"])))
         if n:
             rows = by_shape[shape_id].success.to_numpy()[data.columns["grasp_index"]]
             positive.append(float(rows.mean()))
         else:
             positive.append(np.nan)
     return pd.DataFrame(
-        {"shape_id": ids, "graspness": score, "grasps": count, "datapoints": datapoints, "positive": positive}
+        {
+            "shape_id": ids,
+            "graspness": score,
+            "grasps": count,
+            "datapoints": datapoints,
+            "positive": positive,
+            "stable_poses": poses,
+            "grasps_rendered": grasps_seen,
+        }
     )
+
+
+WHEN = ("before", "after")
 
 
 def summarize(per_shape: pd.DataFrame) -> dict:
     """Paired figures over the shapes whose reconstruction meshed: graspness kept (Fieller 95%), datapoints kept
-    (Fieller 95%), mean datapoints and positive shares before and after."""
+    (Fieller 95%), mean datapoints, positive shares, stable poses and grasps rendered, before and after."""
     meshed = per_shape[per_shape.meshed]
     before, after = meshed.datapoints_before.to_numpy(float), meshed.datapoints_after.to_numpy(float)
     dp = fieller_interval(after, before)
@@ -111,6 +125,7 @@ def summarize(per_shape: pd.DataFrame) -> dict:
         "datapoints_kept_high": dp["high"],
         "positive_before": float(np.nanmean(meshed.positive_before)),
         "positive_after": float(np.nanmean(meshed.positive_after)),
+        **{f"{k}_{w}": float(meshed[f"{k}_{w}"].mean()) for k in ("stable_poses", "grasps_rendered") for w in WHEN},
     }
 
 
@@ -155,6 +170,8 @@ def main() -> None:
     print(
         f"datapoints / shape {summary['datapoints_before']:.1f} -> {summary['datapoints_after']:.1f}: kept {kept[0]} "
         f"[{kept[1]}, {kept[2]}]; positive share {summary['positive_before']:.3f} -> {summary['positive_after']:.3f}; "
+        f"stable poses {summary['stable_poses_before']:.2f} -> {summary['stable_poses_after']:.2f}; grasps with a "
+        f"datapoint {summary['grasps_rendered_before']:.1f} -> {summary['grasps_rendered_after']:.1f}; "
         f"{summary['seconds']} s"
     )
 
