@@ -4,9 +4,9 @@ The ``fidelity`` stage measures the ``recon`` pool: train-split shapes (the Auto
 decoded from their own latents. This study asks the same of held-out shapes. On a project where ``embed`` and
 ``render@original`` have run, for ``--shapes`` random test-split shapes (``--seed``), it
 
-1. decodes each shape's latent (``data/latents.parquet``, from ``models/ae_critic.pt``, the network ``generate``
-   decodes with) and meshes it by ``generate``'s recipe (``generate.decode``; a decoder of signed distances: marching
-   cubes at 0 alone) at the shape's own pitch (``data/voxels.npz``), as the recon pool is made;
+1. decodes each shape's latent (``data/latents.parquet``) with ``models/ae_critic.pt`` and meshes it at the shape's
+   own pitch (``data/voxels.npz``) with the recon pool's own runner (``generate``'s recipe, ``generate.decode``; a
+   decoder of signed distances: marching cubes at 0 alone);
 2. labels the grasps of the original and of its reconstruction as the ``grasps`` stage does (the same ``grasps``
    params and ``seed``, each shape's own generator) and renders their datapoints as the ``render`` stage does;
 3. gives, over the shapes that meshed, the graspness kept and the datapoints kept (after / before, ratios of paired
@@ -29,44 +29,41 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from graspaug.augment.candidates import Candidate
+from graspaug.augment.decode import mesh_batches
+from graspaug.augment.pools import BaseSet
 from graspaug.augment.scores import graspness
 from graspaug.experiments.fidelity.numbers import paired_graspness_kept
 from graspaug.experiments.fidelity.words import paired_graspness_kept_markdown
 from graspaug.experiments.stats import fieller_interval
-from graspaug.geometry.from_voxels import mesh_decoded
-from graspaug.geometry.sdf import mesh_decoded_field
 from graspaug.grasping.labelled import grasps_of_shapes
 from graspaug.io.checkpoints import load_autoencoder
 from graspaug.io.meshes import mesh_path, write_obj
 from graspaug.io.tables import read_table
 from graspaug.io.voxels import read_voxels
-from graspaug.parallel import parallel_map
 from graspaug.pipeline.params.model import load_params
 from graspaug.pipeline.paths import AE_CRITIC_MODEL, GENERATED_SUFFIX, LATENTS, VOXELS, corpus_files
 from graspaug.render.corpus_dataset import render_corpus
-from graspaug.training.autoencoder import decode
 
 
 def reconstruct(project: Path, ids: list[str], params, folder: Path, workers: int) -> dict[str, str | None]:
-    """Each shape of ``ids`` decoded from its latent and meshed as the recon pool is, written to
-    ``folder``/<id>.obj; shape id → why it did not mesh (None where it did)."""
+    """Each shape of ``ids`` decoded from its own latent and meshed by the recon pool's runner
+    (:func:`graspaug.augment.decode.mesh_batches`, parents k and k at weight 0), written to ``folder``/<id>.obj;
+    shape id → why it did not mesh (None where it did)."""
     import torch
 
     ae, _, _ = load_autoencoder(project / AE_CRITIC_MODEL, params.ae.net)
     latents = read_table(project / LATENTS).set_index("shape_id")
     voxels = read_voxels(project / VOXELS)
     pitch = dict(zip(voxels.shape_id, voxels.pitch))
-    grids = decode(ae, np.stack(latents.loc[ids, "z"].to_numpy()), torch.device("cpu"))
-    settings, truncation = params.generate.decode, ae.cfg.truncation
-    if ae.cfg.output == "sdf":
-        mesh_grid = lambda job: mesh_decoded_field(job[0], job[1], truncation, settings)  # noqa: E731
-    else:
-        mesh_grid = lambda job: mesh_decoded(job[0], job[1], settings)  # noqa: E731
-    out = parallel_map(mesh_grid, [(g, pitch[s]) for g, s in zip(grids, ids)], workers, "mesh decodes")
-    for shape_id, (_, mesh, _) in zip(ids, out):
-        if mesh is not None:
-            write_obj(mesh, mesh_path(folder, shape_id, GENERATED_SUFFIX))
-    return {shape_id: reason for shape_id, (_, _, reason) in zip(ids, out)}
+    n, z = len(ids), np.stack(latents.loc[ids, "z"].to_numpy())
+    shapes = BaseSet(np.array(ids), z, np.zeros(n), np.zeros(n), np.array([pitch[s] for s in ids]))  # no scores needed
+    run_batch = mesh_batches(ae, torch.device("cpu"), shapes, params.generate.decode, workers, "mesh decodes")
+    decoded = run_batch([Candidate(k, k, 0.0, "recon") for k in range(n)])
+    for shape_id, d in zip(ids, decoded):
+        if d.mesh is not None:
+            write_obj(d.mesh, mesh_path(folder, shape_id, GENERATED_SUFFIX))
+    return {shape_id: d.reason for shape_id, d in zip(ids, decoded)}
 
 
 def label_and_render(ids: list[str], folder: Path, suffix: str, params, workers: int, label: str) -> pd.DataFrame:
