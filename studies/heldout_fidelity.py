@@ -10,7 +10,7 @@ decoded from their own latents. This study asks the same of held-out shapes. On 
 2. labels the grasps of the original and of its reconstruction as the ``grasps`` stage does (the same ``grasps``
    params and ``seed``, each shape's own generator) and renders their datapoints as the ``render`` stage does;
 3. gives, over the shapes that meshed, the graspness kept and the datapoints kept (after / before, ratios of paired
-   means, Fieller 95%), the positive share of each, and how many meshed.
+   means, Fieller 95%), the datapoints' positive share (the render stage's label), and how many meshed.
 
 It prints a table and writes ``summary.json`` and ``per_shape.csv`` to ``--out``::
 
@@ -67,9 +67,11 @@ def reconstruct(project: Path, ids: list[str], params, folder: Path, workers: in
 
 
 def label_and_render(ids: list[str], folder: Path, suffix: str, params, workers: int, label: str) -> pd.DataFrame:
-    """Per shape of ``ids`` (meshes ``folder``/<id><suffix>): graspness, grasps labelled, datapoints rendered and
-    their positive share, the stable poses rendered and the grasps with at least one datapoint, as the ``grasps`` and
-    ``render`` stages make them."""
+    """Per shape of ``ids`` (meshes ``folder``/<id><suffix>): graspness, grasps labelled, datapoints rendered and how
+    many are labelled positive, the stable poses the render considered (NaN without datapoints) and the grasps with at
+    least one datapoint, as the ``grasps`` and ``render`` stages make them."""
+    if not ids:
+        raise SystemExit("heldout_fidelity: no reconstruction meshed, nothing to label")
     grasps, _ = grasps_of_shapes(folder, ids, suffix, params.grasps, params.seed, workers, f"grasps ({label})")
     index = {s: i for i, s in enumerate(ids)}
     score, count = graspness(grasps.success.to_numpy(), grasps.shape_id.map(index).to_numpy(), len(ids))
@@ -78,24 +80,24 @@ def label_and_render(ids: list[str], folder: Path, suffix: str, params, workers:
     by_shape, results = render_corpus(
         shapes, grasps, folder, suffix, params.render, hand, params.seed, workers, f"render ({label})"
     )
-    datapoints, positive, poses, grasps_seen = [], [], [], []
+    datapoints, positives, poses, grasps_seen = [], [], [], []
     for shape_id, (data, _) in zip(ids, results):
         n = 0 if data is None else len(data)
         datapoints.append(n)
-        poses.append(0 if data is None else data.n_poses)
+        poses.append(np.nan if data is None else data.n_poses)  # a shape without datapoints: left out, as render does
         grasps_seen.append(0 if data is None else len(np.unique(data.columns["grasp_index"])))
-        if n:
-            rows = by_shape[shape_id].success.to_numpy()[data.columns["grasp_index"]]
-            positive.append(float(rows.mean()))
+        if n:  # the render stage's label: a successful grasp whose approach is collision free in that view
+            success = by_shape[shape_id].success.to_numpy()[data.columns["grasp_index"]]
+            positives.append(int((success & data.columns["collision_free"].astype(bool)).sum()))
         else:
-            positive.append(np.nan)
+            positives.append(0)
     return pd.DataFrame(
         {
             "shape_id": ids,
             "graspness": score,
             "grasps": count,
             "datapoints": datapoints,
-            "positive": positive,
+            "positives": positives,
             "stable_poses": poses,
             "grasps_rendered": grasps_seen,
         }
@@ -107,7 +109,8 @@ WHEN = ("before", "after")
 
 def summarize(per_shape: pd.DataFrame) -> dict:
     """Paired figures over the shapes whose reconstruction meshed: graspness kept (Fieller 95%), datapoints kept
-    (Fieller 95%), mean datapoints, positive shares, stable poses and grasps rendered, before and after."""
+    (Fieller 95%), mean datapoints, the datapoints' positive share (pooled), stable poses and grasps rendered, before
+    and after."""
     meshed = per_shape[per_shape.meshed]
     before, after = meshed.datapoints_before.to_numpy(float), meshed.datapoints_after.to_numpy(float)
     dp = fieller_interval(after, before)
@@ -120,10 +123,9 @@ def summarize(per_shape: pd.DataFrame) -> dict:
         "datapoints_kept": dp["ratio"],
         "datapoints_kept_low": dp["low"],
         "datapoints_kept_high": dp["high"],
-        "positive_before": float(np.nanmean(meshed.positive_before)),
-        "positive_after": float(np.nanmean(meshed.positive_after)),
-        **{f"{k}_{w}": float(meshed[f"{k}_{w}"].mean()) for k in ("stable_poses", "grasps_rendered") for w in WHEN},
-    }
+        "positive_before": float(meshed.positives_before.sum() / before.sum()),  # pooled, as the dataset's share
+        "positive_after": float(meshed.positives_after.sum() / after.sum()),
+    } | {f"{k}_{w}": float(np.nanmean(meshed[f"{k}_{w}"])) for k in ("stable_poses", "grasps_rendered") for w in WHEN}
 
 
 def main() -> None:
