@@ -43,7 +43,8 @@ from graspaug.io.tables import read_table
 from graspaug.io.voxels import read_voxels
 from graspaug.pipeline.params.model import load_params
 from graspaug.pipeline.paths import AE_CRITIC_MODEL, GENERATED_SUFFIX, LATENTS, VOXELS, corpus_files
-from graspaug.render.corpus_dataset import render_corpus
+from graspaug.render.corpus_dataset import render_corpus, with_pool_columns
+from graspaug.render.dataset import datapoints_index
 
 
 def reconstruct(project: Path, ids: list[str], params, folder: Path, workers: int) -> dict[str, str | None]:
@@ -66,40 +67,35 @@ def reconstruct(project: Path, ids: list[str], params, folder: Path, workers: in
     return {shape_id: d.reason for shape_id, d in zip(ids, decoded)}
 
 
-def label_and_render(ids: list[str], folder: Path, suffix: str, params, workers: int, label: str) -> pd.DataFrame:
-    """Per shape of ``ids`` (meshes ``folder``/<id><suffix>): graspness, grasps labelled, datapoints rendered and how
-    many are labelled positive, the stable poses the render considered (NaN without datapoints) and the grasps with at
-    least one datapoint, as the ``grasps`` and ``render`` stages make them."""
+def label_and_render(shapes: pd.DataFrame, folder: Path, suffix: str, params, workers: int, label: str) -> pd.DataFrame:
+    """Per shape of ``shapes`` (corpus rows; meshes ``folder``/<id><suffix>): graspness, grasps labelled, datapoints
+    rendered and how many the render stage labels positive (:func:`graspaug.render.dataset.datapoints_index`), the
+    stable poses the render considered (NaN without datapoints) and the grasps with at least one datapoint, as the
+    ``grasps`` and ``render`` stages make them."""
+    ids = list(shapes.shape_id)
     if not ids:
         raise SystemExit("heldout_fidelity: no reconstruction meshed, nothing to label")
     grasps, _ = grasps_of_shapes(folder, ids, suffix, params.grasps, params.seed, workers, f"grasps ({label})")
     index = {s: i for i, s in enumerate(ids)}
     score, count = graspness(grasps.success.to_numpy(), grasps.shape_id.map(index).to_numpy(), len(ids))
-    shapes = pd.DataFrame({"shape_id": ids})
+    shapes = with_pool_columns(shapes.reset_index(drop=True).copy())
     hand = params.grasps.gripper
     by_shape, results = render_corpus(
         shapes, grasps, folder, suffix, params.render, hand, params.seed, workers, f"render ({label})"
     )
-    datapoints, positives, poses, grasps_seen = [], [], [], []
-    for shape_id, (data, _) in zip(ids, results):
-        n = 0 if data is None else len(data)
-        datapoints.append(n)
-        poses.append(np.nan if data is None else data.n_poses)  # a shape without datapoints: left out, as render does
-        grasps_seen.append(0 if data is None else len(np.unique(data.columns["grasp_index"])))
-        if n:  # the render stage's label: a successful grasp whose approach is collision free in that view
-            success = by_shape[shape_id].success.to_numpy()[data.columns["grasp_index"]]
-            positives.append(int((success & data.columns["collision_free"].astype(bool)).sum()))
-        else:
-            positives.append(0)
+    _, parts, _, _, n_poses = datapoints_index(shapes, by_shape, results, params.grasps.threshold)
+    rendered = [s for s, (data, _) in zip(ids, results) if data is not None]
+    part = dict(zip(rendered, parts))
+    poses = dict(zip(rendered, n_poses))  # a shape without datapoints: left out, as render does
     return pd.DataFrame(
         {
             "shape_id": ids,
             "graspness": score,
             "grasps": count,
-            "datapoints": datapoints,
-            "positives": positives,
-            "stable_poses": poses,
-            "grasps_rendered": grasps_seen,
+            "datapoints": [len(part[s]) if s in part else 0 for s in ids],
+            "positives": [int(part[s].label.sum()) if s in part else 0 for s in ids],
+            "stable_poses": [poses.get(s, np.nan) for s in ids],
+            "grasps_rendered": [part[s].grasp_id.nunique() if s in part else 0 for s in ids],
         }
     )
 
@@ -149,8 +145,9 @@ def main() -> None:
         folder = Path(tmp)
         reasons = reconstruct(project, ids, params, folder, args.workers)
         made = [s for s in ids if reasons[s] is None]
-        before = label_and_render(ids, project / mesh_dir, suffix, params, args.workers, "originals")
-        after = label_and_render(made, folder, GENERATED_SUFFIX, params, args.workers, "reconstructions")
+        rows = shapes.set_index("shape_id", drop=False)
+        before = label_and_render(rows.loc[ids], project / mesh_dir, suffix, params, args.workers, "originals")
+        after = label_and_render(rows.loc[made], folder, GENERATED_SUFFIX, params, args.workers, "reconstructions")
     per_shape = before.merge(after, on="shape_id", how="left", suffixes=("_before", "_after"))
     per_shape["meshed"] = per_shape.shape_id.map(lambda s: reasons[s] is None)
     per_shape["reason"] = per_shape.shape_id.map(reasons)
