@@ -335,6 +335,32 @@ def test_dvc_repro_fidelity(tiny_repo):
     assert "Running stage" not in again.stdout
 
 
+def test_heldout_fidelity_study_labels_the_originals_as_the_stages_do(tiny_repo, tmp_path):
+    import json
+
+    work, env = tiny_repo
+    run(["dvc", "repro", "embed", "render@original"], work, env)
+    out = tmp_path / "heldout"
+    cmd = [sys.executable, "studies/heldout_fidelity.py", "--project", str(work), "--shapes", "3", "--workers", "1"]
+    run([*cmd, "--out", str(out)], work, env)
+    per_shape = pd.read_csv(out / "per_shape.csv").set_index("shape_id")
+    summary = json.loads((out / "summary.json").read_text())
+    shapes = pd.read_parquet(work / "data/shapes.parquet").set_index("shape_id")
+    assert len(per_shape) == summary["shapes"] == 3 and (shapes.loc[per_shape.index, "split"] == "test").all()
+    assert 0 < summary["meshed"] == per_shape.meshed.sum() <= 3
+    # the originals' datapoints and positives are the render stage's own, shape by shape
+    index = pd.read_parquet(work / "data/gqcnn/original/index.parquet")
+    stage = index[index.shape_id.isin(per_shape.index)].groupby("shape_id").label.agg(["size", "sum"])
+    stage = stage.reindex(per_shape.index, fill_value=0)
+    assert per_shape.datapoints_before.tolist() == stage["size"].tolist()
+    assert per_shape.positives_before.tolist() == stage["sum"].tolist()
+    grasps = pd.read_parquet(work / "data/grasps/original.parquet")
+    expected = grasps[grasps.shape_id.isin(per_shape.index)].groupby("shape_id").success.mean()
+    assert np.allclose(per_shape.graspness_before, expected.reindex(per_shape.index, fill_value=0))
+    meshed = per_shape[per_shape.meshed]
+    assert np.isclose(summary["graspness_before"], meshed.graspness_before.mean())
+
+
 def test_dvc_repro_gqcnn_matrix_and_report(tiny_repo):
     import json
 
