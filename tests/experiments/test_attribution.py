@@ -151,4 +151,25 @@ def test_the_advice_names_the_pools_that_gain_and_never_the_recon_control():
     )
     shares["warp"]["50"] = _share(0.5, -0.01, 0.02)  # now only the control gains
     advice = recommendation({"shares": shares})[-1]
-    assert "Add real shapes: no generated or procedural pool" in advice and "only the control `recon` does" in advice
+    assert (
+        "At B = 50, add real shapes: no generated or procedural pool" in advice and "the control `recon` does" in advice
+    )
+
+
+def test_the_advice_reads_every_base_size():
+    shares = {
+        "targeted": {"50": _share(-0.2, -0.02, 0.01), "100": _share(0.8, 0.001, 0.02)},  # gains at B = 100 only
+        "warp": {"50": _share(-0.8, -0.02, -0.001), "100": _share(-0.4, -0.02, 0.01)},
+    }
+    lines = recommendation({"shares": shares})
+    assert lines[0] == (
+        "| pool | B = 50: share [95%] | B = 100: share [95%] | its own gain at B = 50 | its own gain at B = 100 |"
+    )
+    assert lines[2].startswith(
+        "| targeted | -20% [-40%, +0%] | +80% [+60%, +100%] | no effect we can claim over 3 draws of the data | a gain"
+    )
+    assert lines[-1].endswith(
+        "At B = 50, add real shapes: no generated or procedural pool tried here adds AP with an interval above zero. "
+        "At B = 100 the pools that add AP with an interval above zero: targeted; targeted adds the most, 80% of as "
+        "many real shapes' gain."
+    )

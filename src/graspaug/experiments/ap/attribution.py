@@ -228,9 +228,9 @@ CONTROLS = {"recon": "control: the new real shapes themselves, decoded"}
 def recommendation(result: dict) -> list[str]:
     """A markdown table (one line each): per pool of ``result["shares"]`` (:func:`combine_draws`), its share of the
     real-shape gain at every augmented base size with its 95% interval, ordered by the share at the smallest base
-    size, and what the pool's own gain over no augmentation says (``gain``, a contrast over draws, in
-    :func:`~graspaug.experiments.stats.verdict`'s words); then a sentence a user can act on, naming no pool of
-    :data:`CONTROLS`."""
+    size, and what the pool's own gain over no augmentation says at each base size (``gain``, a contrast over draws,
+    in :func:`~graspaug.experiments.stats.verdict`'s words); then, per base size, a sentence a user can act on,
+    naming no pool of :data:`CONTROLS`."""
 
     def text(s: dict | None) -> str:
         if not s or s["share"] is None:
@@ -242,34 +242,44 @@ def recommendation(result: dict) -> list[str]:
 
     shares = result["shares"]
     sizes = sorted({b for by_size in shares.values() for b in by_size}, key=int)
-    first = sizes[0]
 
     def at_first(pool: str) -> float:
-        share = shares[pool].get(first, {}).get("share")
+        share = shares[pool].get(sizes[0], {}).get("share")
         return -np.inf if share is None else share
 
     order = sorted(shares, key=at_first, reverse=True)
     lines = [
-        "| pool | " + " | ".join(f"B = {b}: share [95%]" for b in sizes) + " | its own gain at the smallest B |",
-        "|---|" + "---|" * len(sizes) + "---|",
+        "| pool | "
+        + " | ".join(f"B = {b}: share [95%]" for b in sizes)
+        + " | "
+        + " | ".join(f"its own gain at B = {b}" for b in sizes)
+        + " |",
+        "|---|" + "---|" * (2 * len(sizes)),
     ]
     lines += [
         f"| {p}{f' ({CONTROLS[p]})' if p in CONTROLS else ''} | "
         + " | ".join(text(shares[p].get(b)) for b in sizes)
-        + f" | {says(shares[p].get(first))} |"
+        + " | "
+        + " | ".join(says(shares[p].get(b)) for b in sizes)
+        + " |"
         for p in order
     ]
-    gaining = [p for p in order if says(shares[p].get(first)).startswith("a gain")]
-    pools, controls = [p for p in gaining if p not in CONTROLS], [f"`{p}`" for p in gaining if p in CONTROLS]
-    if pools:
-        best = shares[pools[0]][first]["share"]
-        most = "" if best is None else f"; {pools[0]} adds the most, {best:.0%} of as many real shapes' gain"
-        advice = f"At B = {first} the pools that add AP with an interval above zero: {', '.join(pools)}{most}."
-    else:
-        but = f" (only the control {', '.join(controls)} does, and it needs the new real shapes)" if controls else ""
-        none = "no generated or procedural pool tried here adds AP with an interval above zero"
-        advice = f"Add real shapes: {none}{but}."
+    advice = []
+    for b in sizes:
+        gaining = [p for p in order if says(shares[p].get(b)).startswith("a gain")]
+        pools, controls = [p for p in gaining if p not in CONTROLS], [f"`{p}`" for p in gaining if p in CONTROLS]
+        if pools:
+            best = max(pools, key=lambda p: -np.inf if shares[p][b]["share"] is None else shares[p][b]["share"])
+            share = shares[best][b]["share"]
+            most = "" if share is None else f"; {best} adds the most, {share:.0%} of as many real shapes' gain"
+            advice.append(f"At B = {b} the pools that add AP with an interval above zero: {', '.join(pools)}{most}.")
+        else:
+            but = (
+                f" (only the control {', '.join(controls)} does, and it needs the new real shapes)" if controls else ""
+            )
+            none = "no generated or procedural pool tried here adds AP with an interval above zero"
+            advice.append(f"At B = {b}, add real shapes: {none}{but}.")
     return lines + [
         "",
-        f"A share is the pool's AP gain over no augmentation divided by as many real shapes' gain. {advice}",
+        "A share is the pool's AP gain over no augmentation divided by as many real shapes' gain. " + " ".join(advice),
     ]
