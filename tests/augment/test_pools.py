@@ -96,7 +96,7 @@ def test_a_recon_shape_is_the_autoencoders_reconstruction_meshed_at_its_own_scal
     from graspaug.training.autoencoder import decode, encode
 
     torch.manual_seed(0)
-    ae = AutoEncoder(AEConfig(resolution=16, z_dim=8, base_width=4, top_width=16))
+    ae = AutoEncoder(AEConfig(resolution=16, z_dim=8, base_width=4, top_width=16, output="occupancy"))
     with torch.no_grad():  # untrained: a bias that leaves most of the grid occupied, varying with the latent
         ae.decoder.net[-1].bias.fill_(1.0)
     grids = torch.zeros(3, 1, 16, 16, 16)

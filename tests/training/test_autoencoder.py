@@ -44,7 +44,8 @@ def primitive_meshes() -> list[trimesh.Trimesh]:
 
 
 def primitive_grids(resolution: int) -> torch.Tensor:
-    """The eight :func:`primitive_meshes` voxelized with the project's voxelizer: (8, 1, R, R, R) uint8."""
+    """The eight :func:`primitive_meshes` voxelized with the project's voxelizer: (8, 1, R, R, R) uint8 occupancy
+    (the grids of ``output="occupancy"``, which the tests here set: the default decoder is ``sdf``)."""
     grids = [voxelize_solid(m.vertices, m.faces, fit_grid(m.bounds, resolution)) for m in primitive_meshes()]
     return torch.from_numpy(np.stack(grids)[:, None].astype(np.uint8))
 
@@ -52,7 +53,7 @@ def primitive_grids(resolution: int) -> torch.Tensor:
 def test_a_tiny_model_overfits_eight_shapes():
     torch.manual_seed(0)
     x = primitive_grids(16)
-    ae = AutoEncoder(AEConfig(resolution=16, z_dim=32, base_width=8, top_width=32))
+    ae = AutoEncoder(AEConfig(resolution=16, z_dim=32, base_width=8, top_width=32, output="occupancy"))
     cfg = train_settings(batch_size=8, epochs_ae=150, epochs_critic=0, lr_ae=3e-3, flips=False)
     train_autoencoder(ae, x, cfg, CPU, torch.Generator().manual_seed(0))
     assert reconstruction_iou(ae, x, CPU) > 0.9
@@ -72,7 +73,7 @@ def test_a_tiny_model_overfits_eight_shapes():
 def _train_twice_state(seed: int) -> dict[str, torch.Tensor]:
     torch.manual_seed(seed)
     x = primitive_grids(16)
-    cfg = AEConfig(resolution=16, z_dim=16, base_width=4, top_width=16)
+    cfg = AEConfig(resolution=16, z_dim=16, base_width=4, top_width=16, output="occupancy")
     ae, critic = AutoEncoder(cfg), Critic(cfg)
     tcfg = train_settings(batch_size=4, epochs_ae=2, epochs_critic=2)
     gen = torch.Generator().manual_seed(seed)
@@ -130,7 +131,7 @@ def test_same_seed_gives_identical_weights():
 def test_ae_critic_phase_reports_its_losses_and_trains_the_critic():
     torch.manual_seed(0)
     x = primitive_grids(16)
-    cfg = AEConfig(resolution=16, z_dim=16, base_width=4, top_width=16)
+    cfg = AEConfig(resolution=16, z_dim=16, base_width=4, top_width=16, output="occupancy")
     ae, critic = AutoEncoder(cfg), Critic(cfg)
     seen = []
     before = {k: v.clone() for k, v in critic.state_dict().items()}
@@ -153,7 +154,7 @@ def test_phase_2_leaves_the_decoders_normalization_statistics_unchanged():
     its weights still learn."""
     torch.manual_seed(0)
     x = primitive_grids(16)
-    cfg = AEConfig(resolution=16, z_dim=16, base_width=4, top_width=16)
+    cfg = AEConfig(resolution=16, z_dim=16, base_width=4, top_width=16, output="occupancy")
     ae, critic = AutoEncoder(cfg), Critic(cfg)
     train_autoencoder(ae, x, train_settings(batch_size=4, epochs_ae=1), CPU, torch.Generator().manual_seed(0))
     stats_before = _normalization_buffers(ae.decoder)
@@ -178,7 +179,7 @@ def test_phase_2_leaves_the_decoders_normalization_statistics_unchanged():
 def _phase_2_weights(critic: Critic | None, lam: float) -> dict[str, torch.Tensor]:
     torch.manual_seed(3)
     x = primitive_grids(16)
-    cfg = AEConfig(resolution=16, z_dim=16, base_width=4, top_width=16)
+    cfg = AEConfig(resolution=16, z_dim=16, base_width=4, top_width=16, output="occupancy")
     ae = AutoEncoder(cfg)
     if critic is not None:
         critic = Critic(cfg)
@@ -197,8 +198,12 @@ def test_the_control_arm_is_the_ae_critic_with_lambda_zero():
     """A critic trained beside the AE with λ = 0 changes nothing in the AE: the same weights as the
     critic-free control arm, bit for bit (same batches, flips, α draws); with λ > 0 it does."""
     control = _phase_2_weights(None, lam=0.5)  # critic=None ignores λ
-    lam_zero = _phase_2_weights(Critic(AEConfig(resolution=16, z_dim=16, base_width=4, top_width=16)), lam=0.0)
-    lam_half = _phase_2_weights(Critic(AEConfig(resolution=16, z_dim=16, base_width=4, top_width=16)), lam=0.5)
+    lam_zero = _phase_2_weights(
+        Critic(AEConfig(resolution=16, z_dim=16, base_width=4, top_width=16, output="occupancy")), lam=0.0
+    )
+    lam_half = _phase_2_weights(
+        Critic(AEConfig(resolution=16, z_dim=16, base_width=4, top_width=16, output="occupancy")), lam=0.5
+    )
     assert all(torch.equal(control[k], lam_zero[k]) for k in control)
     assert not all(torch.equal(control[k], lam_half[k]) for k in control)
 
@@ -208,7 +213,7 @@ def test_critic_separation_puts_interpolants_on_the_positive_side():
     decodes of an untrained AE score high, so the AUC is 1 and the mean outputs are ordered."""
     torch.manual_seed(0)
     x = primitive_grids(16)
-    ae = AutoEncoder(AEConfig(resolution=16, z_dim=16, base_width=4, top_width=16))
+    ae = AutoEncoder(AEConfig(resolution=16, z_dim=16, base_width=4, top_width=16, output="occupancy"))
 
     class Softness(torch.nn.Module):
         def forward(self, v):
@@ -221,7 +226,7 @@ def test_critic_separation_puts_interpolants_on_the_positive_side():
 
 
 def test_checkpoint_roundtrip_and_mismatch(tmp_path):
-    cfg = AEConfig(resolution=16, z_dim=16, base_width=4, top_width=16)
+    cfg = AEConfig(resolution=16, z_dim=16, base_width=4, top_width=16, output="occupancy")
     ae, critic = AutoEncoder(cfg).eval(), Critic(cfg)
     save_autoencoder(tmp_path / "m.pt", ae, critic, {"lr_ae": 1e-3})
     back, back_critic, params = load_autoencoder(tmp_path / "m.pt", cfg)
@@ -234,7 +239,9 @@ def test_checkpoint_roundtrip_and_mismatch(tmp_path):
     save_autoencoder(tmp_path / "again.pt", ae, critic, {"lr_ae": 1e-3})
     assert (tmp_path / "m.pt").read_bytes() == (tmp_path / "again.pt").read_bytes()  # same weights, same bytes
     with pytest.raises(CheckpointMismatch, match=r"trained with resolution=16 \(params: 32\)"):
-        load_autoencoder(tmp_path / "m.pt", AEConfig(resolution=32, z_dim=16, base_width=4, top_width=16))
+        load_autoencoder(
+            tmp_path / "m.pt", AEConfig(resolution=32, z_dim=16, base_width=4, top_width=16, output="occupancy")
+        )
 
 
 def primitive_fields(resolution: int, truncation: float = 3.0) -> torch.Tensor:
@@ -294,7 +301,7 @@ def test_a_decoder_of_signed_distances_learns_eight_shapes_and_meshes_them():
 def test_an_occupancy_checkpoint_keeps_its_old_layout_and_a_decoder_of_distances_says_what_it_is(tmp_path):
     from graspaug.io.checkpoints import SDF_KEYS
 
-    cfg = AEConfig(resolution=16, z_dim=16, base_width=4, top_width=16)
+    cfg = AEConfig(resolution=16, z_dim=16, base_width=4, top_width=16, output="occupancy")
     save_autoencoder(tmp_path / "occupancy.pt", AutoEncoder(cfg), None, {})
     state = torch.load(tmp_path / "occupancy.pt", weights_only=True)
     assert not set(SDF_KEYS) & set(state["config"])  # the file as before signed distances existed

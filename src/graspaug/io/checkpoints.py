@@ -27,8 +27,8 @@ def save_autoencoder(
     path: str | os.PathLike, ae: AutoEncoder, critic: Critic | None, train_params: dict[str, Any]
 ) -> None:
     """Write the AE (and critic) weights with the network config and training params (atomic). An occupancy
-    network's config leaves out ``output`` and ``truncation`` (both read back as their defaults), so its file is
-    the same, byte for byte, as before a decoder of signed distances existed."""
+    network's config leaves out ``output`` and ``truncation`` (read back as ``occupancy`` and the default
+    truncation), so its file is the same, byte for byte, as before a decoder of signed distances existed."""
     config = dataclasses.asdict(ae.cfg)
     if ae.cfg.output == "occupancy":
         config = {k: v for k, v in config.items() if k not in SDF_KEYS}
@@ -61,7 +61,7 @@ def load_autoencoder(path: str | os.PathLike, expected: AEConfig) -> tuple[AutoE
             f"{path} holds a critic of format {state.get('format')}, this code reads {FORMAT}; retrain it with `dvc "
             "repro train_ae`"
         )
-    saved = AEConfig(**state["config"])
+    saved = AEConfig(**({"output": "occupancy"} | state["config"]))  # no output: an occupancy network's file
     if saved != expected:
         diffs = [
             f"{k}={getattr(saved, k)} (params: {getattr(expected, k)})"

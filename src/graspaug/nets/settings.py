@@ -23,12 +23,12 @@ class AEConfig:
     )
     top_width: int = Field(128, ge=1, description="Channels of the 4×4×4 map before the FC layer (paper: 512).")
     output: Literal["occupancy", "sdf"] = Field(
-        "occupancy",
+        "sdf",
         description=(
-            "What a grid holds, in and out: `occupancy` (0/1 in, a logit out; a decode is meshed by threshold, "
-            "opening, marching cubes at 0.5 and smoothing: the paper's) or `sdf` (the truncated signed distance / "
-            "truncation, in [-1, 1], negative inside; tanh out, an L1 loss weighted near the surface; meshed by "
-            "marching cubes at 0 with sub-voxel faces and no opening or smoothing)."
+            "What a grid holds, in and out: `sdf` (the truncated signed distance / truncation, in [-1, 1], negative "
+            "inside; tanh out, an L1 loss weighted near the surface; meshed by marching cubes at 0 with sub-voxel "
+            "faces and no opening or smoothing) or `occupancy` (0/1 in, a logit out; a decode is meshed by threshold, "
+            "opening, marching cubes at 0.5 and smoothing: the paper's, which the `paper` profile keeps)."
         ),
     )
     truncation: float = Field(

@@ -12,7 +12,9 @@ class AETrainConfig:
     """The two training phases (params section ``ae.train``)."""
 
     batch_size: int = Field(16, ge=2, description="Shapes per batch.")
-    epochs_ae: int = Field(30, ge=0, description="Phase 1 epochs: plain AutoEncoder, binary cross-entropy.")
+    epochs_ae: int = Field(
+        90, ge=0, description="Phase 1 epochs: the plain AutoEncoder and its reconstruction loss (`ae.net.output`)."
+    )
     epochs_critic: int = Field(
         6, ge=0, description="Phase 2 epochs: AE-Critic initialised from phase 1, warm-up included."
     )
