@@ -101,7 +101,7 @@ def sizes(tiny: bool) -> dict:
     if tiny:
         return dict(
             res=16,
-            ae=dict(resolution=16, z_dim=16, base_width=4, top_width=16),
+            ae=dict(resolution=16, z_dim=16, base_width=4, top_width=16, output="occupancy"),
             gq=dict(filters=8, fc=64),
             ae_steps=4,
             critic_steps=3,
@@ -115,7 +115,7 @@ def sizes(tiny: bool) -> dict:
     # evals 20); ae.train.batch_size is not set there: the default 16
     return dict(
         res=64,
-        ae=dict(resolution=64, z_dim=128, base_width=64, top_width=512),
+        ae=dict(resolution=64, z_dim=128, base_width=64, top_width=512, output="occupancy"),
         gq=dict(filters=64, fc=1024),
         ae_steps=20,
         critic_steps=10,

@@ -140,7 +140,7 @@ def test_folded_alpha_covers_zero_to_one_half_uniformly():
 
 def test_with_lambda_zero_the_critic_term_sends_no_gradient_to_the_autoencoder():
     torch.manual_seed(0)
-    cfg = AEConfig(resolution=16, base_width=4, top_width=16)
+    cfg = AEConfig(resolution=16, base_width=4, top_width=16, output="occupancy")
     ae, critic = AutoEncoder(cfg), Critic(cfg)
     x = (torch.rand(4, 1, 16, 16, 16) > 0.6).float()
 

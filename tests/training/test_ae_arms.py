@@ -11,7 +11,7 @@ CPU = torch.device("cpu")
 
 def test_an_arm_logs_its_epochs_and_measures_its_weights(tmp_path):
     torch.manual_seed(0)
-    cfg = AEConfig(resolution=16, z_dim=8, base_width=4, top_width=8)
+    cfg = AEConfig(resolution=16, z_dim=8, base_width=4, top_width=8, output="occupancy")
     grids = (torch.rand(6, 1, 16, 16, 16) > 0.5).to(torch.uint8)
     arms = ArmTrainer(tmp_path / "live", grids[:4], grids[4:], CPU)
 

@@ -106,7 +106,7 @@ def test_the_cosine_schedule_falls_from_lr_ae_to_half_at_mid_training_and_consta
 
 def _phase_1_weights(epochs: int, schedule: str) -> dict[str, torch.Tensor]:
     torch.manual_seed(0)
-    ae = AutoEncoder(AEConfig(resolution=16, z_dim=16, base_width=4, top_width=16))
+    ae = AutoEncoder(AEConfig(resolution=16, z_dim=16, base_width=4, top_width=16, output="occupancy"))
     tcfg = train_settings(batch_size=4, epochs_ae=epochs, lr_schedule=schedule)
     train_autoencoder(ae, primitive_grids(16), tcfg, CPU, torch.Generator().manual_seed(0))
     return ae.state_dict()
