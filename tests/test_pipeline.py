@@ -108,7 +108,7 @@ def test_dvc_repro_critic_eval_and_embed(tiny_repo):
     assert json.loads((work / "metrics/train_ae.json").read_text())["iou_ae"] == summary["ae_iou_test"]
     assert json.loads((work / "reports/timing/train_ae.json").read_text())["ae_shapes_per_s"] > 0
     latents = pd.read_parquet(work / "data/latents.parquet")
-    assert len(latents) == 20 and len(latents.z[0]) == 16
+    assert len(latents) == 20 and len(latents.z[0]) == 32  # the tiny profile's z_dim
     assert set(latents.split) == {"train", "test"}
     shown = run(["dvc", "metrics", "show", "--json"], work, env)
     assert "iou_critic" in shown.stdout
