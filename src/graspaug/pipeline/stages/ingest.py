@@ -68,8 +68,8 @@ def run(params: Params) -> None:
         write_table(shapes, SHAPES_TABLE)
         write_table(rejects, REJECTS_TABLE)
 
-    for reason, n in Counter(rejects["reason"]).most_common():
-        log.info("rejected %d: %s", n, reason)
+    for line in reject_lines(rejects):
+        log.info("ingest: %s", line)
     log.info("ingest: %s", closing_summary(shapes))
     kinds = shapes["duplicate_kind"].value_counts()
     log.info(
@@ -80,7 +80,8 @@ def run(params: Params) -> None:
     )
     counts = shapes["split"].value_counts()
     log.info(
-        "ingest: %d shapes (%d train, %d test), %d rejected, %d/%d watertight, median %d faces, in %.1f s",
+        "ingest: %d shapes (%d train, %d test), %d rejected, %d/%d watertight, median %d faces, %d over the face "
+        "budget of %d (not decimated: the decimator failed or would open the surface), in %.1f s",
         len(shapes),
         counts.get("train", 0),
         counts.get("test", 0),
@@ -88,5 +89,16 @@ def run(params: Params) -> None:
         int(shapes["watertight"].sum()),
         len(shapes),
         int(shapes["faces"].median()),
+        int((shapes["faces"] > cfg.surface.face_budget).sum()),
+        cfg.surface.face_budget,
         time.perf_counter() - start,
     )
+
+
+def reject_lines(rejects: pd.DataFrame, limit: int = 10) -> list[str]:
+    """Log lines naming each rejected file (``rejects``: the reject table, ``source`` and ``reason`` columns) with
+    its reason, the first ``limit`` of them; then how many more and where every one is listed."""
+    lines = [f"rejected {row.source}: {row.reason}" for row in rejects.head(limit).itertuples()]
+    if len(rejects) > limit:
+        lines.append(f"... and {len(rejects) - limit} more, see {REJECTS_TABLE}")
+    return lines
