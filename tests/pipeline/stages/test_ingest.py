@@ -241,7 +241,7 @@ def test_warnings_of_a_broken_file_go_into_its_reason(tmp_path, capfd):
 
 def test_the_log_names_each_rejected_file_and_its_reason(tmp_path, caplog):
     """The log named only reasons ("rejected 1: empty file"); the file was only in data/rejects.parquet."""
-    from graspaug.pipeline.stages.ingest import reject_lines
+    from graspaug.augment.corpus import reject_lines
 
     folder = tmp_path / "meshes"
     folder.mkdir()
@@ -259,7 +259,7 @@ def test_the_log_names_each_rejected_file_and_its_reason(tmp_path, caplog):
     assert any("0 over the face budget of 5000" in m for m in logged), logged
     # past the limit: the first ones, then how many more and where all are
     rejects = pd.DataFrame({"source": [f"folder:m{i}.obj" for i in range(5)], "reason": ["empty file"] * 5})
-    assert reject_lines(rejects, limit=2) == [
+    assert reject_lines(rejects, "data/rejects.parquet", limit=2) == [
         "rejected folder:m0.obj: empty file",
         "rejected folder:m1.obj: empty file",
         "... and 3 more, see data/rejects.parquet",

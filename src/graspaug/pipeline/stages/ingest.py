@@ -11,7 +11,7 @@ from collections import Counter
 
 import pandas as pd
 
-from graspaug.augment.corpus import assign_split, closing_summary, flag_duplicates, ingest_source
+from graspaug.augment.corpus import assign_split, closing_summary, flag_duplicates, ingest_source, reject_lines
 from graspaug.io.atomic import atomic_path
 from graspaug.io.settings import CorpusSettings
 from graspaug.io.sources import folder_sources, pybullet_sources
@@ -68,7 +68,7 @@ def run(params: Params) -> None:
         write_table(shapes, SHAPES_TABLE)
         write_table(rejects, REJECTS_TABLE)
 
-    for line in reject_lines(rejects):
+    for line in reject_lines(rejects, REJECTS_TABLE):
         log.info("ingest: %s", line)
     log.info("ingest: %s", closing_summary(shapes))
     kinds = shapes["duplicate_kind"].value_counts()
@@ -93,12 +93,3 @@ def run(params: Params) -> None:
         cfg.surface.face_budget,
         time.perf_counter() - start,
     )
-
-
-def reject_lines(rejects: pd.DataFrame, limit: int = 10) -> list[str]:
-    """Log lines naming each rejected file (``rejects``: the reject table, ``source`` and ``reason`` columns) with
-    its reason, the first ``limit`` of them; then how many more and where every one is listed."""
-    lines = [f"rejected {row.source}: {row.reason}" for row in rejects.head(limit).itertuples()]
-    if len(rejects) > limit:
-        lines.append(f"... and {len(rejects) - limit} more, see {REJECTS_TABLE}")
-    return lines
