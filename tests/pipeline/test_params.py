@@ -7,6 +7,7 @@ import yaml
 from typer.testing import CliRunner
 
 from graspaug.pipeline.cli import app
+from graspaug.pipeline.params.base import parse_yaml
 from graspaug.pipeline.params.model import Params, ParamsError, json_schema, load_params, params_dict, parse_params
 from graspaug.pipeline.params.profiles import merge, profile_names, profile_params, profile_yaml
 from graspaug.training.settings import TrainSettings
@@ -206,3 +207,27 @@ def test_a_yaml_syntax_error_names_its_line(tmp_path):
     bad.write_text("seed: 0\ngqcnn:\n  seeds: [0, 1\n  members: 3\n")
     with pytest.raises(ParamsError, match=r"params.yaml: not valid YAML at line \d+, column \d+"):
         load_params(bad)
+
+
+def test_a_duplicated_key_is_refused_naming_the_key_and_its_line(tmp_path, repo_root):
+    """YAML forbids a key given twice in one mapping; PyYAML keeps the second value silently and DVC calls the file
+    corrupted, so check-params (and every stage's params load) refuses it, naming the key and both lines."""
+    lines = (repo_root / "params.yaml").read_text().split("\n")
+    at = next(i for i, line in enumerate(lines) if line.strip().startswith("size_m:"))
+    indent = lines[at][: len(lines[at]) - len(lines[at].lstrip())]
+    lines.insert(at + 1, f"{indent}size_m: 0.5")  # the same key again, in the same mapping
+    bad = tmp_path / "params.yaml"
+    bad.write_text("\n".join(lines))
+    result = CliRunner().invoke(app, ["check-params", "--params", str(bad)])
+    assert result.exit_code == 2, result.output
+    assert f"duplicate key ingest.surface.size_m at line {at + 2} (first at line {at + 1})" in result.output
+    assert result.output.count("\n") == 1
+    with pytest.raises(ParamsError, match="duplicate key ingest.surface.size_m"):
+        load_params(bad)
+    # the same key in two mappings is no duplicate; nor is a merge key
+    assert parse_yaml("a: {x: 1}\nb: {x: 2}\nc: &c {y: 1}\nd:\n  <<: *c\n  y: 2\n") == {
+        "a": {"x": 1},
+        "b": {"x": 2},
+        "c": {"y": 1},
+        "d": {"y": 2},
+    }

@@ -171,3 +171,13 @@ def closing_summary(shapes: pd.DataFrame) -> str:
         f"{closed.get('filled', 0)}; "
         f"hull_fill median {shapes['hull_fill'].median():.2f}, lowest {lowest['hull_fill']:.2f} ({lowest['shape_id']})"
     )
+
+
+def reject_lines(rejects: pd.DataFrame, table: str | Path, limit: int = 10) -> list[str]:
+    """Log lines naming each rejected file (``rejects``: the reject table, ``source`` and ``reason`` columns) with
+    its reason, the first ``limit`` of them; then how many more and where every one is listed
+    (``table``)."""
+    lines = [f"rejected {row.source}: {row.reason}" for row in rejects.head(limit).itertuples()]
+    if len(rejects) > limit:
+        lines.append(f"... and {len(rejects) - limit} more, see {table}")
+    return lines

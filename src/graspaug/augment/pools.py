@@ -374,7 +374,8 @@ def log_failure_summary(summary: pd.DataFrame, notes: Sequence[str], out) -> Non
     for note in notes:
         log.info("from-failures: %s", note)
     for row in summary.itertuples():
-        line = f"{row.failure}: {row.shapes} shapes, {row.rejected} decodes rejected {row.why_none}".rstrip()
+        shapes, decodes = ("shape" if row.shapes == 1 else "shapes"), ("decode" if row.rejected == 1 else "decodes")
+        line = f"{row.failure}: {row.shapes} {shapes}, {row.rejected} {decodes} rejected {row.why_none}".rstrip()
         log.log(logging.WARNING if row.why_none else logging.INFO, "from-failures: %s", line)
     served = int((summary.shapes > 0).sum())
     log.info(

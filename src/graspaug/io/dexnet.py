@@ -51,9 +51,17 @@ def read_tensor_field(folder: str | os.PathLike, name: str) -> np.ndarray:
     return np.concatenate([np.load(f)["arr_0"] for f in files])
 
 
-def export_dexnet(source: str | os.PathLike, out: str | os.PathLike, rows_per_file: int = 1000) -> int:
+def export_dexnet(
+    source: str | os.PathLike, out: str | os.PathLike, rows_per_file: int = 1000, pool: str | None = None
+) -> int:
     """Write the rendered dataset in folder ``source`` (``data/gqcnn/<corpus>``) in Dex-Net 2.0's
-    tensor layout into ``out``; returns the number of datapoints."""
+    tensor layout into ``out``; returns the number of datapoints.
+
+    ``pool`` (a generated corpus ``gen_<B>`` only: ``targeted``, ``random``, ...) exports that pool's
+    datapoints alone; None exports every pool, each datapoint's pool in the ``pool_labels`` field
+    (indices into config.json's ``pools``). config.json of a generated corpus names the pool exported
+    (``pool``: a name or ``all``). Raises :class:`~graspaug.errors.DataError` for a pool the corpus does not hold."""
+    from graspaug.errors import DataError
     from graspaug.io.atomic import atomic_path
     from graspaug.io.gqcnn import GraspImages
 
@@ -68,6 +76,14 @@ def export_dexnet(source: str | os.PathLike, out: str | os.PathLike, rows_per_fi
     data = GraspImages.open(source)
     info = json.loads((source / "dataset.json").read_text())
     index = data.index
+    pools = sorted(index["pool"].dropna().unique()) if "pool" in index else []
+    rows = None
+    if pool is not None:
+        if pool not in pools:
+            held = f"its pools: {', '.join(pools)}" if pools else "it holds no pools (only generated corpora do)"
+            raise DataError(f"--pool {pool}: not a pool of {source.name}; {held}")
+        rows = np.flatnonzero((index["pool"] == pool).to_numpy(dtype=bool, na_value=False))
+        index = index.iloc[rows].reset_index(drop=True)
     obj_ids, obj_labels = np.unique(index.shape_id.to_numpy(), return_inverse=True)
     pose_keys = index.shape_id + ":" + index.pose_id.astype(str)
     pose_ids, pose_labels = np.unique(pose_keys.to_numpy(), return_inverse=True)
@@ -86,7 +102,7 @@ def export_dexnet(source: str | os.PathLike, out: str | os.PathLike, rows_per_fi
         axis=1,
     )
     fields = {
-        "depth_ims_tf_table": data.images()[..., None],
+        "depth_ims_tf_table": data.images(rows)[..., None],
         "hand_poses": hand_poses.astype(np.float32),
         # Dex-Net stores each metric times collision_free, and gqcnn labels by the metric alone
         "robust_ferrari_canny": (index.eps * index.collision_free).to_numpy(np.float32),
@@ -96,8 +112,12 @@ def export_dexnet(source: str | os.PathLike, out: str | os.PathLike, rows_per_fi
         "pose_labels": pose_labels.astype(np.uint32),
         "image_labels": image_labels.astype(np.uint32),
     }
+    if pools and pool is None:  # every pool, mixed: say which each datapoint is
+        fields["pool_labels"] = np.searchsorted(pools, index["pool"].to_numpy(dtype=object)).astype(np.uint8)
+    named = {"pool": pool or "all", "pools": [pool] if pool else pools} if pools else {}
     extra = {
-        "source": f"graspaug render ({source.name})",
+        "source": f"graspaug render ({source.name}" + (f", pool {named['pool']})" if pools else ")"),
+        **named,
         "dataset": info,
         "obj_ids": obj_ids.tolist(),
         "pose_ids": pose_ids.tolist(),

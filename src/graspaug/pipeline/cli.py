@@ -298,12 +298,18 @@ def export_dexnet_command(
     corpus: str = typer.Argument(..., help="Rendered corpus: `original` or `gen_<B>`."),
     out: Path = typer.Argument(..., help="Folder to create (must not exist or be empty)."),
     rows_per_file: int = typer.Option(1000, "--rows-per-file", min=1, help="Datapoints per .npz file (Dex-Net: 1000)."),
+    pool: str = typer.Option(
+        "all",
+        "--pool",
+        help="For a generated corpus: the one pool to export (`targeted`, `random`, `real`, ...; config.json names "
+        "it); `all`: every pool, each datapoint's in the `pool_labels` field.",
+    ),
 ) -> None:
     from graspaug.io.dexnet import export_dexnet
     from graspaug.pipeline.paths import gqcnn_dir
 
-    n = export_dexnet(gqcnn_dir(corpus), out, rows_per_file)
-    typer.echo(f"wrote {n} datapoints to {out}")
+    n = export_dexnet(gqcnn_dir(corpus), out, rows_per_file, pool=None if pool == "all" else pool)
+    typer.echo(f"wrote {n} datapoints ({corpus}, pool {pool}) to {out}")
 
 
 @app.command(

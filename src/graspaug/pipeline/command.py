@@ -3,6 +3,8 @@ for the whole CLI)."""
 
 from __future__ import annotations
 
+import errno
+import logging
 import warnings
 
 import typer
@@ -12,14 +14,16 @@ EXIT_CODES = (
     "Exit codes, the same for every command: 0 an answer; 1 no acceptable answer (`plan`: no grasp, or the best one "
     "below the quality floor); 2 bad input or usage (a missing or broken file, a bad param, an output folder it may "
     "not write, too few usable candidates for `--count`), one line naming the culprit; 3 an unexpected error (a bug: "
-    "`graspaug --debug <command> ...` shows its traceback)."
+    "`graspaug --debug <command> ...` shows its traceback), or the system failing the command (disk full, permission "
+    "denied, an I/O error: its cause named)."
 )
 
 _debug = {"on": False}  # set by the root callback (--debug, GRASPAUG_DEBUG) on every invocation
 
 
 def debug_mode(on: bool) -> None:
-    """Show tracebacks and other packages' warnings (``--debug``) or not, for the commands invoked next."""
+    """Show tracebacks and every warning each time it is raised (``--debug``) or not, for the commands invoked
+    next."""
     _debug["on"] = bool(on)
 
 
@@ -31,21 +35,67 @@ def _bad_input_errors() -> tuple[type[BaseException], ...]:
     return (DataError, StageError, CheckpointMismatch, ParamsError, OSError)
 
 
+#: errno values of an OSError that mean the user's input or usage (a path that is missing, a folder where a file
+#: belongs, an output that exists): exit 2. Any other errno (ENOSPC, EACCES, EIO, EROFS, ...) is the system
+#: failing the command: exit 3 with the cause. An OSError without errno (a library's message) is bad input.
+INPUT_ERRNOS = frozenset(
+    {errno.ENOENT, errno.EISDIR, errno.ENOTDIR, errno.EEXIST, errno.ENOTEMPTY, errno.ENAMETOOLONG, errno.ELOOP}
+)
+
+#: Warnings Python itself hides by default (meant for developers of the raising package), hidden here too.
+_QUIET = (DeprecationWarning, PendingDeprecationWarning, ImportWarning, ResourceWarning)
+
+
+class WarningsOnce:
+    """A ``warnings.showwarning`` that logs each distinct warning (category and text) once, on the
+    ``py.warnings`` logger at WARNING level, with the file and line that raised it: a third-party warning
+    (torch, sklearn, trimesh) reaches the stage's log without repeating for every shape."""
+
+    def __init__(self) -> None:
+        self.seen: set[tuple[type, str]] = set()
+
+    def __call__(self, message, category, filename, lineno, file=None, line=None) -> None:
+        key = (category, str(message))
+        if key in self.seen:
+            return
+        self.seen.add(key)
+        where = "/".join(str(filename).split("/")[-2:])
+        text = " ".join(str(message).split())
+        logging.getLogger("py.warnings").warning("%s: %s (%s:%s)", category.__name__, text, where, lineno)
+
+
+def is_system_error(exc: BaseException) -> bool:
+    """Whether ``exc`` is the system failing the command (an OSError whose errno is not in :data:`INPUT_ERRNOS`:
+    disk full, permission denied, I/O error...) rather than bad input."""
+    return isinstance(exc, OSError) and exc.errno is not None and exc.errno not in INPUT_ERRNOS
+
+
 class Command(TyperCommand):
     """A command that keeps the exit-code contract (:data:`EXIT_CODES`): an error of bad input is one line and exit
-    2, any other exception one line and exit 3; ``--debug`` re-raises both (the traceback) and shows the warnings
-    that other packages raise, which are otherwise hidden."""
+    2, the system failing (:func:`is_system_error`) or any other exception one line and exit 3; ``--debug``
+    re-raises them (the traceback). Warnings are logged, each distinct one once (:class:`WarningsOnce`);
+    ``--debug`` leaves Python's warning filters as they are."""
 
     def invoke(self, ctx):
         if _debug["on"]:
             return super().invoke(ctx)
         with warnings.catch_warnings():
-            warnings.filterwarnings("ignore", module=r"^(?!graspaug)")
+            warnings.simplefilter("always")  # every call reaches WarningsOnce, which keeps the first of each
+            for category in _QUIET:
+                warnings.filterwarnings("ignore", category=category)
+            warnings.showwarning = WarningsOnce()
             try:
                 return super().invoke(ctx)
             except (typer.Exit, typer.Abort, KeyboardInterrupt):
                 raise
             except _bad_input_errors() as exc:
+                if is_system_error(exc):
+                    typer.echo(
+                        f"error: {_one_line(exc)} ({errno.errorcode.get(exc.errno, exc.errno)}: the system failed "
+                        "the command, not its input; fix that and run it again)",
+                        err=True,
+                    )
+                    raise typer.Exit(code=3) from None
                 typer.echo(f"error: {_one_line(exc)}", err=True)
                 raise typer.Exit(code=2) from None
             except Exception as exc:  # noqa: BLE001 - the contract: one line, exit 3, the traceback with --debug

@@ -237,3 +237,30 @@ def test_warnings_of_a_broken_file_go_into_its_reason(tmp_path, capfd):
     assert not row["ok"] and "\n" not in row["reason"]
     assert "RuntimeWarning" in row["reason"], row["reason"]
     assert "Warning" not in capfd.readouterr().err
+
+
+def test_the_log_names_each_rejected_file_and_its_reason(tmp_path, caplog):
+    """The log named only reasons ("rejected 1: empty file"); the file was only in data/rejects.parquet."""
+    from graspaug.augment.corpus import reject_lines
+
+    folder = tmp_path / "meshes"
+    folder.mkdir()
+    trimesh.creation.box(extents=(0.1, 0.05, 0.03)).export(folder / "box.stl")
+    trimesh.creation.icosphere(subdivisions=2, radius=0.04).export(folder / "ball.ply")
+    trimesh.creation.cylinder(radius=0.02, height=0.08).export(folder / "can.obj")
+    (folder / "lid.stl").write_bytes(b"")
+    params = {"n_jobs": 1, "data": {"source": "folder", "path": "meshes"}, "ingest": {"min_shapes": 3}}
+    with caplog.at_level(logging.INFO):
+        result = run_stage(tmp_path, "ingest", params)
+    assert result.exit_code == 0, result.output
+    logged = [r.getMessage() for r in caplog.records]
+    named = [m for m in logged if m.startswith("ingest: rejected ") and "lid.stl" in m]
+    assert len(named) == 1 and named[0].endswith("lid.stl: empty file"), logged
+    assert any("0 over the face budget of 5000" in m for m in logged), logged
+    # past the limit: the first ones, then how many more and where all are
+    rejects = pd.DataFrame({"source": [f"folder:m{i}.obj" for i in range(5)], "reason": ["empty file"] * 5})
+    assert reject_lines(rejects, "data/rejects.parquet", limit=2) == [
+        "rejected folder:m0.obj: empty file",
+        "rejected folder:m1.obj: empty file",
+        "... and 3 more, see data/rejects.parquet",
+    ]

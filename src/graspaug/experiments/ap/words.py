@@ -103,7 +103,8 @@ def training_words(t, members: int = 1) -> str:
         else f"Each network is an ensemble of {members} GQ-CNNs (their mean P(success)); each member"
     )
     return (
-        f"{what} trains {t.epochs:g} passes over its own training set ({t.min_steps}-{t.max_steps} steps of "
+        f"{what} trains {t.epochs:g} pass{'' if t.epochs == 1 else 'es'} over its own training set "
+        f"({t.min_steps}-{t.max_steps} steps of "
         f"{t.batch_size}), "
         f"the learning rate annealed to {t.final_lr:g} of its start, and keeps the weights with the best validation AP."
     )

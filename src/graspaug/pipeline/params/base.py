@@ -205,18 +205,60 @@ def parse(raw: Any, model: type[BaseParams]) -> BaseParams:
         raise ParamsError(_one_line(exc.errors()[0], model)) from None
 
 
-def read_yaml(path: str | Path) -> Any:
-    """The parsed params file; raises :class:`ParamsError` for a missing or broken file (with the line)."""
-    path = Path(path)
-    if not path.exists():
-        raise ParamsError(f"{path}: params file not found")
+def _duplicate_key(node: yaml.Node, prefix: str = "") -> str | None:
+    """The first key given twice in one mapping of the composed YAML ``node`` (depth first), as
+    ``key.path at line L (first at line F)``; None when every mapping's keys are distinct. YAML forbids
+    duplicates, PyYAML keeps the last value silently, DVC refuses the file: params are read one way only."""
+    if isinstance(node, yaml.SequenceNode):
+        for i, item in enumerate(node.value):
+            found = _duplicate_key(item, f"{prefix}{i}.")
+            if found:
+                return found
+    if not isinstance(node, yaml.MappingNode):
+        return None
+    first: dict[Any, int] = {}
+    for key_node, value_node in node.value:
+        if key_node.tag == "tag:yaml.org,2002:merge":  # `<<: *anchor` keys are a merge, not a key
+            continue
+        key = key_node.value if isinstance(key_node, yaml.ScalarNode) else id(key_node)
+        line = key_node.start_mark.line + 1
+        if key in first:
+            return f"{prefix}{key} at line {line} (first at line {first[key]})"
+        first[key] = line
+        found = _duplicate_key(value_node, f"{prefix}{key}.")
+        if found:
+            return found
+    return None
+
+
+def parse_yaml(text: str, name: str = "params") -> Any:
+    """The data of YAML ``text`` (``name`` names it in errors), refusing a key given twice in one mapping.
+
+    Raises :class:`ParamsError`: ``<name>: duplicate key ingest.surface.size_m at line 12 (first at line 10)``, or
+    ``<name>: not valid YAML at line L, column C (problem)``."""
+    loader = yaml.SafeLoader(text)
     try:
-        return yaml.safe_load(path.read_text())
+        node = loader.get_single_node()
+        duplicate = _duplicate_key(node) if node is not None else None
+        if duplicate:
+            raise ParamsError(f"{name}: duplicate key {duplicate}; give each key once")
+        return loader.construct_document(node) if node is not None else None
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark is not None else ""
         problem = getattr(exc, "problem", None) or str(exc).splitlines()[0]
-        raise ParamsError(f"{path}: not valid YAML{where} ({problem})") from None
+        raise ParamsError(f"{name}: not valid YAML{where} ({problem})") from None
+    finally:
+        loader.dispose()
+
+
+def read_yaml(path: str | Path) -> Any:
+    """The parsed params file; raises :class:`ParamsError` for a missing or broken file (with the line) and for a
+    key given twice (:func:`parse_yaml`)."""
+    path = Path(path)
+    if not path.exists():
+        raise ParamsError(f"{path}: params file not found")
+    return parse_yaml(path.read_text(), str(path))
 
 
 def load(path: str | Path, model: type[BaseParams]) -> BaseParams:

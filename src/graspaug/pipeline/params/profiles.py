@@ -13,6 +13,7 @@ from typing import Any
 
 import yaml
 
+from graspaug.pipeline.params.base import parse_yaml
 from graspaug.pipeline.params.model import Params, ParamsError, params_dict, parse_params
 
 PROFILES_DIR = Path("profiles")
@@ -45,7 +46,7 @@ def read_overlay(name: str, folder: Path = PROFILES_DIR) -> dict:
     path = Path(folder) / f"{name}.yaml"
     if not path.exists():
         raise ParamsError(f"profile {name!r} not found; known: {', '.join(profile_names(folder))}")
-    overlay = yaml.safe_load(path.read_text()) or {}
+    overlay = parse_yaml(path.read_text(), str(path)) or {}
     if not isinstance(overlay, dict):
         raise ParamsError(f"{path}: expected a mapping of keys")
     return overlay
@@ -130,9 +131,9 @@ def hand_edits(text: str, folder: Path = PROFILES_DIR) -> list[str]:
     named = re.search(r"profile `([^`]+)`", text.split("\n", 3)[1] if text.count("\n") > 1 else "")
     name = named.group(1) if named and named.group(1) in names else DEFAULT
     try:
-        mine = _flat(yaml.safe_load(text) or {})
-    except yaml.YAMLError:
-        return ["its text (not valid YAML)"]
+        mine = _flat(parse_yaml(text) or {})
+    except ParamsError as exc:
+        return [f"its text ({str(exc).removeprefix('params: ')})"]
     theirs = _flat(params_dict(profile_params(name, folder)))
     changed = [f"{k}: {_scalar(v)}" for k, v in mine.items() if k not in theirs or theirs[k] != v]
     return changed + [f"{k} (removed)" for k in theirs if k not in mine] or ["its comments or layout"]

@@ -92,4 +92,5 @@ def run(params: Params) -> None:
         "Interpolations per pair: AE, AE + extra epochs (λ = 0), AE-Critic; main part green, outliers red",
     )
     text = contrast_text(metrics["contrast"]["critic_vs_control"], keys)
-    log.info("critic_eval: critic AUC %s; AE-Critic − control outlier %% at α %s: %s", critic["auc"], keys, text)
+    auc = "undefined" if critic["auc"] is None else f"{critic['auc']:.3f}"
+    log.info("critic_eval: critic AUC %s; AE-Critic − control outlier %% at α %s: %s", auc, keys, text)

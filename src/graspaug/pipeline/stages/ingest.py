@@ -11,7 +11,7 @@ from collections import Counter
 
 import pandas as pd
 
-from graspaug.augment.corpus import assign_split, closing_summary, flag_duplicates, ingest_source
+from graspaug.augment.corpus import assign_split, closing_summary, flag_duplicates, ingest_source, reject_lines
 from graspaug.io.atomic import atomic_path
 from graspaug.io.settings import CorpusSettings
 from graspaug.io.sources import folder_sources, pybullet_sources
@@ -68,8 +68,8 @@ def run(params: Params) -> None:
         write_table(shapes, SHAPES_TABLE)
         write_table(rejects, REJECTS_TABLE)
 
-    for reason, n in Counter(rejects["reason"]).most_common():
-        log.info("rejected %d: %s", n, reason)
+    for line in reject_lines(rejects, REJECTS_TABLE):
+        log.info("ingest: %s", line)
     log.info("ingest: %s", closing_summary(shapes))
     kinds = shapes["duplicate_kind"].value_counts()
     log.info(
@@ -80,7 +80,8 @@ def run(params: Params) -> None:
     )
     counts = shapes["split"].value_counts()
     log.info(
-        "ingest: %d shapes (%d train, %d test), %d rejected, %d/%d watertight, median %d faces, in %.1f s",
+        "ingest: %d shapes (%d train, %d test), %d rejected, %d/%d watertight, median %d faces, %d over the face "
+        "budget of %d (not decimated: the decimator failed or would open the surface), in %.1f s",
         len(shapes),
         counts.get("train", 0),
         counts.get("test", 0),
@@ -88,5 +89,7 @@ def run(params: Params) -> None:
         int(shapes["watertight"].sum()),
         len(shapes),
         int(shapes["faces"].median()),
+        int((shapes["faces"] > cfg.surface.face_budget).sum()),
+        cfg.surface.face_budget,
         time.perf_counter() - start,
     )
