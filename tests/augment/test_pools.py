@@ -186,3 +186,33 @@ def test_the_warp_and_primitives_pools_are_the_data_seeds_and_warp_only_base_sha
     assert np.isclose(np.sort(out.kept[-1].mesh.extents)[1], SurfaceSettings().size_m)  # the ingest size rule
     xy, groups = tsne_groups(base, out.index, 5.0, 0)
     assert len(xy) == 4 + 4 and set(groups[4:]) <= {"generated (rarity)", "generated (graspness)"}  # latents only
+
+
+def test_the_procedural_pool_adds_procedural_objects_outside_the_corpus_and_refuses_its_own():
+    """The procedural pool holds pybullet's random_urdfs objects made solid by ingest's rule, none of the experiment's
+    own sources, in an order the data seed fixes; with the procedural corpus as the experiment's own corpus it has
+    nothing to add and says so."""
+    from graspaug.augment.decode import control_runners, procedural_sources
+    from graspaug.errors import DataError
+    from graspaug.geometry.settings import SurfaceSettings
+    from graspaug.io.sources import pybullet_sources
+
+    every = pybullet_sources()
+    own = [s.name for s in every[:-12]]  # this experiment's corpus: all but 12 procedural objects
+    sources = procedural_sources(own, key=[0, 1, 4])
+    assert {s.name for s in sources} == {s.name for s in every[-12:]}
+    assert [s.name for s in sources] == [s.name for s in procedural_sources(own, key=[0, 1, 4])]
+    assert [s.name for s in sources] != [s.name for s in procedural_sources(own, key=[1, 1, 4])]
+
+    base, cfg = make_base(4), GenerateParams(base_sizes=(4,), ratios=(0.0, 1.0))
+    pools = ("targeted", "procedural")
+    controls = control_runners(pools, [], cfg, SurfaceSettings(), 0, 4, 1, procedural=sources)
+    ids = [s.shape_id for s in sources]
+    out = generate_pools(base, cfg, 0, some_rejected, 2, pools, controls=controls, procedural_ids=ids)
+    procedural = out.index[out.index.pool == "procedural"]
+    assert len(procedural) == 4 and procedural.parent_a.isin(ids).all()
+    assert procedural.rarity_vs_base.isna().all() and (procedural.watertight & procedural.one_piece).all()
+    assert not set(procedural.parent_a) & {s.shape_id for s in every[:-12]}
+
+    with pytest.raises(DataError, match="procedural pool: 4 shapes needed, the procedural corpus holds 0"):
+        generate_pools(base, cfg, 0, some_rejected, 2, pools, controls=controls, procedural_ids=[])

@@ -67,6 +67,7 @@ def test_the_declared_contrasts():
         "blend/50-1",
         "warp/50-1",
         "primitives/50-1",
+        "procedural/50-1",
         "ceiling",
     ]
     assert "recon/50-1" not in [v.name for v in seed_variants([50], [0.0, 1.0], [50], False, ("targeted", "real"))]

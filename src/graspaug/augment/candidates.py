@@ -275,6 +275,15 @@ class PrimitiveStream(CandidateStream):
         self._append([Candidate(k, k, 0.0, "primitives") for k in range(n_shapes)])
 
 
+class ProceduralStream(CandidateStream):
+    """The ``procedural`` pool's stream: object k of a shuffled procedural corpus (parents k and k, weight 0), in
+    order, so a rejected object is replaced by the next one. No shape of the experiment's corpus is its parent."""
+
+    def __init__(self, n_shapes: int) -> None:
+        super().__init__()
+        self._append([Candidate(k, k, 0.0, "procedural") for k in range(n_shapes)])
+
+
 class FollowStream(CandidateStream):
     """Another pool's candidates for a control pool (the ``blend`` pool follows the targeted one):
     ``first`` (that pool's kept candidates, in order: the same pairs and weights) then the rest of

@@ -125,16 +125,60 @@ def primitive_batches(
     return run_batch
 
 
-WARP_SEED, PRIMITIVE_SEED = 0x3A2B, 0x9817  # the warp and primitives pools' own streams of the data seed
+def procedural_batches(
+    sources: Sequence, surface, workers: int, label: str
+) -> Callable[[list[Candidate]], list[Decoded]]:
+    """A batch runner for the ``procedural`` pool: candidate k (:class:`~graspaug.augment.candidates.ProceduralStream`)
+    becomes ``sources[k]`` (:class:`graspaug.io.sources.Source`, already shuffled by :func:`procedural_sources`)
+    loaded and made one closed solid by ingest's rule (:func:`graspaug.geometry.prepare.prepare_shape` with
+    ``surface``, a :class:`~graspaug.geometry.settings.SurfaceSettings`): the object as it is, sized as ingest sizes
+    a shape; on ``workers`` processes. A file that ingest would reject is rejected with the same reason."""
+    from graspaug.geometry.loading import MeshRejected, load_shape
+    from graspaug.geometry.prepare import prepare_shape
+    from graspaug.parallel import parallel_map
+
+    def one(c: Candidate):
+        source = sources[c.a]
+        try:
+            return prepare_shape(load_shape(source.path, source.unit_scale), surface).mesh, None
+        except MeshRejected as exc:
+            return None, f"{source.name}: {exc}"
+
+    def run_batch(candidates: list[Candidate]) -> list[Decoded]:
+        out = parallel_map(one, candidates, workers, label)
+        return [Decoded(c, np.zeros(0, np.uint8), mesh, reason) for c, (mesh, reason) in zip(candidates, out)]
+
+    return run_batch
+
+
+def procedural_sources(exclude: Sequence[str], key: Sequence[int]) -> list:
+    """The ``procedural`` pool's corpus: pybullet's ``random_urdfs`` objects
+    (:func:`graspaug.io.sources.pybullet_sources`) whose portable name is not in ``exclude`` (the experiment's own
+    sources: a corpus is never its own procedural pool), shuffled by the stream ``key``."""
+    from graspaug.io.sources import pybullet_sources
+
+    excluded = set(exclude)
+    sources = [s for s in pybullet_sources() if s.name not in excluded]
+    return [sources[i] for i in np.random.default_rng(list(key)).permutation(len(sources))]
+
+
+WARP_SEED, PRIMITIVE_SEED, PROCEDURAL_SEED = 0x3A2B, 0x9817, 0x51D3  # the no-network pools' streams of the data seed
 
 
 def control_runners(
-    pools: Sequence[str], meshes: Sequence, cfg, surface, seed: int, base_size: int, workers: int
+    pools: Sequence[str],
+    meshes: Sequence,
+    cfg,
+    surface,
+    seed: int,
+    base_size: int,
+    workers: int,
+    procedural: Sequence = (),
 ) -> dict[str, Callable[[list[Candidate]], list[Decoded]]]:
     """The runners of the no-network pools among ``pools`` for base size ``base_size``: ``blend``, ``warp`` (both on
-    ``meshes``, the base set's meshes, m) and ``primitives``, with ``cfg`` (a
-    :class:`~graspaug.augment.settings.GenerateSettings`), ``surface`` (the ingest sizing rule) and the data
-    ``seed``."""
+    ``meshes``, the base set's meshes, m), ``primitives`` and ``procedural`` (on ``procedural``, the sources of
+    :func:`procedural_sources`), with ``cfg`` (a :class:`~graspaug.augment.settings.GenerateSettings`), ``surface``
+    (the ingest sizing rule) and the data ``seed``."""
     runners = {
         "blend": lambda: blend_batches(meshes, cfg.blend.resolution, cfg.blend.margin, workers, f"blend {base_size}"),
         "warp": lambda: warp_batches(
@@ -143,5 +187,6 @@ def control_runners(
         "primitives": lambda: primitive_batches(
             cfg.primitives, surface, [seed, PRIMITIVE_SEED, base_size], workers, f"primitives {base_size}"
         ),
+        "procedural": lambda: procedural_batches(procedural, surface, workers, f"procedural {base_size}"),
     }
     return {name: make() for name, make in runners.items() if name in pools}

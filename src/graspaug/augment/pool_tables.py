@@ -15,6 +15,7 @@ ID_LETTERS = {
     "blend": "b",
     "warp": "w",
     "primitives": "p",
+    "procedural": "x",
     "failure": "f",
 }  # gen_<B>_<letter><order>
 

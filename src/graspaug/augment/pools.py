@@ -23,6 +23,7 @@ from graspaug.augment.candidates import (
     FollowStream,
     PoolExhausted,
     PrimitiveStream,
+    ProceduralStream,
     RandomStream,
     ReconStream,
     TargetedStream,
@@ -86,7 +87,8 @@ def base_set(ids: np.ndarray, latents: pd.DataFrame, scores: pd.DataFrame, voxel
 
 
 Pools = dict[str, tuple[list[Decoded], list[Decoded]]]
-GENERATED_POOLS = ("targeted", "random", "recon", "blend", "warp", "primitives")  # what generate makes, in index order
+# what generate makes, in index order
+GENERATED_POOLS = ("targeted", "random", "recon", "blend", "warp", "primitives", "procedural")
 FOLLOWERS = ("blend", "warp")  # the controls that follow the targeted pool's candidates (its parents and weights)
 PRIMITIVE_TRIES = 20  # the primitives stream holds this many assemblies per shape needed
 Runner = Callable[[list[Candidate]], list[Decoded]]
@@ -109,6 +111,7 @@ def fill_pools(
     pools: Sequence[str] = ("targeted", "random"),
     recon: ReconSource | None = None,
     controls: dict[str, Runner] | None = None,
+    procedural: int = 0,
 ) -> tuple[Pools, TargetedStream, int]:
     """Fill each of ``pools`` (of :data:`GENERATED_POOLS`; the targeted one always) to
     ``pool_size(cfg.ratios, B)`` kept shapes: ``targeted`` and ``random`` (seeded by
@@ -117,7 +120,8 @@ def fill_pools(
     no-network pools with their runner in ``controls``: ``blend`` (:func:`.decode.blend_batches`) and
     ``warp`` (:func:`.decode.warp_batches`) on the targeted pool's candidates (its kept ones first: the same
     parents and weights), ``primitives`` (:func:`.decode.primitive_batches`) on assemblies 0, 1, … of
-    :class:`PrimitiveStream` (:data:`PRIMITIVE_TRIES` per shape needed).
+    :class:`PrimitiveStream` (:data:`PRIMITIVE_TRIES` per shape needed), ``procedural``
+    (:func:`.decode.procedural_batches`) on objects 0, 1, … of its shuffled corpus (``procedural``: how many).
 
     Returns (pools: name → (kept, rejected) Decoded lists, in :data:`GENERATED_POOLS` order, the
     targeted stream as widened, shapes per pool); a :class:`graspaug.errors.DataError` if a pool's
@@ -131,14 +135,21 @@ def fill_pools(
     if "recon" in pools and recon is None:
         raise DataError(f"generate {base_size}: the recon pool needs the real pool's shapes")
     controls = controls or {}
-    for name in ("blend", "warp", "primitives"):
+    for name in ("blend", "warp", "primitives", "procedural"):
         if name in pools and name not in controls:
             raise DataError(f"generate {base_size}: the {name} pool needs its runner (the base set's meshes)")
+    if "procedural" in pools and procedural < needed:
+        raise DataError(
+            f"generate {base_size}, procedural pool: {needed} shapes needed, the procedural corpus holds {procedural} "
+            "objects outside this experiment's corpus (the pool adds pybullet's random_urdfs to a corpus of your own; "
+            "with data.source: pybullet it has nothing to add)"
+        )
     streams = {
         "targeted": (targeted_stream, run_batch),
         "random": (RandomStream(base_size, cfg.alphas, np.random.default_rng([seed, BASE_SEED, base_size])), run_batch),
         "recon": (ReconStream(len(recon.shapes.ids)), recon.run_batch) if recon else None,
         "primitives": (PrimitiveStream(PRIMITIVE_TRIES * needed), controls.get("primitives")),
+        "procedural": (ProceduralStream(procedural), controls.get("procedural")),
     }
     out = {}
     for name in (p for p in GENERATED_POOLS if p == "targeted" or p in pools):
@@ -188,10 +199,12 @@ def generated_set(
     k: int,
     n_examples: int,
     recon_shapes: BaseSet | None = None,
+    procedural_ids: Sequence[str] = (),
 ) -> GeneratedSet:
     """The :class:`GeneratedSet` of ``pools`` (:func:`fill_pools`: the pools, the targeted stream
     and the shapes per pool) for ``base``; ``k``: the rarity's neighbours; ``n_examples``: targeted
-    decodes to picture; ``recon_shapes``: the shapes the recon pool reconstructs."""
+    decodes to picture; ``recon_shapes``: the shapes the recon pool reconstructs; ``procedural_ids``: the
+    procedural pool's objects in stream order."""
     base_size = len(base.ids)
     sources = {name: (base.ids, base.z) for name in pools}
     if recon_shapes is not None:
@@ -204,6 +217,8 @@ def generated_set(
             np.array([f"assembly_{i:04d}" for i in range(n)]),
             np.full((n, base.z.shape[1]), np.nan),
         )
+    if "procedural" in pools:  # object k of the shuffled procedural corpus: not a parent of this corpus, no latent
+        sources["procedural"] = (np.asarray(procedural_ids), np.full((len(procedural_ids), base.z.shape[1]), np.nan))
     rows, reject_rows = pool_tables(sources, pools, base_size)
     index = pd.DataFrame(rows)
     index["rarity_vs_base"] = latent_rarity(base.z, k, np.stack(index.z.to_numpy()))
@@ -235,10 +250,13 @@ def generate_pools(
     pools: Sequence[str] = ("targeted", "random"),
     recon: ReconSource | None = None,
     controls: dict[str, Runner] | None = None,
+    procedural_ids: Sequence[str] = (),
 ) -> GeneratedSet:
-    """:func:`fill_pools` then :func:`generated_set` (``k``: the rarity's neighbours)."""
-    filled, targeted, needed = fill_pools(base, cfg, seed, run_batch, pools, recon, controls)
-    return generated_set(base, filled, targeted, needed, k, cfg.n_examples, recon.shapes if recon else None)
+    """:func:`fill_pools` then :func:`generated_set` (``k``: the rarity's neighbours; ``procedural_ids``: the
+    procedural pool's objects in stream order)."""
+    filled, targeted, needed = fill_pools(base, cfg, seed, run_batch, pools, recon, controls, len(procedural_ids))
+    recon_shapes = recon.shapes if recon else None
+    return generated_set(base, filled, targeted, needed, k, cfg.n_examples, recon_shapes, procedural_ids)
 
 
 def latent_rarity(z_base: np.ndarray, k: int, z: np.ndarray) -> np.ndarray:

@@ -138,10 +138,12 @@ class TrainSettings:
         return int(min(self.max_steps, max(self.min_steps, -(-self.epochs * n_datapoints // self.batch_size))))
 
 
-POOLS = ("targeted", "random", "real", "recon", "blend", "warp", "primitives")
+POOLS = ("targeted", "random", "real", "recon", "blend", "warp", "primitives", "procedural")
 """Pools of augmented networks, in report order: ``targeted`` / ``random`` (interpolants of the
 base set's rare-and-graspable neighbours / of random pairs), ``real`` (more real train shapes, the
 positive control), ``recon`` (the real pool's shapes decoded from their own latents), ``blend``
 (the targeted pool's pairs and weights interpolated with no network: mixed signed distance fields),
 ``warp`` (each targeted pair's nearer parent under a random smooth deformation: the handcrafted
-augmentation) and ``primitives`` (random assemblies of primitives: procedural objects, no real parent)."""
+augmentation), ``primitives`` (random assemblies of primitives: procedural objects, no real parent) and
+``procedural`` (objects of pybullet's procedural ``random_urdfs`` corpus added as they are: what a researcher whose own
+corpus is real objects gets for free)."""

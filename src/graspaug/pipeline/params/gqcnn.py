@@ -52,7 +52,9 @@ class GQCNNParams:
         "what decoding and meshing cost), `blend` (the targeted pool's pairs and weights interpolated with no "
         "network, by mixing the parents' signed distance fields), `warp` (each targeted pair's nearer parent under a "
         "random smooth deformation: scale, shear, taper, bend), `primitives` (random assemblies of 1 to "
-        "generate.primitives.max_parts boxes, cylinders, spheres, capsules and rings); `generate` makes the generated "
+        "generate.primitives.max_parts boxes, cylinders, spheres, capsules and rings), `procedural` (pybullet's "
+        "random_urdfs objects as they are, beside a corpus of your own: what procedural objects give for free); "
+        "`generate` makes the generated "
         "ones. `targeted` is always trained.",
     )
     members: int = Field(

@@ -74,7 +74,7 @@ def run(params: Params, base_size: int) -> None:
             ids, folder, suffix, parents = split.real_pool[:count], SHAPES_DIR, MESH_SUFFIX, None
         else:
             rows = generated[generated.pool == pool].head(count)
-            parents = None if pool == "primitives" else rows  # an assembly has no real parent
+            parents = None if pool in ("primitives", "procedural") else rows  # no real parent
             ids, folder, suffix = list(rows.shape_id), generated_meshes(b), GENERATED_SUFFIX
         meshes = {s: read_mesh(mesh_path(folder, s, suffix)) for s in ids}
         rows = rendered[rendered.shape_id.isin(ids)]

@@ -4,10 +4,11 @@ Targeted: the base set's rare, and separately graspable, shapes with their N-th 
 neighbours, ``(1 - α) z_a + α z_b`` decoded by the AE-Critic and meshed (paper Section III-C);
 random: random pairs; recon: the real pool's shapes (the GQ-CNN experiment's order) from their own
 latents; blend: the targeted pairs with no network; warp: each targeted pair's nearer parent randomly deformed;
-primitives: random assemblies of primitives. ``gqcnn.pools`` says which; each holds
-``ceil(max ratio × B)`` kept shapes, the first ``round(R × B)`` ratio R's set; a failed shape is
-replaced by the next candidate. Writes ``data/generated/<B>/`` (``meshes/``, ``index``, ``rejects``
-and ``base.parquet``), ``metrics/generate/<B>.json``, ``reports/generate/<B>/`` (summary, pictures)."""
+primitives: random assemblies of primitives; procedural: pybullet's random_urdfs objects as they are (beside a
+corpus of your own). ``gqcnn.pools`` says which; each holds ``ceil(max ratio × B)`` kept shapes, the first
+``round(R × B)`` ratio R's set; a failed shape is replaced by the next candidate. Writes
+``data/generated/<B>/`` (``meshes/``, ``index``, ``rejects`` and ``base.parquet``), ``metrics/generate/<B>.json``,
+``reports/generate/<B>/`` (summary, pictures)."""
 
 from __future__ import annotations
 
@@ -17,7 +18,7 @@ from functools import partial
 
 import numpy as np
 
-from graspaug.augment.decode import control_runners, mesh_batches
+from graspaug.augment.decode import PROCEDURAL_SEED, control_runners, mesh_batches, procedural_sources
 from graspaug.augment.pool_tables import generate_headline
 from graspaug.augment.pools import GENERATED_POOLS, ReconSource, base_ids, base_set, generate_pools, tsne_groups
 from graspaug.device import resolve_device
@@ -68,9 +69,16 @@ def run(params: Params, base_size: int) -> None:
         recon = ReconSource(real, meshes(real, label=f"generate {base_size} recon"))
     solids = [read_mesh(mesh_path(paths.SHAPES_DIR, s)) for s in ids] if {"blend", "warp"} & set(pools) else []
     surface = params.ingest.surface  # the warp and primitives pools' shapes are sized as ingest sizes a shape
-    controls = control_runners(pools, solids, cfg, surface, params.data_seed, base_size, params.workers)
+    procedural = []
+    if "procedural" in pools:  # the procedural corpus without this corpus' own sources, shuffled by the data seed
+        procedural = procedural_sources(list(shapes.source), [params.data_seed, PROCEDURAL_SEED, base_size])
+    controls = control_runners(
+        pools, solids, cfg, surface, params.data_seed, base_size, params.workers, procedural=procedural
+    )
     run_batch = meshes(base, label=f"generate {base_size}")
-    out = generate_pools(base, cfg, params.data_seed, run_batch, params.score.k, pools, recon, controls)
+    out = generate_pools(
+        base, cfg, params.data_seed, run_batch, params.score.k, pools, recon, controls, [s.shape_id for s in procedural]
+    )
     for level, message in [(logging.INFO, n) for n in out.notes] + [(logging.WARNING, w) for w in out.warnings]:
         log.log(level, "generate %d: %s", base_size, message)
 
