@@ -17,7 +17,7 @@ from pathlib import Path
 from typing import Any, Literal
 
 import yaml
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, create_model, model_validator
+from pydantic import BaseModel, ConfigDict, Field, PrivateAttr, ValidationError, create_model, model_validator
 
 #: Every section of params.yaml, in the order the pipeline runs.
 SECTIONS = (
@@ -131,6 +131,18 @@ class BaseParams(BaseModel):
                 raise ValueError(problem)
         return self
 
+    _file_text: str | None = PrivateAttr(None)  # set by load(): the file's header names its profile
+
+    def __eq__(self, other: object) -> bool:  # equal values are equal params, whichever file they came from
+        if not isinstance(other, BaseModel):
+            return NotImplemented
+        return type(self) is type(other) and self.__dict__ == other.__dict__
+
+    @property
+    def file_text(self) -> str | None:
+        """The text of the params file these params were read from (:func:`load`); None when built in code."""
+        return self._file_text
+
     @property
     def workers(self):
         """Where per-shape loops run (``graspaug.parallel.Workers``); not a DVC param: results do not depend on it."""
@@ -205,13 +217,14 @@ def parse(raw: Any, model: type[BaseParams]) -> BaseParams:
         raise ParamsError(_one_line(exc.errors()[0], model)) from None
 
 
-def read_yaml(path: str | Path) -> Any:
-    """The parsed params file; raises :class:`ParamsError` for a missing or broken file (with the line)."""
+def read_yaml(path: str | Path, text: str | None = None) -> Any:
+    """The parsed params file (its ``text`` when already read); raises :class:`ParamsError` for a missing or broken
+    file (with the line)."""
     path = Path(path)
-    if not path.exists():
+    if text is None and not path.exists():
         raise ParamsError(f"{path}: params file not found")
     try:
-        return yaml.safe_load(path.read_text())
+        return yaml.safe_load(path.read_text() if text is None else text)
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark is not None else ""
@@ -220,5 +233,12 @@ def read_yaml(path: str | Path) -> Any:
 
 
 def load(path: str | Path, model: type[BaseParams]) -> BaseParams:
-    """Read and check the sections of ``model`` in the params file at ``path``; raises :class:`ParamsError`."""
-    return parse(read_yaml(path), model)
+    """Read and check the sections of ``model`` in the params file at ``path``; raises :class:`ParamsError`. The
+    file's text stays with them (``file_text``): a report names the profile its header names."""
+    path = Path(path)
+    if not path.exists():
+        raise ParamsError(f"{path}: params file not found")
+    text = path.read_text()
+    params = parse(read_yaml(path, text), model)
+    params._file_text = text
+    return params
