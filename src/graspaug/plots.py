@@ -24,9 +24,12 @@ def pyplot():
     return plt
 
 
+DPI = 110  # pixels per inch of every saved figure
+
+
 def save_figure(fig, path: str | os.PathLike) -> None:
     with atomic_path(path) as tmp:
-        fig.savefig(tmp, dpi=110, bbox_inches="tight", format="png")
+        fig.savefig(tmp, dpi=DPI, bbox_inches="tight", format="png")
     pyplot().close(fig)
 
 
@@ -84,7 +87,10 @@ def voxel_rows(
     """
     plt = pyplot()
     n_rows, n_cols = len(rows), len(rows[0])
-    fig = plt.figure(figsize=(1.9 * n_cols, 1.9 * n_rows))
+    height = 1.9 * n_rows + 0.5  # inches: a row per shape and the title's line
+    fig = plt.figure(figsize=(1.9 * n_cols, height))
+    # margins in inches, not shares of the height: the title sits its own line above the first row, whatever the rows
+    fig.subplots_adjust(left=0.06, right=0.99, bottom=0.01, top=1 - 0.42 / height, wspace=0.02, hspace=0.08)
     for r, row in enumerate(rows):
         for c, (occ, main) in enumerate(row):
             ax = fig.add_subplot(n_rows, n_cols, r * n_cols + c + 1, projection="3d")
@@ -98,11 +104,12 @@ def voxel_rows(
             ax.set_zlim(0, R)
             ax.set_axis_off()
             ax.view_init(elev=25, azim=40)
+            ax.set_box_aspect(None, zoom=1.3)  # the cube fills its cell (3D axes keep a wide margin by default)
             if r == 0:
-                ax.set_title(col_labels[c], fontsize=8)
+                ax.set_title(col_labels[c], fontsize=8, pad=0)
             if c == 0:
                 ax.text2D(-0.15, 0.5, row_labels[r], transform=ax.transAxes, rotation=90, va="center", fontsize=8)
-    fig.suptitle(title, fontsize=10)
+    fig.suptitle(title, fontsize=10, y=1 - 0.08 / height, va="top")
     save_figure(fig, path)
 
 
@@ -196,17 +203,15 @@ def crop_grid(
     save_figure(fig, path)
 
 
-def ap_vs_ratio(table: pd.DataFrame, path: str | os.PathLike, title: str) -> None:
-    """The paper's Fig. 7: test AP against the augmentation ratio, one panel per base size, one
-    line per pool (targeted solid, random dashed, real dotted, recon dash-dotted), each starting from the base
-    set alone at ratio 0, with 95% t-interval error bars; the ceiling (every train shape) as a
-    grey band. ``table``: :func:`graspaug.experiments.ap.numbers.network_table` (columns ``pool``,
-    ``base_size``, ``ratio``, ``test_ap``, ``test_ap_ci``)."""
+def ap_vs_ratio(figure: dict, path: str | os.PathLike, title: str) -> None:
+    """The paper's Fig. 7 as :func:`graspaug.experiments.ap.figures.ratio_panels` lays it out (``figure``): one panel
+    per augmented base size, one line per pool (targeted solid, random dashed, real dotted, recon dash-dotted) with
+    its interval as error bars, each reference (a base size alone, the ceiling) a horizontal line with its band on
+    every panel; the AP axis ``figure["ylim"]``, shared."""
     plt = pyplot()
-    networks = table[table.pool != "ceiling"]
-    bases = sorted(networks.base_size.unique())
+    panels = figure["panels"]
     fig, axes = plt.subplots(
-        1, max(len(bases), 1), figsize=(3.6 * max(len(bases), 1) + 0.8, 3.8), sharey=True, squeeze=False
+        1, len(panels), figsize=(3.6 * len(panels) + 0.8, 3.8), sharey=True, squeeze=False, layout="constrained"
     )
     styles = {
         "targeted": ("-", "tab:blue"),
@@ -214,47 +219,41 @@ def ap_vs_ratio(table: pd.DataFrame, path: str | os.PathLike, title: str) -> Non
         "real": (":", "tab:green"),
         "recon": ("-.", "tab:purple"),
     }
-    ceiling = table[table.pool == "ceiling"]
-    for ax, base in zip(axes[0], bases):
-        rows = networks[networks.base_size == base]
-        alone = rows[rows.ratio == 0]
-        for pool, (style, color) in styles.items():
-            curve = pd.concat([alone, rows[(rows.pool == pool) & (rows.ratio > 0)]]).sort_values("ratio")
-            if len(curve) > len(alone):
-                ax.errorbar(
-                    curve.ratio,
-                    curve.test_ap,
-                    yerr=np.nan_to_num(curve.test_ap_ci.to_numpy(dtype=float)),
-                    marker="o",
-                    markersize=4,
-                    capsize=3,
-                    linestyle=style,
-                    color=color,
-                    label=pool,
-                )
-        if len(alone) and len(rows) == len(alone):
+    reference_colors = ["tab:brown", "tab:pink", "tab:olive", "tab:cyan"]
+    for ax, panel in zip(axes[0], panels):
+        for curve in panel["curves"]:
+            style, color = styles.get(curve["pool"], ("-", "tab:blue"))
             ax.errorbar(
-                alone.ratio,
-                alone.test_ap,
-                yerr=np.nan_to_num(alone.test_ap_ci.to_numpy(dtype=float)),
+                curve["x"],
+                curve["ap"],
+                yerr=np.stack([curve["ap"] - curve["low"], curve["high"] - curve["ap"]]),  # (2, n), clipped
                 marker="o",
+                markersize=4,
                 capsize=3,
-                color="tab:blue",
-                label="base set alone",
+                linestyle=style,
+                color=color,
+                label=curve["pool"],
             )
-        if len(ceiling) and np.isfinite(ceiling.test_ap.iloc[0]):
-            top, half = float(ceiling.test_ap.iloc[0]), float(np.nan_to_num(ceiling.test_ap_ci.iloc[0]))
-            ax.axhline(top, color="grey", linewidth=1, label="ceiling (all train shapes)")
-            ax.axhspan(top - half, top + half, color="grey", alpha=0.15, linewidth=0)
-        ax.set_title(f"B = {base}", fontsize=9)
-        ax.set_xlabel("ratio R (generated : base)")
+        others = iter(reference_colors)
+        for ref in panel["references"]:
+            color = "grey" if ref["label"].startswith("ceiling") else next(others, "black")
+            ax.axhline(ref["ap"], color=color, linewidth=1, linestyle=(0, (6, 2)), label=ref["label"])
+            ax.axhspan(ref["low"], ref["high"], color=color, alpha=0.12, linewidth=0)
+        ax.set_title(panel["title"], fontsize=9)
+        ax.set_xlabel(panel["xlabel"])
+        xs = sorted({float(v) for c in panel["curves"] for v in c["x"]})
+        if xs:
+            ax.set_xticks(xs)
+            pad = 0.08 * (xs[-1] - xs[0]) if xs[-1] > xs[0] else 0.5
+            ax.set_xlim(xs[0] - pad, xs[-1] + pad)
         ax.grid(alpha=0.3)
+    axes[0, 0].set_ylim(*figure["ylim"])
     axes[0, 0].set_ylabel("test Average Precision")
-    legend = {}  # every label once, from whichever panel has it (the smallest base size may have no augmented lines)
+    legend = {}  # every label once, from whichever panel has it
     for ax in axes[0]:
         for handle, label in zip(*ax.get_legend_handles_labels()):
             legend.setdefault(label, handle)
-    axes[0, 0].legend(legend.values(), legend.keys(), fontsize=7, loc="upper left")
+    axes[0, 0].legend(legend.values(), legend.keys(), fontsize=7, loc="best")
     fig.suptitle(title, fontsize=9)
     save_figure(fig, path)
 

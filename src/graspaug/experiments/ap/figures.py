@@ -10,13 +10,87 @@ import pandas as pd
 
 from graspaug.experiments.ap.numbers import object_improvement, test_predictions
 
+#: The range Average Precision lives in: intervals are clipped to it and the AP axis stays within it.
+AP_RANGE = (0.0, 1.0)
+POOLS_DRAWN = ("targeted", "random", "real", "recon")  # the pools Fig. 7 draws, in this order
+
+
+def _interval(rows: pd.DataFrame) -> dict[str, np.ndarray]:
+    """``rows``' test AP (n,) and its 95% t-interval (``test_ap_ci`` half-width; none: the point) clipped to
+    :data:`AP_RANGE`: ``{"ap", "low", "high"}``, each (n,) float."""
+    ap = rows.test_ap.to_numpy(dtype=float)
+    half = np.nan_to_num(rows.test_ap_ci.to_numpy(dtype=float))
+    return {"ap": ap, "low": np.clip(ap - half, *AP_RANGE), "high": np.clip(ap + half, *AP_RANGE)}
+
+
+def ratio_panels(table: pd.DataFrame) -> dict:
+    """What Fig. 7 draws of ``table`` (:func:`~graspaug.experiments.ap.numbers.network_table`).
+
+    One panel per base size B with augmented networks (a ratio > 0): per pool of :data:`POOLS_DRAWN` a curve of test
+    AP against ratio R starting from B alone at R = 0, with its interval. A base size with only R = 0 (the positive
+    control's larger base set) has no curve of its own: it is a horizontal ``reference`` (a line and its band) on
+    every panel, as is the ceiling (every train shape). Without any augmented base size there is one panel of AP
+    against B. Every interval is clipped to :data:`AP_RANGE`, and ``ylim`` (low, high) spans what is drawn with a
+    margin, within :data:`AP_RANGE`.
+
+    Returns ``{"panels": [{"title", "xlabel", "curves": [{"pool", "x": (n,), "ap", "low", "high"}],
+    "references": [{"label", "ap", "low", "high"}]}], "ylim": (low, high)}``, AP values as floats in [0, 1].
+    """
+    networks = table[(table.pool != "ceiling") & np.isfinite(table.test_ap.to_numpy(dtype=float))]
+    augmented = sorted(networks.base_size[networks.ratio > 0].unique())
+    references = []
+    for base in sorted(set(networks.base_size) - set(augmented)):
+        alone = _interval(networks[(networks.base_size == base) & (networks.ratio == 0)].head(1))
+        references.append({"label": f"B = {base} alone (R = 0)", **{k: float(v[0]) for k, v in alone.items()}})
+    ceiling = table[(table.pool == "ceiling") & np.isfinite(table.test_ap.to_numpy(dtype=float))]
+    if len(ceiling):
+        top = _interval(ceiling.head(1))
+        references.append({"label": "ceiling (all train shapes)", **{k: float(v[0]) for k, v in top.items()}})
+    panels = []
+    for base in augmented:
+        rows = networks[networks.base_size == base]
+        alone = rows[rows.ratio == 0].head(1)
+        curves = []
+        for pool in POOLS_DRAWN:
+            added = rows[(rows.pool == pool) & (rows.ratio > 0)]
+            if len(added):
+                curve = pd.concat([alone, added]).sort_values("ratio")
+                curves.append({"pool": pool, "x": curve.ratio.to_numpy(dtype=float), **_interval(curve)})
+        panels.append(
+            {"title": f"B = {base}", "xlabel": "ratio R (generated : base)", "curves": curves, "references": references}
+        )
+    if not panels:  # no augmented networks: AP against the base size, the references' own axis
+        alone = networks[networks.ratio == 0].drop_duplicates("base_size").sort_values("base_size")
+        curve = {"pool": "base set alone", "x": alone.base_size.to_numpy(dtype=float), **_interval(alone)}
+        ceiling_only = [r for r in references if r["label"].startswith("ceiling")]
+        panels.append(
+            {
+                "title": "no augmented networks",
+                "xlabel": "base set size B (R = 0)",
+                "curves": [curve],
+                "references": ceiling_only,
+            }
+        )
+    lows = [v for p in panels for c in p["curves"] for v in c["low"]] + [r["low"] for r in references]
+    highs = [v for p in panels for c in p["curves"] for v in c["high"]] + [r["high"] for r in references]
+    if not lows:
+        return {"panels": panels, "ylim": AP_RANGE}
+    low, high = min(lows), max(highs)
+    margin = max(0.05 * (high - low), 0.02)
+    return {"panels": panels, "ylim": (max(AP_RANGE[0], low - margin), min(AP_RANGE[1], high + margin))}
+
 
 def draw_ap_vs_ratio(table: pd.DataFrame, seeds: list[int], path: Path) -> None:
-    """Fig. 7: test AP against the ratio per base size and pool (``table``:
-    :func:`~graspaug.experiments.ap.numbers.network_table`, over training ``seeds``), 95% t-interval bars."""
+    """Fig. 7: test AP against the ratio per augmented base size and pool (``table``:
+    :func:`~graspaug.experiments.ap.numbers.network_table`, over training ``seeds``), 95% t-interval bars clipped to
+    [0, 1], base sizes without augmented networks as reference lines (:func:`ratio_panels`)."""
     from graspaug.plots import ap_vs_ratio
 
-    ap_vs_ratio(table, path, f"Test AP vs augmentation ratio (seeds {seeds}; error bars: 95% t-interval)")
+    ap_vs_ratio(
+        ratio_panels(table),
+        path,
+        f"Test AP vs augmentation ratio (seeds {seeds}; error bars: 95% t-interval, clipped to [0, 1])",
+    )
 
 
 def draw_pr_roc(

@@ -69,6 +69,7 @@ def write_trials_report(
     chosen: dict,
     model_seeds: list[int],
     scores_file: str,
+    header: str = "",
 ) -> None:
     """Write into the folder ``out``: ``trials.csv`` (``trials`` without planning times),
     ``objects.csv``, ``calibration.csv``, ``success.csv`` and ``success.png`` (rate per object and
@@ -76,7 +77,8 @@ def write_trials_report(
     ``rows`` (:func:`graspaug.experiments.cell.trials.run_object`'s) and ``report.md``. ``objects``: the
     :class:`~graspaug.experiments.cell.trials.PreparedObject` of the trials; ``metrics``:
     :func:`~graspaug.experiments.cell.numbers.summarize`'s with ``calibration``; ``chosen``: arm →
-    (pool, ratio); ``scores_file``: the scores table's path as the report names it."""
+    (pool, ratio); ``scores_file``: the scores table's path as the report names it; ``header``: the lines report.md
+    opens with (the profile and corpus that made it)."""
     from graspaug.plots import pick_story, success_bars
 
     base_size = metrics["setup"]["base_size"]
@@ -94,4 +96,4 @@ def write_trials_report(
         if row["_depth"] is not None:
             path = out / "trials" / f"{row['arm']}-{row['object']}.png"
             pick_story(**trial_picture(row, chosen[row["arm"]][1]), path=path)
-    (out / "report.md").write_text(report_text(metrics, trials, calibration_table, scores_file))
+    (out / "report.md").write_text(header + report_text(metrics, trials, calibration_table, scores_file))

@@ -112,11 +112,13 @@ def write_round(
     metrics_dir: Path,
     report_dir: Path,
     followed: pd.DataFrame | None = None,
+    header: str = "",
 ) -> pd.DataFrame:
     """Round ``round_``'s figures (:func:`~graspaug.experiments.lifelong.numbers.arm_contrasts` of ``networks``: draw
     → seed → arm → folder, tested on ``labels`` / ``objects`` (N,)) as metrics files in ``metrics_dir`` and its
     report, curve and failures picture (``history``: the failures chosen so far; ``voxels``: the corpus's VoxelSet;
-    ``followed``: the last round's failures before and now, None in round 0) in ``report_dir``; ``params`` the
+    ``followed``: the last round's failures before and now, None in round 0; ``header``: the lines report.md opens with,
+    the profile and corpus that made it) in ``report_dir``; ``params`` the
     stage's (``lifelong``, ``gqcnn.seeds``, ``seed``, ``data_seed``). Returns ``curve`` (None in round 0) with this
     round's rows appended."""
     cfg = params.lifelong
@@ -135,7 +137,7 @@ def write_round(
     )
     words = {"design": design, "command": f"dvc repro lifelong@r{round_}" if round_ else "dvc repro lifelong_start"}
     with atomic_path(report_dir, directory=True) as folder:
-        (folder / "report.md").write_text(round_markdown(round_, result, followed, persistent, words))
+        (folder / "report.md").write_text(header + round_markdown(round_, result, followed, persistent, words))
         rounds, series, bands = curve_series(curve, ARMS if round_ else ["none"])
         title = f"Test AP per round (B = {cfg.base_size}, 95% intervals over seeds × test objects)"
         lines(rounds, series, folder / "curve.png", "round", "test AP", title, bands)

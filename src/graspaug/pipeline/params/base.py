@@ -17,7 +17,7 @@ from pathlib import Path
 from typing import Any, Literal
 
 import yaml
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, create_model, model_validator
+from pydantic import BaseModel, ConfigDict, Field, PrivateAttr, ValidationError, create_model, model_validator
 
 #: Every section of params.yaml, in the order the pipeline runs.
 SECTIONS = (
@@ -130,6 +130,18 @@ class BaseParams(BaseModel):
             if problem:
                 raise ValueError(problem)
         return self
+
+    _file_text: str | None = PrivateAttr(None)  # set by load(): the file's header names its profile
+
+    def __eq__(self, other: object) -> bool:  # equal values are equal params, whichever file they came from
+        if not isinstance(other, BaseModel):
+            return NotImplemented
+        return type(self) is type(other) and self.__dict__ == other.__dict__
+
+    @property
+    def file_text(self) -> str | None:
+        """The text of the params file these params were read from (:func:`load`); None when built in code."""
+        return self._file_text
 
     @property
     def workers(self):
@@ -252,15 +264,22 @@ def parse_yaml(text: str, name: str = "params") -> Any:
         loader.dispose()
 
 
-def read_yaml(path: str | Path) -> Any:
-    """The parsed params file; raises :class:`ParamsError` for a missing or broken file (with the line) and for a
-    key given twice (:func:`parse_yaml`)."""
+def read_yaml(path: str | Path, text: str | None = None) -> Any:
+    """The parsed params file (its ``text`` when already read); raises :class:`ParamsError` for a missing or broken
+    file (with the line) and for a key given twice (:func:`parse_yaml`)."""
     path = Path(path)
-    if not path.exists():
+    if text is None and not path.exists():
         raise ParamsError(f"{path}: params file not found")
-    return parse_yaml(path.read_text(), str(path))
+    return parse_yaml(path.read_text() if text is None else text, str(path))
 
 
 def load(path: str | Path, model: type[BaseParams]) -> BaseParams:
-    """Read and check the sections of ``model`` in the params file at ``path``; raises :class:`ParamsError`."""
-    return parse(read_yaml(path), model)
+    """Read and check the sections of ``model`` in the params file at ``path``; raises :class:`ParamsError`. The
+    file's text stays with them (``file_text``): a report names the profile its header names."""
+    path = Path(path)
+    if not path.exists():
+        raise ParamsError(f"{path}: params file not found")
+    text = path.read_text()
+    params = parse(read_yaml(path, text), model)
+    params._file_text = text
+    return params

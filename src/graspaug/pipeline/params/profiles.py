@@ -15,6 +15,7 @@ import yaml
 
 from graspaug.pipeline.params.base import parse_yaml
 from graspaug.pipeline.params.model import Params, ParamsError, params_dict, parse_params
+from graspaug.pipeline.provenance import fingerprint_line
 
 PROFILES_DIR = Path("profiles")
 DEFAULT = "default"
@@ -82,7 +83,8 @@ def _scalar(value: Any) -> str:
 
 
 def params_yaml(params: Params, header: str) -> str:
-    """A complete params.yaml for ``params``: every key, each with its meaning as a comment."""
+    """A complete params.yaml for ``params``: every key, each with its meaning as a comment; the ``header`` and the
+    values' fingerprint (:func:`~graspaug.pipeline.provenance.fingerprint_line`) on top."""
     comments = _comments()
     lines = ["# yaml-language-server: $schema=params.schema.json"] + [
         f"# {line}".rstrip() for line in header.splitlines()
@@ -98,8 +100,10 @@ def params_yaml(params: Params, header: str) -> str:
             else:
                 lines.append(f"{indent}{key}: {_scalar(value)}" + (f"  # {comment}" if comment else ""))
 
+    head, lines[:] = list(lines), []
     emit(params_dict(params), (), "")
-    return "\n".join(lines) + "\n"
+    body = "\n".join(lines) + "\n"
+    return "\n".join([*head, fingerprint_line(body), body])
 
 
 def profile_yaml(name: str, folder: Path = PROFILES_DIR) -> str:

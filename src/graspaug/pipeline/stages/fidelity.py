@@ -46,6 +46,7 @@ from graspaug.pipeline.paths import (
     gqcnn_dir,
     grasps_table,
 )
+from graspaug.pipeline.provenance import report_header
 from graspaug.pipeline.stages import StageError
 from graspaug.rng import shape_rng
 from graspaug.training.gqcnn_data import load_split
@@ -89,7 +90,8 @@ def run(params: Params, base_size: int) -> None:
     folder.mkdir(parents=True, exist_ok=True)
     write_csv(table, folder / "fidelity.csv")
     with atomic_path(folder / "fidelity.md") as tmp:
-        tmp.write_text(fidelity_markdown(table, b, len(reference)))
+        header = report_header(params.file_text, read_table(SHAPES_TABLE))  # the profile and corpus
+        tmp.write_text(header + fidelity_markdown(table, b, len(reference)))
     write_json_files(fidelity_headline(table), fidelity_metrics(b))
     log.info(
         "fidelity %d: %d pools, %d real shapes, %.1f s", b, len(pools), len(reference), time.perf_counter() - start

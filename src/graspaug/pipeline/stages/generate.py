@@ -69,16 +69,11 @@ def run(params: Params, base_size: int) -> None:
         recon = ReconSource(real, meshes(real, label=f"generate {base_size} recon"))
     solids = [read_mesh(mesh_path(paths.SHAPES_DIR, s)) for s in ids] if {"blend", "warp"} & set(pools) else []
     surface = params.ingest.surface  # the warp and primitives pools' shapes are sized as ingest sizes a shape
-    procedural = []
-    if "procedural" in pools:  # the procedural corpus without this corpus' own sources, shuffled by the data seed
-        procedural = procedural_sources(list(shapes.source), [params.data_seed, PROCEDURAL_SEED, base_size])
-    controls = control_runners(
-        pools, solids, cfg, surface, params.data_seed, base_size, params.workers, procedural=procedural
-    )
-    run_batch = meshes(base, label=f"generate {base_size}")
-    out = generate_pools(
-        base, cfg, params.data_seed, run_batch, params.score.k, pools, recon, controls, [s.shape_id for s in procedural]
-    )
+    key = [params.data_seed, PROCEDURAL_SEED, base_size]  # the procedural corpus less this one's sources, shuffled
+    procedural = procedural_sources(list(shapes.source), key) if "procedural" in pools else []
+    controls = control_runners(pools, solids, cfg, surface, params.data_seed, base_size, params.workers, procedural)
+    run_batch, procedural_ids = meshes(base, label=f"generate {base_size}"), [s.shape_id for s in procedural]
+    out = generate_pools(base, cfg, params.data_seed, run_batch, params.score.k, pools, recon, controls, procedural_ids)
     for level, message in [(logging.INFO, n) for n in out.notes] + [(logging.WARNING, w) for w in out.warnings]:
         log.log(level, "generate %d: %s", base_size, message)
 

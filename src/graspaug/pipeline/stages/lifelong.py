@@ -24,6 +24,7 @@ from graspaug.io.voxels import read_voxels
 from graspaug.pipeline import paths
 from graspaug.pipeline.params import ae, generate, gqcnn, grasps, lifelong, render, score
 from graspaug.pipeline.params.base import params_model
+from graspaug.pipeline.provenance import report_header
 from graspaug.pipeline.stages import StageError
 from graspaug.training.gqcnn_data import Corpora, load_split, training_shapes
 from graspaug.training.networks import seed_card, train_paired
@@ -92,7 +93,8 @@ def run(params: Params, round_: int) -> None:
         start = {s: paths.gqcnn_seed_dir(s) / arm_variant("none", b, 0).name for s in gq.seeds}
         networks = {params.data_seed: round_networks(start, seed_dirs, variants)}
         curve = pd.read_csv(before / "curve.csv")
-        reports = paths.lifelong_metrics(round_), paths.lifelong_reports(round_)
-        curve = write_round(round_, networks, labels, objects, curve, history, params, voxels, *reports, followed)
+        reports = paths.lifelong_metrics(round_), paths.lifelong_reports(round_), followed
+        header = report_header(params.file_text, shapes)  # the profile and corpus
+        curve = write_round(round_, networks, labels, objects, curve, history, params, voxels, *reports, header)
         curve.to_csv(folder / "curve.csv", index=False)
     log.info("%s: %d new shapes per arm, %d generated datapoints in all", label, len(index) // 2, total)

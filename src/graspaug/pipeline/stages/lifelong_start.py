@@ -23,6 +23,7 @@ from graspaug.pipeline.params.base import params_model
 from graspaug.pipeline.params.generate import GenerateParams
 from graspaug.pipeline.params.gqcnn import GQCNNParams
 from graspaug.pipeline.params.lifelong import LifelongParams
+from graspaug.pipeline.provenance import report_header
 from graspaug.pipeline.stages import StageError
 
 log = logging.getLogger(__name__)
@@ -50,6 +51,8 @@ def run(params: Params) -> None:
         errors.assign(chosen=errors.index.isin(chosen)).to_csv(folder / "failures.csv")
         history.to_csv(folder / "history.csv", index=False)
         reports = paths.lifelong_metrics(0), paths.lifelong_reports(0)
-        curve = write_round(0, networks, labels, objects, None, history, params, read_voxels(paths.VOXELS), *reports)
+        header = report_header(params.file_text, read_table(paths.SHAPES_TABLE))  # the profile and corpus
+        voxels = read_voxels(paths.VOXELS)
+        curve = write_round(0, networks, labels, objects, None, history, params, voxels, *reports, header=header)
         curve.to_csv(folder / "curve.csv", index=False)
     log.info("lifelong r0: failures %s (validation AP %s)", chosen, np.round(errors.ap.loc[chosen].to_numpy(), 3))

@@ -6,10 +6,9 @@ Reads every network of every seed (``models/gqcnn/s<seed>/``). Writes ``metrics/
 ``over``, ``n_seeds``, ``sd``; test, validation and per-object AP per network; ``chosen_ratio`` per base size, picked
 on validation AP), ``ap_table.csv``, ``report.md``, ``decomposition.{md,json}`` (the gap to real shapes step by step,
 real → recon → blend → targeted / random, intervals over the seeds and test objects of this run's one draw of the
-data), ``ap_vs_ratio.png`` (Fig. 7),
-``improvement_by_score.png`` (Fig. 8: per-object AP change of the chosen ratio over 1:0 at the largest base size, by
-rarity and graspness interval) and ``tsne_graspness.png`` (Fig. 1).
-"""
+data), ``ap_vs_ratio.png`` (Fig. 7), ``improvement_by_score.png`` (Fig. 8: per-object AP change of the chosen ratio
+over 1:0 at the largest base size, by rarity and graspness interval) and ``tsne_graspness.png`` (Fig. 1); the .md
+reports open with the profile and corpus that made them."""
 
 from __future__ import annotations
 
@@ -38,12 +37,14 @@ from graspaug.pipeline.paths import (
     LATENTS,
     REPORT_DIR,
     SCORES,
+    SHAPES_TABLE,
     base_set_table,
     generated_index,
     gqcnn_dir,
     gqcnn_seed_dir,
     grasps_table,
 )
+from graspaug.pipeline.provenance import report_header
 
 log = logging.getLogger(__name__)
 
@@ -57,7 +58,8 @@ Params = params_model(
 
 
 def run(params: Params) -> None:
-    gen, cfg, seeds = params.generate, params.gqcnn, list(params.gqcnn.seeds)
+    gen, cfg, seeds, data_seed = params.generate, params.gqcnn, list(params.gqcnn.seeds), params.data_seed
+    header = report_header(params.file_text, read_table(SHAPES_TABLE))  # the profile and corpus, on every report
     seed_dirs = {seed: gqcnn_seed_dir(seed) for seed in seeds}
     # a missing network is a DataError, which the CLI prints in one line
     ev = evaluate_networks(seed_dirs, gqcnn_dir("original"), gen, cfg, params.seed)
@@ -71,7 +73,7 @@ def run(params: Params) -> None:
     write_json(steps, REPORT_DIR / "decomposition.json")
     extras += [losing_step(steps["contrasts"], b) for b in cfg.augment_base_sizes]
     with atomic_path(REPORT_DIR / "decomposition.md") as tmp:
-        tmp.write_text(decomposition_markdown(steps, cfg.augment_base_sizes, "dvc repro report"))
+        tmp.write_text(header + decomposition_markdown(steps, cfg.augment_base_sizes, "dvc repro report"))
     # Fig. 8: the largest augmented base size, its ratio chosen on validation against 1:0
     base = max(cfg.augment_base_sizes)
     compare = chosen.get(base, max(gen.ratios))
@@ -87,12 +89,12 @@ def run(params: Params) -> None:
     # Fig. 1: t-SNE of original train and generated latents by graspness
     tsne, perplexity = REPORT_DIR / "tsne_graspness.png", params.embed.perplexity
     draw_latent_map(latents, scores, augmentation, generated_graspness, base, perplexity, params.seed, tsne)
-    positive_share = float(labels.mean())
-    ap_report = ap_metrics(results, table, chosen, positive_share, seeds)
+    positives = float(labels.mean())  # the share of positive test grasps: AP without skill
+    ap_report = ap_metrics(results, table, chosen, positives, seeds)
     write_json(ap_report, AP_REPORT)
     write_json_files(ap_headline(ap_report), AP_METRICS)
     words = training_words(cfg.train, cfg.members)
     with atomic_path(REPORT_DIR / "report.md") as tmp:
-        tmp.write_text(report_markdown(table, results, chosen, extras, seeds, positive_share, words, params.data_seed))
+        tmp.write_text(header + report_markdown(table, results, chosen, extras, seeds, positives, words, data_seed))
     for name, c in results.items():
         log.info("report: %s", verdict(name, c))

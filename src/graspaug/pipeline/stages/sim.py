@@ -8,8 +8,7 @@ D435-like noisy depth image. Each arm's networks also rank the grasps ``grasp_ca
 (:mod:`graspaug.experiments.cell.numbers`). Writes ``metrics/sim/<contrast>.json`` (``mean``, ``lo``, ``hi``: paired
 difference in success, bootstrap over objects; ``ranking_<contrast>``: in ROC AUC against the executed grasps'
 outcomes) and ``reports/sim/`` (``summary.json``, ``report.md``, ``trials.csv``, ``success.{csv,png}``,
-``objects.csv``, ``calibration.csv``, ``timing.json``, ``trials/<arm>-<object>.png``).
-"""
+``objects.csv``, ``calibration.csv``, ``timing.json``, ``trials/<arm>-<object>.png``)."""
 
 from __future__ import annotations
 
@@ -46,6 +45,7 @@ from graspaug.pipeline.params.grasps import GraspsParams
 from graspaug.pipeline.params.ingest import IngestParams
 from graspaug.pipeline.params.render import RenderParams
 from graspaug.pipeline.params.sim import SimParams
+from graspaug.pipeline.provenance import report_header
 from graspaug.pipeline.stages import StageError
 
 log = logging.getLogger(__name__)
@@ -75,9 +75,8 @@ def run(params: Params) -> None:
     seed_dirs = {seed: paths.gqcnn_seed_dir(seed) for seed in model_seeds}
     chosen = arms(best, cfg.base_size, seed_dirs, params.generate.base_sizes)
     # an empty or unreadable sim.objects_path: a DataError, which the CLI prints in one line
-    objects, skipped = trial_objects(
-        cfg, read_table(paths.SHAPES_TABLE), paths.SHAPES_DIR, params.ingest, params.seed, params.workers
-    )
+    shapes = read_table(paths.SHAPES_TABLE)
+    objects, skipped = trial_objects(cfg, shapes, paths.SHAPES_DIR, params.ingest, params.seed, params.workers)
     jobs = object_jobs(objects, chosen, seed_dirs, cfg.attempts, params.seed, cfg.n_pictures)
     log.info("sim: %s", trials_plan(objects, chosen, cfg.attempts, len(model_seeds), skipped))
     rows = run_trials(jobs, cfg, params.render.crop, params.workers)
@@ -89,9 +88,10 @@ def run(params: Params) -> None:
     metrics["ranking"] = cell_ranking(read_table(executed), seed_dirs, chosen, cfg.n_bootstrap, params.seed)
     timing = planning_timing(trials, list(chosen))
 
+    header = report_header(params.file_text, shapes)  # the profile and corpus that made the report
     with atomic_path(paths.SIM_REPORT_DIR, directory=True) as out:
         write_trials_report(
-            out, rows, trials, objects, calibration_table, metrics, chosen, model_seeds, paths.SCORES.as_posix()
+            out, rows, trials, objects, calibration_table, metrics, chosen, model_seeds, paths.SCORES.as_posix(), header
         )
         timing["stage_seconds"] = round(time.perf_counter() - start, 1)
         write_json(timing, out / "timing.json")
