@@ -4,9 +4,9 @@ command whose adapter sits here as it knows the file names.
 The folder is ingested as the pipeline ingests (``ingest`` params, real size kept: ``ingest.surface.size: real``),
 grasps sampled and labelled by the ``grasps`` params with the models' gripper and label threshold, datapoints rendered
 by the ``render`` params with the models' camera (their model card). The test set is cached in ``<cache>/<key>/``
-(:func:`~graspaug.experiments.evaluate.testset.fingerprint`): a second run or another model costs its predictions. Writes into ``out`` (refused if it holds files this
-command did not write): ``report.md``, ``evaluate.json`` (every AP and difference as a contrast, the counts, the cache
-key) and ``rejects.csv`` (the files not used, and why).
+(:func:`~graspaug.experiments.evaluate.testset.fingerprint`): another model costs its predictions. Writes into
+``out`` (refused if it holds files this command did not write): ``report.md``, ``evaluate.json`` (every AP and
+difference as a contrast, the counts, the cache key) and ``rejects.csv`` (the files not used, and why).
 """
 
 from __future__ import annotations
