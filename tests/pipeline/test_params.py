@@ -36,7 +36,8 @@ def test_schema_file_is_up_to_date(repo_root):
     [
         (
             {"ingest": {"max_facez": 3}},
-            "ingest.max_facez: unknown key; allowed here: max_faces, max_file_mb, min_shapes, test_fraction, surface",
+            "ingest.max_facez: unknown key; allowed here: max_faces, max_file_mb, min_shapes, test_fraction, "
+            "min_voxels, surface",
         ),
         ({"colour": 1}, "colour: unknown key; allowed here: seed,"),
         (

@@ -64,10 +64,27 @@ def _with_warnings(reason: str, caught: list) -> str:
     return f"{reason} (warnings: {'; '.join(messages[:2])}{'; …' if len(messages) > 2 else ''})" if messages else reason
 
 
-def ingest_source(source: Source, max_faces: int, max_file_mb: float, settings: SurfaceSettings, out_dir: Path) -> dict:
+def occupied_voxels(mesh, resolution: int, margin: int) -> int:
+    """Occupied voxels of ``mesh``'s solid grid as the ``voxelize`` stage builds it (R³ fit to the bounds with
+    ``margin`` empty voxels): a thin shape (a fork's tines) can fill none at a coarse R."""
+    grid = fit_grid(mesh.bounds, resolution, margin)
+    return int(np.count_nonzero(voxelize_solid(np.asarray(mesh.vertices), np.asarray(mesh.faces), grid)))
+
+
+def ingest_source(
+    source: Source,
+    max_faces: int,
+    max_file_mb: float,
+    settings: SurfaceSettings,
+    out_dir: Path,
+    voxel_grid: tuple[int, int] | None = None,
+    min_voxels: int = 1,
+) -> dict:
     """Process one source: a shapes row (``ok``) or a rejects row (``reason``). Symlinks to
     regular files are read; special files and broken links are rejected before opening.
-    Warnings while reading go into the reason of a rejected file, never to the console."""
+    Warnings while reading go into the reason of a rejected file, never to the console.
+    With ``voxel_grid`` (resolution R, margin in voxels of the voxelize stage), a shape whose solid grid
+    holds fewer than ``min_voxels`` occupied voxels is rejected: the AutoEncoder would see it empty."""
     row: dict = {"shape_id": source.shape_id, "source": source.name}
     problem = file_problem(Path(source.path))
     if problem is not None:
@@ -79,6 +96,13 @@ def ingest_source(source: Source, max_faces: int, max_file_mb: float, settings: 
             loaded = load_shape(source.path, source.unit_scale, max_faces, max_file_mb)
             prepared = prepare_shape(loaded, settings)
             row["_occupancy"] = occupancy_bits(prepared.mesh)
+            if voxel_grid is not None:
+                filled = occupied_voxels(prepared.mesh, *voxel_grid)
+                if filled < min_voxels:
+                    raise MeshRejected(
+                        f"{'empty' if filled == 0 else 'nearly empty'} voxel grid: {filled} occupied voxels at "
+                        f"{voxel_grid[0]}³ < min_voxels={min_voxels}"
+                    )
         except MeshRejected as exc:
             return {**row, "ok": False, "reason": _with_warnings(str(exc), caught)}
         except OSError as exc:

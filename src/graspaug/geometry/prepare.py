@@ -9,7 +9,7 @@ import trimesh
 
 from graspaug.geometry.closing import MIN_ENCLOSED, close_surface
 from graspaug.geometry.loading import LoadedShape, MeshRejected
-from graspaug.geometry.normalize import Normalization, normalization
+from graspaug.geometry.normalize import Normalization, centering, normalization
 from graspaug.geometry.settings import SurfaceSettings
 from graspaug.geometry.solid import outer_surface_of_parts, resolution_for_parts
 
@@ -27,8 +27,23 @@ class PreparedShape:
     hull_fill: float = 1.0  # volume / convex hull volume
 
 
+def _check_real_size(surface: trimesh.Trimesh, settings: SurfaceSettings) -> None:
+    """Raise :class:`MeshRejected` when a shape kept at its real size is too small (largest extent below
+    ``settings.min_extent``) or too large for the gripper (the smallest side of its oriented bounding box, m,
+    above ``settings.max_width``)."""
+    largest = float(surface.extents.max())
+    if largest < settings.min_extent:
+        raise MeshRejected(f"too small: largest extent {largest:.4f} m < min_extent={settings.min_extent:g} m")
+    smallest = float(np.min(surface.bounding_box_oriented.primitive.extents))
+    if smallest > settings.max_width:
+        raise MeshRejected(
+            f"too large for the gripper: smallest side {smallest:.3f} m > max_width={settings.max_width:g} m"
+        )
+
+
 def prepare_shape(loaded: LoadedShape, settings: SurfaceSettings) -> PreparedShape:
-    """Rebuild one closed, one-piece outer surface, then center and scale it.
+    """Rebuild one closed, one-piece outer surface, then center it and (``settings.size``: ``normalize``) scale it
+    by the size rule or (``real``) keep its size.
 
     Raises
     ------
@@ -36,7 +51,8 @@ def prepare_shape(loaded: LoadedShape, settings: SurfaceSettings) -> PreparedSha
         when an open mesh can only be closed by bridging a hole wider than
         ``settings.max_gap`` (more than ``1 - MIN_ENCLOSED`` of its area bounds nothing),
         when the rebuilt solid has no volume or is split into pieces of which the
-        largest misses more than ``settings.max_dropped`` of the volume.
+        largest misses more than ``settings.max_dropped`` of the volume, and at real size when it is
+        too small or too large for the gripper (:func:`_check_real_size`).
     """
     closed_by = loaded.closed_by
     if loaded.parts:
@@ -64,7 +80,11 @@ def prepare_shape(loaded: LoadedShape, settings: SurfaceSettings) -> PreparedSha
         raise MeshRejected(f"in pieces: {dropped:.0%} of the volume lies outside the largest piece")
     if not surface.is_watertight:
         raise MeshRejected("could not close the surface")
-    norm = normalization(surface, settings.size_rule, settings.size_m)
+    if settings.size == "real":
+        norm = centering(surface)
+        _check_real_size(surface, settings)
+    else:
+        norm = normalization(surface, settings.size_rule, settings.size_m)
     mesh = norm.apply(surface)
     if not np.isfinite(mesh.vertices).all():
         raise MeshRejected("degenerate: normalization produced non-finite coordinates")

@@ -37,15 +37,37 @@ class SurfaceSettings:
         ),
     )
     face_budget: int = Field(5000, ge=100, description="Triangles per outer surface after quadric decimation.")
+    size: Literal["normalize", "real"] = Field(
+        "normalize",
+        description=(
+            "`normalize`: every shape is scaled so the size rule's extent is size_m (the default corpus' units are "
+            "arbitrary); `real`: each shape keeps its size in the file (times data.unit_scale), and shapes the "
+            "gripper cannot take (min_extent, max_width) are rejected."
+        ),
+    )
+    min_extent: float = Field(
+        0.01,
+        gt=0,
+        description="With size `real`: a shape whose largest extent is below this (m) is rejected as too small.",
+    )
+    max_width: float = Field(
+        0.08,
+        gt=0,
+        description=(
+            "With size `real`: a shape whose oriented bounding box's smallest side exceeds this (m) is rejected, as no "
+            "parallel-jaw grasp fits across it (the Franka Panda's opening, grasps.gripper.max_width)."
+        ),
+    )
     size_rule: Literal["min", "mid", "max"] = Field(
-        "mid", description="Which extent the size rule fixes: `min`, `mid` (the middle one) or `max`."
+        "mid",
+        description="With size `normalize`: which extent the size rule fixes: `min`, `mid` (the middle one) or `max`.",
     )
     size_m: float = Field(
         0.06,
         gt=0,
         description=(
-            "That extent after scaling, meters. Default: middle extent 0.06 m, so a Franka Panda (0.08 m opening) "
-            "closes across the two smaller extents of most objects."
+            "With size `normalize`: that extent after scaling, meters. Default: middle extent 0.06 m, so a Franka "
+            "Panda (0.08 m opening) closes across the two smaller extents of most objects."
         ),
     )
     max_dropped: float = Field(

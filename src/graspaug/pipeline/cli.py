@@ -4,7 +4,7 @@ A stage command imports its stage module, and through it only the params section
 reads, when it runs (``tests/test_dvc_deps.py`` derives each stage's code deps from that); the
 params tables in ``--help`` are filled in when help is shown.
 
-Over 400 lines because it is a table: 25 commands (one per stage, and ``plan``, ``from-failures``,
+Over 400 lines because it is a table: 26 commands (one per stage, and ``plan``, ``from-failures``, ``evaluate``,
 ``export-model``, ``profile``, ``schema``), each a few lines of options with the help text a user reads; the work
 is elsewhere (``pipeline/stages/``, ``planning/report.py``) and errors go through one handler
 (:mod:`graspaug.pipeline.command`).
@@ -483,6 +483,33 @@ def from_failures_command(
     import graspaug.pipeline.stages.from_failures as command
 
     _run(lambda p: command.run(p, folder, network, worst, count, per_failure, out, force), _load(params, command))
+
+
+@app.command(
+    cls=Command,
+    name="evaluate",
+    help="Test trained GQ-CNNs on your own objects: every mesh under --corpus (.obj .stl .ply .off .glb, metres "
+    "unless --unit-scale) is ingested at real size, its grasps sampled and labelled, its datapoints rendered for the "
+    "models' camera (their card), as the pipeline makes its test set; prints each model's test AP with a 95% interval "
+    "over objects and the paired difference of each model against the first. The test set is cached by the files' "
+    "content and those settings (--cache), so another model costs seconds. Writes report.md, evaluate.json and "
+    "rejects.csv into --out.",
+)
+def evaluate_command(
+    models: list[Path] = typer.Argument(..., help="Trained GQ-CNNs (model.pt); the first is the reference."),
+    corpus: Path = typer.Option(..., "--corpus", "-c", help="Folder of meshes (searched recursively)."),
+    out: Path = typer.Option(Path("reports/evaluate"), "--out", "-o", help="Folder to write (or one evaluate wrote)."),
+    cache: Path = typer.Option(Path(".graspaug-cache/evaluate"), "--cache", help="Folder of cached test sets."),
+    unit_scale: float = typer.Option(1.0, "--unit-scale", min=1e-9, help="Metres per file unit (0.001: mm files)."),
+    limit: int | None = typer.Option(None, "--limit", min=1, help="Use only the first N files in sorted order."),
+    resamples: int = typer.Option(1000, "--resamples", min=100, help="Bootstrap resamples of the objects."),
+    force: bool = ForceOption,
+    params: Path = ParamsOption,
+) -> None:
+    import graspaug.pipeline.stages.evaluate as command
+
+    for line in command.run(_load(params, command), models, corpus, out, cache, unit_scale, limit, resamples, force):
+        typer.echo(line)
 
 
 @app.command(

@@ -19,6 +19,14 @@ class IngestParams:
         le=0.9,
         description="Share of shapes in the test split (0.2663 = the paper's 363 test : 1000 train).",
     )
+    min_voxels: int = Field(
+        8,
+        ge=0,
+        description=(
+            "A shape whose solid grid at voxelize.resolution holds fewer occupied voxels is rejected (a thin shape, a "
+            "fork, is empty at 16³); 0 keeps all."
+        ),
+    )
     surface: SurfaceSettings = Field(
         default_factory=SurfaceSettings, description="How each shape's closed outer surface is rebuilt and sized."
     )

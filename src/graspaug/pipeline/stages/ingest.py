@@ -18,12 +18,15 @@ from graspaug.io.sources import folder_sources, pybullet_sources
 from graspaug.io.tables import write_table
 from graspaug.pipeline.params.base import params_model
 from graspaug.pipeline.params.ingest import IngestParams
+from graspaug.pipeline.params.voxelize import VoxelizeParams
 from graspaug.pipeline.paths import REJECTS_TABLE, SHAPES_DIR, SHAPES_TABLE
 from graspaug.pipeline.stages import StageError
 
 log = logging.getLogger(__name__)
 
-Params = params_model("The params the `ingest` stage reads.", data=CorpusSettings, ingest=IngestParams)
+Params = params_model(
+    "The params the `ingest` stage reads.", data=CorpusSettings, ingest=IngestParams, voxelize=VoxelizeParams
+)
 
 
 def run(params: Params) -> None:
@@ -32,6 +35,7 @@ def run(params: Params) -> None:
 
     start = time.perf_counter()
     data, cfg = params.data, params.ingest
+    grid = (params.voxelize.resolution, params.voxelize.margin)  # the AutoEncoder's grid: no empty shape reaches it
     if data.source == "pybullet":
         sources = pybullet_sources(data.limit)
     else:
@@ -42,7 +46,7 @@ def run(params: Params) -> None:
     with atomic_path(SHAPES_DIR, directory=True) as tmp_dir:
         tmp_dir = tmp_dir.resolve()  # worker processes may have another working directory
         rows = parallel_map(
-            lambda s: ingest_source(s, cfg.max_faces, cfg.max_file_mb, cfg.surface, tmp_dir),
+            lambda s: ingest_source(s, cfg.max_faces, cfg.max_file_mb, cfg.surface, tmp_dir, grid, cfg.min_voxels),
             sources,
             params.workers,
             "ingest",

@@ -1,0 +1,74 @@
+"""Ingest keeps an object's real size when asked, rejects what the gripper cannot take, and rejects a shape whose
+voxel grid at the AutoEncoder's resolution is (nearly) empty ([trust] #62 item 3)."""
+
+from __future__ import annotations
+
+import numpy as np
+import trimesh
+
+from graspaug.augment.corpus import ingest_source, occupied_voxels
+from graspaug.geometry.settings import SurfaceSettings
+from graspaug.io.sources import Source
+
+REAL = SurfaceSettings(size="real", resolution=64, finest_resolution=64)
+
+
+def fork(length: float = 0.18) -> trimesh.Trimesh:
+    """A YCB-like fork, metres: a thin handle plate along x and a wider head plate at one end, 4 mm thick."""
+    handle = trimesh.creation.box(extents=[0.62 * length, 0.014, 0.004])
+    handle.apply_translation([-0.19 * length, 0.0, 0.0])
+    head = trimesh.creation.box(extents=[0.40 * length, 0.026, 0.004])
+    head.apply_translation([0.30 * length, 0.0, 0.0])
+    return trimesh.util.concatenate([handle, head])
+
+
+def source_of(mesh: trimesh.Trimesh, folder, name: str, unit_scale: float = 1.0) -> Source:
+    path = folder / f"{name}.stl"
+    mesh.export(path)
+    return Source(name, f"folder:{name}.stl", path, unit_scale)
+
+
+def test_real_size_keeps_an_18_cm_fork_18_cm_long(tmp_path):
+    source = source_of(fork(), tmp_path, "fork")
+    real = ingest_source(source, 10**6, 10.0, REAL, tmp_path)
+    assert real["ok"], real.get("reason")
+    assert abs(max(real["extent_x"], real["extent_y"], real["extent_z"]) - 0.18) < 0.004
+    assert abs(real["scale"] - 1.0) < 1e-12
+    normalized = ingest_source(source, 10**6, 10.0, SurfaceSettings(resolution=64, finest_resolution=64), tmp_path)
+    assert normalized["ok"] and max(normalized["extent_x"], normalized["extent_y"]) > 0.3  # the old rule: ~0.44 m
+
+
+def test_real_size_follows_the_unit_scale(tmp_path):
+    millimetres = fork()
+    millimetres.apply_scale(1000.0)
+    row = ingest_source(source_of(millimetres, tmp_path, "fork_mm", 0.001), 10**6, 10.0, REAL, tmp_path)
+    assert row["ok"] and abs(row["extent_x"] - 0.18) < 0.004
+
+
+def test_real_size_rejects_what_the_gripper_cannot_take(tmp_path):
+    big = ingest_source(
+        source_of(trimesh.creation.box(extents=[0.2, 0.15, 0.12]), tmp_path, "crate"), 10**6, 10.0, REAL, tmp_path
+    )
+    assert not big["ok"] and big["reason"].startswith(
+        "too large for the gripper: smallest side 0.120 m > max_width=0.08"
+    )
+    crumb = ingest_source(
+        source_of(trimesh.creation.icosphere(radius=0.003), tmp_path, "crumb"), 10**6, 10.0, REAL, tmp_path
+    )
+    assert not crumb["ok"] and crumb["reason"].startswith("too small: largest extent 0.006")
+
+
+def test_a_shape_empty_at_the_voxel_resolution_is_rejected_with_its_reason(tmp_path):
+    source = source_of(fork(), tmp_path, "fork")
+    kept = ingest_source(source, 10**6, 10.0, REAL, tmp_path)
+    mesh = trimesh.load(tmp_path / "fork.ply")
+    assert occupied_voxels(mesh, 16, 1) == 0 and occupied_voxels(mesh, 128, 1) > 0  # thin: empty at 16³ only
+    assert kept["ok"]
+    empty = ingest_source(source, 10**6, 10.0, REAL, tmp_path, voxel_grid=(16, 1), min_voxels=8)
+    assert not empty["ok"] and empty["reason"] == "empty voxel grid: 0 occupied voxels at 16³ < min_voxels=8"
+    fine = ingest_source(source, 10**6, 10.0, REAL, tmp_path, voxel_grid=(128, 1), min_voxels=8)
+    assert fine["ok"]
+    cube = ingest_source(
+        source_of(trimesh.creation.box(extents=[0.05] * 3), tmp_path, "cube"), 10**6, 10.0, REAL, tmp_path, (16, 1), 8
+    )
+    assert cube["ok"] and np.isclose(cube["extent_x"], 0.05, atol=0.002)

@@ -1,0 +1,148 @@
+"""`graspaug evaluate MODEL… --corpus DIR` on a folder of real-size trimesh primitives with two seeded GQ-CNNs: every
+model's test AP with an interval over objects, the paired difference, the cached test set, bad input refused."""
+
+from __future__ import annotations
+
+import json
+import os
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+import torch
+import trimesh
+from sklearn.metrics import average_precision_score
+from typer.testing import CliRunner
+
+from graspaug.experiments.evaluate.numbers import test_ap as ap_of_models
+from graspaug.grasping.gripper import ParallelJawGripper
+from graspaug.io.checkpoints import finish_gqcnn_card, gqcnn_card, save_gqcnn
+from graspaug.nets.gqcnn import GQCNN, GQCNNConfig
+from graspaug.pipeline.cli import app
+from graspaug.pipeline.params.profiles import profile_yaml
+from graspaug.render.settings import CropGeometry, Intrinsics, ViewpointRanges
+
+REPO = Path(__file__).resolve().parents[2]
+#: The real corpus beside the project (../shared from the main checkout, ../../shared from a worktree under wt/).
+GSO300 = next(
+    (p for p in (REPO.parent / "shared/corpora/gso300", REPO.parents[1] / "shared/corpora/gso300") if p.is_dir()),
+    REPO / "absent",
+)
+
+
+def test_ap_and_paired_differences_over_objects():
+    rng = np.random.default_rng(0)
+    objects = np.repeat([f"o{i}" for i in range(12)], 20)
+    labels = rng.random(len(objects)) < 0.3
+    noisy = labels + rng.normal(0, 0.8, len(labels))
+    out = ap_of_models(labels, objects, {"noisy": noisy, "same": noisy.copy(), "perfect": labels * 1.0}, 300, 0)
+    assert out["objects"] == 12 and out["datapoints"] == 240
+    assert out["models"]["noisy"]["mean"] == pytest.approx(average_precision_score(labels, noisy))
+    assert out["models"]["perfect"]["mean"] == 1.0
+    low, high = out["models"]["noisy"]["objects_low"], out["models"]["noisy"]["objects_high"]
+    assert low < out["models"]["noisy"]["mean"] < high
+    same = out["differences"]["same − noisy"]  # paired over the same resamples: exactly nothing
+    assert same["mean"] == 0 and same["objects_low"] == 0 and same["objects_high"] == 0
+    better = out["differences"]["perfect − noisy"]
+    assert better["objects_low"] > 0 and better["over"] == "objects"
+
+
+def _model(path: Path, seed: int) -> Path:
+    """A seeded, untrained GQ-CNN with the model card train_gqcnn writes (label threshold 0.0005, the tiny one)."""
+    torch.manual_seed(seed)
+    card = gqcnn_card(CropGeometry(), Intrinsics(), ViewpointRanges(), ParallelJawGripper(), 0.0005, 0)
+    summary = {
+        "pool": "targeted",
+        "base_size": 4,
+        "ratio": 0.0,
+        "seed": seed,
+        "train": {},
+        "validation": {},
+        "test": {},
+    }
+    save_gqcnn(path, GQCNN(GQCNNConfig(image_input="depth")), summary, finish_gqcnn_card(card, summary))
+    return path
+
+
+@pytest.fixture(scope="module")
+def project(tmp_path_factory, repo_root):
+    """A folder with the tiny params, two models and a corpus of real-size objects (metres), one too wide to grasp."""
+    root = tmp_path_factory.mktemp("evaluate")
+    (root / "params.yaml").write_text(profile_yaml("tiny", repo_root / "profiles"))
+    corpus = root / "objects"
+    corpus.mkdir()
+    shapes = {
+        "box.stl": trimesh.creation.box(extents=[0.05, 0.03, 0.08]),
+        "can.obj": trimesh.creation.cylinder(radius=0.02, height=0.09),
+        "bar.stl": trimesh.creation.capsule(radius=0.012, height=0.08),
+        "block.stl": trimesh.creation.box(extents=[0.04, 0.04, 0.04]),
+        "crate.stl": trimesh.creation.box(extents=[0.2, 0.15, 0.12]),  # wider than the Panda's 8 cm opening
+    }
+    for name, mesh in shapes.items():
+        mesh.export(corpus / name)
+    models = [_model(root / f"m{seed}.pt", seed) for seed in (0, 1)]
+    return root, corpus, models
+
+
+def _evaluate(root: Path, *args: str):
+    cwd = os.getcwd()
+    os.chdir(root)
+    try:
+        return CliRunner().invoke(app, ["evaluate", *args])
+    finally:
+        os.chdir(cwd)
+
+
+def test_evaluate_prints_each_models_ap_and_the_paired_difference(project):
+    root, corpus, models = project
+    result = _evaluate(root, str(models[0]), str(models[1]), "--corpus", str(corpus), "--resamples", "200")
+    assert result.exit_code == 0, result.output
+    assert f"{models[0]}: test AP" in result.output and f"{models[1]} − {models[0]}:" in result.output
+    report = json.loads((root / "reports/evaluate/evaluate.json").read_text())
+    assert report["counts"]["files"] == 5 and report["counts"]["shapes"] == 4 and report["counts"]["rejected"] == 1
+    assert 1 <= report["objects"] <= 4 and report["datapoints"] > 0
+    first = report["models"][str(models[0])]
+    assert first["over"] == "objects" and (first["mean"] is None or 0 <= first["mean"] <= 1)
+    rejects = (root / "reports/evaluate/rejects.csv").read_text()
+    assert "crate.stl" in rejects and "too large for the gripper" in rejects
+    assert "Test AP on" in (root / "reports/evaluate/report.md").read_text()
+
+    cached = list((root / ".graspaug-cache/evaluate").iterdir())
+    assert len(cached) == 1
+    made = cached[0].stat().st_mtime
+    start = time.perf_counter()
+    again = _evaluate(root, str(models[1]), "--corpus", str(corpus), "--resamples", "200")
+    assert again.exit_code == 0, again.output
+    assert time.perf_counter() - start < 20  # the cached test set: only the predictions
+    assert list((root / ".graspaug-cache/evaluate").iterdir()) == cached and cached[0].stat().st_mtime == made
+    second = json.loads((root / "reports/evaluate/evaluate.json").read_text())["models"][str(models[1])]
+    assert second == report["models"][str(models[1])]  # the same test set, the same resamples
+
+
+def test_bad_folders_and_models_are_refused_in_one_line(project, tmp_path):
+    root, corpus, models = project
+    missing = _evaluate(root, str(models[0]), "--corpus", str(tmp_path / "nowhere"))
+    assert missing.exit_code == 2 and "no such folder" in missing.output and len(missing.output.splitlines()) == 1
+    (tmp_path / "notes.txt").write_text("no meshes here")
+    empty = _evaluate(root, str(models[0]), "--corpus", str(tmp_path))
+    assert empty.exit_code == 2 and "no mesh files" in empty.output
+    (tmp_path / "broken.pt").write_text("not a checkpoint")
+    broken = _evaluate(root, str(models[0]), str(tmp_path / "broken.pt"), "--corpus", str(corpus))
+    assert broken.exit_code == 2 and "broken.pt" in broken.output and len(broken.output.splitlines()) == 1
+
+
+@pytest.mark.skipif(not GSO300.is_dir(), reason="the gso300 corpus is not on this machine")
+def test_gso300_objects_keep_their_real_size(tmp_path):
+    from graspaug.augment.corpus import ingest_source
+    from graspaug.geometry.settings import SurfaceSettings
+    from graspaug.io.sources import folder_sources
+
+    rows = [
+        ingest_source(s, 10**6, 100.0, SurfaceSettings(size="real"), tmp_path) for s in folder_sources(GSO300, 1.0, 3)
+    ]
+    for row in rows:
+        if row["ok"]:
+            assert (
+                abs(row["scale"] - 1.0) < 1e-12 and 0.01 <= max(row["extent_x"], row["extent_y"], row["extent_z"]) < 1
+            )
