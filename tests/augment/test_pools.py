@@ -206,13 +206,16 @@ def test_the_procedural_pool_adds_procedural_objects_outside_the_corpus_and_refu
 
     base, cfg = make_base(4), GenerateParams(base_sizes=(4,), ratios=(0.0, 1.0))
     pools = ("targeted", "procedural")
-    controls = control_runners(pools, [], cfg, SurfaceSettings(), 0, 4, 1, procedural=sources)
+    real_size = SurfaceSettings(size="real")  # a corpus kept at real size: procedural objects still normalized
+    controls = control_runners(pools, [], cfg, real_size, 0, 4, 1, procedural=sources)
     ids = [s.shape_id for s in sources]
     out = generate_pools(base, cfg, 0, some_rejected, 2, pools, controls=controls, procedural_ids=ids)
     procedural = out.index[out.index.pool == "procedural"]
     assert len(procedural) == 4 and procedural.parent_a.isin(ids).all()
     assert procedural.rarity_vs_base.isna().all() and (procedural.watertight & procedural.one_piece).all()
     assert not set(procedural.parent_a) & {s.shape_id for s in every[:-12]}
+    middle = [sorted(d.mesh.extents)[1] for d in out.kept if d.candidate.selected_by == "procedural"]
+    assert np.allclose(middle, SurfaceSettings().size_m, rtol=1e-3)
 
     with pytest.raises(DataError, match="procedural pool: 4 shapes needed, the procedural corpus holds 0"):
         generate_pools(base, cfg, 0, some_rejected, 2, pools, controls=controls, procedural_ids=[])

@@ -7,6 +7,7 @@ random smooth deformation; :func:`primitive_batches`: random assemblies of primi
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING
 
@@ -131,16 +132,20 @@ def procedural_batches(
     """A batch runner for the ``procedural`` pool: candidate k (:class:`~graspaug.augment.candidates.ProceduralStream`)
     becomes ``sources[k]`` (:class:`graspaug.io.sources.Source`, already shuffled by :func:`procedural_sources`)
     loaded and made one closed solid by ingest's rule (:func:`graspaug.geometry.prepare.prepare_shape` with
-    ``surface``, a :class:`~graspaug.geometry.settings.SurfaceSettings`): the object as it is, sized as ingest sizes
-    a shape; on ``workers`` processes. A file that ingest would reject is rejected with the same reason."""
+    ``surface``, a :class:`~graspaug.geometry.settings.SurfaceSettings`): the object as the default corpus holds it,
+    scaled by ``surface``'s size rule even where the corpus keeps real size (size ``real``), as the procedural
+    corpus' units are arbitrary; on ``workers`` processes. A file that ingest would reject is rejected with the same
+    reason."""
     from graspaug.geometry.loading import MeshRejected, load_shape
     from graspaug.geometry.prepare import prepare_shape
     from graspaug.parallel import parallel_map
 
+    normalized = dataclasses.replace(surface, size="normalize")  # arbitrary units: sized as the default corpus is
+
     def one(c: Candidate):
         source = sources[c.a]
         try:
-            return prepare_shape(load_shape(source.path, source.unit_scale), surface).mesh, None
+            return prepare_shape(load_shape(source.path, source.unit_scale), normalized).mesh, None
         except MeshRejected as exc:
             return None, f"{source.name}: {exc}"
 
