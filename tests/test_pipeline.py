@@ -174,8 +174,10 @@ def test_from_failures_generates_from_train_shapes_near_a_users_failure_meshes(t
     trimesh.creation.box((0.02, 0.05, 0.08)).export(failures / "box.obj")
     trimesh.creation.capsule(height=0.06, radius=0.015).export(failures / "capsule.stl")
     (failures / "broken.obj").write_text("not a mesh\n")
+    (failures / "empty.stl").write_bytes(b"")
     command = ["graspaug", "from-failures", str(failures), "--count", "3", "--per-failure", "2"]
-    run([*command, "-o", str(tmp_path / "out")], work, env)
+    first = run([*command, "-o", str(tmp_path / "out")], work, env)
+    assert "from-failures: skipping" in first.stderr and "sim: skipping" not in first.stderr, first.stderr
     index = pd.read_csv(tmp_path / "out/index.csv")
     shapes = pd.read_parquet(work / "data/shapes.parquet")
     train = set(shapes.shape_id[shapes.split == "train"])
@@ -184,7 +186,7 @@ def test_from_failures_generates_from_train_shapes_near_a_users_failure_meshes(t
     assert set(index.parent_a) | set(index.parent_b) <= train and index.parent_a.nunique() <= 2 * 2
     assert all((tmp_path / "out/meshes" / f"{s}.obj").stat().st_size > 0 for s in index.shape_id)
     skipped = pd.read_csv(tmp_path / "out/skipped.csv")
-    assert list(skipped.file) == ["broken.obj"] and skipped.reason.iloc[0]
+    assert list(skipped.file) == ["broken.obj", "empty.stl"] and skipped.reason.all()
     assert list(pd.read_csv(tmp_path / "out/failures.csv").object) == ["box", "capsule"]
     # the user's meshes are the anchors' seeds: each anchor is among the 2 train shapes nearest a failure mesh
     anchors = nearest_train_shapes(work, failures, train, 2)
@@ -206,7 +208,17 @@ def test_from_failures_generates_from_train_shapes_near_a_users_failure_meshes(t
         assert refused.returncode == 2 and refused.stderr.strip().count("\n") == 0, refused.stderr
         assert str(out) in refused.stderr
     assert (mine / "notes.txt").read_text() == "my notes" and len(list(mine.iterdir())) == 1
-    assert sorted(p.name for p in failures.iterdir()) == ["box.obj", "broken.obj", "capsule.stl"]
+    assert sorted(p.name for p in failures.iterdir()) == ["box.obj", "broken.obj", "capsule.stl", "empty.stl"]
+    # a rerun into its own folder refuses a file the user added there since, and keeps it (and the last answer)
+    (tmp_path / "out/my_analysis.txt").write_text("x")
+    rerun = subprocess.run([*command, "-o", str(tmp_path / "out")], cwd=work, env=env, capture_output=True, text=True)
+    assert rerun.returncode == 2 and "my_analysis.txt" in rerun.stderr.strip().splitlines()[-1], rerun.stderr
+    assert (tmp_path / "out/my_analysis.txt").read_text() == "x"
+    pd.testing.assert_frame_equal(pd.read_csv(tmp_path / "out/index.csv"), index)
+    # a symlinked -o is refused before any work: no mesh of the folder was read (no skipping warning)
+    (tmp_path / "link").symlink_to(tmp_path / "again")
+    linked = subprocess.run([*command, "-o", str(tmp_path / "link")], cwd=work, env=env, capture_output=True, text=True)
+    assert linked.returncode == 2 and "is a symbolic link" in linked.stderr and "skipping" not in linked.stderr
     missing = subprocess.run(
         [*command[:2], str(tmp_path / "nowhere")], cwd=work, env=env, capture_output=True, text=True
     )

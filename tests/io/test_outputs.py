@@ -1,36 +1,110 @@
-"""Output folders: a command replaces only what it made, never its input."""
+"""Output folders: a command replaces only the files it wrote, never the user's nor its input."""
 
 from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import textwrap
 
 import pytest
 
 from graspaug.errors import DataError
-from graspaug.io.atomic import atomic_path
-from graspaug.io.outputs import MARKER, check_output_files, check_output_folder, made_by, mark
+from graspaug.io.outputs import (
+    MARKER,
+    check_output_files,
+    check_output_folder,
+    made_by,
+    output_folder,
+    owned_files,
+)
+
+
+def _write(out, command: str, files: dict[str, str], **kwargs) -> None:
+    with output_folder(out, command, **kwargs) as tmp:
+        for name, text in files.items():
+            (tmp / name).parent.mkdir(parents=True, exist_ok=True)
+            (tmp / name).write_text(text)
 
 
 def test_a_folder_holding_a_users_file_is_refused_and_kept(tmp_path):
     project = tmp_path / "myproject"
     project.mkdir()
     (project / "notes.txt").write_text("mine")
-    with pytest.raises(DataError, match=r"myproject already holds files that graspaug from-failures did not write"):
+    with pytest.raises(DataError, match=r"myproject holds notes.txt, which graspaug from-failures did not write"):
         check_output_folder(project, "from-failures")
     assert (project / "notes.txt").read_text() == "mine"
     check_output_folder(project, "from-failures", force=True)  # --force: the user's call
 
 
-def test_a_folder_the_command_made_is_replaced_and_another_commands_is_not(tmp_path):
-    out = tmp_path / "out"
-    with atomic_path(out, directory=True) as tmp:
-        mark(tmp, "from-failures")
-        (tmp / "index.csv").write_text("shape_id\n")
-    assert made_by(out) == "graspaug from-failures" and (out / MARKER).is_file()
-    check_output_folder(out, "from-failures")  # its own: replaced
-    with pytest.raises(DataError, match="did not write"):
+def test_a_rerun_replaces_its_own_files_and_refuses_a_file_added_since(tmp_path):
+    """The issue's case: a second run into the folder of the first, after the user added a file there."""
+    out = tmp_path / "out_new"
+    _write(out, "from-failures", {"index.csv": "1", "meshes/failure_0000.obj": "v", "meshes/failure_0001.obj": "v"})
+    assert made_by(out) == "graspaug from-failures"
+    assert owned_files(out, "from-failures") == {"index.csv", "meshes/failure_0000.obj", "meshes/failure_0001.obj"}
+    _write(out, "from-failures", {"index.csv": "2", "meshes/failure_0000.obj": "w"})  # its own: replaced
+    assert (out / "index.csv").read_text() == "2" and not (out / "meshes/failure_0001.obj").exists()
+    (out / "my_analysis.txt").write_text("x")
+    with pytest.raises(DataError, match=r"out_new holds my_analysis.txt, which graspaug from-failures did not"):
+        _write(out, "from-failures", {"index.csv": "3"})
+    assert (out / "my_analysis.txt").read_text() == "x" and (out / "index.csv").read_text() == "2"
+    _write(out, "from-failures", {"index.csv": "3"}, force=True)  # force writes beside it, never deletes it
+    assert (out / "my_analysis.txt").read_text() == "x" and (out / "index.csv").read_text() == "3"
+    assert not (out / "meshes").exists() and owned_files(out, "from-failures") == {"index.csv"}
+    with pytest.raises(DataError, match="did not write"):  # another command's folder
         check_output_folder(out, "export-model")
-    check_output_folder(tmp_path / "new", "from-failures")  # missing: made
-    (tmp_path / "empty").mkdir()
-    check_output_folder(tmp_path / "empty", "from-failures")
+    assert sorted(os.listdir(tmp_path)) == ["out_new"]  # no staging folder left
+
+
+def test_an_older_one_line_marker_vouches_for_no_file(tmp_path):
+    (tmp_path / "old").mkdir()
+    (tmp_path / "old" / MARKER).write_text("graspaug from-failures\n")
+    (tmp_path / "old/index.csv").write_text("1")
+    assert made_by(tmp_path / "old") == "graspaug from-failures"
+    with pytest.raises(DataError, match="holds index.csv, which"):
+        check_output_folder(tmp_path / "old", "from-failures")
+
+
+def test_a_failure_leaves_the_folder_as_it_was(tmp_path):
+    out = tmp_path / "out"
+    _write(out, "export-model", {"model.ts": "old", "card.json": "old"})
+    with pytest.raises(RuntimeError), output_folder(out, "export-model") as tmp:
+        (tmp / "model.ts").write_text("half")
+        raise RuntimeError("crash mid-write")
+    assert {p.name: p.read_text() for p in out.iterdir() if p.name != MARKER} == {"model.ts": "old", "card.json": "old"}
+    with pytest.raises(RuntimeError), output_folder(tmp_path / "new", "export-model") as tmp:
+        (tmp / "model.ts").write_text("half")
+        raise RuntimeError("crash mid-write")
+    assert sorted(os.listdir(tmp_path)) == ["out"]
+
+
+KILLED_WRITER = textwrap.dedent("""
+    import os, signal, sys
+    from graspaug.io.outputs import output_folder
+    with output_folder(sys.argv[1], "from-failures") as tmp:
+        (tmp / "index.csv").write_text("half")
+        os.kill(os.getpid(), signal.SIGKILL)
+""")
+
+
+def test_a_killed_writer_leaves_nothing_under_the_final_name_and_the_next_run_cleans_up(tmp_path):
+    result = subprocess.run([sys.executable, "-c", KILLED_WRITER, str(tmp_path / "out")])
+    assert result.returncode == -signal.SIGKILL
+    assert not (tmp_path / "out").exists() and len(list(tmp_path.glob(".out.tmp-*"))) == 1
+    _write(tmp_path / "out", "from-failures", {"index.csv": "whole"})
+    assert sorted(os.listdir(tmp_path)) == ["out"] and (tmp_path / "out/index.csv").read_text() == "whole"
+
+
+def test_a_symlinked_output_folder_is_refused_even_with_force(tmp_path):
+    (tmp_path / "real").mkdir()
+    (tmp_path / "real/keep.txt").write_text("mine")
+    (tmp_path / "link").symlink_to(tmp_path / "real")
+    for force in (False, True):
+        with pytest.raises(DataError, match=r"link is a symbolic link \(to .*real\)"):
+            check_output_folder(tmp_path / "link", "from-failures", force=force)
+    assert (tmp_path / "real/keep.txt").read_text() == "mine" and (tmp_path / "link").is_symlink()
 
 
 @pytest.mark.parametrize(("out", "word"), [("missed", "is"), ("missed/out", "lies inside"), (".", "holds")])
@@ -39,7 +113,7 @@ def test_an_output_inside_or_around_an_input_is_refused_even_with_force(tmp_path
     missed.mkdir()
     (missed / "mug.obj").write_text("v 0 0 0\n")
     with pytest.raises(DataError, match=f"{word} the input folder"):
-        check_output_folder(tmp_path / out, "from-failures", inputs=[missed], force=True)
+        check_output_folder(tmp_path / out, "from-failures", inputs=[missed, None], force=True)
     assert (missed / "mug.obj").exists()
 
 

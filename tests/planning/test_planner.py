@@ -256,12 +256,13 @@ def test_export_model_replaces_only_its_own_folder(model_path, tmp_path):
     mine.mkdir()
     (mine / "notes.txt").write_text("mine")
     refused = CliRunner().invoke(app, ["export-model", str(model_path), str(mine)])
-    assert refused.exit_code == 2 and "did not write (notes.txt)" in refused.output, refused.output
+    assert refused.exit_code == 2 and "holds notes.txt, which graspaug export-model did not write" in refused.output
     assert sorted(p.name for p in mine.iterdir()) == ["notes.txt"]
     for _ in range(2):  # its own folder: written again
         assert CliRunner().invoke(app, ["export-model", str(model_path), str(tmp_path / "ours")]).exit_code == 0
     forced = CliRunner().invoke(app, ["export-model", str(model_path), str(mine), "--force"])
     assert forced.exit_code == 0 and (mine / "model.ts").is_file()
+    assert (mine / "notes.txt").read_text() == "mine"  # --force writes beside the user's file, never deletes it
 
 
 def test_export_model_gives_the_same_probabilities(model_path, tmp_path):

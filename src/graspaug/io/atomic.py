@@ -7,7 +7,7 @@ import glob
 import os
 import shutil
 import tempfile
-from collections.abc import Iterator
+from collections.abc import Iterable, Iterator
 from pathlib import Path
 
 
@@ -56,3 +56,13 @@ def atomic_path(path: str | os.PathLike, directory: bool = False) -> Iterator[Pa
         else:
             tmp.unlink(missing_ok=True)
         raise
+
+
+@contextlib.contextmanager
+def atomic_paths(paths: Iterable[str | os.PathLike]) -> Iterator[list[Path]]:
+    """Yield a temporary sibling of each of ``paths`` (files) to write into; only when the block ends without error
+    move them all over their final names, the last of ``paths`` first and the first last (so a reader that checks the
+    first file, such as a ``grasp.json`` beside its ``grasp.png``, finds the others already in place). If the block
+    raises, no final name is touched and every temporary is removed."""
+    with contextlib.ExitStack() as stack:  # exits in reverse order: the first path is moved in last
+        yield [stack.enter_context(atomic_path(path)) for path in paths]

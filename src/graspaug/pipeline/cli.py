@@ -34,7 +34,10 @@ app = typer.Typer(
 
 ParamsOption = typer.Option(Path("params.yaml"), "--params", "-p", help="The params file to read.")
 ForceOption = typer.Option(
-    False, "--force", help="Replace an output folder that holds files this command did not write."
+    False,
+    "--force",
+    help="Write into an output folder that holds files this command did not write: those of the names it writes are "
+    "replaced, the others kept.",
 )
 
 
@@ -296,7 +299,7 @@ def render_command(
 )
 def export_dexnet_command(
     corpus: str = typer.Argument(..., help="Rendered corpus: `original` or `gen_<B>`."),
-    out: Path = typer.Argument(..., help="Folder to create (must not exist or be empty)."),
+    out: Path = typer.Argument(..., help="Folder to write (new, empty, or one export-dexnet wrote)."),
     rows_per_file: int = typer.Option(1000, "--rows-per-file", min=1, help="Datapoints per .npz file (Dex-Net: 1000)."),
     pool: str = typer.Option(
         "all",
@@ -304,11 +307,14 @@ def export_dexnet_command(
         help="For a generated corpus: the one pool to export (`targeted`, `random`, `real`, ...; config.json names "
         "it); `all`: every pool, each datapoint's in the `pool_labels` field.",
     ),
+    force: bool = ForceOption,
 ) -> None:
     from graspaug.io.dexnet import export_dexnet
+    from graspaug.io.outputs import output_folder
     from graspaug.pipeline.paths import gqcnn_dir
 
-    n = export_dexnet(gqcnn_dir(corpus), out, rows_per_file, pool=None if pool == "all" else pool)
+    with output_folder(out, "export-dexnet", [gqcnn_dir(corpus)], force) as tmp:
+        n = export_dexnet(gqcnn_dir(corpus), tmp, rows_per_file, pool=None if pool == "all" else pool)
     typer.echo(f"wrote {n} datapoints ({corpus}, pool {pool}) to {out}")
 
 
@@ -458,8 +464,9 @@ def plan_command(
     "objects worst first, each with its `anchors`, `shapes` made, decodes `rejected` and, for one that got no shape, "
     "`why_none`; with `--network` every validation object's datapoints, log loss and AP), `<out>/rejects.csv` (each "
     "rejected decode, its reason and the `failure` it served) and `<out>/skipped.csv` (files that could not be used, "
-    "and why); the log has a line per failure object, a warning for one that got nothing. An existing `--out` that "
-    "from-failures did not write is refused (`--force` replaces it); one inside FOLDER is always refused. Feed the "
+    "and why); the log has a line per failure object, a warning for one that got nothing. An existing `--out` holding "
+    "a file from-failures did not write is refused before any work (`--force` writes beside it, keeping it); a "
+    "symbolic link, or a folder inside FOLDER, is always refused. Feed the "
     "meshes to your own pipeline, or to this one (`data.source: folder`, `data.path`).\n\n" + EXIT_CODES,
 )
 def from_failures_command(
@@ -474,8 +481,8 @@ def from_failures_command(
         Path("failures_generated"),
         "--out",
         "-o",
-        help="Folder to write: a new or empty one, or one from-failures wrote (then replaced whole). Never inside "
-        "FOLDER, data/ or models/.",
+        help="Folder to write: a new or empty one, or one from-failures wrote (its files from the last run are "
+        "replaced, nothing else). Never inside FOLDER, data/ or models/.",
     ),
     force: bool = ForceOption,
     params: Path = ParamsOption,
@@ -525,12 +532,11 @@ def export_model_command(
     out: Path = typer.Argument(..., help="Folder to write (new, empty, or one export-model wrote)."),
     force: bool = ForceOption,
 ) -> None:
-    from graspaug.io.outputs import check_output_folder, mark
+    from graspaug.io.outputs import output_folder
     from graspaug.planning import export_model
 
-    check_output_folder(out, "export-model", force=force)
-    info = export_model(model, out)
-    mark(out, "export-model")
+    with output_folder(out, "export-model", force=force) as tmp:
+        info = export_model(model, tmp)
     typer.echo(f"wrote {', '.join(str(out / f) for f in [*info['files'], 'card.json'])} (ONNX: {info['onnx']})")
 
 

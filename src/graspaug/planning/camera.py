@@ -74,20 +74,28 @@ def intrinsics_for(depth_shape: tuple[int, int], intrinsics: Intrinsics | dict) 
 
 
 def check_depth(depth: np.ndarray, fill_missing: bool = False) -> np.ndarray:
-    """A float64 copy of ``depth`` (H, W) m after checks; pixels that are NaN, inf or <= 0
-    (missing) are an error, or with ``fill_missing`` take the value of the nearest valid pixel."""
+    """A float64 copy of ``depth`` (H, W) m (or (H, W, 1), a single channel) after checks: real numbers (not
+    complex, not bool); pixels that are NaN, inf or <= 0 (missing) are an error, or with ``fill_missing`` take the
+    value of the nearest valid pixel."""
     depth = np.asarray(depth)
     if depth.ndim == 3 and depth.shape[2] == 1:
         depth = depth[..., 0]
     if depth.ndim != 2:
-        raise PlanningError(f"the depth image must be a 2-D array (H, W) in meters, got shape {depth.shape}")
+        raise PlanningError(
+            f"the depth image must be a 2-D array (H, W) in meters (or (H, W, 1)), got shape {depth.shape}"
+        )
+    if depth.dtype.kind == "c":
+        raise PlanningError(
+            f"the depth image holds complex numbers (dtype {depth.dtype}); depths are real meters: save its real "
+            "part (depth.real) if that is what the camera measured"
+        )
     if min(depth.shape) < MIN_IMAGE_PX:
         raise PlanningError(
             f"the depth image is {depth.shape[1]}×{depth.shape[0]} px; planning needs at least "
             f"{MIN_IMAGE_PX}×{MIN_IMAGE_PX}"
         )
-    if not np.issubdtype(depth.dtype, np.number):
-        raise PlanningError(f"the depth image must hold numbers (meters), got dtype {depth.dtype}")
+    if depth.dtype.kind not in "uif":
+        raise PlanningError(f"the depth image must hold real numbers (meters), got dtype {depth.dtype}")
     depth = depth.astype(np.float64)
     missing = ~np.isfinite(depth) | (depth <= 0)
     if missing.all():

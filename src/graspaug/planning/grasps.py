@@ -61,6 +61,13 @@ def jaw_endpoints(centers: np.ndarray, angles: np.ndarray, widths: np.ndarray) -
     return np.stack([centers - half, centers + half], axis=1)
 
 
+def opening_widths(grasps: ImageGrasps, fx: float, fy: float) -> np.ndarray:
+    """(N,) jaw openings (m) of image ``grasps`` seen by a camera of focal lengths ``fx``, ``fy`` (px): each
+    opening ``widths`` (px) along its jaw direction, at its gripper depth ``depths`` (m)."""
+    per_px = np.hypot(np.cos(grasps.angles) / fx, np.sin(grasps.angles) / fy)  # m per px per m of depth
+    return per_px * grasps.widths * grasps.depths
+
+
 def grasp_features(grasps: ImageGrasps) -> np.ndarray:
     """(N, 5) Dex-Net's grasp feature vector: jaw 1 (u, v) px, jaw 2 (u, v) px, the depth in cm."""
     jaws = jaw_endpoints(grasps.centers, grasps.angles, grasps.widths)

@@ -13,6 +13,9 @@ from graspaug.planning.errors import PlanningError
 #: A 16-bit depth PNG whose median reading is below this (mm) holds some other unit (no camera sees
 #: a scene 2 cm away).
 MIN_PNG_MEDIAN_MM = 20
+#: ... and one whose median reading is below this (mm, a table 10 cm from the camera, nearer than a grasping
+#: camera stands: the gripper alone is longer) likely holds centimeters.
+MIN_PNG_TABLE_MM = 100
 
 
 def read_depth_image(path: str | os.PathLike) -> np.ndarray:
@@ -50,6 +53,11 @@ def read_depth_image(path: str | os.PathLike) -> np.ndarray:
             raise PlanningError(
                 f"depth image {path}: its median reading is {np.median(valid):g}, but a 16-bit depth PNG holds "
                 f"millimeters (a camera 0.7 m away reads 700): it looks like meters; save meters as .npy instead"
+            )
+        if valid.size and np.median(valid) < MIN_PNG_TABLE_MM:
+            raise PlanningError(
+                f"depth image {path}: its median reading is {np.median(valid):g}, a table {np.median(valid) / 10:g} "
+                "cm from the camera in millimeters: it looks like centimeters; a 16-bit depth PNG holds millimeters"
             )
         depth = pixels.astype(np.float64) / 1000.0
         depth[pixels == 0] = np.nan

@@ -17,7 +17,7 @@ import torch
 from graspaug.planning.camera import camera_adapter, check_depth, intrinsics_for
 from graspaug.planning.card import ModelCard
 from graspaug.planning.errors import NoGraspFound, PlanningError
-from graspaug.planning.grasps import ImageGrasps, jaw_endpoints
+from graspaug.planning.grasps import ImageGrasps, jaw_endpoints, opening_widths
 from graspaug.planning.policies import CrossEntropyGraspPolicy, GraspPolicy, RandomAntipodalPolicy
 from graspaug.planning.sampler import antipodal_in_image
 from graspaug.planning.settings import CEMSettings, SamplerSettings
@@ -92,10 +92,13 @@ class Planner:
     """A GQ-CNN (or none: a random antipodal grasp) with its model card and sampler settings.
 
     ``sampler`` and ``cem`` default to the simulator's (Dex-Net 2.0's) with the jaw opening of
-    the card's gripper. With ``check_image`` (the default) a grasp is returned only if the image
-    shows it antipodal and reachable (:func:`~graspaug.planning.sampler.antipodal_in_image`: jaws
-    on depth edges inside the friction cone, free space beside them down to the grasp depth);
-    the candidates are then the last cross-entropy iteration's and the seeds. Dex-Net's policy,
+    the card's gripper. With ``check_image`` (the default) a grasp is returned only if it fits the
+    gripper (its opening in meters at its gripper depth, :attr:`PlannedGrasp.width`, at most the
+    card's ``max_width``: the sampler bounds the opening at the depth of one jaw's edge, and a grasp
+    deeper than that edge opens wider) and the image shows it antipodal and reachable
+    (:func:`~graspaug.planning.sampler.antipodal_in_image`: jaws on depth edges inside the friction
+    cone, free space beside them down to the grasp depth); the candidates, filtered so before they
+    are ranked, are then the last cross-entropy iteration's and the seeds. Dex-Net's policy,
     which the simulated robot runs (``check_image=False``), trusts the network instead.
     ``threads``: torch threads while planning (1 suits the network's small batches; 0 leaves
     torch's setting).
@@ -116,6 +119,11 @@ class Planner:
         if sampler is None:
             sampler = SamplerSettings(max_width=float(self.card.gripper.get("max_width", SamplerSettings().max_width)))
         self.sampler, self.cem = sampler, cem
+
+    @property
+    def max_width(self) -> float:
+        """The widest jaw opening (m) of the card's gripper (the sampler's when the card names none)."""
+        return float(self.card.gripper.get("max_width", self.sampler.max_width))
 
     def policy(self, intrinsics: Intrinsics) -> GraspPolicy:
         """The grasp policy for images of a camera with ``intrinsics`` (the network's, or random antipodal)."""
@@ -155,7 +163,12 @@ class Planner:
         reach = float(self.card.gripper.get("fingertip_offset", 0.0))
         accept = None
         if self.check_image:
-            accept = lambda g: antipodal_in_image(image, g, self.sampler, reach)  # noqa: E731
+            widest = self.max_width * (1 + 1e-9)
+
+            def accept(g: ImageGrasps) -> np.ndarray:  # virtual-image grasps → (N,) bool
+                fits = opening_widths(adapter.to_original(g), intrinsics.fx, intrinsics.fy) <= widest
+                return fits & antipodal_in_image(image, g, self.sampler, reach)
+
         before = torch.get_num_threads()
         if self.threads:
             torch.set_num_threads(self.threads)
@@ -208,7 +221,7 @@ class Planner:
         (u, v), angle, depth, width_px = g.centers[0], float(g.angles[0]), float(g.depths[0]), float(g.widths[0])
         position = intrinsics.rays([u], [v])[0] * depth
         jaw = np.array([math.cos(angle) / intrinsics.fx, math.sin(angle) / intrinsics.fy, 0.0])
-        width = float(np.linalg.norm(jaw) * width_px * depth)
+        width = float(opening_widths(g, intrinsics.fx, intrinsics.fy)[0])
         x = jaw / np.linalg.norm(jaw)
         z = np.array([0.0, 0.0, 1.0])
         rotation = np.stack([x, np.cross(z, x), z], axis=1)
@@ -229,7 +242,20 @@ def load_planner(
     ``threads``: see :class:`Planner`."""
     from graspaug.io.checkpoints import read_gqcnn
 
-    net, card = read_gqcnn(Path(path))
+    path = Path(path)
+    if path.is_dir():
+        inside = sorted(p.relative_to(path).as_posix() for p in path.rglob("model.pt"))
+        shown = ", ".join(inside[:6]) + (f" and {len(inside) - 6} more" if len(inside) > 6 else "")
+        held = f": it holds {f'{len(inside)} networks, ' if len(inside) > 1 else ''}{shown}" if inside else ""
+        raise PlanningError(f"model {path}: a folder, not a model.pt file{held}")
+    if path.is_file():
+        with open(path, "rb") as f:
+            if f.read(6) == b"\x93NUMPY":
+                raise PlanningError(
+                    f"model {path}: a NumPy array (.npy), not a trained GQ-CNN (a model.pt file); the depth image "
+                    "is the first argument, the network --model"
+                )
+    net, card = read_gqcnn(path)
     if card is None:
         log.warning(
             "%s has no model card: assuming the default training camera (f = 525 px, 0.65-0.75 m) and 96 → 32 px crops",

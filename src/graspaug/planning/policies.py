@@ -88,6 +88,8 @@ class CrossEntropyGraspPolicy:
         scored = len(grasps)
         for _ in range(self.cem.num_iters):
             n_elite = max(1, int(math.ceil(self.cem.elite_fraction * len(grasps))))
+            if n_elite < 2:  # a mixture needs two grasps to fit: keep those scored so far
+                break
             elite = grasps.take(np.argsort(-q, kind="stable")[:n_elite])
             components = max(
                 1, min(self.cem.gmm_components, int(math.ceil(self.cem.gmm_component_fraction * n_elite)), n_elite)

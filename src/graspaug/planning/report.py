@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from graspaug.io.atomic import atomic_path
+from graspaug.io.atomic import atomic_paths
 from graspaug.io.outputs import check_output_files
 from graspaug.planning.camera import check_depth, intrinsics_for
 from graspaug.planning.errors import PlanningError
@@ -66,6 +66,7 @@ def plan_files(
         checked = check_depth(image, fill_missing)  # missing pixels filled once, here
     except PlanningError as exc:
         raise PlanningError(f"{depth}: {exc}") from None
+    image = np.asarray(image).reshape(checked.shape)  # (H, W, 1) → (H, W), as check_depth took it
     camera = intrinsics_for(checked.shape, read_intrinsics(intrinsics, *focal_and_center, checked.shape))
     planner = load_planner(model)
     grasps = planner.plan(checked, camera, seed, top, camera_distance)
@@ -73,44 +74,50 @@ def plan_files(
     floor = quality_floor(planner.card, min_quality)
     accepted = [floor.accepts(g.quality) for g in grasps]
     json_path, png_path = out / "grasp.json", out / "grasp.png"
-    out.mkdir(parents=True, exist_ok=True)
-    with atomic_path(json_path) as tmp:
-        tmp.write_text(
-            json.dumps(
-                {
-                    "written_by": PLAN_MARK,
-                    "depth": str(depth),
-                    "model": str(model),
-                    "accepted": bool(grasps) and accepted[0],  # the best grasp clears the quality floor
-                    "quality_floor": floor.to_dict(),
-                    "warnings": warnings,
-                    "grasps": [{**g.to_dict(), "accepted": ok} for g, ok in zip(grasps, accepted, strict=True)],
-                    "model_card": planner.card.to_dict(),
-                },
-                indent=1,
-            )
-            + "\n"
-        )
     labels = [
         f"#{i + 1}  Q = {g.quality:.3f}, {1000 * g.width:.0f} mm" + ("" if ok else f"  rejected (< {floor.value:.3f})")
         for i, (g, ok) in enumerate(zip(grasps, accepted, strict=True))
     ]
     verdict = f"; rejected: Q < floor {floor.value:.3f}" if grasps and not accepted[0] else ""
     shown = np.where(np.isfinite(image) & (image > 0), image, np.nan) if image.dtype.kind == "f" else image
-    crops, openings = planner.network_crops(image, camera, grasps, camera_distance, fill_missing)
     finger = float(planner.card.gripper.get("finger_width", 0.0))
-    planned_grasps(
-        np.nan_to_num(shown, nan=float(np.nanmax(shown))),
-        [g.jaw_pixels for g in grasps],
-        labels,
-        png_path,
-        f"{depth.name}: {len(grasps)} grasp(s), model {model.resolve().parent.name}/{model.name}{verdict}",
-        rejected=[not ok for ok in accepted],
-        finger_px=[finger * camera.fx / g.depth for g in grasps] if finger > 0 else None,
-        crops=crops,
-        crop_openings=openings,
-        px_per_cm=0.01 * camera.fx / grasps[0].depth if grasps else None,
-    )
+    made = not out.exists()
+    out.mkdir(parents=True, exist_ok=True)
+    try:  # both files drawn and written into temporaries first: a failure leaves neither, nor a folder it made
+        with atomic_paths([json_path, png_path]) as (json_tmp, png_tmp):
+            crops, openings = planner.network_crops(image, camera, grasps, camera_distance, fill_missing)
+            planned_grasps(
+                np.nan_to_num(shown, nan=float(np.nanmax(shown))),
+                [g.jaw_pixels for g in grasps],
+                labels,
+                png_tmp,
+                f"{depth.name}: {len(grasps)} grasp(s), model {model.resolve().parent.name}/{model.name}{verdict}",
+                rejected=[not ok for ok in accepted],
+                finger_px=[finger * camera.fx / g.depth for g in grasps] if finger > 0 else None,
+                crops=crops,
+                crop_openings=openings,
+                px_per_cm=0.01 * camera.fx / grasps[0].depth if grasps else None,
+            )
+            json_tmp.write_text(
+                json.dumps(
+                    {
+                        "written_by": PLAN_MARK,
+                        "depth": str(depth),
+                        "model": str(model),
+                        "accepted": bool(grasps) and accepted[0],  # the best grasp clears the quality floor
+                        "quality_floor": floor.to_dict(),
+                        "warnings": warnings,
+                        "grasps": [{**g.to_dict(), "accepted": ok} for g, ok in zip(grasps, accepted, strict=True)],
+                        "model_card": planner.card.to_dict(),
+                    },
+                    indent=1,
+                )
+                + "\n"
+            )
+    except BaseException:
+        if made and not any(out.iterdir()):
+            out.rmdir()
+        raise
     said = [f"warning: {w}" for w in warnings]
     if not grasps:
         line = f"no grasp: no antipodal pair of depth edges in {depth} fits the gripper (wrote {json_path})"

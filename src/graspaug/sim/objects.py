@@ -128,13 +128,13 @@ def draw_physics(volume: float, settings: ObjectPhysics, rng: np.random.Generato
 
 
 def folder_meshes(
-    folder: Path, surface, max_faces: int = 1_000_000, max_file_mb: float = 100.0
+    folder: Path, surface, max_faces: int = 1_000_000, max_file_mb: float = 100.0, label: str = "sim"
 ) -> tuple[list[tuple[str, trimesh.Trimesh]], dict[str, str]]:
     """The meshes (.obj, .stl, .ply) of ``folder``, named by file stem, each loaded, closed and
     scaled as the corpus's shapes are (:func:`graspaug.geometry.prepare.prepare_shape` with
     ``surface``, the ``ingest.surface`` settings), and {file name: reason} for those skipped.
     Raises ValueError (one line) when the folder is missing or holds no mesh file, or when no
-    mesh survives."""
+    mesh survives. ``label`` starts each skipped file's warning (the command that reads the folder)."""
     from graspaug.geometry.loading import MeshRejected, load_shape
     from graspaug.geometry.prepare import prepare_shape
 
@@ -150,7 +150,7 @@ def folder_meshes(
             meshes.append((path.stem, prepare_shape(load_shape(path, 1.0, max_faces, max_file_mb), surface).mesh))
         except (MeshRejected, OSError, ValueError) as exc:
             skipped[path.name] = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
-            log.warning("sim: skipping %s: %s", path, skipped[path.name])
+            log.warning("%s: skipping %s: %s", label, path, skipped[path.name])
     if not meshes:
         raise ValueError(
             f"sim.objects_path: no usable mesh in {folder} ({len(skipped)} skipped: "

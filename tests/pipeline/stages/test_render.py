@@ -109,10 +109,16 @@ def test_render_writes_shards_index_metrics_and_a_dexnet_export(tmp_path, monkey
         pose_ids[read_tensor_field(out, "pose_labels")], index.shape_id + ":" + index.pose_id.astype(str)
     )
 
+    (out / "notes.txt").write_text("mine")  # a file of the user's in the folder: refused, and kept
     again = CliRunner().invoke(app, ["export-dexnet", "original", str(out)])
-    assert again.exit_code == 2 and "is not empty" in again.output
+    assert again.exit_code == 2 and "holds notes.txt, which graspaug export-dexnet did not write" in again.output
+    assert (out / "notes.txt").read_text() == "mine"
+    (out / "notes.txt").unlink()  # its own folder: its files replaced
+    assert CliRunner().invoke(app, ["export-dexnet", "original", str(out)]).exit_code == 0
+    assert len(list((out / "tensors").glob("hand_poses_*.npz"))) == int(np.ceil(len(data) / 1000))
     missing = CliRunner().invoke(app, ["export-dexnet", "gen_50", str(tmp_path / "other")])
     assert missing.exit_code == 2 and "no rendered dataset" in missing.output
+    assert not (tmp_path / "other").exists()
 
 
 def test_render_params_are_checked(tmp_path):

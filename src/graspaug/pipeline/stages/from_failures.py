@@ -5,7 +5,8 @@ The failure objects are a folder of meshes (closed, scaled, voxelized and encode
 *validation* objects of one of this project's networks (the test split never chooses). Their nearest train shapes in
 latent space anchor interpolants decoded and meshed as ``generate`` does; a failure object is never a parent.
 
-Writes, all at once, into ``out`` (refused if it holds files this command did not write, :mod:`graspaug.io.outputs`):
+Writes, all at once, into ``out`` (refused before any work if it holds a file this command did not write, is a link
+or lies inside an input; only the files of its last run are replaced, :mod:`graspaug.io.outputs`):
 ``meshes/failure_<order>.obj`` (m), ``index.csv`` (per shape: its failure object, parents, ``alpha``, size),
 ``failures.csv`` (the objects, worst first: shapes, rejected decodes and why none), ``rejects.csv`` (with the failure
 each decode served), ``skipped.csv`` (unusable files, and why).
@@ -23,10 +24,9 @@ from graspaug.augment.pools import base_set, failure_shapes, failure_summary, lo
 from graspaug.device import resolve_device
 from graspaug.errors import DataError
 from graspaug.experiments.lifelong.numbers import failure_anchors, validation_errors
-from graspaug.io.atomic import atomic_path
 from graspaug.io.checkpoints import load_autoencoder
 from graspaug.io.meshes import mesh_path, write_obj
-from graspaug.io.outputs import check_output_folder, mark
+from graspaug.io.outputs import check_output_folder, output_folder
 from graspaug.io.tables import read_table
 from graspaug.io.voxels import read_voxels
 from graspaug.pipeline import paths
@@ -59,7 +59,8 @@ def run(params: Params, folder, network: str | None, worst: int, count: int, per
         raise DataError("give either a folder of failure meshes or --network (its worst validation objects)")
     if min(count, per_failure, worst) < 1:
         raise DataError(f"--count, --per-failure, --worst must be at least 1; got {count}, {per_failure}, {worst}")
-    check_output_folder(out, COMMAND, [folder, "data", "models"] if folder else ["data", "models"], force)
+    inputs = [folder, "data", "models"]
+    check_output_folder(out, COMMAND, inputs, force)
     device = resolve_device(params.device)
     ae, _, _ = load_autoencoder(paths.AE_CRITIC_MODEL, params.ae.net)
     shapes, latents = read_table(paths.SHAPES_TABLE), read_table(paths.LATENTS).set_index("shape_id")
@@ -73,7 +74,9 @@ def run(params: Params, folder, network: str | None, worst: int, count: int, per
     else:
         ingest, grid = params.ingest, params.voxelize
         try:
-            meshes, skipped = folder_meshes(Path(folder), ingest.surface, ingest.max_faces, ingest.max_file_mb)
+            meshes, skipped = folder_meshes(
+                Path(folder), ingest.surface, ingest.max_faces, ingest.max_file_mb, label=COMMAND
+            )
         except ValueError as exc:
             raise DataError(str(exc).replace("sim.objects_path", "the failure folder")) from None
         names = [name for name, _ in meshes]
@@ -86,8 +89,7 @@ def run(params: Params, folder, network: str | None, worst: int, count: int, per
     run_batch = mesh_batches(ae, device, pool, params.generate.decode, params.workers, "from failures")
     index, rejects, kept, notes = failure_shapes(pool, anchors, served, count, params.generate, run_batch)
     summary = failure_summary(names, served, index, rejects)
-    with atomic_path(out, directory=True) as tmp:
-        mark(tmp, COMMAND)
+    with output_folder(out, COMMAND, inputs, force) as tmp:
         (tmp / "meshes").mkdir()
         for shape_id, decoded in zip(index.shape_id, kept):
             write_obj(decoded.mesh, mesh_path(tmp / "meshes", shape_id, ".obj"))
