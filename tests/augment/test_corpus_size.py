@@ -72,3 +72,22 @@ def test_a_shape_empty_at_the_voxel_resolution_is_rejected_with_its_reason(tmp_p
         source_of(trimesh.creation.box(extents=[0.05] * 3), tmp_path, "cube"), 10**6, 10.0, REAL, tmp_path, (16, 1), 8
     )
     assert cube["ok"] and np.isclose(cube["extent_x"], 0.05, atol=0.002)
+
+
+def test_fit_keeps_what_the_gripper_takes_and_shrinks_what_it_cannot(tmp_path):
+    """Size `fit`: the fork keeps its 18 cm; a 20 × 15 × 12 cm crate keeps its shape, scaled until its narrowest side
+    is 0.9 of the gripper's opening (its scale in the row); a crumb is still too small."""
+    fit = SurfaceSettings(size="fit", resolution=64, finest_resolution=64)
+    kept = ingest_source(source_of(fork(), tmp_path, "fork"), 10**6, 10.0, fit, tmp_path)
+    assert kept["ok"] and abs(kept["scale"] - 1.0) < 1e-12
+    assert abs(max(kept["extent_x"], kept["extent_y"], kept["extent_z"]) - 0.18) < 0.004
+    crate = trimesh.creation.box(extents=[0.2, 0.15, 0.12])
+    shrunk = ingest_source(source_of(crate, tmp_path, "crate"), 10**6, 10.0, fit, tmp_path)
+    assert shrunk["ok"], shrunk.get("reason")
+    extents = sorted([shrunk["extent_x"], shrunk["extent_y"], shrunk["extent_z"]])
+    assert np.allclose(extents, np.array([0.12, 0.15, 0.2]) * 0.072 / 0.12, rtol=0.02)
+    assert abs(shrunk["scale"] - 0.6) < 0.01
+    crumb = ingest_source(
+        source_of(trimesh.creation.icosphere(radius=0.003), tmp_path, "crumb"), 10**6, 10.0, fit, tmp_path
+    )
+    assert not crumb["ok"] and crumb["reason"].startswith("too small")

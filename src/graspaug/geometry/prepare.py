@@ -27,6 +27,9 @@ class PreparedShape:
     hull_fill: float = 1.0  # volume / convex hull volume
 
 
+FIT_SHARE = 0.9  # size `fit`: a shape too wide for the gripper is scaled until its narrowest side is this share of it
+
+
 def _check_real_size(surface: trimesh.Trimesh, settings: SurfaceSettings) -> None:
     """Raise :class:`MeshRejected` when a shape kept at its real size is too small (largest extent below
     ``settings.min_extent``) or too large for the gripper (the smallest side of its oriented bounding box, m,
@@ -43,7 +46,9 @@ def _check_real_size(surface: trimesh.Trimesh, settings: SurfaceSettings) -> Non
 
 def prepare_shape(loaded: LoadedShape, settings: SurfaceSettings) -> PreparedShape:
     """Rebuild one closed, one-piece outer surface, then center it and (``settings.size``: ``normalize``) scale it
-    by the size rule or (``real``) keep its size.
+    by the size rule, (``real``) keep its size, or (``fit``) keep its size unless the gripper cannot close across it,
+    when it is scaled down until the smallest side of its oriented bounding box is :data:`FIT_SHARE` of
+    ``settings.max_width``.
 
     Raises
     ------
@@ -80,7 +85,12 @@ def prepare_shape(loaded: LoadedShape, settings: SurfaceSettings) -> PreparedSha
         raise MeshRejected(f"in pieces: {dropped:.0%} of the volume lies outside the largest piece")
     if not surface.is_watertight:
         raise MeshRejected("could not close the surface")
-    if settings.size == "real":
+    if settings.size == "fit":  # real size, but a shape too wide for the gripper shrinks until it fits
+        smallest = float(np.min(surface.bounding_box_oriented.primitive.extents))
+        scale = min(1.0, FIT_SHARE * settings.max_width / smallest)
+        norm = Normalization(scale=scale, offset=scale * centering(surface).offset)
+        _check_real_size(norm.apply(surface), settings)
+    elif settings.size == "real":
         norm = centering(surface)
         _check_real_size(surface, settings)
     else:

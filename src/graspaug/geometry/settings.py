@@ -37,25 +37,29 @@ class SurfaceSettings:
         ),
     )
     face_budget: int = Field(5000, ge=100, description="Triangles per outer surface after quadric decimation.")
-    size: Literal["normalize", "real"] = Field(
+    size: Literal["normalize", "real", "fit"] = Field(
         "normalize",
         description=(
             "`normalize`: every shape is scaled so the size rule's extent is size_m (the default corpus' units are "
             "arbitrary); `real`: each shape keeps its size in the file (times data.unit_scale), and shapes the "
-            "gripper cannot take (min_extent, max_width) are rejected."
+            "gripper cannot take (min_extent, max_width) are rejected; `fit`: as `real`, but a shape too wide for the "
+            "gripper is scaled down (its shape kept, its scale in the shape table) until its narrowest side is 0.9 "
+            "max_width."
         ),
     )
     min_extent: float = Field(
         0.01,
         gt=0,
-        description="With size `real`: a shape whose largest extent is below this (m) is rejected as too small.",
+        description="With size `real` or `fit`: a shape whose largest extent is below this (m) is rejected as too "
+        "small.",
     )
     max_width: float = Field(
         0.08,
         gt=0,
         description=(
-            "With size `real`: a shape whose oriented bounding box's smallest side exceeds this (m) is rejected, as no "
-            "parallel-jaw grasp fits across it (the Franka Panda's opening, grasps.gripper.max_width)."
+            "With size `real`: a shape whose oriented bounding box's smallest side exceeds this (m) is rejected "
+            "(`fit`: scaled down), as no parallel-jaw grasp fits across it (the Franka Panda's opening, "
+            "grasps.gripper.max_width)."
         ),
     )
     size_rule: Literal["min", "mid", "max"] = Field(
