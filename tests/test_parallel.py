@@ -90,3 +90,67 @@ def test_workers_hand_freed_memory_back_so_loky_restarts_none(tmp_path):
         )
     assert len(rows) == 60
     assert not [w for w in caught if "worker stopped" in str(w.message)]
+
+
+@pytest.fixture(scope="module")
+def rendered_tiny(repo_root, tmp_path_factory):
+    """A project folder holding the tiny profile's ingested, graded and rendered original shapes (20 default
+    objects, about 30 s) and params that train its three 1:0 and ceiling networks (no generated shapes)."""
+    from graspaug.pipeline.stages import grasps, ingest, render
+
+    tiny = profile_params("tiny", repo_root / "profiles")
+    params = tiny.model_copy(update={"gqcnn": dataclasses.replace(tiny.gqcnn, augment_base_sizes=())})
+    folder = tmp_path_factory.mktemp("rendered")
+    with pytest.MonkeyPatch.context() as patch:
+        patch.chdir(folder)
+        ingest.run(params)
+        grasps.run(params)
+        render.run(params)
+    return folder, params
+
+
+def run_train_gqcnn(source, folder, params, monkeypatch) -> dict[str, bytes]:
+    """``train_gqcnn`` seed 0 in a copy ``folder`` of the project ``source``: every output file's bytes by path
+    (the timing file left out)."""
+    import shutil
+
+    from graspaug.pipeline.stages import train_gqcnn
+
+    shutil.copytree(source, folder)
+    monkeypatch.chdir(folder)
+    train_gqcnn.run(params, 0)
+    outputs = [*sorted((folder / "models/gqcnn/s0").rglob("*")), folder / "metrics/gqcnn/s0.json"]
+    outputs += [folder / "reports/gqcnn/networks/s0.json", folder / "reports/gqcnn/validation/s0.csv"]
+    return {str(p.relative_to(folder)): p.read_bytes() for p in outputs if p.is_file()}
+
+
+def test_train_gqcnn_on_a_dask_cluster_equals_the_local_run_byte_for_byte(rendered_tiny, tmp_path, monkeypatch):
+    """The networks of a seed go one per task to a real two-worker LocalCluster, each task with one torch
+    thread; a local run at one thread writes the same bytes (at another thread count float sums round
+    differently: docs/cluster.md)."""
+    import torch
+
+    from graspaug.training.networks import TASK_THREADS
+
+    distributed = pytest.importorskip("distributed")
+    source, params = rendered_tiny
+    before = torch.get_num_threads()
+    torch.set_num_threads(TASK_THREADS)
+    try:
+        local = run_train_gqcnn(source, tmp_path / "local", params, monkeypatch)
+    finally:
+        torch.set_num_threads(before)
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
+        on_cluster = params.model_copy(update={"executor": "dask", "scheduler": cluster.scheduler_address})
+        with distributed.Client(cluster) as client, distributed.get_task_stream(client) as stream:
+            remote = run_train_gqcnn(source, tmp_path / "cluster", on_cluster, monkeypatch)
+        workers = set(cluster.scheduler_info["workers"])
+    # one task per network (a joblib batch of one call), each on one of the cluster's workers
+    tasks = [t for t in stream.data if str(t["key"]).startswith("batch_of__in_folder_1_calls")]
+    assert len(tasks) == 3 and {t["worker"] for t in tasks} <= workers, stream.data
+    models = sorted(p for p in local if p.endswith("model.pt"))
+    assert models == [f"models/gqcnn/s0/{n}/model.pt" for n in ("ceiling", "targeted/4-0", "targeted/6-0")]
+    assert local.keys() == remote.keys()
+    assert [p for p in local if local[p] != remote[p]] == []
+    timing = (tmp_path / "cluster/reports/timing/train_gqcnn/s0.json").read_text()
+    assert '"threads": 1' in timing and '"networks": 3' in timing

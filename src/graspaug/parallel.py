@@ -1,5 +1,5 @@
-"""Per-shape loops: joblib worker processes with a tqdm progress bar, on this machine or on a
-Dask distributed cluster.
+"""Per-shape loops (and a seed's networks): joblib worker processes with a tqdm progress bar, on this
+machine or on a Dask distributed cluster.
 
 ``Workers(executor="dask", scheduler="tcp://host:8786")`` sends the same calls through joblib's
 ``dask`` backend to the cluster behind that scheduler; its workers must import graspaug and see
@@ -83,12 +83,21 @@ def _trimmed(fn: Callable[..., T], item: Any) -> T:
         release_freed_memory()
 
 
-def parallel_map(fn: Callable[..., T], items: Sequence[Any], workers: int | Workers, desc: str) -> list[T]:
+def parallel_map(
+    fn: Callable[..., T],
+    items: Sequence[Any],
+    workers: int | Workers,
+    desc: str,
+    unit: str = "shape",
+    batch_size: int | str = "auto",
+) -> list[T]:
     """``[fn(item) for item in items]`` on ``workers`` (a process count or :class:`Workers`), in
-    order, with a progress bar."""
+    order, with a progress bar ``desc`` counting ``unit``s. One local job (or one item) runs here, in
+    this process; otherwise calls go to the workers ``batch_size`` at a time (joblib's ``auto`` groups
+    calls that finish in well under a second; 1: one call per task)."""
     workers = workers if isinstance(workers, Workers) else Workers(n_jobs=workers)
     results: list[T] = []
-    with tqdm(total=len(items), desc=desc, unit="shape", dynamic_ncols=True) as bar:
+    with tqdm(total=len(items), desc=desc, unit=unit, dynamic_ncols=True) as bar:
         if workers.executor == "joblib" and (workers.n_jobs == 1 or len(items) <= 1):
             for item in items:
                 results.append(fn(item))
@@ -104,7 +113,7 @@ def parallel_map(fn: Callable[..., T], items: Sequence[Any], workers: int | Work
             backend, n_jobs = contextlib.nullcontext(), workers.n_jobs
             calls = (delayed(_trimmed)(fn, item) for item in items)
         with backend:
-            for result in Parallel(n_jobs=n_jobs, return_as="generator", batch_size="auto")(calls):
+            for result in Parallel(n_jobs=n_jobs, return_as="generator", batch_size=batch_size)(calls):
                 results.append(result)
                 bar.update()
     return results

@@ -10,12 +10,20 @@ summary), ``summary.json``, ``history.csv`` (validation AP per evaluation),
 With ``gqcnn.members`` = K > 1 every network is an ensemble of K members (member m of every
 variant starts from the same weights and noise stream) whose mean P(success) is validated and
 tested; ``*_predictions_members.npy`` (K, N) keep each member's.
+
+Where the networks train (:func:`train_jobs`): here, one after another with torch's threads, or one network per
+task on :class:`~graspaug.parallel.Workers` (local processes or a Dask cluster), each task with
+:data:`TASK_THREADS` torch threads. Every network starts from its own initial weights and noise seeds, so it
+comes out the same wherever it trains, byte for byte at the same thread count; at another thread count
+float sums round differently (docs/cluster.md).
 """
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import json
+import logging
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -29,6 +37,7 @@ from graspaug.errors import DataError
 from graspaug.io.checkpoints import finish_gqcnn_card, gqcnn_card, operating_point, save_gqcnn, training_range
 from graspaug.nets.gqcnn import GQCNN, GQCNNEnsemble, GQCNNStack
 from graspaug.nets.settings import GQCNNConfig
+from graspaug.parallel import Workers, parallel_map
 from graspaug.training.gqcnn import GraspArrays, classification_metrics, predict_members, train_members
 from graspaug.training.gqcnn_data import (
     Corpora,
@@ -40,6 +49,8 @@ from graspaug.training.gqcnn_data import (
 )
 from graspaug.training.settings import TrainSettings
 from graspaug.training.variants import Variant
+
+log = logging.getLogger(__name__)
 
 
 def stream_seeds(global_seed: int, seed: int, member: int = 0) -> tuple[int, int]:
@@ -172,6 +183,7 @@ def train_network(job: NetworkJob, val: GraspArrays | None = None, test: GraspAr
         **summary,
         "train_seconds": seconds,
         "samples_per_second": fits[0]["samples_per_second"],  # every member's samples
+        "threads": torch.get_num_threads(),  # torch threads it trained with
     }
 
 
@@ -183,17 +195,61 @@ def seed_card(render, grasps, global_seed: int) -> dict:
     return gqcnn_card(render.crop, render.intrinsics, render.viewpoints, grasps.gripper, grasps.threshold, global_seed)
 
 
-def train_jobs(jobs: list[NetworkJob], val: GraspArrays, test: GraspArrays, desc: str) -> list[dict]:
-    """Train the networks of ``jobs`` one after another (:func:`train_network`, progress bar ``desc``)
-    on the seed's validation and test datapoints; their summaries. A network that cannot be
-    trained (a ValueError) is a :class:`~graspaug.errors.DataError` (one line)."""
-    results = []
-    for job in tqdm(jobs, desc=desc, unit="network"):
-        try:
-            results.append(train_network(job, val, test))
-        except ValueError as exc:
-            raise DataError(str(exc)) from None
-    return results
+TASK_THREADS = 1  # torch threads of a network trained beside others: a small network's layers scale poorly over
+# threads, so a core per network trains more networks per hour than cores shared by one (docs/cluster.md)
+
+
+def _train_task(job: NetworkJob, threads: int) -> dict:
+    """:func:`train_network` of ``job`` with ``threads`` torch threads (restored after), reading the seed's
+    validation and test datapoints itself: a worker reads them from the project folder it shares rather than
+    receiving them with every network."""
+    before = torch.get_num_threads()
+    torch.set_num_threads(threads)
+    try:
+        return train_network(job)
+    finally:
+        torch.set_num_threads(before)
+
+
+def _in_process(workers: Workers | int) -> bool:
+    """Whether :func:`train_jobs` trains on ``workers`` here, in this process (one local job)."""
+    local = workers if isinstance(workers, int) else workers.n_jobs if workers.executor == "joblib" else 0
+    return local == 1
+
+
+def _where(workers: Workers | int) -> str:
+    """Where :func:`train_jobs` trains on ``workers``, in words."""
+    if _in_process(workers):
+        return "in this process, one after another"
+    if isinstance(workers, Workers) and workers.executor == "dask":
+        return "one per task on the Dask cluster at %s, %d torch thread(s) each" % (workers.scheduler, TASK_THREADS)
+    n_jobs = workers.n_jobs if isinstance(workers, Workers) else workers
+    return "one per task on %d local processes, %d torch thread(s) each" % (n_jobs, TASK_THREADS)
+
+
+def network_workers(workers: Workers) -> Workers | int:
+    """Where a seed's networks train, given where the per-shape loops run: the Dask cluster of ``workers``
+    (executor dask), else this process, one network at a time with every thread (two 1-thread processes
+    were no faster on 2 cores: docs/results.md#one-network-at-a-time)."""
+    return workers if workers.executor == "dask" else 1
+
+
+def train_jobs(
+    jobs: list[NetworkJob], val: GraspArrays, test: GraspArrays, desc: str, workers: Workers | int = 1
+) -> list[dict]:
+    """Train the networks of ``jobs`` (:func:`train_network`, progress bar ``desc``) on the seed's validation
+    and test datapoints; their summaries, in the order of ``jobs``. ``workers`` 1: here, one after another;
+    otherwise one network per task on ``workers`` with :data:`TASK_THREADS` torch threads (each task reads the
+    validation and test datapoints itself, the same rows). A network that cannot be trained (a ValueError) is
+    a :class:`~graspaug.errors.DataError` (one line)."""
+    log.info("%s: %d networks %s", desc, len(jobs), _where(workers))
+    try:
+        if _in_process(workers):
+            return [train_network(job, val, test) for job in tqdm(jobs, desc=desc, unit="network")]
+        task = functools.partial(_train_task, threads=TASK_THREADS)
+        return parallel_map(task, jobs, workers, desc, unit="network", batch_size=1)
+    except ValueError as exc:
+        raise DataError(str(exc)) from None
 
 
 def _by_member(value):
@@ -248,9 +304,9 @@ def read_history(seed_dir: Path, variants: list[Variant]) -> pd.DataFrame:
 def seed_plan(variants: list[Variant], members: int, n_validation: int, val_rows, test_rows, device) -> str:
     """One line on a seed's training: the networks and members, the validation shapes
     (``n_validation``) and datapoints (``val_rows`` (N,)), the test datapoints (``test_rows`` (M,))
-    and the torch ``device``."""
+    and the torch ``device``; :func:`train_jobs` says where the networks train."""
     return (
-        "%d networks of %d member(s) (a network's members at once, the networks one after another); "
+        "%d networks of %d member(s) (a network's members at once); "
         "validation %d shapes (%d datapoints), test %d datapoints; on %s"
         % (len(variants), members, n_validation, len(val_rows), len(test_rows), device)
     )
@@ -278,14 +334,14 @@ def save_seed_split(seed_dir: Path, split: ExperimentSplit, test_rows: np.ndarra
 
 
 def seed_timing(results: list[dict], seconds: float) -> dict:
-    """A seed's timing file: ``seconds`` (s, rounded to 0.1), the network count, torch's thread
-    count, the median training samples per second over ``results`` (:func:`train_network`'s
-    summaries) and each network's training seconds by ``<pool>/<B>-<R>``."""
+    """A seed's timing file: ``seconds`` (s, rounded to 0.1), the network count, the torch threads a
+    network trained with (the most over ``results``, :func:`train_network`'s summaries), their median
+    training samples per second and each network's training seconds by ``<pool>/<B>-<R>``."""
     speed = [r["samples_per_second"] for r in results]
     return {
         "seconds": round(seconds, 1),
         "networks": len(results),
-        "threads": torch.get_num_threads(),
+        "threads": max((r["threads"] for r in results), default=torch.get_num_threads()),
         "samples_per_second_median": round(float(np.median(speed)), 1),
         "train_seconds": {
             f"{r['pool']}/{r['base_size']}-{r['ratio']:g}": round(r["train_seconds"], 1) for r in results
@@ -322,23 +378,28 @@ def train_paired(
     corpora: Corpora,
     card: dict,
     label: str,
+    workers: Workers | int = 1,
 ) -> dict[int, list[dict]]:
     """Train ``variants`` for every training seed of the ``gqcnn`` params as :mod:`train_gqcnn
     <graspaug.pipeline.stages.train_gqcnn>` does (the seed's initial weights and noise streams, validated on
     ``split.validation``, tested on the test split of ``corpora.original``), each seed into
-    ``out_dir``/s<seed>/ with its ``test_rows.npy``, ``val_rows.npy`` and ``split.json``.
-    Returns training seed → the networks' summaries (:func:`train_network`)."""
+    ``out_dir``/s<seed>/ with its ``test_rows.npy``, ``val_rows.npy`` and ``split.json``; every seed's networks
+    on ``workers`` at once (:func:`train_jobs`). Returns training seed → the networks' summaries
+    (:func:`train_network`)."""
     val, val_rows = shapes_datapoints(corpora.original, split.validation)
     test, test_rows = test_set(corpora.original)
-    out = {}
+    jobs = []
     for seed in gqcnn.seeds:
         inits, noise_seeds = seed_members(gqcnn.net, global_seed, seed, gqcnn.members)
         folder = Path(out_dir) / f"s{seed}"
         folder.mkdir(parents=True, exist_ok=True)
-        jobs = [
+        jobs += [
             NetworkJob(v, split, gqcnn.net, gqcnn.train, inits, noise_seeds, seed, str(device), folder, corpora, card)
             for v in variants
         ]
-        out[seed] = train_jobs(jobs, val, test, f"{label} (seed {seed})")
-        save_seed_split(folder, split, test_rows, val_rows)
+    results = train_jobs(jobs, val, test, f"{label} (seeds {', '.join(map(str, gqcnn.seeds))})", workers)
+    out = {}
+    for i, seed in enumerate(gqcnn.seeds):
+        out[seed] = results[i * len(variants) : (i + 1) * len(variants)]
+        save_seed_split(Path(out_dir) / f"s{seed}", split, test_rows, val_rows)
     return out

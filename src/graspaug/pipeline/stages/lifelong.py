@@ -27,7 +27,7 @@ from graspaug.pipeline.params.base import params_model
 from graspaug.pipeline.provenance import report_header
 from graspaug.pipeline.stages import StageError
 from graspaug.training.gqcnn_data import Corpora, load_split, training_shapes
-from graspaug.training.networks import seed_card, train_paired
+from graspaug.training.networks import network_workers, seed_card, train_paired
 
 log = logging.getLogger(__name__)
 
@@ -83,7 +83,9 @@ def run(params: Params, round_: int) -> None:
             folder / "real.csv", index=False
         )
         corpora, card = Corpora(original, {b: folder / "dataset"}), seed_card(params.render, params.grasps, params.seed)
-        train_paired(variants, split, gq, params.seed, device, nets, corpora, card, label)
+        train_paired(
+            variants, split, gq, params.seed, device, nets, corpora, card, label, network_workers(params.workers)
+        )
         seed_dirs, corpus = {s: nets / f"s{s}" for s in gq.seeds}, read_table(original / "index.parquet")
         history = pd.read_csv(before / "history.csv")
         errors, history, followed = score_round(seed_dirs, variants, ARMS, corpus, failures, history, round_, cfg.worst)

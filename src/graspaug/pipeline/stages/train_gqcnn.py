@@ -37,6 +37,7 @@ from graspaug.plots import validation_curves
 from graspaug.training.gqcnn_data import Corpora, load_split, shapes_datapoints, test_set
 from graspaug.training.networks import (
     NetworkJob,
+    network_workers,
     precision_warning,
     read_history,
     result_lines,
@@ -79,14 +80,13 @@ def run(params: Params, seed: int) -> None:
     log.info("train_gqcnn seed %d: %s", seed, plan)
     if (warning := precision_warning(cfg.train.precision, device)) is not None:
         log.warning("%s", warning)
-    # one network at a time with every thread: two 1-thread workers were slower on 2 cores (docs/results.md#benchmarks)
     with atomic_path(gqcnn_seed_dir(seed), directory=True) as folder:
         card = seed_card(params.render, params.grasps, params.seed)
         jobs = [
             NetworkJob(v, split, cfg.net, cfg.train, inits, noise_seeds, seed, str(device), folder, corpora, card)
             for v in variants
         ]
-        results = train_jobs(jobs, val, test, f"train GQ-CNNs (seed {seed})")
+        results = train_jobs(jobs, val, test, f"train GQ-CNNs (seed {seed})", network_workers(params.workers))
         save_seed_split(folder, split, test_rows, val_rows)
         history = read_history(folder, variants)
     write_csv(history, gqcnn_val_curves(seed).with_suffix(".csv"))
