@@ -109,9 +109,10 @@ class BaseParams(BaseModel):
     n_jobs: int = Field(2, ge=-1, description="Worker processes for per-shape loops (-1: all cores).")
     executor: Literal["joblib", "dask"] = Field(
         "joblib",
-        description="Where per-shape loops (ingest, voxelize, grasps, generate, render, sim) run: `joblib` (n_jobs "
-        "local processes) or `dask` (the Dask cluster at `scheduler`; needs `pip install 'graspaug[dask]'` and "
-        "workers that see the project at the same path).",
+        description="Where per-shape loops (ingest, voxelize, grasps, generate, render, sim) and the GQ-CNN networks "
+        "(train_gqcnn, lifelong) run: `joblib` (n_jobs local processes; networks one after another in the stage's "
+        "process) or `dask` (the Dask cluster at `scheduler`, one network per task at 1 torch thread; needs `pip "
+        "install 'graspaug[dask]'` and workers that see the project at the same path).",
     )
     scheduler: str | None = Field(
         None, description="Dask scheduler address when executor is `dask`, e.g. tcp://10.0.0.5:8786."

@@ -79,13 +79,11 @@ def run(params: Params, round_: int) -> None:
         write_table(index if made is None else pd.concat([made, index], ignore_index=True), folder / "shapes.parquet")
         rejects.to_csv(folder / "rejects.csv", index=False)
         pd.DataFrame(skipped, columns=["shape_id", "reason"]).to_csv(folder / "skipped.csv", index=False)
-        pd.DataFrame({"shape_id": training_shapes(variants[ARMS.index("real")], split)[0][b:]}).to_csv(
-            folder / "real.csv", index=False
-        )
+        real = training_shapes(variants[ARMS.index("real")], split)[0][b:]
+        pd.DataFrame({"shape_id": real}).to_csv(folder / "real.csv", index=False)
         corpora, card = Corpora(original, {b: folder / "dataset"}), seed_card(params.render, params.grasps, params.seed)
-        train_paired(
-            variants, split, gq, params.seed, device, nets, corpora, card, label, network_workers(params.workers)
-        )
+        workers = network_workers(params.workers)
+        train_paired(variants, split, gq, params.seed, device, nets, corpora, card, label, workers)
         seed_dirs, corpus = {s: nets / f"s{s}" for s in gq.seeds}, read_table(original / "index.parquet")
         history = pd.read_csv(before / "history.csv")
         errors, history, followed = score_round(seed_dirs, variants, ARMS, corpus, failures, history, round_, cfg.worst)
