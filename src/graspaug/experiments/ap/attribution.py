@@ -31,11 +31,13 @@ from graspaug.experiments.ap.numbers import (
 from graspaug.experiments.stats import (
     ObjectBootstrap,
     draw_scope,
+    interval_text,
     nested_contrast,
     nested_indices,
     nested_interval,
     nested_means,
-    percentile_interval,
+    ratio_interval,
+    share_text,
     verdict,
 )
 from graspaug.training.variants import seed_variants
@@ -79,10 +81,12 @@ def combine_draws(
     dict — ``contrasts``: name → a :func:`~graspaug.experiments.stats.contrast` over ``draws``
     (:func:`nested_interval`) with ``per_draw`` (mean over seeds per draw) and ``meaning``; ``shares``: pool →
     augmented base size → the share of the real-shape gain that the pool gives (its mean gain over no augmentation,
-    mean over ratios, divided by the real pool's; the ratio of the nested means and its percentile interval:
-    ``share``, ``low``, ``high``) and ``gain``, that gain as a contrast over draws (the declared
-    ``<pool>_vs_none@B`` where there is one); ``share``: the targeted pool's;
-    ``draws``, ``seeds``
+    mean over ratios, divided by the real pool's): ``share``, ``low``, ``high``, ``bounded``
+    (:func:`~graspaug.experiments.stats.ratio_interval` over the same nested resamples; unbounded, ends None, when
+    the real gain's interval holds zero), ``gain``, the pool's gain as a contrast over draws (the declared
+    ``<pool>_vs_none@B`` where there is one), and ``real_gain``, the denominator as a contrast over draws;
+    ``share``: the targeted pool's; ``draws``, ``seeds``. Every nested interval uses the same resamples of draws,
+    seeds and objects, so a gain quoted twice (a contrast, a share's numerator) has one interval.
     """
     seeds = sorted({s for d in draws.values() for s in d})
     if any(sorted(d) != seeds for d in draws.values()):
@@ -114,16 +118,19 @@ def combine_draws(
     full, resampled = {}, {}
     for name in names:
         full[name], resampled[name] = arrays(lambda contrasts, name=name: contrasts[name].terms)
-    rng = np.random.default_rng([seed, 0xA77])
+
+    def rng() -> np.random.Generator:  # the same draws and seeds for every figure: one figure, one interval
+        return np.random.default_rng([seed, 0xA77])
+
     out = {
         name: nested_contrast(
-            nested_interval(full[name], resampled[name], rng),
+            nested_interval(full[name], resampled[name], rng()),
             per_draw=[round(float(v), 5) if np.isfinite(v) else None for v in full[name].mean(axis=1)],
             meaning=per_draw[next(iter(per_draw))][1][name].meaning,
         )
         for name in names
     }
-    indices = nested_indices(len(draws), len(seeds), n_resamples, rng)
+    indices = nested_indices(len(draws), len(seeds), n_resamples, rng())  # those of every nested_interval above
     shares: dict[str, dict[str, dict]] = {}  # pool → base size → the share of the real-shape gain
     nonzero = [float(r) for r in generate.ratios if r > 0]
     for b in gqcnn.augment_base_sizes if "real" in gqcnn.pools and nonzero else ():
@@ -136,19 +143,22 @@ def combine_draws(
             for pool in gqcnn.pools
         }
         real_full, real_resampled = gains["real"]
+        real_gain = nested_contrast(nested_interval(real_full, real_resampled, rng()))
         for pool, (f, r) in gains.items():
             if pool == "real":
                 continue
-            ratio = nested_means(r, indices) / nested_means(real_resampled, indices)
-            low, high = percentile_interval(ratio)
-            mean = float(f.mean() / real_full.mean())
-            declared = out.get(f"{pool}_vs_none@{b}")  # the same terms: one interval for one gain
-            gain = declared if declared is not None else nested_contrast(nested_interval(f, r, rng))
+            share = ratio_interval(
+                f.mean(), real_full.mean(), nested_means(r, indices), nested_means(real_resampled, indices)
+            )
+            declared = out.get(f"{pool}_vs_none@{b}")  # the same terms and resamples: one interval for one gain
+            gain = declared if declared is not None else nested_contrast(nested_interval(f, r, rng()))
             shares.setdefault(pool, {})[str(b)] = {
-                "share": mean if np.isfinite(mean) else None,
-                "low": low,
-                "high": high,
+                "share": share["ratio"],
+                "low": share["low"],
+                "high": share["high"],
+                "bounded": share["bounded"],
                 "gain": gain,
+                "real_gain": real_gain,
             }
     return {
         "contrasts": out,
@@ -211,14 +221,25 @@ def decomposition_markdown(result: dict, augment_base_sizes: Sequence[int], comm
         mean = "-" if c["mean"] is None else f"{c['mean']:+.4f}"
         lines.append(f"| `{name}` | {mean} | {interval} | {per_draw} | {c['meaning']} |")
     lines += ["", "## What it says", ""]
-    for b, s in result["share"].items():
-        interval = "unbounded" if s["low"] is None else f"[{s['low']:.0%}, {s['high']:.0%}]"
-        share = "an undefined share" if s["share"] is None else f"{s['share']:.0%}"
-        lines.append(f"- B = {b}: targeted shapes give {share} of the real-shape gain, 95% interval {interval}.")
+    lines += [f"- {share_sentence('targeted', b, s)}" for b, s in result["share"].items()]
     lines += [f"- {losing_step(result['contrasts'], b)}" for b in augment_base_sizes]
     if result.get("shares"):
         lines += ["", "## What to add: each pool's share of the real-shape gain", "", *recommendation(result)]
     return "\n".join(lines) + "\n"
+
+
+def share_sentence(pool: str, base_size, s: dict) -> str:
+    """One sentence: ``pool``'s share of the real-shape gain at ``base_size`` (an entry of :func:`combine_draws`'s
+    ``shares``) beside its denominator, the real shapes' own gain, and the pool's own gain, each with its interval
+    and verdict."""
+    real, gain = s["real_gain"], s["gain"]
+    share = share_text({"ratio": s["share"], "low": s["low"], "high": s["high"], "bounded": s["bounded"]})
+    why = "" if s["bounded"] else " (unbounded: the real shapes' gain is not clearly nonzero)"
+    return (
+        f"B = {base_size}: {pool} shapes give {share}{why} of the real-shape gain (95% interval by test inversion); "
+        f"the real shapes' gain {interval_text(real)} AP, {verdict(real)}; {pool}'s own gain "
+        f"{interval_text(gain)} AP, {verdict(gain)}."
+    )
 
 
 CONTROLS = {"recon": "control: the new real shapes themselves, decoded"}
@@ -235,7 +256,7 @@ def recommendation(result: dict) -> list[str]:
     def text(s: dict | None) -> str:
         if not s or s["share"] is None:
             return "-"
-        return f"{s['share']:+.0%} " + ("[unbounded]" if s["low"] is None else f"[{s['low']:+.0%}, {s['high']:+.0%}]")
+        return share_text({"ratio": s["share"], "low": s["low"], "high": s["high"], "bounded": s["bounded"]})
 
     def says(s: dict | None) -> str:  # the pool's own gain over no augmentation, in the one verdict's words
         return "n/a" if not s or s["gain"]["mean"] is None else verdict(s["gain"])
@@ -256,6 +277,14 @@ def recommendation(result: dict) -> list[str]:
         + " |",
         "|---|" + "---|" * (2 * len(sizes)),
     ]
+    real = {b: next(iter(shares.values()))[b]["real_gain"] for b in sizes}
+    lines.append(  # the denominator of every share, beside them
+        "| real (the denominator: as many real shapes' gain) | "
+        + " | ".join(f"{interval_text(real[b])} AP" for b in sizes)
+        + " | "
+        + " | ".join(verdict(real[b]) for b in sizes)
+        + " |"
+    )
     lines += [
         f"| {p}{f' ({CONTROLS[p]})' if p in CONTROLS else ''} | "
         + " | ".join(text(shares[p].get(b)) for b in sizes)
@@ -270,8 +299,12 @@ def recommendation(result: dict) -> list[str]:
         pools, controls = [p for p in gaining if p not in CONTROLS], [f"`{p}`" for p in gaining if p in CONTROLS]
         if pools:
             best = max(pools, key=lambda p: -np.inf if shares[p][b]["share"] is None else shares[p][b]["share"])
-            share = shares[best][b]["share"]
-            most = "" if share is None else f"; {best} adds the most, {share:.0%} of as many real shapes' gain"
+            share = shares[best][b]
+            most = (
+                f"; {best} adds the most, {share_text(share | {'ratio': share['share']})} of as many real shapes' gain"
+                if share["bounded"]
+                else f"; {best}'s share of the real-shape gain is unbounded (that gain is not clearly nonzero)"
+            )
             advice.append(f"At B = {b} the pools that add AP with an interval above zero: {', '.join(pools)}{most}.")
         else:
             but = (
@@ -281,5 +314,7 @@ def recommendation(result: dict) -> list[str]:
             advice.append(f"At B = {b}, add real shapes: {none}{but}.")
     return lines + [
         "",
-        "A share is the pool's AP gain over no augmentation divided by as many real shapes' gain. " + " ".join(advice),
+        "A share is the pool's AP gain over no augmentation divided by as many real shapes' gain, its 95% interval by "
+        "test inversion over the same resamples (unbounded when the real shapes' gain is not clearly nonzero). "
+        + " ".join(advice),
     ]
