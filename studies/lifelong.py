@@ -29,7 +29,7 @@ import pandas as pd
 from graspaug.experiments.ap.numbers import test_labels
 from graspaug.experiments.lifelong.figures import curve_series
 from graspaug.experiments.lifelong.numbers import ARMS, arm_contrasts, arm_variant, curve_rows, round_networks
-from graspaug.experiments.stats import interval_text
+from graspaug.experiments.stats import interval_text, share_text
 from graspaug.io.tables import read_table
 from graspaug.pipeline.params.profiles import merge, params_yaml, read_overlay
 from graspaug.plots import lines
@@ -136,7 +136,8 @@ def markdown(result: dict, params, command: str, seconds: float, follow: pd.Data
         for name, c in r["contrasts"].items():
             lines_.append(f"| {k} | `{name}@r{k}` | {interval_text(c)} |")
         if "share" in r:
-            lines_.append(f"| {k} | share of the real gain | {interval_text(r['share'], '+.2f')} |")
+            real = interval_text(r["contrasts"]["real_data"])
+            lines_.append(f"| {k} | share of the real gain (its denominator: {real}) | {share_text(r['share'])} |")
     lines_ += ["", "| round | arm | test AP [95% interval] |", "|---|---|---|"]
     for k, r in result.items():
         lines_ += [f"| {k} | {a} | {interval_text(c, '.4f')} |" for a, c in r["ap"].items()]

@@ -423,6 +423,13 @@ def ratio_interval(
     return {"ratio": ratio, "low": float(ok.min()), "high": float(ok.max()), "bounded": True} | den
 
 
+def share_headline(share: dict) -> dict[str, float | None]:
+    """A :func:`ratio_interval` as a metrics file holds it, under :func:`headline`'s keys: ``mean`` (the ratio),
+    ``lo``, ``hi`` (None when unbounded), rounded to 5 decimals."""
+    values = {"mean": share.get("ratio"), "lo": share.get("low"), "hi": share.get("high")}
+    return {k: None if v is None else round(float(v), 5) for k, v in values.items()}
+
+
 def share_text(share: dict, spec: str = "+.0%") -> str:
     """A :func:`ratio_interval` in words: ``ratio [low, high]``, or ``ratio [unbounded]`` (``n/a`` without a
     ratio); what a share is read beside: its denominator, printed by the caller."""
