@@ -26,6 +26,7 @@ from graspaug.experiments.ap.numbers import (
     collect,
     datapoint_matched_contrasts,
     declared_contrasts,
+    nested_rng,
     test_predictions,
 )
 from graspaug.experiments.stats import (
@@ -120,7 +121,7 @@ def combine_draws(
         full[name], resampled[name] = arrays(lambda contrasts, name=name: contrasts[name].terms)
 
     def rng() -> np.random.Generator:  # the same draws and seeds for every figure: one figure, one interval
-        return np.random.default_rng([seed, 0xA77])
+        return nested_rng(seed)
 
     out = {
         name: nested_contrast(
