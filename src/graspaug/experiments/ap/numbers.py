@@ -372,11 +372,12 @@ def object_improvement(by_network: dict[tuple, pd.Series], base_size: int, ratio
 
 
 def network_table(runs: pd.DataFrame, per_object: pd.DataFrame) -> pd.DataFrame:
-    """Per network: test AP mean and 95% t half-width over seeds, validation AP mean, per-object mean AP."""
+    """Per network: test AP mean and 95% t half-width over seeds (NaN where the interval would leave AP's range
+    [0, 1]: too few seeds), validation AP mean, per-object mean AP."""
     rows = []
     merged = runs.merge(per_object, on=["pool", "base_size", "ratio", "seed"], how="left")
     for (pool, base, ratio), g in merged.groupby(["pool", "base_size", "ratio"], sort=False):
-        t = t_interval(g.test_ap.astype(float))
+        t = t_interval(g.test_ap.astype(float), bounds=(0.0, 1.0))
         half = np.nan if t["high"] is None else t["high"] - t["mean"]
         rows.append(
             {

@@ -107,7 +107,8 @@ def report_markdown(
     for r in table.itertuples():
         ratio = "all" if r.pool == "ceiling" else f"1:{r.ratio:g}"
         base = "-" if r.pool == "ceiling" else str(r.base_size)
-        ci = "" if not np.isfinite(r.test_ap_ci) else f" ± {r.test_ap_ci:.4f}"
+        ci = f" ± {r.test_ap_ci:.4f}" if np.isfinite(r.test_ap_ci) else ""
+        ci = " (too few seeds for ±)" if not ci and getattr(r, "n_seeds", 1) > 1 else ci  # ± would leave [0, 1]
         lines.append(
             f"| {r.pool} | {base} | {ratio} | {_fmt(r.test_ap)}{ci} | {_fmt(r.per_object_ap)} | {_fmt(r.val_ap)} | "
             f"{_fmt(r.test_roc_auc)} |"
