@@ -14,7 +14,7 @@ objects serves every draw, seed and network.
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 
 import numpy as np
@@ -93,17 +93,37 @@ def combine_draws(
     if any(sorted(d) != seeds for d in draws.values()):
         raise DataError("every draw needs the same training seeds")
     variants = seed_variants(generate.base_sizes, generate.ratios, gqcnn.augment_base_sizes, False, gqcnn.pools)
-    boot = ObjectBootstrap(object_ids, n_resamples, seed)
+    runs = {d: collect(seed_dirs, variants) for d, seed_dirs in draws.items()}
+    predictions = lambda d, s, key: test_predictions(draws[d][s], key)  # noqa: E731
+    return combine_runs(runs, predictions, labels, object_ids, generate, gqcnn, n_resamples, seed)
+
+
+def combine_runs(
+    runs: Mapping[int, pd.DataFrame],
+    predictions: Callable[[int, int, tuple], np.ndarray],
+    labels: np.ndarray,
+    object_ids: np.ndarray,
+    generate,
+    gqcnn,
+    n_resamples: int,
+    seed: int,
+) -> dict:
+    """:func:`combine_draws` from the networks' tables rather than their folders (what ``results/attribution/``
+    keeps: :mod:`graspaug.experiments.results`): ``runs``: data seed → :func:`collect`'s table of that draw;
+    ``predictions(draw, seed, (pool, B, R))``: (N,) the network's P(success) on the test datapoints. The same
+    result, figure for figure."""
+    seeds = sorted({int(s) for r in runs.values() for s in r.seed})
     per_draw: dict[int, tuple[pd.DataFrame, dict[str, Contrast]]] = {}
-    for d, seed_dirs in draws.items():
-        runs = collect(seed_dirs, variants)
-        per_draw[d] = runs, {c.name: c for c in draw_contrasts(runs, generate, gqcnn)}
+    for d, draw_runs in runs.items():
+        per_draw[d] = draw_runs, {c.name: c for c in draw_contrasts(draw_runs, generate, gqcnn)}
+    draws = list(runs)
+    boot = ObjectBootstrap(object_ids, n_resamples, seed)
     names = [n for n in next(iter(per_draw.values()))[1] if all(n in c for _, c in per_draw.values())]
     cache: dict = {}
 
     def boot_ap(d: int, s: int, key) -> np.ndarray:
         if (d, s, key) not in cache:
-            cache[d, s, key] = boot.average_precision(labels, test_predictions(draws[d][s], key))
+            cache[d, s, key] = boot.average_precision(labels, predictions(d, s, key))
         return cache[d, s, key]
 
     def arrays(terms_of) -> tuple[np.ndarray, np.ndarray]:

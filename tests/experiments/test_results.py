@@ -1,0 +1,91 @@
+"""Results as data (issue #58): the studies' per-network tables in results/ recompute every figure the README and
+docs/results.md quote."""
+
+import json
+import re
+from pathlib import Path
+
+from typer.testing import CliRunner
+
+from graspaug.experiments.ap.attribution import combine_draws
+from graspaug.experiments.results import (
+    DOCUMENTS,
+    attribution_figures,
+    check_markdown,
+    combine_attribution,
+    recompute,
+    write_attribution,
+)
+from graspaug.pipeline.cli import app
+from tests.experiments.test_attribution import GENERATE, GQCNN, LABELS, OBJECTS, make_draws
+
+ROOT = Path(__file__).resolve().parents[2]
+META = {"command": "python studies/attribution.py --draws 0 1", "commit": "0" * 40, "date": "2026-11-28"}
+
+
+def _results(tmp_path, real_noise=0.1):
+    draws = make_draws(tmp_path / "networks", seeds=(0, 1, 2), real_noise=real_noise)
+    result = combine_draws(draws, LABELS, OBJECTS, GENERATE, GQCNN, n_resamples=200, seed=3)
+    folder = tmp_path / "repo" / "results" / "attribution"
+    write_attribution(folder, draws, LABELS, OBJECTS, GENERATE, GQCNN, META | {"n_resamples": 200, "seed": 3})
+    return result, folder
+
+
+def test_the_results_tables_recompute_the_studys_result_figure_for_figure(tmp_path):
+    result, folder = _results(tmp_path)
+    assert json.loads((folder / "meta.json").read_text())["commit"] == "0" * 40  # the code that made them
+    again = combine_attribution(folder)
+    assert again["contrasts"] == result["contrasts"] and again["shares"] == result["shares"]
+    figures = attribution_figures(result)
+    assert figures["attribution/share/recon@10"] == "+100% [+100%, +100%]"  # the real gain is clear here
+    real = result["shares"]["recon"]["10"]["real_gain"]
+    assert (
+        figures["attribution/real_gain@10"]
+        == f"{real['mean']:+.4f} [{real['draws_low']:+.4f}, {real['draws_high']:+.4f}]"
+    )
+    assert recompute(folder.parent)[0] == figures
+
+
+def test_a_marked_figure_that_differs_or_that_no_study_recomputes_is_named(tmp_path):
+    figures = {"attribution/targeted_vs_none@10": "+0.0100 [+0.0010, +0.0210]"}
+    good = "gain <!-- results:attribution/targeted_vs_none@10 -->+0.0100 [+0.0010, +0.0210] at B = 10"
+    assert check_markdown(good, figures, "README.md") == []
+    bad = good.replace("+0.0210]", "+0.0200]") + " and <!-- results:attribution/share/targeted@10 -->+78%"
+    problems = check_markdown(bad, figures, "README.md")
+    assert problems == [
+        "README.md: attribution/targeted_vs_none@10: quoted '+0.0100 [+0.0010, +0.0200]', "
+        "recomputed '+0.0100 [+0.0010, +0.0210]'",
+        "README.md: attribution/share/targeted@10: no study in results/ recomputes it",
+    ]
+
+
+def test_graspaug_results_recomputes_and_checks_the_documents(tmp_path):
+    result, folder = _results(tmp_path)
+    repo = folder.parents[1]
+    quoted = attribution_figures(result)["attribution/targeted_vs_blend@10"]
+    (repo / "docs").mkdir()
+    (repo / "docs/results.md").write_text("nothing marked\n")
+    (repo / "README.md").write_text(f"<!-- results:attribution/targeted_vs_blend@10 -->{quoted}\n")
+    ok = CliRunner().invoke(app, ["results", "--root", str(repo), "--check"])
+    assert ok.exit_code == 0, ok.output
+    assert f"attribution/targeted_vs_blend@10: {quoted}" in ok.output
+    written = json.loads((repo / "reports/results/attribution/figures.json").read_text())
+    assert written["attribution/targeted_vs_blend@10"] == quoted
+    assert "## What to add" in (repo / "reports/results/attribution/decomposition.md").read_text()
+    (repo / "README.md").write_text("<!-- results:attribution/targeted_vs_blend@10 -->+0.5000 [+0.4000, +0.6000]\n")
+    bad = CliRunner().invoke(app, ["results", "--root", str(repo), "--check"])
+    assert bad.exit_code == 2 and "attribution/targeted_vs_blend@10" in bad.output
+
+
+def test_the_readme_and_results_quote_only_what_the_committed_results_recompute():
+    """Every marked figure of the README and docs/results.md equals what `graspaug results` recomputes from the
+    committed results/; and the README's Results section quotes no share of the real-shape gain (the three-draw
+    shares were withdrawn: their per-network results were not kept, and the sound interval needs them)."""
+    figures, _ = recompute(ROOT / "results")
+    for doc in DOCUMENTS:
+        assert check_markdown((ROOT / doc).read_text(), figures, doc) == []
+    readme = (ROOT / "README.md").read_text()
+    results = readme.split("## Results", 1)[1].split("\n## ", 1)[0]
+    shares = re.findall(r"[+−-]?\d+% \[[+−-]?\d+%, [+−-]?\d+%\]", results)  # e.g. "+78% [+1%, +200%]"
+    assert shares == [], f"the README quotes shares no committed result recomputes: {shares}"
+    assert "not recomputable from committed data (measured 2026-11-27, commit 960d70e)" in results
