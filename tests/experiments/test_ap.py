@@ -207,6 +207,11 @@ def test_evaluate_networks_is_the_report_chain_step_by_step(tmp_path):
     assert len(rows) == 2 and all(quoted in row for row in rows)  # the table and its sentence: one interval
     assert sum(verdict(one) in row for row in rows) == 2 and "t-interval" not in text.split("## What the")[1]
     assert f"[{one['draws_low']:+.4f}, {one['draws_high']:+.4f}]" in decomposition
+    # the share of the real-shape gain: one function (stats.ratio_interval via combine_draws) for the report, the
+    # decomposition and the multi-draw study, so report.md's sentence is the decomposition's, word for word
+    sentence = words.gain_sentences(steps["share"], ev.table, chosen, ceiling_shapes=None)[0]
+    assert f"- {sentence}" in decomposition and "of the real-shape gain (95% interval by test inversion)" in sentence
+    assert "the real shapes' gain " in sentence  # beside its denominator
 
     predictions = figures.compared_predictions(seed_dirs[0], 10, 1.0, ceiling=True)
     assert list(predictions) == ["B = 10, 1:0", "B = 10, 1:1", "ceiling"]
