@@ -430,6 +430,7 @@ def ap_metrics(contrasts: dict, table: pd.DataFrame, chosen: dict[int, float], p
 
 
 def ap_headline(report: dict) -> dict[str, dict]:
-    """The experiment's metrics from its :func:`ap_metrics` report: per declared contrast its mean and
-    95% t-interval over seeds (:func:`~graspaug.experiments.stats.headline`), one metrics file each."""
+    """The experiment's metrics from its :func:`ap_metrics` report: per declared contrast its mean and the one
+    interval it is judged by, the 95% bootstrap over seeds × test objects
+    (:func:`~graspaug.experiments.stats.headline`), one metrics file each."""
     return {name: headline(c) for name, c in report["contrasts"].items()}
