@@ -162,9 +162,9 @@ def test_arm_contrasts_pair_the_arms_within_a_seed_and_say_when_the_real_data_ga
     assert c["real_data"]["draws_low"] > 0 and c["failure_vs_real"]["draws_high"] < 0  # the control shows
     assert c["failure_vs_random"]["mean"] == pytest.approx(0.0, abs=1e-12)  # the same network: nothing, exactly
     assert c["failure_vs_random"]["draws_low"] <= 0 <= c["failure_vs_random"]["draws_high"]
-    assert out["ap"]["real"]["mean"] > out["ap"]["none"]["mean"] and 0 < out["share"]["ratio"] < 0.5
+    assert out["ap"]["real"]["mean"] > out["ap"]["none"]["mean"] and 0 < out["share"]["share"] < 0.5
     share = out["share"]  # the real gain is clearly positive: a bounded share that holds its estimate
-    assert share["bounded"] and share["low"] <= share["ratio"] <= share["high"]
+    assert share["bounded"] and share["low"] <= share["share"] <= share["high"]
     assert (share["denominator_low"], share["denominator_high"]) == pytest.approx(  # one set of resamples
         (c["real_data"]["draws_low"], c["real_data"]["draws_high"]), abs=1e-5
     )
@@ -207,7 +207,7 @@ def test_a_rounds_verdicts_are_scoped_to_its_one_draw_of_the_data():
     persistent = pd.DataFrame({"object": ["o1"], "rounds": [1]})
     text = round_markdown(1, result | {"draws": [0]}, None, persistent, {"design": "D.", "command": "c"})
     assert "| `failure_vs_real@r1` | -0.0200 [-0.0300, -0.0100] | a loss in this draw of the data |" in text
-    share = {"ratio": 1.5, "low": None, "high": None, "bounded": False}  # a real gain not clearly nonzero
+    share = {"share": 1.5, "low": None, "high": None, "bounded": False}  # a real gain not clearly nonzero
     real = contrast(0.001, "draws", 4, 1, draws=(-0.01, 0.012))
     failure = contrast(0.0015, "draws", 4, 1, draws=(-0.01, 0.013))
     both = {"real_data": real, "failure_vs_none": failure}

@@ -192,12 +192,12 @@ def test_a_share_of_a_real_gain_whose_interval_holds_zero_is_unbounded():
     pool = 0.001321 + 0.5 * (real - real_mean) + rng.normal(0.0, 0.002, size=real.shape)
     assert percentile_interval(real) == pytest.approx((-0.0059, 0.0068))
     out = ratio_interval(0.001321, real_mean, pool, real)
-    assert out["ratio"] == pytest.approx(13.21)
+    assert out["share"] == pytest.approx(13.21)
     assert not out["bounded"] and out["low"] is None and out["high"] is None
     assert (out["denominator_low"], out["denominator_high"]) == pytest.approx((-0.0059, 0.0068))
     assert share_text(out) == "+1321% [unbounded]"
     old_low, old_high = percentile_interval(pool / real)  # the old method: bounded, and its value outside it
-    assert not old_low <= out["ratio"] <= old_high
+    assert not old_low <= out["share"] <= old_high
 
 
 def test_a_share_of_a_clearly_positive_gain_matches_fiellers_closed_form_on_paired_data():
@@ -209,8 +209,8 @@ def test_a_share_of_a_clearly_positive_gain_matches_fiellers_closed_form_on_pair
     boot = ObjectBootstrap(np.arange(400), 4000, 1)
     out = ratio_interval(pool.mean(), real.mean(), boot.means(pool), boot.means(real))
     closed = fieller_interval(pool, real)
-    assert out["bounded"] and out["low"] < out["ratio"] < out["high"]
-    assert out["ratio"] == pytest.approx(closed["ratio"])
+    assert out["bounded"] and out["low"] < out["share"] < out["high"]
+    assert out["share"] == pytest.approx(closed["ratio"])
     width = closed["high"] - closed["low"]
     assert out["low"] == pytest.approx(closed["low"], abs=0.05 * width)  # within bootstrap error
     assert out["high"] == pytest.approx(closed["high"], abs=0.05 * width)

@@ -124,7 +124,7 @@ def attribution_figures(result: dict, study: str = "attribution") -> dict[str, s
     out = {f"{study}/{name}": interval_text(c) for name, c in result["contrasts"].items()}
     for pool, by_size in result["shares"].items():
         for b, s in by_size.items():
-            out[f"{study}/share/{pool}@{b}"] = share_text(s | {"ratio": s["share"]})
+            out[f"{study}/share/{pool}@{b}"] = share_text(s)
             out[f"{study}/real_gain@{b}"] = interval_text(s["real_gain"])
     return out
 

@@ -388,7 +388,7 @@ def ratio_interval(
 
     Returns
     -------
-    dict — ``ratio`` (numerator / denominator; None when the denominator is 0 or either is not finite), ``low``,
+    dict — ``share`` (numerator / denominator; None when the denominator is 0 or either is not finite), ``low``,
     ``high`` (None when unbounded), ``bounded``, and the denominator's own percentile interval
     ``denominator_low``, ``denominator_high``
     """
@@ -400,7 +400,7 @@ def ratio_interval(
     finite = np.isfinite(numerator) and np.isfinite(denominator) and denominator != 0
     ratio = float(numerator / denominator) if finite else None
     den_low, den_high = percentile_interval(y, level)
-    unbounded = {"ratio": ratio, "low": None, "high": None, "bounded": False}
+    unbounded = {"share": ratio, "low": None, "high": None, "bounded": False}
     den = {"denominator_low": den_low, "denominator_high": den_high}
     if len(y) == 0 or den_low is None or den_low <= 0 <= den_high:
         return unbounded | den
@@ -420,21 +420,21 @@ def ratio_interval(
     ok = points[accepted(points)]
     if len(ok) == 0:
         return unbounded | den
-    return {"ratio": ratio, "low": float(ok.min()), "high": float(ok.max()), "bounded": True} | den
+    return {"share": ratio, "low": float(ok.min()), "high": float(ok.max()), "bounded": True} | den
 
 
 def share_headline(share: dict) -> dict[str, float | None]:
-    """A :func:`ratio_interval` as a metrics file holds it, under :func:`headline`'s keys: ``mean`` (the ratio),
+    """A :func:`ratio_interval` as a metrics file holds it, under :func:`headline`'s keys: ``mean`` (the share),
     ``lo``, ``hi`` (None when unbounded), rounded to 5 decimals."""
-    values = {"mean": share.get("ratio"), "lo": share.get("low"), "hi": share.get("high")}
+    values = {"mean": share.get("share"), "lo": share.get("low"), "hi": share.get("high")}
     return {k: None if v is None else round(float(v), 5) for k, v in values.items()}
 
 
 def share_text(share: dict, spec: str = "+.0%") -> str:
-    """A :func:`ratio_interval` in words: ``ratio [low, high]``, or ``ratio [unbounded]`` (``n/a`` without a
+    """A :func:`ratio_interval` in words: ``share [low, high]``, or ``share [unbounded]`` (``n/a`` without a
     ratio); what a share is read beside: its denominator, printed by the caller."""
-    if share is None or share.get("ratio") is None:
+    if share is None or share.get("share") is None:
         return "n/a"
     if not share["bounded"]:
-        return f"{format(share['ratio'], spec)} [unbounded]"
-    return f"{format(share['ratio'], spec)} [{format(share['low'], spec)}, {format(share['high'], spec)}]"
+        return f"{format(share['share'], spec)} [unbounded]"
+    return f"{format(share['share'], spec)} [{format(share['low'], spec)}, {format(share['high'], spec)}]"

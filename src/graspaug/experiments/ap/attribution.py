@@ -174,7 +174,7 @@ def combine_runs(
             declared = out.get(f"{pool}_vs_none@{b}")  # the same terms and resamples: one interval for one gain
             gain = declared if declared is not None else nested_contrast(nested_interval(f, r, rng()))
             shares.setdefault(pool, {})[str(b)] = {
-                "share": share["ratio"],
+                "share": share["share"],
                 "low": share["low"],
                 "high": share["high"],
                 "bounded": share["bounded"],
@@ -254,7 +254,7 @@ def share_sentence(pool: str, base_size, s: dict) -> str:
     ``shares``) beside its denominator, the real shapes' own gain, and the pool's own gain, each with its interval
     and verdict."""
     real, gain = s["real_gain"], s["gain"]
-    share = share_text({"ratio": s["share"], "low": s["low"], "high": s["high"], "bounded": s["bounded"]})
+    share = share_text(s)
     why = "" if s["bounded"] else " (unbounded: the real shapes' gain is not clearly nonzero)"
     return (
         f"B = {base_size}: {pool} shapes give {share}{why} of the real-shape gain (95% interval by test inversion); "
@@ -277,7 +277,7 @@ def recommendation(result: dict) -> list[str]:
     def text(s: dict | None) -> str:
         if not s or s["share"] is None:
             return "-"
-        return share_text({"ratio": s["share"], "low": s["low"], "high": s["high"], "bounded": s["bounded"]})
+        return share_text(s)
 
     def says(s: dict | None) -> str:  # the pool's own gain over no augmentation, in the one verdict's words
         return "n/a" if not s or s["gain"]["mean"] is None else verdict(s["gain"])
@@ -322,7 +322,7 @@ def recommendation(result: dict) -> list[str]:
             best = max(pools, key=lambda p: -np.inf if shares[p][b]["share"] is None else shares[p][b]["share"])
             share = shares[best][b]
             most = (
-                f"; {best} adds the most, {share_text(share | {'ratio': share['share']})} of as many real shapes' gain"
+                f"; {best} adds the most, {share_text(share)} of as many real shapes' gain"
                 if share["bounded"]
                 else f"; {best}'s share of the real-shape gain is unbounded (that gain is not clearly nonzero)"
             )

@@ -186,7 +186,7 @@ def arm_contrasts(
     -------
     dict — ``ap``: arm → a :func:`~graspaug.experiments.stats.contrast` over ``draws``; ``contrasts``: name → the
     same; ``share``: the share of the real shapes' gain that failure-targeted shapes give
-    (:func:`~graspaug.experiments.stats.ratio_interval` over the same nested resamples: ``ratio``, ``low``, ``high``,
+    (:func:`~graspaug.experiments.stats.ratio_interval` over the same nested resamples: ``share``, ``low``, ``high``,
     ``bounded``; unbounded when ``real_data``'s interval holds zero), ``draws``, ``seeds``. Every interval uses the
     same resamples of draws, seeds and objects.
     """
