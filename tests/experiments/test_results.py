@@ -89,3 +89,33 @@ def test_the_readme_and_results_quote_only_what_the_committed_results_recompute(
     shares = re.findall(r"[+−-]?\d+% \[[+−-]?\d+%, [+−-]?\d+%\]", results)  # e.g. "+78% [+1%, +200%]"
     assert shares == [], f"the README quotes shares no committed result recomputes: {shares}"
     assert "not recomputable from committed data (measured 2026-11-27, commit 960d70e)" in results
+
+
+def test_the_lifelong_tables_recompute_every_rounds_figures(tmp_path):
+    import numpy as np
+
+    from graspaug.experiments.lifelong.numbers import arm_contrasts
+    from graspaug.experiments.results import combine_lifelong, lifelong_figures, write_lifelong
+
+    rng = np.random.default_rng(4)
+    objects = np.repeat([f"o{i}" for i in range(30)], 8)
+    labels = rng.integers(0, 2, size=len(objects))
+    skill = {"none": 0.5, "failure": 0.7, "random": 0.6, "real": 1.5}
+    networks = {}
+    for d in (0, 1):
+        for s in (0, 1):
+            for arm, k in skill.items():
+                folder = tmp_path / f"d{d}" / f"s{s}" / arm
+                folder.mkdir(parents=True)
+                p = 1 / (1 + np.exp(-(k * (2 * labels - 1) + rng.normal(size=len(labels)))))
+                np.save(folder / "test_predictions.npy", p.astype(np.float32))
+                networks.setdefault(d, {}).setdefault(s, {})[arm] = folder
+    rounds = {0: {d: {s: {"none": a["none"]} for s, a in by.items()} for d, by in networks.items()}, 1: networks}
+    study = {k: arm_contrasts(n, labels, objects, 200, 7) for k, n in rounds.items()}
+    folder = tmp_path / "results" / "lifelong"
+    write_lifelong(folder, rounds, labels, objects, META | {"n_resamples": 200, "seed": 7})
+    again = combine_lifelong(folder)
+    assert again == study  # float32 predictions, as the networks saved them: figure for figure
+    figures = lifelong_figures(study)
+    assert figures["lifelong/r1/share"].endswith("]") and "lifelong/r0/ap/none" in figures
+    assert recompute(tmp_path / "results")[0] == figures

@@ -13,6 +13,10 @@ README and docs/results.md quote, recomputed from them (issue #58).
 * ``meta.json`` — the exact ``command`` and code ``commit`` that made them, the date, and the params the combination
   reads (``base_sizes``, ``ratios``, ``augment_base_sizes``, ``pools``, ``n_resamples``, ``seed``), written last.
 
+``results/lifelong/`` (written by ``studies/lifelong.py``, :func:`write_lifelong`): ``predictions.parquet`` (one
+float32 column per round, draw, training seed and arm, ``r<k>/<draw>/<seed>/<arm>``), ``test.parquet`` and
+``meta.json`` as above.
+
 A quoted figure is marked in the markdown by an html comment naming its key, the figure right after it::
 
     <!-- results:attribution/targeted_vs_none@100 -->+0.0100 [+0.0010, +0.0210]
@@ -129,10 +133,6 @@ def attribution_figures(result: dict, study: str = "attribution") -> dict[str, s
     return out
 
 
-STUDIES = {"attribution": (combine_attribution, attribution_figures)}
-"""Study name → (read and combine its ``results/<study>/`` folder, its figures by key)."""
-
-
 def recompute(results_dir: Path) -> tuple[dict[str, str], dict[str, dict]]:
     """Every figure of every study folder in ``results_dir`` (``results/``): (key → text, study → result). A study
     folder named ``<study>`` or ``<study>-<label>`` (e.g. ``attribution-real-objects``) is read by ``<study>``'s
@@ -167,8 +167,8 @@ def check_markdown(text: str, figures: Mapping[str, str], name: str = "markdown"
 
 
 def write_recomputed(results: Mapping[str, dict], figures: Mapping[str, str], out: Path) -> None:
-    """Write each study's recomputed result into ``out``/<study>/: ``summary.json``, ``decomposition.md`` (the
-    attribution report) and ``figures.json`` (its figures by key), each file atomically."""
+    """Write each study's recomputed result into ``out``/<study>/: ``summary.json``, ``figures.json`` (its figures by
+    key) and, for an attribution study, ``decomposition.md`` (its report); each file atomically."""
     from graspaug.experiments.ap.attribution import decomposition_markdown
     from graspaug.io.atomic import atomic_path
 
@@ -176,13 +176,83 @@ def write_recomputed(results: Mapping[str, dict], figures: Mapping[str, str], ou
         folder = Path(out) / study
         folder.mkdir(parents=True, exist_ok=True)
         own = {k: v for k, v in figures.items() if k.startswith(f"{study}/")}
-        files = {
-            "summary.json": json.dumps(result, indent=1),
-            "decomposition.md": decomposition_markdown(
-                result, result["augment_base_sizes"], f"graspaug results (results/{study})"
-            ),
-            "figures.json": json.dumps(own, indent=1, ensure_ascii=False),
-        }
+        files = {"summary.json": json.dumps(result, indent=1), "figures.json": json.dumps(own, indent=1)}
+        if study.split("-")[0] == "attribution":
+            command = f"graspaug results (results/{study})"
+            files["decomposition.md"] = decomposition_markdown(result, result["augment_base_sizes"], command)
         for name, text in files.items():
             with atomic_path(folder / name) as tmp:
                 tmp.write_text(text + ("" if text.endswith("\n") else "\n"))
+
+
+def write_lifelong(folder: Path, rounds: Mapping[int, Mapping], labels, object_ids, meta: dict) -> None:
+    """Write the lifelong study's tables into ``folder``: ``predictions.parquet`` (one float32 column per round, draw,
+    training seed and arm, ``r<k>/<draw>/<seed>/<arm>``), ``test.parquet`` (``label``, ``object``) and ``meta.json``
+    (``meta``: ``command``, ``commit``, ``date``, ``n_resamples``, ``seed``; written last).
+
+    Parameters
+    ----------
+    rounds : round → :func:`~graspaug.experiments.lifelong.numbers.arm_contrasts`'s ``networks`` of that round
+        (draw → seed → arm → network folder)
+    labels, object_ids : (N,) — the test datapoints' labels and objects, in the predictions' order
+    """
+    from graspaug.experiments.lifelong.numbers import network_predictions
+    from graspaug.io.atomic import atomic_path
+
+    columns = {
+        f"r{k}/{d}/{s}/{arm}": network_predictions(network).astype(np.float32)
+        for k, networks in rounds.items()
+        for d, by_seed in networks.items()
+        for s, by_arm in by_seed.items()
+        for arm, network in by_arm.items()
+    }
+    folder.mkdir(parents=True, exist_ok=True)
+    (folder / "meta.json").unlink(missing_ok=True)  # a folder without meta.json is an unfinished one
+    test = pd.DataFrame({"label": np.asarray(labels, dtype=np.int8), "object": np.asarray(object_ids)})
+    for name, frame in {"predictions.parquet": pd.DataFrame(columns), "test.parquet": test}.items():
+        with atomic_path(folder / name) as tmp:
+            frame.to_parquet(tmp, index=False)
+    with atomic_path(folder / "meta.json") as tmp:
+        tmp.write_text(json.dumps(dict(meta), indent=1) + "\n")
+
+
+def combine_lifelong(folder: Path) -> dict:
+    """Round → :func:`~graspaug.experiments.lifelong.numbers.arm_contrasts` of the tables :func:`write_lifelong` wrote
+    in ``folder``, with the resamples and seed of its ``meta.json``: the study's ``summary.json``, figure for figure."""
+    from graspaug.experiments.lifelong.numbers import arm_contrasts
+
+    missing = [name for name in ("predictions.parquet", "test.parquet", "meta.json") if not (folder / name).is_file()]
+    if missing:
+        raise DataError(f"{folder}: no {', '.join(missing)} (an unfinished or foreign results folder)")
+    meta = json.loads((folder / "meta.json").read_text())
+    predictions, test = pd.read_parquet(folder / "predictions.parquet"), pd.read_parquet(folder / "test.parquet")
+    rounds: dict = {}
+    for name in predictions.columns:
+        k, d, s, arm = name.split("/")
+        by_arm = rounds.setdefault(int(k[1:]), {}).setdefault(int(d), {}).setdefault(int(s), {})
+        by_arm[arm] = predictions[name].to_numpy()
+    labels, objects = test.label.to_numpy(), test.object.to_numpy()
+    return {
+        k: arm_contrasts(networks, labels, objects, meta["n_resamples"], meta["seed"])
+        for k, networks in sorted(rounds.items())
+    }
+
+
+def lifelong_figures(result: dict, study: str = "lifelong") -> dict[str, str]:
+    """Every figure of a lifelong result (:func:`combine_lifelong`) by key: ``<study>/r<k>/<contrast>``,
+    ``<study>/r<k>/ap/<arm>`` (``mean [low, high]``, AP) and ``<study>/r<k>/share`` (its interval by test inversion,
+    or ``[unbounded]``)."""
+    out = {}
+    for k, r in result.items():
+        out |= {f"{study}/r{k}/ap/{arm}": interval_text(c, ".4f") for arm, c in r["ap"].items()}
+        out |= {f"{study}/r{k}/{name}": interval_text(c) for name, c in r["contrasts"].items()}
+        if "share" in r:
+            out[f"{study}/r{k}/share"] = share_text(r["share"])
+    return out
+
+
+STUDIES = {
+    "attribution": (combine_attribution, attribution_figures),
+    "lifelong": (combine_lifelong, lifelong_figures),
+}
+"""Study name → (read and combine its ``results/<study>/`` folder, its figures by key)."""

@@ -178,7 +178,8 @@ def arm_contrasts(
     Parameters
     ----------
     networks : data seed → training seed → arm (``none``, ``failure``, ``random``, ``real``) → the network's
-        folder (``test_predictions.npy``); every draw has the same seeds and arms
+        folder (``test_predictions.npy``) or its (N,) predictions themselves (:func:`network_predictions`; what
+        ``results/lifelong/`` keeps); every draw has the same seeds and arms
     labels, object_ids : (N,) — the test datapoints' labels and objects, in the predictions' order
     n_resamples, seed : resamples of the objects and of the nested bootstrap, and their seed
 
@@ -201,7 +202,7 @@ def arm_contrasts(
             raise DataError(f"draw {d} has training seeds {sorted(networks[d])}, not {seeds}")
         for j, s in enumerate(seeds):
             for a, arm in enumerate(arms):
-                p = np.load(Path(networks[d][s][arm]) / "test_predictions.npy")
+                p = network_predictions(networks[d][s][arm])
                 full[a, i, j] = average_precision_score(labels, p)
                 resampled[a, i, j] = boot.average_precision(labels, p)
 
@@ -234,6 +235,14 @@ def arm_contrasts(
         )
         out["share"] = rounded(share)  # beside it in every report: its denominator, contrasts["real_data"]
     return out
+
+
+def network_predictions(network) -> np.ndarray:
+    """(N,) a network's P(success) on the test datapoints: ``network`` is its folder (``test_predictions.npy``) or
+    the predictions themselves (an array)."""
+    if isinstance(network, (str, Path)):
+        return np.load(Path(network) / "test_predictions.npy")
+    return np.asarray(network, dtype=float)
 
 
 def failure_history(previous: pd.DataFrame | None, round_: int, chosen: Sequence[str]) -> pd.DataFrame:
