@@ -91,7 +91,7 @@ def test_combine_draws_gives_every_contrast_one_interval_over_draws_seeds_and_ob
     assert shares["blend"]["10"]["share"] == pytest.approx(gain["blend"] / gain["real"])
     assert "## What to add" in text  # recon gains as real shapes do, but it is a control: never the advice
     assert "| recon (control: the new real shapes themselves, decoded) | +100% [unbounded] |" in text
-    assert "| real (the denominator: as many real shapes' gain) | " + interval_text(real) + " AP |" in text
+    assert f"| (the denominator) | {interval_text(real)} AP, {verdict(real)} |" in text
     assert f"the real shapes' gain {interval_text(real)} AP, {verdict(real)}" in text  # beside the share
 
 
@@ -166,8 +166,8 @@ def test_the_advice_names_the_pools_that_gain_and_never_the_recon_control():
     }
     lines = recommendation({"shares": shares})
     assert lines[2] == (  # the denominator of every share, beside them
-        "| real (the denominator: as many real shapes' gain) | +0.0200 [+0.0100, +0.0300] AP "
-        "| a gain over 3 draws of the data |"
+        "| real (as many more real shapes: every share's denominator) | (the denominator) "
+        "| +0.0200 [+0.0100, +0.0300] AP, a gain over 3 draws of the data |"
     )
     assert lines[3].startswith("| recon (control: the new real shapes themselves, decoded) | +90% [+70%, +110%] |")
     assert [line.split(" |")[0] for line in lines[4:6]] == ["| warp", "| primitives"]  # ordered by share
@@ -192,7 +192,8 @@ def test_the_advice_reads_every_base_size():
         "| pool | B = 50: share [95%] | B = 100: share [95%] | its own gain at B = 50 | its own gain at B = 100 |"
     )
     assert lines[3].startswith(
-        "| targeted | -20% [-40%, +0%] | +80% [+60%, +100%] | no effect we can claim over 3 draws of the data | a gain"
+        "| targeted | -20% [-40%, +0%] | +80% [+60%, +100%] | -0.0050 [-0.0200, +0.0100] AP, no effect we can claim "
+        "over 3 draws of the data | +0.0105 [+0.0010, +0.0200] AP, a gain"
     )
     assert lines[-1].endswith(
         "At B = 50, add real shapes: no generated or procedural pool tried here adds AP with an interval above zero. "

@@ -282,6 +282,9 @@ def recommendation(result: dict) -> list[str]:
     def says(s: dict | None) -> str:  # the pool's own gain over no augmentation, in the one verdict's words
         return "n/a" if not s or s["gain"]["mean"] is None else verdict(s["gain"])
 
+    def own(s: dict | None) -> str:  # that gain, its interval and its verdict
+        return "n/a" if not s or s["gain"]["mean"] is None else f"{interval_text(s['gain'])} AP, {verdict(s['gain'])}"
+
     shares = result["shares"]
     sizes = sorted({b for by_size in shares.values() for b in by_size}, key=int)
 
@@ -300,17 +303,17 @@ def recommendation(result: dict) -> list[str]:
     ]
     real = {b: next(iter(shares.values()))[b]["real_gain"] for b in sizes}
     lines.append(  # the denominator of every share, beside them
-        "| real (the denominator: as many real shapes' gain) | "
-        + " | ".join(f"{interval_text(real[b])} AP" for b in sizes)
+        "| real (as many more real shapes: every share's denominator) | "
+        + " | ".join("(the denominator)" for b in sizes)
         + " | "
-        + " | ".join(verdict(real[b]) for b in sizes)
+        + " | ".join(f"{interval_text(real[b])} AP, {verdict(real[b])}" for b in sizes)
         + " |"
     )
     lines += [
         f"| {p}{f' ({CONTROLS[p]})' if p in CONTROLS else ''} | "
         + " | ".join(text(shares[p].get(b)) for b in sizes)
         + " | "
-        + " | ".join(says(shares[p].get(b)) for b in sizes)
+        + " | ".join(own(shares[p].get(b)) for b in sizes)
         + " |"
         for p in order
     ]
