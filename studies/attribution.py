@@ -8,10 +8,12 @@ from the run cache), with params.yaml written from the profile plus ``data_seed:
 ``--set key=value``; it runs ``dvc repro report`` (the GQ-CNN experiment, not the robot cell).
 Then :func:`graspaug.experiments.ap.attribution.combine_draws` combines the draws' networks (a
 hierarchical bootstrap over draws, seeds within draws and test objects) and writes
-``summary.json`` and ``decomposition.md`` into ``--workdir``. A finished draw is not run again.
+``summary.json`` and ``decomposition.md`` into ``--workdir``, and the per-network, per-test-datapoint tables with
+the command and commit that made them into this repository's ``results/<--results>/`` (commit them: ``graspaug
+results`` recomputes every quoted figure from them). A finished draw is not run again.
 
     python studies/attribution.py [--draws 0 1 2] [--workdir ../attribution] [--profile attribution]
-        [--set 'gqcnn.augment_base_sizes=[50]'] [--resamples 2000] [--combine-only]
+        [--set 'gqcnn.augment_base_sizes=[50]'] [--resamples 2000] [--combine-only] [--results attribution]
 """
 
 from __future__ import annotations
@@ -27,6 +29,7 @@ import yaml
 
 from graspaug.experiments.ap.attribution import combine_draws, decomposition_markdown
 from graspaug.experiments.ap.numbers import test_labels
+from graspaug.experiments.results import write_attribution
 from graspaug.io.tables import read_table
 from graspaug.pipeline.params.model import params_dict, parse_params
 from graspaug.pipeline.params.profiles import merge, params_yaml, read_overlay
@@ -70,6 +73,9 @@ def main() -> None:
     parser.add_argument("--set", dest="changes", action="append", default=[], help="key.path=value (YAML)")
     parser.add_argument("--resamples", type=int, default=2000)
     parser.add_argument("--combine-only", action="store_true", help="combine finished draws, run nothing")
+    parser.add_argument(
+        "--results", default="attribution", help="results/<this>/: the per-network tables (`graspaug results`)"
+    )
     args = parser.parse_args()
     start = time.perf_counter()
     params = {k: draw_params(args.profile, k, args.changes) for k in args.draws}
@@ -89,6 +95,11 @@ def main() -> None:
         raise SystemExit("the draws were tested on different datapoints: they must share seed and the test split")
     result = combine_draws(draws, labels, objects, p.generate, p.gqcnn, args.resamples, p.seed)
     command = "python studies/attribution.py " + " ".join(sys.argv[1:])
+    commit = subprocess.run(["git", "rev-parse", "HEAD"], cwd=ROOT, capture_output=True, text=True).stdout.strip()
+    meta = {"command": command, "commit": commit, "date": time.strftime("%Y-%m-%d"), "profile": args.profile}
+    meta |= {"draws": args.draws, "n_resamples": args.resamples, "seed": p.seed}
+    results = ROOT / "results" / args.results  # the per-network tables every quoted figure is recomputed from
+    write_attribution(results, draws, labels, objects, p.generate, p.gqcnn, meta)
     text = decomposition_markdown(result, p.gqcnn.augment_base_sizes, command)
     (args.workdir / "summary.json").write_text(json.dumps(result, indent=1))
     (args.workdir / "decomposition.md").write_text(text)

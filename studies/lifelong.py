@@ -8,10 +8,11 @@ outputs are linked from DIR/draw<k> (an attribution study's draws: the same prof
 the rounds run as ``graspaug lifelong-start`` and ``graspaug lifelong --round r<k>``, the commands the DVC stages
 run. A finished round is not run again. Then :func:`~graspaug.experiments.lifelong.numbers.arm_contrasts` combines
 the draws per round and ``summary.json``, ``lifelong.md``, ``followed.csv``, ``curve.png`` (test AP) and ``gain.png``
-(the gain over round 0) are written into ``--workdir``.
+(the gain over round 0) are written into ``--workdir``, and every network's test predictions with the command and
+commit into this repository's ``results/<--results>/`` (``graspaug results`` recomputes every figure from them).
 
     python studies/lifelong.py [--draws 0 1 2] [--workdir ../lifelong] [--profile lifelong] [--reuse ../attribution]
-        [--resamples 2000] [--combine-only]
+        [--resamples 2000] [--combine-only] [--results lifelong]
 """
 
 from __future__ import annotations
@@ -29,7 +30,8 @@ import pandas as pd
 from graspaug.experiments.ap.numbers import test_labels
 from graspaug.experiments.lifelong.figures import curve_series
 from graspaug.experiments.lifelong.numbers import ARMS, arm_contrasts, arm_variant, curve_rows, round_networks
-from graspaug.experiments.stats import interval_text
+from graspaug.experiments.results import write_lifelong
+from graspaug.experiments.stats import interval_text, share_text
 from graspaug.io.tables import read_table
 from graspaug.pipeline.params.profiles import merge, params_yaml, read_overlay
 from graspaug.plots import lines
@@ -83,14 +85,16 @@ def run_draw(folder: Path, params, profile: str, reuse: Path | None) -> None:
             subprocess.run(command, cwd=folder, env=env, check=True)
 
 
-def combine(folders: dict[int, Path], params, n_resamples: int) -> dict:
-    """Every round's arms and contrasts over the draws (``folders``: data seed → draw folder)."""
+def combine(folders: dict[int, Path], params, n_resamples: int, results: Path, meta: dict) -> dict:
+    """Every round's arms and contrasts over the draws (``folders``: data seed → draw folder); the networks' test
+    predictions, with ``meta`` (command, commit, date), go to ``results`` (``results/lifelong/``: `graspaug results`
+    recomputes every figure from them)."""
     cfg, seeds = params.lifelong, params.gqcnn.seeds
     first = next(iter(folders.values()))
     index = read_table(first / "data/gqcnn/original/index.parquet")
     labels, objects = test_labels(index, first / "models/gqcnn/s0")
     start = arm_variant("none", cfg.base_size, 0).name
-    out = {}
+    out, rounds = {}, {}
     for k in [0, *cfg.round_numbers()]:
         variants = [arm_variant(arm, cfg.base_size, k * cfg.shapes_per_round) for arm in ARMS]
         networks = {}
@@ -102,6 +106,8 @@ def combine(folders: dict[int, Path], params, n_resamples: int) -> dict:
                 seed_dirs = {s: folder / f"models/lifelong/r{k}/s{s}" for s in seeds}
                 networks[d] = round_networks(starts, seed_dirs, variants)
         out[k] = arm_contrasts(networks, labels, objects, n_resamples, params.seed)
+        rounds[k] = networks
+    write_lifelong(results, rounds, labels, objects, meta | {"n_resamples": n_resamples, "seed": params.seed})
     return out
 
 
@@ -136,7 +142,8 @@ def markdown(result: dict, params, command: str, seconds: float, follow: pd.Data
         for name, c in r["contrasts"].items():
             lines_.append(f"| {k} | `{name}@r{k}` | {interval_text(c)} |")
         if "share" in r:
-            lines_.append(f"| {k} | share of the real gain | {interval_text(r['share'], '+.2f')} |")
+            real = interval_text(r["contrasts"]["real_data"])
+            lines_.append(f"| {k} | share of the real gain (its denominator: {real}) | {share_text(r['share'])} |")
     lines_ += ["", "| round | arm | test AP [95% interval] |", "|---|---|---|"]
     for k, r in result.items():
         lines_ += [f"| {k} | {a} | {interval_text(c, '.4f')} |" for a, c in r["ap"].items()]
@@ -161,6 +168,7 @@ def main() -> None:
     parser.add_argument("--reuse", type=Path, default=None, help="a study's workdir whose draws hold the inputs")
     parser.add_argument("--resamples", type=int, default=2000)
     parser.add_argument("--combine-only", action="store_true", help="combine finished draws, run nothing")
+    parser.add_argument("--results", default="lifelong", help="results/<this>/: the networks' test predictions")
     args = parser.parse_args()
     start = time.perf_counter()
     params = {k: draw_params(args.profile, k) for k in args.draws}
@@ -171,9 +179,11 @@ def main() -> None:
             run_draw(folders[k], params[k], args.profile, reuse)
         print(f"draw {k}: done ({time.perf_counter() - start:.0f} s)", flush=True)
     p = params[args.draws[0]]
-    result = combine(folders, p, args.resamples)
-    (args.workdir / "summary.json").write_text(json.dumps({str(k): r for k, r in result.items()}, indent=1) + "\n")
     command = "python studies/lifelong.py " + " ".join(sys.argv[1:])
+    commit = subprocess.run(["git", "rev-parse", "HEAD"], cwd=ROOT, capture_output=True, text=True).stdout.strip()
+    meta = {"command": command, "commit": commit, "date": time.strftime("%Y-%m-%d"), "draws": args.draws}
+    result = combine(folders, p, args.resamples, ROOT / "results" / args.results, meta)
+    (args.workdir / "summary.json").write_text(json.dumps({str(k): r for k, r in result.items()}, indent=1) + "\n")
     follow = followed(folders, p.lifelong.round_numbers())
     follow.to_csv(args.workdir / "followed.csv", index=False)
     (args.workdir / "lifelong.md").write_text(markdown(result, p, command, time.perf_counter() - start, follow))

@@ -471,9 +471,10 @@ def test_dvc_repro_gqcnn_matrix_and_report(tiny_repo):
     }
     assert ("targeted_vs_none_chosen@6" in ap["contrasts"]) == ("6" in ap["chosen_ratio"])
     for c in ap["contrasts"].values():
-        assert c["over"] == "seeds" and c["draws_low"] is None
+        assert c["over"] == "draws" and c["n_draws"] == 1  # judged by the one interval over seeds × objects
         if c["mean"] is not None:
-            assert c["n_seeds"] == 2 and c["seeds_low"] <= c["mean"] <= c["seeds_high"]
+            assert c["n_seeds"] == 2 and c["draws_low"] <= c["mean"] <= c["draws_high"]
+            assert c["seeds_low"] is None or -1 <= c["seeds_low"] <= c["mean"] <= c["seeds_high"] <= 1
     assert set(ap["networks"]["targeted"]["6"]) == {"0", "0.5", "1"} and ap["seeds"] == [0, 1]
     assert (
         "| targeted | 4 | 1:0 |" in report
@@ -647,7 +648,8 @@ def test_dvc_repro_sim(tiny_repo, tmp_path):
             c["n_trials"] == (4 if name == "network_vs_antipodal" else 8)
             and c["objects_low"] <= c["mean"] <= c["objects_high"]
         )
-        assert c["n_seeds"] == 2 and c["seeds_low"] <= c["mean"] <= c["seeds_high"]
+        assert c["n_seeds"] == 2  # a t-interval over 2 seeds only where it stays within [-1, 1]
+        assert c["seeds_low"] is None or -1 <= c["seeds_low"] <= c["mean"] <= c["seeds_high"] <= 1
         headline = json.loads((work / f"metrics/sim/{name}.json").read_text())
         assert headline == {"mean": round(c["mean"], 5), "lo": c["objects_low"], "hi": c["objects_high"]}
     ranking, executed = metrics["ranking"], pd.read_csv(work / "reports/grasp_calibration/grasps.csv")

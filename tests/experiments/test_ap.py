@@ -9,7 +9,7 @@ import pytest
 from graspaug.errors import DataError
 from graspaug.experiments.ap import figures, numbers, words
 from graspaug.experiments.ap.numbers import collect, declared_contrasts
-from graspaug.experiments.stats import contrast
+from graspaug.experiments.stats import contrast, interval_text, verdict
 from graspaug.training.settings import POOLS
 from graspaug.training.variants import seed_variants
 
@@ -77,7 +77,6 @@ def test_gain_sentences_give_shares_and_call_a_gap_within_the_ceilings_interval_
     import pandas as pd
 
     from graspaug.experiments.ap.words import gain_sentences
-    from graspaug.experiments.stats import fieller_interval
 
     table = pd.DataFrame(
         [
@@ -89,21 +88,25 @@ def test_gain_sentences_give_shares_and_call_a_gap_within_the_ceilings_interval_
         ],
         columns=["pool", "base_size", "ratio", "test_ap", "test_ap_ci"],
     )
-    results = {  # real shapes: +0.08, seed by seed +0.07, +0.09, +0.08, +0.08
-        "targeted_vs_none@50": {"mean": 0.02, "per_seed": [0.01, 0.03, 0.02, 0.02]},
-        "targeted_vs_real@50": {"mean": -0.06, "per_seed": [-0.06, -0.06, -0.06, -0.06]},
-    }
-    lines = gain_sentences(results, table, {50: 1.0, 200: 1.0}, [50], ceiling_shapes=600)
-    assert "give 25% of the gain of the same number of real shapes" in lines[0]
-    share = fieller_interval(np.array([0.01, 0.03, 0.02, 0.02]), np.array([0.07, 0.09, 0.08, 0.08]))
-    assert f"95% Fieller interval over seeds [{share['low']:.0%}, {share['high']:.0%}]" in lines[0]
-    noisy = {**results, "targeted_vs_real@50": {"mean": -0.01, "per_seed": [-0.1, 0.1, -0.06, 0.02]}}
-    assert "Fieller interval is unbounded" in gain_sentences(noisy, table, {}, [50], ceiling_shapes=None)[0]
+    real = contrast(0.08, "draws", 4, 1, draws=(0.06, 0.10))
+    gain = contrast(0.02, "draws", 4, 1, draws=(0.01, 0.03))
+    shares = {"50": {"share": 0.25, "low": 0.1, "high": 0.4, "bounded": True, "gain": gain, "real_gain": real}}
+    lines = gain_sentences(shares, table, {50: 1.0, 200: 1.0}, ceiling_shapes=600)
+    assert lines[0] == (
+        "B = 50: targeted shapes give +25% [+10%, +40%] of the real-shape gain (95% interval by test inversion); "
+        "the real shapes' gain +0.0800 [+0.0600, +0.1000] AP, a gain in this draw of the data; targeted's own gain "
+        "+0.0200 [+0.0100, +0.0300] AP, a gain in this draw of the data."
+    )
+    noisy = {"50": shares["50"] | {"low": None, "high": None, "bounded": False}}
+    assert (
+        "+25% [unbounded] (unbounded: the real shapes' gain is not clearly nonzero)"
+        in (gain_sentences(noisy, table, {}, ceiling_shapes=None)[0])
+    )
     assert "1:1 closes 20% of the gap" in lines[1]  # (0.42 - 0.40) / (0.50 - 0.40)
     assert "no gap for augmentation to close" in lines[2] and "closes" not in lines[2]  # 0.005 < ±0.01: not "100%"
-    assert gain_sentences(results, table, {50: 1.0}, [50], ceiling_shapes=None) == lines[:1]
+    assert gain_sentences(shares, table, {50: 1.0}, ceiling_shapes=None) == lines[:1]
     below = table.assign(test_ap=table.test_ap.where(table.pool != "ceiling", 0.30))
-    assert "below 1:0" in gain_sentences(results, below, {50: 1.0}, [], ceiling_shapes=600)[0]
+    assert "below 1:0" in gain_sentences({}, below, {50: 1.0}, ceiling_shapes=600)[0]
 
 
 def test_networks_are_read_from_the_seed_folders_given(tmp_path):
@@ -188,6 +191,29 @@ def test_evaluate_networks_is_the_report_chain_step_by_step(tmp_path):
     assert np.array_equal(ev.object_ids, object_ids)
     assert ev.ceiling_shapes == 2 - 1  # the train shapes t0, t1 but one validation shape
 
+    # issue #62 item 7: one interval and one verdict per contrast, the same in report.md and decomposition.md
+    from graspaug.experiments.ap.attribution import combine_draws, decomposition_markdown
+
+    steps = combine_draws({0: seed_dirs}, labels, object_ids, generate, gqcnn, 50, 5)
+    one = results["targeted_vs_real@10"]
+    assert one["over"] == "draws" and one["n_draws"] == 1  # seeds × objects: judged by its nested interval
+    same = steps["contrasts"]["targeted_vs_real@10"]  # the same resamples: equal up to the report's rounding
+    assert [one[k] for k in ("mean", "draws_low", "draws_high")] == pytest.approx(
+        [same[k] for k in ("mean", "draws_low", "draws_high")], abs=1e-5
+    )
+    text = words.report_markdown(ev.table, results, chosen, [], list(seed_dirs), 0.3, "Words.", 0)
+    decomposition = decomposition_markdown(steps, [10], "dvc repro report")
+    quoted = interval_text(one)
+    rows = [line for line in text.splitlines() if "`targeted_vs_real@10`" in line]
+    assert len(rows) == 2 and all(quoted in row for row in rows)  # the table and its sentence: one interval
+    assert sum(verdict(one) in row for row in rows) == 2 and "t-interval" not in text.split("## What the")[1]
+    assert f"[{one['draws_low']:+.4f}, {one['draws_high']:+.4f}]" in decomposition
+    # the share of the real-shape gain: one function (stats.ratio_interval via combine_draws) for the report, the
+    # decomposition and the multi-draw study, so report.md's sentence is the decomposition's, word for word
+    sentence = words.gain_sentences(steps["share"], ev.table, chosen, ceiling_shapes=None)[0]
+    assert f"- {sentence}" in decomposition and "of the real-shape gain (95% interval by test inversion)" in sentence
+    assert "the real shapes' gain " in sentence  # beside its denominator
+
     predictions = figures.compared_predictions(seed_dirs[0], 10, 1.0, ceiling=True)
     assert list(predictions) == ["B = 10, 1:0", "B = 10, 1:1", "ceiling"]
     np.testing.assert_array_equal(
@@ -248,7 +274,9 @@ def test_datapoint_matched_contrasts_interpolate_the_real_shape_curve_in_datapoi
 def test_the_report_scopes_its_verdicts_to_its_one_draw_of_the_data():
     """One run's intervals cover its draw of the data and its training seeds: report.md says which, that
     other draws are not covered and where they are combined, and calls a loss a loss in this draw."""
-    loss = contrast(-0.034, "seeds", 4, seeds=(-0.055, -0.014), objects=(-0.05, -0.02), sd=0.013, meaning="m")
+    loss = contrast(
+        -0.034, "draws", 4, seeds=(-0.055, -0.014), objects=(-0.05, -0.02), draws=(-0.06, -0.01), sd=0.013, meaning="m"
+    )
     table = pd.DataFrame(
         [("targeted", 50, 0.0, 0.3, 0.01, 0.3, 0.3, 0.8, 4)],
         columns=["pool", "base_size", "ratio", "test_ap", "test_ap_ci", "per_object_ap", "val_ap", "test_roc_auc", "n"],
@@ -258,4 +286,7 @@ def test_the_report_scopes_its_verdicts_to_its_one_draw_of_the_data():
     assert "does not cover other draws" in text and "`python studies/attribution.py --draws 0 1 2`" in text
     assert "Over three draws of the data" in text
     assert "a loss in this draw of the data" in text and "a real loss" not in text
-    assert "a real gain" not in words.verdict("x", loss | {"mean": 0.03, "seeds_low": 0.01, "seeds_high": 0.05})
+    assert "a real gain" not in words.verdict("x", loss | {"mean": 0.03, "draws_low": 0.01, "draws_high": 0.05})
+    assert "`targeted_vs_random@50` (m): -0.0340 [-0.0600, -0.0100] AP, a loss in this draw of the data." in text
+    two = loss | {"seeds_low": None, "seeds_high": None, "n_seeds": 2}  # a t-interval past [-1, 1]: none
+    assert "| too few seeds |" in words.report_markdown(table, {"x": two}, {}, [], [0, 1], 0.3, "Words.", 1)

@@ -9,7 +9,7 @@ from sklearn.metrics import average_precision_score
 
 from graspaug.errors import DataError
 from graspaug.experiments.ap.attribution import combine_draws, decomposition_markdown, losing_step, recommendation
-from graspaug.experiments.stats import contrast
+from graspaug.experiments.stats import contrast, interval_text, verdict
 from graspaug.training.variants import seed_variants
 
 GENERATE = SimpleNamespace(base_sizes=[10, 20], ratios=[0.0, 1.0])
@@ -19,8 +19,9 @@ OBJECTS = np.array([f"o{i % 12}" for i in range(60)])
 DATAPOINTS = {"targeted/10-0": 300, "targeted/20-0": 1200, "real/10-1": 600}  # the real-shape curve
 
 
-def make_draws(tmp_path, draws=(0, 1), seeds=(0, 1)):
-    """Networks whose test predictions are noise around the labels; recon predicts exactly as real."""
+def make_draws(tmp_path, draws=(0, 1), seeds=(0, 1), real_noise=0.8):
+    """Networks whose test predictions are noise around the labels (SD 0.8; the real pool's ``real_noise``); recon
+    predicts exactly as real."""
     rng = np.random.default_rng(0)
     out = {}
     for d in draws:
@@ -29,7 +30,8 @@ def make_draws(tmp_path, draws=(0, 1), seeds=(0, 1)):
             seed_dir = tmp_path / f"draw{d}" / f"s{s}"
             predictions = {}
             for v in seed_variants(GENERATE.base_sizes, GENERATE.ratios, GQCNN.augment_base_sizes, False, GQCNN.pools):
-                p = predictions["real/10-1"] if v.name == "recon/10-1" else LABELS + rng.normal(0, 0.8, len(LABELS))
+                noise = real_noise if v.name == "real/10-1" else 0.8
+                p = predictions["real/10-1"] if v.name == "recon/10-1" else LABELS + rng.normal(0, noise, len(LABELS))
                 predictions[v.name] = p
                 (seed_dir / v.name).mkdir(parents=True)
                 np.save(seed_dir / v.name / "test_predictions.npy", p.astype(np.float32))
@@ -68,7 +70,11 @@ def test_combine_draws_gives_every_contrast_one_interval_over_draws_seeds_and_ob
     shares = result["shares"]  # every pool but real, as a share of the real pool's gain over no augmentation
     assert set(shares) == {"targeted", "random", "recon", "blend"} and shares["targeted"] == result["share"]
     recon, contrasts = shares["recon"]["10"], result["contrasts"]
-    assert (recon["share"], recon["low"], recon["high"]) == pytest.approx((1.0, 1.0, 1.0))
+    # the real pool is as noisy as the others: its gain's interval holds zero, so every share is unbounded, even
+    # that of recon, which predicts exactly as real (the ratio of the resamples was "+100% [+100%, +100%]")
+    real = recon["real_gain"]
+    assert real["draws_low"] <= 0 <= real["draws_high"]
+    assert recon["share"] == pytest.approx(1.0) and not recon["bounded"] and recon["low"] is recon["high"] is None
     real_gain = contrasts["targeted_vs_none@10"]["mean"] - contrasts["targeted_vs_real@10"]["mean"]
     assert recon["gain"]["mean"] == pytest.approx(real_gain) and recon["gain"]["over"] == "draws"
     gain = {  # the blend pool's share by hand: its gain over 1:0 over the real pool's, mean over draws and seeds
@@ -84,7 +90,21 @@ def test_combine_draws_gives_every_contrast_one_interval_over_draws_seeds_and_ob
     }
     assert shares["blend"]["10"]["share"] == pytest.approx(gain["blend"] / gain["real"])
     assert "## What to add" in text  # recon gains as real shapes do, but it is a control: never the advice
-    assert "| recon (control: the new real shapes themselves, decoded) | +100% [+100%, +100%] |" in text
+    assert "| recon (control: the new real shapes themselves, decoded) | +100% [unbounded] |" in text
+    assert f"| (the denominator) | {interval_text(real)} AP, {verdict(real)} |" in text
+    assert f"the real shapes' gain {interval_text(real)} AP, {verdict(real)}" in text  # beside the share
+
+
+def test_a_share_of_a_clear_real_gain_holds_its_estimate_and_its_gains_are_the_contrasts(tmp_path):
+    draws = make_draws(tmp_path, seeds=(0, 1, 2), real_noise=0.1)  # the real pool predicts the labels well
+    result = combine_draws(draws, LABELS, OBJECTS, GENERATE, GQCNN, n_resamples=300, seed=0)
+    recon, blend = result["shares"]["recon"]["10"], result["shares"]["blend"]["10"]
+    assert recon["real_gain"]["draws_low"] > 0
+    assert (recon["share"], recon["low"], recon["high"], recon["bounded"]) == pytest.approx((1.0, 1.0, 1.0, True))
+    assert blend["bounded"] and blend["low"] <= blend["share"] <= blend["high"]
+    declared = result["contrasts"]["blend_vs_recon@10"]  # one set of resamples: a difference of gains adds up
+    assert blend["gain"]["mean"] - recon["gain"]["mean"] == pytest.approx(declared["mean"], abs=1e-9)
+    assert result["shares"]["targeted"]["10"]["gain"] == result["contrasts"]["targeted_vs_none@10"]
 
 
 def test_every_draw_needs_the_same_training_seeds(tmp_path):
@@ -134,7 +154,8 @@ def test_a_network_without_a_test_ap_gives_no_mean_and_valid_json(tmp_path):
 
 def _share(share: float, gain_low: float, gain_high: float) -> dict:
     gain = contrast((gain_low + gain_high) / 2, "draws", 4, 3, draws=(gain_low, gain_high))
-    return {"share": share, "low": share - 0.2, "high": share + 0.2, "gain": gain}
+    real = contrast(0.02, "draws", 4, 3, draws=(0.01, 0.03))
+    return {"share": share, "low": share - 0.2, "high": share + 0.2, "bounded": True, "gain": gain, "real_gain": real}
 
 
 def test_the_advice_names_the_pools_that_gain_and_never_the_recon_control():
@@ -144,10 +165,15 @@ def test_the_advice_names_the_pools_that_gain_and_never_the_recon_control():
         "primitives": {"50": _share(-0.5, -0.03, -0.01)},
     }
     lines = recommendation({"shares": shares})
-    assert lines[2].startswith("| recon (control: the new real shapes themselves, decoded) | +90% [+70%, +110%] |")
-    assert [line.split(" |")[0] for line in lines[3:5]] == ["| warp", "| primitives"]  # ordered by share
+    assert lines[2] == (  # the denominator of every share, beside them
+        "| real (as many more real shapes: every share's denominator) | (the denominator) "
+        "| +0.0200 [+0.0100, +0.0300] AP, a gain over 3 draws of the data |"
+    )
+    assert lines[3].startswith("| recon (control: the new real shapes themselves, decoded) | +90% [+70%, +110%] |")
+    assert [line.split(" |")[0] for line in lines[4:6]] == ["| warp", "| primitives"]  # ordered by share
     assert lines[-1].endswith(
-        "pools that add AP with an interval above zero: warp; warp adds the most, 50% of as many real shapes' gain."
+        "pools that add AP with an interval above zero: warp; warp adds the most, +50% [+30%, +70%] of as many real "
+        "shapes' gain."
     )
     shares["warp"]["50"] = _share(0.5, -0.01, 0.02)  # now only the control gains
     advice = recommendation({"shares": shares})[-1]
@@ -165,11 +191,12 @@ def test_the_advice_reads_every_base_size():
     assert lines[0] == (
         "| pool | B = 50: share [95%] | B = 100: share [95%] | its own gain at B = 50 | its own gain at B = 100 |"
     )
-    assert lines[2].startswith(
-        "| targeted | -20% [-40%, +0%] | +80% [+60%, +100%] | no effect we can claim over 3 draws of the data | a gain"
+    assert lines[3].startswith(
+        "| targeted | -20% [-40%, +0%] | +80% [+60%, +100%] | -0.0050 [-0.0200, +0.0100] AP, no effect we can claim "
+        "over 3 draws of the data | +0.0105 [+0.0010, +0.0200] AP, a gain"
     )
     assert lines[-1].endswith(
         "At B = 50, add real shapes: no generated or procedural pool tried here adds AP with an interval above zero. "
-        "At B = 100 the pools that add AP with an interval above zero: targeted; targeted adds the most, 80% of as "
-        "many real shapes' gain."
+        "At B = 100 the pools that add AP with an interval above zero: targeted; targeted adds the most, +80% [+60%, "
+        "+100%] of as many real shapes' gain."
     )

@@ -162,7 +162,12 @@ def test_arm_contrasts_pair_the_arms_within_a_seed_and_say_when_the_real_data_ga
     assert c["real_data"]["draws_low"] > 0 and c["failure_vs_real"]["draws_high"] < 0  # the control shows
     assert c["failure_vs_random"]["mean"] == pytest.approx(0.0, abs=1e-12)  # the same network: nothing, exactly
     assert c["failure_vs_random"]["draws_low"] <= 0 <= c["failure_vs_random"]["draws_high"]
-    assert out["ap"]["real"]["mean"] > out["ap"]["none"]["mean"] and 0 < out["share"]["mean"] < 0.5
+    assert out["ap"]["real"]["mean"] > out["ap"]["none"]["mean"] and 0 < out["share"]["share"] < 0.5
+    share = out["share"]  # the real gain is clearly positive: a bounded share that holds its estimate
+    assert share["bounded"] and share["low"] <= share["share"] <= share["high"]
+    assert (share["denominator_low"], share["denominator_high"]) == pytest.approx(  # one set of resamples
+        (c["real_data"]["draws_low"], c["real_data"]["draws_high"]), abs=1e-5
+    )
     assert arm_variant("none", 50, 0).name == "targeted/50-0"
     assert arm_variant("failure", 50, 25).name == "failure/50-0.5"
     import pandas as pd
@@ -202,6 +207,18 @@ def test_a_rounds_verdicts_are_scoped_to_its_one_draw_of_the_data():
     persistent = pd.DataFrame({"object": ["o1"], "rounds": [1]})
     text = round_markdown(1, result | {"draws": [0]}, None, persistent, {"design": "D.", "command": "c"})
     assert "| `failure_vs_real@r1` | -0.0200 [-0.0300, -0.0100] | a loss in this draw of the data |" in text
+    share = {"share": 1.5, "low": None, "high": None, "bounded": False}  # a real gain not clearly nonzero
+    real = contrast(0.001, "draws", 4, 1, draws=(-0.01, 0.012))
+    failure = contrast(0.0015, "draws", 4, 1, draws=(-0.01, 0.013))
+    both = {"real_data": real, "failure_vs_none": failure}
+    text = round_markdown(
+        1, result | {"share": share, "contrasts": both}, None, persistent, {"design": "", "command": ""}
+    )
+    assert (
+        "give: +150% [unbounded] (95% interval by test inversion; unbounded when the real shapes' gain is not "
+        "clearly nonzero), beside its denominator, the real shapes' gain `real_data` +0.0010 [-0.0100, +0.0120] AP "
+        "(no effect we can claim in this draw of the data)"
+    ) in text
     result["contrasts"]["failure_vs_real"] = c | {"n_draws": 3}
     text = round_markdown(1, result | {"draws": [0, 1, 2]}, None, persistent, {"design": "D.", "command": "c"})
     assert "| a loss over 3 draws of the data |" in text

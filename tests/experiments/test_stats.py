@@ -168,3 +168,60 @@ def test_one_contrast_type_names_each_interval_by_what_it_covers():
     assert verdict(over_draws) == "a loss over 3 draws of the data"
     with pytest.raises(ValueError, match="over must be one of"):
         contrast(0.0, "t")
+
+
+def _nested_gain(mean: float, low: float, high: float, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+    """A gain's (draws, seeds) values and (draws, seeds, resamples) object resamples whose nested bootstrap
+    (:func:`nested_means` over one set of indices) has the given 2.5% and 97.5% percentiles: returned as the
+    (R,) nested means, shifted and scaled onto ``low``, ``high``, with the mean of all cells ``mean``."""
+    from graspaug.experiments.stats import nested_indices, nested_means
+
+    cells = rng.normal(0.0, 1.0, size=(3, 4, 4000))
+    nested = nested_means(cells, nested_indices(3, 4, 4000, np.random.default_rng(7)))
+    q_low, q_high = np.quantile(nested, [0.025, 0.975])
+    return low + (nested - q_low) * (high - low) / (q_high - q_low), mean
+
+
+def test_a_share_of_a_real_gain_whose_interval_holds_zero_is_unbounded():
+    """Issue #58: a real-pool gain of +0.0001 [-0.0059, +0.0068] gave a share of +1321% with the "bounded"
+    percentile interval of the resampled ratios, [-677%, +848%], which excludes its own value."""
+    from graspaug.experiments.stats import percentile_interval, ratio_interval, share_text
+
+    rng = np.random.default_rng(58)
+    real, real_mean = _nested_gain(0.0001, -0.0059, 0.0068, rng)
+    pool = 0.001321 + 0.5 * (real - real_mean) + rng.normal(0.0, 0.002, size=real.shape)
+    assert percentile_interval(real) == pytest.approx((-0.0059, 0.0068))
+    out = ratio_interval(0.001321, real_mean, pool, real)
+    assert out["share"] == pytest.approx(13.21)
+    assert not out["bounded"] and out["low"] is None and out["high"] is None
+    assert (out["denominator_low"], out["denominator_high"]) == pytest.approx((-0.0059, 0.0068))
+    assert share_text(out) == "+1321% [unbounded]"
+    old_low, old_high = percentile_interval(pool / real)  # the old method: bounded, and its value outside it
+    assert not old_low <= out["share"] <= old_high
+
+
+def test_a_share_of_a_clearly_positive_gain_matches_fiellers_closed_form_on_paired_data():
+    from graspaug.experiments.stats import ObjectBootstrap, fieller_interval, ratio_interval
+
+    rng = np.random.default_rng(5)
+    real = rng.normal(0.05, 0.05, size=400)  # paired: one (pool gain, real gain) per object
+    pool = 0.6 * real + rng.normal(0.0, 0.03, size=400)
+    boot = ObjectBootstrap(np.arange(400), 4000, 1)
+    out = ratio_interval(pool.mean(), real.mean(), boot.means(pool), boot.means(real))
+    closed = fieller_interval(pool, real)
+    assert out["bounded"] and out["low"] < out["share"] < out["high"]
+    assert out["share"] == pytest.approx(closed["ratio"])
+    width = closed["high"] - closed["low"]
+    assert out["low"] == pytest.approx(closed["low"], abs=0.05 * width)  # within bootstrap error
+    assert out["high"] == pytest.approx(closed["high"], abs=0.05 * width)
+    assert out["denominator_low"] > 0
+
+
+def test_a_t_interval_that_leaves_the_quantitys_range_is_no_interval():
+    """Issue #62 item 8: two seeds of a success-rate difference gave ±3.177; too few seeds say so instead."""
+    from graspaug.experiments.stats import DIFFERENCE_RANGE, t_interval
+
+    two = t_interval([0.1, -0.15], bounds=DIFFERENCE_RANGE)
+    assert two["mean"] == pytest.approx(-0.025) and two["low"] is None and not two["usable"]
+    four = t_interval([0.02, 0.03, 0.025, 0.035], bounds=DIFFERENCE_RANGE)
+    assert four["usable"] and -1 <= four["low"] < four["high"] <= 1

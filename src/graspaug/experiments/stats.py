@@ -11,7 +11,9 @@
   weights for the bootstrap; :func:`weighted_roc_auc`: ROC AUC as sklearn's (ties count
   half), with datapoint weights;
 * :func:`nested_interval`: one interval over data draws, training seeds and test objects (a
-  hierarchical bootstrap); :func:`fieller_interval`: a ratio of paired means (a share of a gain);
+  hierarchical bootstrap); :func:`ratio_interval`: a ratio of two noisy gains (a share of a gain) by test
+  inversion over their bootstrap, unbounded when the denominator's interval holds zero; :func:`fieller_interval`:
+  its closed form for paired means over seeds (the reference it is tested against);
 * :func:`wilson_interval` (a success rate). No McNemar test: the robot trials' picks cluster by
   object and training seed, so they are compared with the object bootstrap and the t-interval;
 * :func:`contrast`: the one result type of every experiment (a mean and its intervals, each keyed by what it
@@ -27,19 +29,27 @@ import numpy as np
 from scipy import stats
 from scipy.stats import binomtest
 
+#: The range of a difference of two AP values, success rates or AUCs (each in [0, 1]).
+DIFFERENCE_RANGE = (-1.0, 1.0)
 
-def t_interval(values, level: float = 0.95) -> dict:
+
+def t_interval(values, level: float = 0.95, bounds: tuple[float, float] | None = None) -> dict:
     """Mean and two-sided ``level`` t-interval of ``values`` (one per seed); the interval is
-    None for fewer than two values."""
+    None for fewer than two values, and None too when ``bounds`` (the quantity's range, e.g.
+    :data:`DIFFERENCE_RANGE` for a difference of two rates) is given and the interval leaves it:
+    too few seeds for a usable interval (``usable`` False). Never clipped: a clipped t-interval
+    would claim a coverage it does not have."""
     x = np.asarray([v for v in values if v is not None and np.isfinite(v)], dtype=float)
     n = len(x)
     if n == 0:
-        return {"mean": None, "low": None, "high": None, "n_seeds": 0}
+        return {"mean": None, "low": None, "high": None, "n_seeds": 0, "usable": False}
     mean = float(x.mean())
     if n < 2:
-        return {"mean": mean, "low": None, "high": None, "n_seeds": 1}
+        return {"mean": mean, "low": None, "high": None, "n_seeds": 1, "usable": False}
     half = float(stats.t.ppf(0.5 + level / 2, n - 1) * x.std(ddof=1) / np.sqrt(n))
-    return {"mean": mean, "low": mean - half, "high": mean + half, "n_seeds": n}
+    if bounds is not None and (mean - half < bounds[0] or mean + half > bounds[1]):
+        return {"mean": mean, "low": None, "high": None, "n_seeds": n, "usable": False}
+    return {"mean": mean, "low": mean - half, "high": mean + half, "n_seeds": n, "usable": True}
 
 
 class ObjectBootstrap:
@@ -347,3 +357,84 @@ def fieller_interval(x, y, level: float = 0.95) -> dict:
         return {"ratio": ratio, "low": None, "high": None, "bounded": False}
     root = np.sqrt(disc)
     return {"ratio": ratio, "low": float((b - root) / a), "high": float((b + root) / a), "bounded": True}
+
+
+def ratio_interval(
+    numerator: float,
+    denominator: float,
+    resampled_numerator: np.ndarray,
+    resampled_denominator: np.ndarray,
+    level: float = 0.95,
+) -> dict:
+    """A ratio of two noisy gains, numerator / denominator (e.g. a pool's AP gain over no augmentation divided by as
+    many real shapes' gain: a share), with a ``level`` interval by test inversion over one bootstrap (Fieller's
+    idea, the one method for every share in the package).
+
+    θ is in the interval when the test of ``numerator − θ·denominator = 0`` does not reject: when 0 lies within the
+    percentile interval of its resamples, i.e. at least (1 − level)/2 of the resampled
+    ``resampled_numerator − θ·resampled_denominator`` lie at or below 0 and as many at or above it. The set of such
+    θ is an interval when the denominator is clearly nonzero (then it is the percentile interval of the resampled
+    ratios), and unbounded (an unbounded interval or the complement of one) when the denominator's own percentile
+    interval holds zero: the data then say nothing about the ratio's size, and both ends are None. The percentile
+    interval of the resampled ratios alone is not used: with a denominator near zero it is bounded and may exclude
+    its own estimate (issue #58). :func:`fieller_interval` is the closed form of the same idea for paired means.
+
+    Parameters
+    ----------
+    numerator, denominator : float — the two gains on all the data (AP, or any unit: the ratio has none)
+    resampled_numerator, resampled_denominator : (R,) float — the same under R resamples, the same resamples for
+        both (e.g. :func:`nested_means` with one set of :func:`nested_indices`); NaN resamples are left out
+    level : float — the interval's coverage
+
+    Returns
+    -------
+    dict — ``share`` (numerator / denominator; None when the denominator is 0 or either is not finite), ``low``,
+    ``high`` (None when unbounded), ``bounded``, and the denominator's own percentile interval
+    ``denominator_low``, ``denominator_high``
+    """
+    x, y = np.asarray(resampled_numerator, dtype=float), np.asarray(resampled_denominator, dtype=float)
+    if x.shape != y.shape or x.ndim != 1:
+        raise ValueError(f"ratio_interval: resamples of shapes {x.shape} and {y.shape}, need two equal (R,)")
+    keep = np.isfinite(x) & np.isfinite(y)
+    x, y = x[keep], y[keep]
+    finite = np.isfinite(numerator) and np.isfinite(denominator) and denominator != 0
+    ratio = float(numerator / denominator) if finite else None
+    den_low, den_high = percentile_interval(y, level)
+    unbounded = {"share": ratio, "low": None, "high": None, "bounded": False}
+    den = {"denominator_low": den_low, "denominator_high": den_high}
+    if len(y) == 0 or den_low is None or den_low <= 0 <= den_high:
+        return unbounded | den
+    tail = (1 - level) / 2
+
+    def accepted(theta: np.ndarray) -> np.ndarray:  # (T,) → (T,) bool: 0 within the differences' percentiles
+        diff = x[None, :] - theta[:, None] * y[None, :]  # (T, R)
+        return ((diff <= 0).mean(axis=1) >= tail) & ((diff >= 0).mean(axis=1) >= tail)
+
+    nonzero = y != 0
+    breaks = np.unique(x[nonzero] / y[nonzero])  # where a resample's difference changes sign
+    far = 10 * (np.abs(breaks).max() + 1)
+    between = (breaks[:-1] + breaks[1:]) / 2
+    if accepted(np.array([-far, far])).any():  # open at an end: unbounded
+        return unbounded | den
+    points = np.concatenate([breaks, between])
+    ok = points[accepted(points)]
+    if len(ok) == 0:
+        return unbounded | den
+    return {"share": ratio, "low": float(ok.min()), "high": float(ok.max()), "bounded": True} | den
+
+
+def share_headline(share: dict) -> dict[str, float | None]:
+    """A :func:`ratio_interval` as a metrics file holds it, under :func:`headline`'s keys: ``mean`` (the share),
+    ``lo``, ``hi`` (None when unbounded), rounded to 5 decimals."""
+    values = {"mean": share.get("share"), "lo": share.get("low"), "hi": share.get("high")}
+    return {k: None if v is None else round(float(v), 5) for k, v in values.items()}
+
+
+def share_text(share: dict, spec: str = "+.0%") -> str:
+    """A :func:`ratio_interval` in words: ``share [low, high]``, or ``share [unbounded]`` (``n/a`` without a
+    ratio); what a share is read beside: its denominator, printed by the caller."""
+    if share is None or share.get("share") is None:
+        return "n/a"
+    if not share["bounded"]:
+        return f"{format(share['share'], spec)} [unbounded]"
+    return f"{format(share['share'], spec)} [{format(share['low'], spec)}, {format(share['high'], spec)}]"

@@ -574,6 +574,35 @@ def profile_command(
 
 @app.command(
     cls=Command,
+    name="results",
+    help="Recompute every figure the README and docs/results.md quote from the studies' per-network tables in "
+    "`results/<study>/` (written by `python studies/attribution.py`): writes `<out>/<study>/summary.json`, "
+    "`decomposition.md` and `figures.json` (key → the quoted text) and prints each figure. `--check`: a figure the "
+    "markdown marks (`<!-- results:KEY -->` before it) that differs from the recomputed one, or that no study "
+    "recomputes, is an error naming it (exit 2).",
+)
+def results_command(
+    root: Path = typer.Option(Path("."), "--root", help="The repository (its results/, README.md, docs/)."),
+    out: Path = typer.Option(Path("reports/results"), "--out", "-o", help="Folder for the recomputed tables."),
+    check: bool = typer.Option(False, "--check", help="Compare the marked figures of README.md, docs/results.md."),
+) -> None:
+    from graspaug.experiments.results import DOCUMENTS, check_markdown, recompute, write_recomputed
+
+    figures, results = recompute(root / "results")
+    write_recomputed(results, figures, root / out)
+    for key, text in figures.items():
+        typer.echo(f"{key}: {text}")
+    if check:
+        problems = [p for doc in DOCUMENTS for p in check_markdown((root / doc).read_text(), figures, doc)]
+        if problems:
+            from graspaug.errors import DataError
+
+            raise DataError(f"{len(problems)} quoted figure(s) differ from results/: {'; '.join(problems)}")
+        typer.echo(f"every marked figure of {', '.join(DOCUMENTS)} equals the recomputed one")
+
+
+@app.command(
+    cls=Command,
     name="schema",
     help="Write the JSON Schema of params.yaml (every key's type, range, default and meaning), for editors: "
     "params.yaml's first line `# yaml-language-server: $schema=params.schema.json` makes VS Code's YAML extension "

@@ -14,7 +14,7 @@ objects serves every draw, seed and network.
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 
 import numpy as np
@@ -26,16 +26,19 @@ from graspaug.experiments.ap.numbers import (
     collect,
     datapoint_matched_contrasts,
     declared_contrasts,
+    nested_rng,
     test_predictions,
 )
 from graspaug.experiments.stats import (
     ObjectBootstrap,
     draw_scope,
+    interval_text,
     nested_contrast,
     nested_indices,
     nested_interval,
     nested_means,
-    percentile_interval,
+    ratio_interval,
+    share_text,
     verdict,
 )
 from graspaug.training.variants import seed_variants
@@ -79,26 +82,48 @@ def combine_draws(
     dict — ``contrasts``: name → a :func:`~graspaug.experiments.stats.contrast` over ``draws``
     (:func:`nested_interval`) with ``per_draw`` (mean over seeds per draw) and ``meaning``; ``shares``: pool →
     augmented base size → the share of the real-shape gain that the pool gives (its mean gain over no augmentation,
-    mean over ratios, divided by the real pool's; the ratio of the nested means and its percentile interval:
-    ``share``, ``low``, ``high``) and ``gain``, that gain as a contrast over draws (the declared
-    ``<pool>_vs_none@B`` where there is one); ``share``: the targeted pool's;
-    ``draws``, ``seeds``
+    mean over ratios, divided by the real pool's): ``share``, ``low``, ``high``, ``bounded``
+    (:func:`~graspaug.experiments.stats.ratio_interval` over the same nested resamples; unbounded, ends None, when
+    the real gain's interval holds zero), ``gain``, the pool's gain as a contrast over draws (the declared
+    ``<pool>_vs_none@B`` where there is one), and ``real_gain``, the denominator as a contrast over draws;
+    ``share``: the targeted pool's; ``draws``, ``seeds``. Every nested interval uses the same resamples of draws,
+    seeds and objects, so a gain quoted twice (a contrast, a share's numerator) has one interval.
     """
     seeds = sorted({s for d in draws.values() for s in d})
     if any(sorted(d) != seeds for d in draws.values()):
         raise DataError("every draw needs the same training seeds")
     variants = seed_variants(generate.base_sizes, generate.ratios, gqcnn.augment_base_sizes, False, gqcnn.pools)
-    boot = ObjectBootstrap(object_ids, n_resamples, seed)
+    runs = {d: collect(seed_dirs, variants) for d, seed_dirs in draws.items()}
+    predictions = lambda d, s, key: test_predictions(draws[d][s], key)  # noqa: E731
+    return combine_runs(runs, predictions, labels, object_ids, generate, gqcnn, n_resamples, seed)
+
+
+def combine_runs(
+    runs: Mapping[int, pd.DataFrame],
+    predictions: Callable[[int, int, tuple], np.ndarray],
+    labels: np.ndarray,
+    object_ids: np.ndarray,
+    generate,
+    gqcnn,
+    n_resamples: int,
+    seed: int,
+) -> dict:
+    """:func:`combine_draws` from the networks' tables rather than their folders (what ``results/attribution/``
+    keeps: :mod:`graspaug.experiments.results`): ``runs``: data seed → :func:`collect`'s table of that draw;
+    ``predictions(draw, seed, (pool, B, R))``: (N,) the network's P(success) on the test datapoints. The same
+    result, figure for figure."""
+    seeds = sorted({int(s) for r in runs.values() for s in r.seed})
     per_draw: dict[int, tuple[pd.DataFrame, dict[str, Contrast]]] = {}
-    for d, seed_dirs in draws.items():
-        runs = collect(seed_dirs, variants)
-        per_draw[d] = runs, {c.name: c for c in draw_contrasts(runs, generate, gqcnn)}
+    for d, draw_runs in runs.items():
+        per_draw[d] = draw_runs, {c.name: c for c in draw_contrasts(draw_runs, generate, gqcnn)}
+    draws = list(runs)
+    boot = ObjectBootstrap(object_ids, n_resamples, seed)
     names = [n for n in next(iter(per_draw.values()))[1] if all(n in c for _, c in per_draw.values())]
     cache: dict = {}
 
     def boot_ap(d: int, s: int, key) -> np.ndarray:
         if (d, s, key) not in cache:
-            cache[d, s, key] = boot.average_precision(labels, test_predictions(draws[d][s], key))
+            cache[d, s, key] = boot.average_precision(labels, predictions(d, s, key))
         return cache[d, s, key]
 
     def arrays(terms_of) -> tuple[np.ndarray, np.ndarray]:
@@ -114,16 +139,19 @@ def combine_draws(
     full, resampled = {}, {}
     for name in names:
         full[name], resampled[name] = arrays(lambda contrasts, name=name: contrasts[name].terms)
-    rng = np.random.default_rng([seed, 0xA77])
+
+    def rng() -> np.random.Generator:  # the same draws and seeds for every figure: one figure, one interval
+        return nested_rng(seed)
+
     out = {
         name: nested_contrast(
-            nested_interval(full[name], resampled[name], rng),
+            nested_interval(full[name], resampled[name], rng()),
             per_draw=[round(float(v), 5) if np.isfinite(v) else None for v in full[name].mean(axis=1)],
             meaning=per_draw[next(iter(per_draw))][1][name].meaning,
         )
         for name in names
     }
-    indices = nested_indices(len(draws), len(seeds), n_resamples, rng)
+    indices = nested_indices(len(draws), len(seeds), n_resamples, rng())  # those of every nested_interval above
     shares: dict[str, dict[str, dict]] = {}  # pool → base size → the share of the real-shape gain
     nonzero = [float(r) for r in generate.ratios if r > 0]
     for b in gqcnn.augment_base_sizes if "real" in gqcnn.pools and nonzero else ():
@@ -136,19 +164,22 @@ def combine_draws(
             for pool in gqcnn.pools
         }
         real_full, real_resampled = gains["real"]
+        real_gain = nested_contrast(nested_interval(real_full, real_resampled, rng()))
         for pool, (f, r) in gains.items():
             if pool == "real":
                 continue
-            ratio = nested_means(r, indices) / nested_means(real_resampled, indices)
-            low, high = percentile_interval(ratio)
-            mean = float(f.mean() / real_full.mean())
-            declared = out.get(f"{pool}_vs_none@{b}")  # the same terms: one interval for one gain
-            gain = declared if declared is not None else nested_contrast(nested_interval(f, r, rng))
+            share = ratio_interval(
+                f.mean(), real_full.mean(), nested_means(r, indices), nested_means(real_resampled, indices)
+            )
+            declared = out.get(f"{pool}_vs_none@{b}")  # the same terms and resamples: one interval for one gain
+            gain = declared if declared is not None else nested_contrast(nested_interval(f, r, rng()))
             shares.setdefault(pool, {})[str(b)] = {
-                "share": mean if np.isfinite(mean) else None,
-                "low": low,
-                "high": high,
+                "share": share["share"],
+                "low": share["low"],
+                "high": share["high"],
+                "bounded": share["bounded"],
                 "gain": gain,
+                "real_gain": real_gain,
             }
     return {
         "contrasts": out,
@@ -211,14 +242,25 @@ def decomposition_markdown(result: dict, augment_base_sizes: Sequence[int], comm
         mean = "-" if c["mean"] is None else f"{c['mean']:+.4f}"
         lines.append(f"| `{name}` | {mean} | {interval} | {per_draw} | {c['meaning']} |")
     lines += ["", "## What it says", ""]
-    for b, s in result["share"].items():
-        interval = "unbounded" if s["low"] is None else f"[{s['low']:.0%}, {s['high']:.0%}]"
-        share = "an undefined share" if s["share"] is None else f"{s['share']:.0%}"
-        lines.append(f"- B = {b}: targeted shapes give {share} of the real-shape gain, 95% interval {interval}.")
+    lines += [f"- {share_sentence('targeted', b, s)}" for b, s in result["share"].items()]
     lines += [f"- {losing_step(result['contrasts'], b)}" for b in augment_base_sizes]
     if result.get("shares"):
         lines += ["", "## What to add: each pool's share of the real-shape gain", "", *recommendation(result)]
     return "\n".join(lines) + "\n"
+
+
+def share_sentence(pool: str, base_size, s: dict) -> str:
+    """One sentence: ``pool``'s share of the real-shape gain at ``base_size`` (an entry of :func:`combine_draws`'s
+    ``shares``) beside its denominator, the real shapes' own gain, and the pool's own gain, each with its interval
+    and verdict."""
+    real, gain = s["real_gain"], s["gain"]
+    share = share_text(s)
+    why = "" if s["bounded"] else " (unbounded: the real shapes' gain is not clearly nonzero)"
+    return (
+        f"B = {base_size}: {pool} shapes give {share}{why} of the real-shape gain (95% interval by test inversion); "
+        f"the real shapes' gain {interval_text(real)} AP, {verdict(real)}; {pool}'s own gain "
+        f"{interval_text(gain)} AP, {verdict(gain)}."
+    )
 
 
 CONTROLS = {"recon": "control: the new real shapes themselves, decoded"}
@@ -235,10 +277,13 @@ def recommendation(result: dict) -> list[str]:
     def text(s: dict | None) -> str:
         if not s or s["share"] is None:
             return "-"
-        return f"{s['share']:+.0%} " + ("[unbounded]" if s["low"] is None else f"[{s['low']:+.0%}, {s['high']:+.0%}]")
+        return share_text(s)
 
     def says(s: dict | None) -> str:  # the pool's own gain over no augmentation, in the one verdict's words
         return "n/a" if not s or s["gain"]["mean"] is None else verdict(s["gain"])
+
+    def own(s: dict | None) -> str:  # that gain, its interval and its verdict
+        return "n/a" if not s or s["gain"]["mean"] is None else f"{interval_text(s['gain'])} AP, {verdict(s['gain'])}"
 
     shares = result["shares"]
     sizes = sorted({b for by_size in shares.values() for b in by_size}, key=int)
@@ -256,11 +301,19 @@ def recommendation(result: dict) -> list[str]:
         + " |",
         "|---|" + "---|" * (2 * len(sizes)),
     ]
+    real = {b: next(iter(shares.values()))[b]["real_gain"] for b in sizes}
+    lines.append(  # the denominator of every share, beside them
+        "| real (as many more real shapes: every share's denominator) | "
+        + " | ".join("(the denominator)" for b in sizes)
+        + " | "
+        + " | ".join(f"{interval_text(real[b])} AP, {verdict(real[b])}" for b in sizes)
+        + " |"
+    )
     lines += [
         f"| {p}{f' ({CONTROLS[p]})' if p in CONTROLS else ''} | "
         + " | ".join(text(shares[p].get(b)) for b in sizes)
         + " | "
-        + " | ".join(says(shares[p].get(b)) for b in sizes)
+        + " | ".join(own(shares[p].get(b)) for b in sizes)
         + " |"
         for p in order
     ]
@@ -270,8 +323,12 @@ def recommendation(result: dict) -> list[str]:
         pools, controls = [p for p in gaining if p not in CONTROLS], [f"`{p}`" for p in gaining if p in CONTROLS]
         if pools:
             best = max(pools, key=lambda p: -np.inf if shares[p][b]["share"] is None else shares[p][b]["share"])
-            share = shares[best][b]["share"]
-            most = "" if share is None else f"; {best} adds the most, {share:.0%} of as many real shapes' gain"
+            share = shares[best][b]
+            most = (
+                f"; {best} adds the most, {share_text(share)} of as many real shapes' gain"
+                if share["bounded"]
+                else f"; {best}'s share of the real-shape gain is unbounded (that gain is not clearly nonzero)"
+            )
             advice.append(f"At B = {b} the pools that add AP with an interval above zero: {', '.join(pools)}{most}.")
         else:
             but = (
@@ -281,5 +338,7 @@ def recommendation(result: dict) -> list[str]:
             advice.append(f"At B = {b}, add real shapes: {none}{but}.")
     return lines + [
         "",
-        "A share is the pool's AP gain over no augmentation divided by as many real shapes' gain. " + " ".join(advice),
+        "A share is the pool's AP gain over no augmentation divided by as many real shapes' gain, its 95% interval by "
+        "test inversion over the same resamples (unbounded when the real shapes' gain is not clearly nonzero). "
+        + " ".join(advice),
     ]

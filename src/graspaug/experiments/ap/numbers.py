@@ -22,8 +22,9 @@ network is read:
 * ``<pool>_vs_real_datapoints@B``: the same pools against real shapes at as many training
   datapoints (:func:`datapoint_matched_contrasts`), since a generated shape yields fewer.
 
-The share of the real-shape gain that targeted shapes give has a Fieller interval over seeds
-(:func:`gain_sentences`).
+Each contrast is judged by one interval, the nested bootstrap over seeds and test objects
+(:func:`evaluate_contrasts`); the share of the real-shape gain that targeted shapes give has an interval by test
+inversion over the same resamples (:func:`graspaug.experiments.ap.attribution.combine_draws`).
 """
 
 from __future__ import annotations
@@ -39,9 +40,11 @@ from sklearn.metrics import average_precision_score
 
 from graspaug.errors import DataError
 from graspaug.experiments.stats import (
+    DIFFERENCE_RANGE,
     ObjectBootstrap,
     contrast,
     headline,
+    nested_interval,
     percentile_interval,
     t_interval,
 )
@@ -292,10 +295,14 @@ def evaluate_contrasts(
     n_resamples: int,
     seed: int,
 ) -> dict:
-    """Per contrast: mean over seeds, 95% t-interval over seeds, SD of the per-seed values, and
-    a 95% bootstrap interval resampling test objects (the same resamples for every network).
-    ``seed_dirs``: training seed → the folder of its networks; ``labels``, ``object_ids`` (N,):
-    the test datapoints' labels and objects."""
+    """Per contrast, a :func:`~graspaug.experiments.stats.contrast` judged by ONE interval, the one that covers both
+    sources of variance: the 95% nested bootstrap over the training seeds and the test objects (``draws_low``,
+    ``draws_high``, ``over`` ``draws`` with ``n_draws`` 1: :func:`~graspaug.experiments.stats.nested_interval` on
+    this one draw, with the resamples :func:`graspaug.experiments.ap.attribution.combine_draws` uses, so the
+    decomposition quotes the same interval). Secondary, never judged: the 95% t-interval over seeds (``seeds_*``;
+    None where it leaves [−1, 1]: too few seeds), the bootstrap over test objects alone (``objects_*``), the SD of
+    the per-seed values. ``seed_dirs``: training seed → the folder of its networks; ``labels``, ``object_ids``
+    (N,): the test datapoints' labels and objects."""
     seeds = list(seed_dirs)
     boot = ObjectBootstrap(object_ids, n_resamples, seed)
     ap = runs.set_index(["pool", "base_size", "ratio", "seed"]).test_ap.astype(float)  # None (one class) → NaN
@@ -307,24 +314,32 @@ def evaluate_contrasts(
         return cache[key, s]
 
     out = {}
+    r5 = lambda v: None if v is None else round(float(v), 5)  # noqa: E731
     for c in contrasts:
         per_seed = [sum(w * ap.get((*k, s), np.nan) for w, k in c.terms) for s in seeds]
-        summary = t_interval(per_seed)
-        resampled = np.mean([sum(w * boot_ap(k, s) for w, k in c.terms) for s in seeds], axis=0)
-        low, high = percentile_interval(resampled)
+        summary = t_interval(per_seed, bounds=DIFFERENCE_RANGE)
+        resampled = np.array([sum(w * boot_ap(k, s) for w, k in c.terms) for s in seeds])  # (S, R)
+        low, high = percentile_interval(resampled.mean(axis=0))
+        nested = nested_interval(np.array([per_seed]), resampled[None], nested_rng(seed))
         finite = [v for v in per_seed if np.isfinite(v)]
-        r5 = lambda v: None if v is None else round(float(v), 5)  # noqa: E731
         out[c.name] = contrast(
             r5(summary["mean"]),
-            "seeds",
+            "draws",
             summary["n_seeds"],
             seeds=(r5(summary["low"]), r5(summary["high"])),
             objects=(r5(low), r5(high)),
+            draws=(r5(nested["low"]), r5(nested["high"])),
             sd=round(float(np.std(finite, ddof=1)), 5) if len(finite) > 1 else None,
             per_seed=[round(float(v), 5) if np.isfinite(v) else None for v in per_seed],
             meaning=c.meaning,
         )
     return out
+
+
+def nested_rng(seed: int) -> np.random.Generator:
+    """The generator of the draws and seeds of every nested interval of the AP experiment (a fresh one per
+    interval: the same resamples for every contrast, so a figure quoted in two reports has one interval)."""
+    return np.random.default_rng([seed, 0xA77])
 
 
 def per_object_aps(
@@ -357,11 +372,12 @@ def object_improvement(by_network: dict[tuple, pd.Series], base_size: int, ratio
 
 
 def network_table(runs: pd.DataFrame, per_object: pd.DataFrame) -> pd.DataFrame:
-    """Per network: test AP mean and 95% t half-width over seeds, validation AP mean, per-object mean AP."""
+    """Per network: test AP mean and 95% t half-width over seeds (NaN where the interval would leave AP's range
+    [0, 1]: too few seeds), validation AP mean, per-object mean AP."""
     rows = []
     merged = runs.merge(per_object, on=["pool", "base_size", "ratio", "seed"], how="left")
     for (pool, base, ratio), g in merged.groupby(["pool", "base_size", "ratio"], sort=False):
-        t = t_interval(g.test_ap.astype(float))
+        t = t_interval(g.test_ap.astype(float), bounds=(0.0, 1.0))
         half = np.nan if t["high"] is None else t["high"] - t["mean"]
         rows.append(
             {
@@ -414,6 +430,7 @@ def ap_metrics(contrasts: dict, table: pd.DataFrame, chosen: dict[int, float], p
 
 
 def ap_headline(report: dict) -> dict[str, dict]:
-    """The experiment's metrics from its :func:`ap_metrics` report: per declared contrast its mean and
-    95% t-interval over seeds (:func:`~graspaug.experiments.stats.headline`), one metrics file each."""
+    """The experiment's metrics from its :func:`ap_metrics` report: per declared contrast its mean and the one
+    interval it is judged by, the 95% bootstrap over seeds × test objects
+    (:func:`~graspaug.experiments.stats.headline`), one metrics file each."""
     return {name: headline(c) for name, c in report["contrasts"].items()}

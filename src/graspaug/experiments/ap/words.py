@@ -5,9 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from graspaug.experiments.ap.attribution import share_sentence
 from graspaug.experiments.stats import (
     draw_scope,
-    fieller_interval,
+    interval_text,
 )
 from graspaug.experiments.stats import (
     verdict as contrast_verdict,
@@ -15,34 +16,16 @@ from graspaug.experiments.stats import (
 
 
 def gain_sentences(
-    results: dict, table: pd.DataFrame, chosen: dict[int, float], augment_base_sizes, ceiling_shapes: int | None
+    shares: dict, table: pd.DataFrame, chosen: dict[int, float], ceiling_shapes: int | None
 ) -> list[str]:
-    """The report's sentences on scale: per augmented base size, targeted augmentation's gain as
-    a share of the same number of real shapes' gain (mean over ratios), and, with the ceiling
-    (``ceiling_shapes`` train shapes; None without it), the share of the gap from 1:0 to the
-    ceiling that the chosen ratio closes. A gap within the ceiling's 95% t half-width is
-    reported as no gap rather than as a share of noise. The share of the real-shape gain has a Fieller
-    interval over seeds (:func:`~graspaug.experiments.stats.fieller_interval`); the ceiling's share none."""
-    out = []
-    for b in augment_base_sizes:
-        t, r = results.get(f"targeted_vs_none@{b}"), results.get(f"targeted_vs_real@{b}")
-        real_gain = (
-            t["mean"] - r["mean"] if t and r and None not in (t["mean"], r["mean"]) else 0.0
-        )  # mean over R of AP(real, B, R) - AP(B, 1:0)
-        if real_gain:
-            gain = np.array([np.nan if v is None else v for v in t["per_seed"]], dtype=float)
-            real = gain - np.array([np.nan if v is None else v for v in r["per_seed"]], dtype=float)
-            ok = np.isfinite(gain) & np.isfinite(real)
-            share = fieller_interval(gain[ok], real[ok])
-            interval = (
-                f"95% Fieller interval over seeds [{share['low']:.0%}, {share['high']:.0%}]"
-                if share["bounded"]
-                else "the real-shape gain is not clearly nonzero over seeds, so its Fieller interval is unbounded"
-            )
-            out.append(
-                f"At B = {b}, generated shapes give {t['mean'] / real_gain:.0%} of the gain of the same number of "
-                f"real shapes ({t['mean']:+.4f} vs {real_gain:+.4f} AP, mean over ratios; {interval})."
-            )
+    """The report's sentences on scale: per augmented base size, targeted augmentation's share of the same number of
+    real shapes' gain (``shares``: base size → the targeted entry of
+    :func:`~graspaug.experiments.ap.attribution.combine_draws`'s ``shares``, the decomposition's own figures: its
+    interval by test inversion, unbounded when the real gain's interval holds zero), beside that gain and
+    targeted's own; and, with the ceiling (``ceiling_shapes`` train shapes; None without it), the share of the gap
+    from 1:0 to the ceiling that the chosen ratio closes. A gap within the ceiling's 95% t half-width is reported
+    as no gap rather than as a share of noise; the ceiling's share has no interval."""
+    out = [share_sentence("targeted", b, s) for b, s in shares.items()]
     nets = table.set_index(["pool", "base_size", "ratio"])
     if ceiling_shapes is None or ("ceiling", 0, 0.0) not in nets.index:
         return out
@@ -70,25 +53,11 @@ def gain_sentences(
 
 
 def verdict(name: str, c: dict) -> str:
-    """One sentence: does the contrast's interval exclude zero, by both intervals; the words scoped to
-    the run's one draw of the data (:func:`~graspaug.experiments.stats.draw_verdict`)."""
+    """One sentence: the contrast with its one interval (its ``over``: seeds × test objects) and its one verdict,
+    scoped to the run's one draw of the data (:func:`~graspaug.experiments.stats.draw_verdict`)."""
     if c["mean"] is None:
         return f"`{name}` ({c['meaning']}): no value (a test set with one class?)."
-    if c["seeds_low"] is None:
-        return f"`{name}` ({c['meaning']}): {c['mean']:+.4f} with one seed, no interval; not evidence either way."
-    t_side = "above zero" if c["seeds_low"] > 0 else ("below zero" if c["seeds_high"] < 0 else "includes zero")
-    b_side = (
-        "above zero"
-        if (c["objects_low"] or 0) > 0
-        else ("below zero" if (c["objects_high"] or 0) < 0 else "includes zero")
-    )
-    word = contrast_verdict(c)
-    return (
-        f"`{name}` ({c['meaning']}): {c['mean']:+.4f} AP, 95% t-interval over {c['n_seeds']} seeds "
-        f"[{c['seeds_low']:+.4f}, {c['seeds_high']:+.4f}] "
-        f"({t_side}), bootstrap over test objects [{c['objects_low']:+.4f}, {c['objects_high']:+.4f}] ({b_side}): "
-        f"{word}."
-    )
+    return f"`{name}` ({c['meaning']}): {interval_text(c)} AP, {contrast_verdict(c)}."
 
 
 def _fmt(v, digits: int = 4) -> str:
@@ -139,7 +108,8 @@ def report_markdown(
     for r in table.itertuples():
         ratio = "all" if r.pool == "ceiling" else f"1:{r.ratio:g}"
         base = "-" if r.pool == "ceiling" else str(r.base_size)
-        ci = "" if not np.isfinite(r.test_ap_ci) else f" ± {r.test_ap_ci:.4f}"
+        ci = f" ± {r.test_ap_ci:.4f}" if np.isfinite(r.test_ap_ci) else ""
+        ci = " (too few seeds for ±)" if not ci and getattr(r, "n_seeds", 1) > 1 else ci  # ± would leave [0, 1]
         lines.append(
             f"| {r.pool} | {base} | {ratio} | {_fmt(r.test_ap)}{ci} | {_fmt(r.per_object_ap)} | {_fmt(r.val_ap)} | "
             f"{_fmt(r.test_roc_auc)} |"
@@ -148,12 +118,18 @@ def report_markdown(
         "",
         "## Contrasts (declared before any network was read)",
         "",
-        "| contrast | mean | 95% t-interval | SD over seeds | 95% bootstrap (objects) |",
-        "|---|---|---|---|---|",
+        "Each contrast is judged by one interval, the 95% bootstrap over training seeds and test objects together "
+        "(the one every report quotes). Secondary columns, never judged on their own: the 95% t-interval over seeds "
+        '("too few seeds" where it would leave [−1, 1]), the SD over seeds, the bootstrap over test objects alone.',
+        "",
+        "| contrast | mean [95% interval: seeds × objects] | verdict | t over seeds | SD over seeds | objects alone |",
+        "|---|---|---|---|---|---|",
     ]
     for name, c in contrasts.items():
+        t_cell = "too few seeds" if c["seeds_low"] is None else f"[{_fmt(c['seeds_low'])}, {_fmt(c['seeds_high'])}]"
+        word = "-" if c["mean"] is None else contrast_verdict(c)
         lines.append(
-            f"| `{name}` | {_fmt(c['mean'])} | [{_fmt(c['seeds_low'])}, {_fmt(c['seeds_high'])}] | {_fmt(c['sd'])} | "
+            f"| `{name}` | {interval_text(c)} | {word} | {t_cell} | {_fmt(c['sd'])} | "
             f"[{_fmt(c['objects_low'])}, {_fmt(c['objects_high'])}] |"
         )
     excluding = [n for n, c in contrasts.items() if contrast_verdict(c).startswith(("a gain", "a loss"))]
@@ -163,8 +139,7 @@ def report_markdown(
         "",
         draw_scope(data_seed, seeds, "ap"),
         "",
-        "- Contrasts whose t-interval excludes zero: "
-        f"{', '.join(f'`{n}`' for n in excluding) if excluding else 'none'}.",
+        f"- Contrasts whose interval excludes zero: {', '.join(f'`{n}`' for n in excluding) if excluding else 'none'}.",
     ]
     lines += [f"- {verdict(n, c)}" for n, c in contrasts.items()]
     if chosen:

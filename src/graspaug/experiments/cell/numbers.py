@@ -12,6 +12,7 @@ import pandas as pd
 from graspaug.errors import DataError
 from graspaug.experiments.ap.numbers import test_predictions, test_rows
 from graspaug.experiments.stats import (
+    DIFFERENCE_RANGE,
     ObjectBootstrap,
     contrast,
     headline,
@@ -83,7 +84,7 @@ def trial_contrast(trials: pd.DataFrame, arm: str, reference: str, n_boot: int =
     are then not 0/1, and the counts are None)."""
     paired = paired_outcomes(trials, arm, reference)
     per_seed = paired.groupby("seed").apply(lambda d: float(d.a.mean() - d.b.mean()), include_groups=False)
-    over_seeds = t_interval(per_seed.to_numpy())
+    over_seeds = t_interval(per_seed.to_numpy(), bounds=DIFFERENCE_RANGE)  # none past [-1, 1]: too few seeds
     once = -1 in set(trials.seed[trials.arm.isin([arm, reference])])
     if once:
         drops = paired.groupby(["object", "attempt"], sort=False).agg(a=("a", "mean"), b=("b", "mean")).reset_index()
@@ -317,7 +318,7 @@ def ranking_summary(grasps: pd.DataFrame, seeds: list, scores: dict, full: dict,
             continue
         per_seed = full[arm] - full[reference]
         lo, hi = percentile_interval((resampled[arm] - resampled[reference]).mean(axis=0))
-        over_seeds = t_interval(per_seed)
+        over_seeds = t_interval(per_seed, bounds=DIFFERENCE_RANGE)  # none past [-1, 1]: too few seeds
         contrasts[name] = contrast(
             rounded(per_seed.mean()),
             "objects",

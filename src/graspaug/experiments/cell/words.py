@@ -17,8 +17,11 @@ def _number(x) -> str:
 
 
 def _t(c: dict) -> str:
-    """A contrast's t-interval over seeds as a table cell ("–" with one seed)."""
-    return "–" if c["seeds_low"] is None else f"[{c['seeds_low']:+.3f}, {c['seeds_high']:+.3f}]"
+    """A contrast's t-interval over seeds as a secondary table cell ("–" with one seed; "too few seeds" where it would
+    leave the difference's range [−1, 1]: :func:`~graspaug.experiments.stats.t_interval`)."""
+    if c["seeds_low"] is None:
+        return "–" if (c.get("n_seeds") or 0) < 2 else "too few seeds"
+    return f"[{c['seeds_low']:+.3f}, {c['seeds_high']:+.3f}]"
 
 
 def _interval(c: dict) -> str:
@@ -98,13 +101,14 @@ def ranking_lines(ranking: dict) -> list[str]:
         "All arms are scored on the same executed grasps: no drop, sensor noise or planner search differs between "
         f"them. For reference, the robust ε ranks them at {ref['eps']:.3f}, the label at {ref['label']:.3f}. "
         "The networks' ROC AUC against the grasps' labels is beside it (means over training seeds). Intervals: "
-        "95% bootstrap over the shapes, 95% t over training seeds.",
+        "95% bootstrap over the shapes, which the verdicts read; the 95% t over training seeds is a secondary column, "
+        "never judged on its own.",
         "",
         "| arm | ROC AUC against the cell's outcomes | against the labels |",
         "|---|---|---|",
         *[f"| {arm} | {a['auc']:.3f} | {_number(a.get('auc_label'))} |" for arm, a in ranking["arms"].items()],
         "",
-        "| contrast | AUC difference | 95% bootstrap (shapes) | 95% t (seeds) |",
+        "| contrast | AUC difference | 95% bootstrap (shapes) | secondary: 95% t (seeds) |",
         "|---|---|---|---|",
     ]
     for name, c in ranking["contrasts"].items():
@@ -156,11 +160,12 @@ def report_text(metrics: dict, trials: pd.DataFrame, calibration_table: pd.DataF
         "",
         "Paired success difference (arm − reference) over the attempts of every "
         "training seed; 95% percentile bootstrap interval with the objects as the unit (each resampled object "
-        "brings all its attempts), and the 95% t-interval over training seeds of the per-seed differences. "
+        "brings all its attempts), the interval every verdict reads; secondary, never judged on its own: the 95% "
+        't-interval over training seeds of the per-seed differences ("too few seeds" where it would leave [−1, 1]). '
         "Against the antipodal arm (one run per drop) a drop counts once, the network's outcomes averaged over "
         "the seeds. No McNemar test: the picks cluster by object and seed.",
         "",
-        "| contrast | difference | 95% bootstrap (objects) | 95% t (seeds) | paired drops | objects |",
+        "| contrast | difference | 95% bootstrap (objects) | secondary: 95% t (seeds) | paired drops | objects |",
         "|---|---|---|---|---|---|",
     ]
     for name, c in metrics["contrasts"].items():

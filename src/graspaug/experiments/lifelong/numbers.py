@@ -20,12 +20,11 @@ from sklearn.neighbors import NearestNeighbors
 from graspaug.errors import DataError
 from graspaug.experiments.stats import (
     ObjectBootstrap,
-    contrast,
     nested_contrast,
     nested_indices,
     nested_interval,
     nested_means,
-    percentile_interval,
+    ratio_interval,
 )
 from graspaug.training.variants import Variant
 
@@ -179,15 +178,18 @@ def arm_contrasts(
     Parameters
     ----------
     networks : data seed → training seed → arm (``none``, ``failure``, ``random``, ``real``) → the network's
-        folder (``test_predictions.npy``); every draw has the same seeds and arms
+        folder (``test_predictions.npy``) or its (N,) predictions themselves (:func:`network_predictions`; what
+        ``results/lifelong/`` keeps); every draw has the same seeds and arms
     labels, object_ids : (N,) — the test datapoints' labels and objects, in the predictions' order
     n_resamples, seed : resamples of the objects and of the nested bootstrap, and their seed
 
     Returns
     -------
     dict — ``ap``: arm → a :func:`~graspaug.experiments.stats.contrast` over ``draws``; ``contrasts``: name → the
-    same; ``share``: the share of the real shapes' gain that failure-targeted shapes give (ratio of nested means,
-    percentile interval; the same type), ``draws``, ``seeds``
+    same; ``share``: the share of the real shapes' gain that failure-targeted shapes give
+    (:func:`~graspaug.experiments.stats.ratio_interval` over the same nested resamples: ``share``, ``low``, ``high``,
+    ``bounded``; unbounded when ``real_data``'s interval holds zero), ``draws``, ``seeds``. Every interval uses the
+    same resamples of draws, seeds and objects.
     """
     draws = list(networks)
     seeds = sorted(networks[draws[0]])
@@ -200,17 +202,20 @@ def arm_contrasts(
             raise DataError(f"draw {d} has training seeds {sorted(networks[d])}, not {seeds}")
         for j, s in enumerate(seeds):
             for a, arm in enumerate(arms):
-                p = np.load(Path(networks[d][s][arm]) / "test_predictions.npy")
+                p = network_predictions(networks[d][s][arm])
                 full[a, i, j] = average_precision_score(labels, p)
                 resampled[a, i, j] = boot.average_precision(labels, p)
-    rng = np.random.default_rng([seed, 0x11FE])
+
+    def rng() -> np.random.Generator:  # the same draws and seeds for every figure: one figure, one interval
+        return np.random.default_rng([seed, 0x11FE])
+
     at = {arm: a for a, arm in enumerate(arms)}
     rounded = lambda d: {k: (round(v, 5) if isinstance(v, float) else v) for k, v in d.items()}  # noqa: E731
     out = {
-        "ap": {arm: rounded(nested_contrast(nested_interval(full[a], resampled[a], rng))) for arm, a in at.items()},
+        "ap": {arm: rounded(nested_contrast(nested_interval(full[a], resampled[a], rng()))) for arm, a in at.items()},
         "contrasts": {
             name: rounded(
-                nested_contrast(nested_interval(full[at[a]] - full[at[b]], resampled[at[a]] - resampled[at[b]], rng))
+                nested_contrast(nested_interval(full[at[a]] - full[at[b]], resampled[at[a]] - resampled[at[b]], rng()))
             )
             for name, (a, b) in ARM_CONTRASTS.items()
             if a in at and b in at
@@ -221,12 +226,23 @@ def arm_contrasts(
     if {"none", "failure", "real"} <= set(at):
         x = resampled[at["failure"]] - resampled[at["none"]]
         y = resampled[at["real"]] - resampled[at["none"]]
-        indices = nested_indices(len(draws), len(seeds), n_resamples, rng)
-        low, high = percentile_interval(nested_means(x, indices) / nested_means(y, indices))
-        gain = (full[at["real"]] - full[at["none"]]).mean()
-        mean = float((full[at["failure"]] - full[at["none"]]).mean() / gain) if gain else None
-        out["share"] = rounded(contrast(mean, "draws", len(seeds), len(draws), draws=(low, high)))
+        indices = nested_indices(len(draws), len(seeds), n_resamples, rng())  # those of every interval above
+        share = ratio_interval(
+            float((full[at["failure"]] - full[at["none"]]).mean()),
+            float((full[at["real"]] - full[at["none"]]).mean()),
+            nested_means(x, indices),
+            nested_means(y, indices),
+        )
+        out["share"] = rounded(share)  # beside it in every report: its denominator, contrasts["real_data"]
     return out
+
+
+def network_predictions(network) -> np.ndarray:
+    """(N,) a network's P(success) on the test datapoints: ``network`` is its folder (``test_predictions.npy``) or
+    the predictions themselves (an array)."""
+    if isinstance(network, (str, Path)):
+        return np.load(Path(network) / "test_predictions.npy")
+    return np.asarray(network, dtype=float)
 
 
 def failure_history(previous: pd.DataFrame | None, round_: int, chosen: Sequence[str]) -> pd.DataFrame:

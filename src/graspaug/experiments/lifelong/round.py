@@ -23,6 +23,7 @@ from graspaug.experiments.lifelong.words import round_markdown
 from graspaug.experiments.stats import (
     draw_scope,
     headline,
+    share_headline,
 )
 from graspaug.grasping.labelled import grasps_of_shapes
 from graspaug.io.atomic import atomic_path
@@ -125,7 +126,7 @@ def write_round(
     result = arm_contrasts(networks, labels, objects, cfg.n_bootstrap, params.seed)
     figures = {f"ap_{arm}": headline(ap) for arm, ap in result["ap"].items()}
     figures |= {name: headline(c) for name, c in result["contrasts"].items()}
-    figures |= {"share": headline(result["share"])} if "share" in result else {}
+    figures |= {"share": share_headline(result["share"])} if "share" in result else {}
     write_json_files(figures, metrics_dir)
     curve = curve_rows(round_, result) if curve is None else pd.concat([curve, curve_rows(round_, result)])
     persistent = persistent_failures(history)

@@ -6,6 +6,7 @@ import pandas as pd
 
 from graspaug.experiments.stats import (
     interval_text,
+    share_text,
     verdict,
 )
 
@@ -33,10 +34,14 @@ def round_markdown(
             word = verdict(c)
             lines.append(f"| `{name}@r{round_}` | {interval_text(c)} | {word} |")
     if "share" in result:
+        real, failure = result["contrasts"].get("real_data"), result["contrasts"].get("failure_vs_none")
         lines += [
             "",
             "Share of the real shapes' gain that failure-targeted shapes give: "
-            f"{interval_text(result['share'], '+.2f')} (a ratio of two intervals: read it when `real_data` shows).",
+            f"{share_text(result['share'])} (95% interval by test inversion; unbounded when the real shapes' gain is "
+            f"not clearly nonzero), beside its denominator, the real shapes' gain `real_data` {interval_text(real)} "
+            f"AP ({verdict(real)}), and failure-targeted shapes' own gain `failure_vs_none` {interval_text(failure)} "
+            f"AP ({verdict(failure)}).",
         ]
     if followed is not None:
         lines += [

@@ -1,8 +1,9 @@
 """Stage ``report``: the paper's GQ-CNN experiment in one table, declared contrasts with intervals, figures, words.
 
 Reads every network of every seed (``models/gqcnn/s<seed>/``). Writes ``metrics/ap/<contrast>.json`` (``mean``,
-``lo``, ``hi``: 95% t over seeds) and, in ``reports/gqcnn/``: ``ap.json`` (per declared contrast a
-:func:`~graspaug.experiments.stats.contrast`: ``mean``, ``seeds_low``/``seeds_high``, ``objects_low``/``objects_high``,
+``lo``, ``hi``: the 95% bootstrap over seeds × test objects, the one interval every report quotes) and, in
+``reports/gqcnn/``: ``ap.json`` (per declared contrast a :func:`~graspaug.experiments.stats.contrast`: ``mean``,
+``draws_low``/``draws_high`` (the judged one), secondary ``seeds_low``/``seeds_high``, ``objects_low``/``objects_high``,
 ``over``, ``n_seeds``, ``sd``; test, validation and per-object AP per network; ``chosen_ratio`` per base size, picked
 on validation AP), ``ap_table.csv``, ``report.md``, ``decomposition.{md,json}`` (the gap to real shapes step by step,
 real → recon → blend → targeted / random, intervals over the seeds and test objects of this run's one draw of the
@@ -66,11 +67,12 @@ def run(params: Params) -> None:
     table, chosen, results, labels = ev.table, ev.chosen, ev.contrasts, ev.labels
     write_csv(table, REPORT_DIR / "ap_table.csv")
     write_csv(ratio_curves(table), REPORT_DIR / "ap_vs_ratio.csv")  # the curves of ap_vs_ratio.png, one column each
-    extras = gain_sentences(results, table, chosen, cfg.augment_base_sizes, ev.ceiling_shapes if cfg.ceiling else None)
     draw_ap_vs_ratio(table, seeds, REPORT_DIR / "ap_vs_ratio.png")
-    # real → recon → blend → targeted / random, step by step, on this run's one draw of the data
+    # real → recon → blend → targeted / random, step by step, on this run's one draw of the data (the same
+    # resamples as evaluate_networks': every contrast and share is quoted with one interval in both reports)
     steps = combine_draws({params.data_seed: seed_dirs}, labels, ev.object_ids, gen, cfg, 1000, params.seed)
     write_json(steps, REPORT_DIR / "decomposition.json")
+    extras = gain_sentences(steps["share"], table, chosen, ev.ceiling_shapes if cfg.ceiling else None)
     extras += [losing_step(steps["contrasts"], b) for b in cfg.augment_base_sizes]
     with atomic_path(REPORT_DIR / "decomposition.md") as tmp:
         tmp.write_text(header + decomposition_markdown(steps, cfg.augment_base_sizes, "dvc repro report"))

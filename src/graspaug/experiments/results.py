@@ -1,0 +1,258 @@
+"""Results as data: each study's per-network, per-test-datapoint tables in ``results/<study>/``, and every figure the
+README and docs/results.md quote, recomputed from them (issue #58).
+
+``results/attribution/`` (written by ``studies/attribution.py``, read by :func:`recompute`):
+
+* ``networks.parquet`` — one row per draw, training seed and network: ``draw`` (``data_seed``), ``pool``,
+  ``base_size``, ``ratio``, ``seed``, ``val_ap``, ``test_ap``, ``test_roc_auc``, ``train_datapoints``
+  (:func:`~graspaug.experiments.ap.numbers.collect`'s columns);
+* ``predictions.parquet`` — one row per test datapoint, one float32 column per network,
+  ``<draw>/<seed>/<pool>/<B>-<R>``: its P(success);
+* ``test.parquet`` — one row per test datapoint, in the same order: ``label`` (1: a successful grasp), ``object``
+  (its test shape);
+* ``meta.json`` — the exact ``command`` and code ``commit`` that made them, the date, and the params the combination
+  reads (``base_sizes``, ``ratios``, ``augment_base_sizes``, ``pools``, ``n_resamples``, ``seed``), written last.
+
+``results/lifelong/`` (written by ``studies/lifelong.py``, :func:`write_lifelong`): ``predictions.parquet`` (one
+float32 column per round, draw, training seed and arm, ``r<k>/<draw>/<seed>/<arm>``), ``test.parquet`` and
+``meta.json`` as above.
+
+A quoted figure is marked in the markdown by an html comment naming its key, the figure right after it::
+
+    <!-- results:attribution/targeted_vs_none@100 -->+0.0100 [+0.0010, +0.0210]
+
+and :func:`check_markdown` says where a marked figure differs from the recomputed one (``graspaug results --check``).
+"""
+
+from __future__ import annotations
+
+import json
+import re
+from collections.abc import Mapping
+from pathlib import Path
+from types import SimpleNamespace
+
+import numpy as np
+import pandas as pd
+
+from graspaug.errors import DataError
+from graspaug.experiments.stats import interval_text, share_text
+
+MARKER = re.compile(r"<!-- results:([\w@./+-]+) -->")
+FILES = ("networks.parquet", "predictions.parquet", "test.parquet", "meta.json")
+DOCUMENTS = ("README.md", "docs/results.md")  # the markdown whose marked figures must equal the recomputed ones
+
+
+def _column(draw: int, seed: int, key: tuple) -> str:
+    from graspaug.training.variants import network_variant
+
+    return f"{draw}/{seed}/{network_variant(*key).name}"
+
+
+def write_attribution(
+    folder: Path, draws: Mapping[int, Mapping[int, Path]], labels, object_ids, generate, gqcnn, meta: dict
+) -> None:
+    """Write the attribution study's tables (module docstring) into ``folder`` from its networks' folders.
+
+    Parameters
+    ----------
+    draws : data seed → training seed → the folder of that seed's networks (``summary.json``, ``test_predictions.npy``)
+    labels, object_ids : (N,) — the test datapoints' labels and objects, in the predictions' order
+    generate, gqcnn : the params sections the draws ran with
+    meta : ``command``, ``commit``, ``date``, ``n_resamples``, ``seed`` — kept in ``meta.json``
+    """
+    from graspaug.experiments.ap.numbers import collect, test_predictions
+    from graspaug.io.atomic import atomic_path
+    from graspaug.training.variants import seed_variants
+
+    variants = seed_variants(generate.base_sizes, generate.ratios, gqcnn.augment_base_sizes, False, gqcnn.pools)
+    tables, columns = [], {}
+    for d, seed_dirs in draws.items():
+        runs = collect(seed_dirs, variants)
+        tables.append(runs.assign(draw=d)[["draw", *runs.columns]])
+        for s, folder_s in seed_dirs.items():
+            for v in variants:
+                key = (v.pool, v.base_size, float(v.ratio))
+                columns[_column(d, s, key)] = test_predictions(folder_s, key).astype(np.float32)
+    folder.mkdir(parents=True, exist_ok=True)
+    frames = {
+        "networks.parquet": pd.concat(tables, ignore_index=True),
+        "predictions.parquet": pd.DataFrame(columns),
+        "test.parquet": pd.DataFrame({"label": np.asarray(labels, dtype=np.int8), "object": np.asarray(object_ids)}),
+    }
+    (folder / "meta.json").unlink(missing_ok=True)  # a folder without meta.json is an unfinished one
+    for name, frame in frames.items():
+        with atomic_path(folder / name) as tmp:
+            frame.to_parquet(tmp, index=False)
+    keep = {
+        "base_sizes": list(generate.base_sizes),
+        "ratios": [float(r) for r in generate.ratios],
+        "augment_base_sizes": list(gqcnn.augment_base_sizes),
+        "pools": list(gqcnn.pools),
+    }
+    with atomic_path(folder / "meta.json") as tmp:
+        tmp.write_text(json.dumps(meta | keep, indent=1) + "\n")
+
+
+def combine_attribution(folder: Path) -> dict:
+    """:func:`~graspaug.experiments.ap.attribution.combine_runs` of the tables in ``folder`` (module docstring), with
+    the resamples and seed its ``meta.json`` names: the study's ``summary.json``, figure for figure."""
+    from graspaug.experiments.ap.attribution import combine_runs
+
+    missing = [name for name in FILES if not (folder / name).is_file()]
+    if missing:
+        raise DataError(f"{folder}: no {', '.join(missing)} (an unfinished or foreign results folder)")
+    meta = json.loads((folder / "meta.json").read_text())
+    networks = pd.read_parquet(folder / "networks.parquet")
+    predictions = pd.read_parquet(folder / "predictions.parquet")
+    test = pd.read_parquet(folder / "test.parquet")
+    runs = {int(d): g.drop(columns="draw").reset_index(drop=True) for d, g in networks.groupby("draw", sort=True)}
+
+    def network(d: int, s: int, key: tuple) -> np.ndarray:
+        name = _column(d, s, key)
+        if name not in predictions:
+            raise DataError(f"{folder / 'predictions.parquet'}: no column {name!r}")
+        return predictions[name].to_numpy()
+
+    generate = SimpleNamespace(base_sizes=meta["base_sizes"], ratios=meta["ratios"])
+    gqcnn = SimpleNamespace(augment_base_sizes=meta["augment_base_sizes"], pools=tuple(meta["pools"]))
+    labels, objects = test.label.to_numpy(), test.object.to_numpy()
+    result = combine_runs(runs, network, labels, objects, generate, gqcnn, meta["n_resamples"], meta["seed"])
+    return result | {"augment_base_sizes": meta["augment_base_sizes"]}
+
+
+def attribution_figures(result: dict, study: str = "attribution") -> dict[str, str]:
+    """Every figure of an attribution result (:func:`combine_attribution`) as the text a document quotes, by key:
+    ``<study>/<contrast>`` (``mean [low, high]``, AP, 4 decimals), ``<study>/share/<pool>@<B>`` (the share with its
+    interval by test inversion, or ``[unbounded]``), ``<study>/real_gain@<B>`` (the shares' denominator)."""
+    out = {f"{study}/{name}": interval_text(c) for name, c in result["contrasts"].items()}
+    for pool, by_size in result["shares"].items():
+        for b, s in by_size.items():
+            out[f"{study}/share/{pool}@{b}"] = share_text(s)
+            out[f"{study}/real_gain@{b}"] = interval_text(s["real_gain"])
+    return out
+
+
+def recompute(results_dir: Path) -> tuple[dict[str, str], dict[str, dict]]:
+    """Every figure of every study folder in ``results_dir`` (``results/``): (key → text, study → result). A study
+    folder named ``<study>`` or ``<study>-<label>`` (e.g. ``attribution-real-objects``) is read by ``<study>``'s
+    functions and its keys start with its folder name."""
+    figures, results = {}, {}
+    for folder in sorted(p for p in Path(results_dir).iterdir() if p.is_dir()) if Path(results_dir).is_dir() else ():
+        kind = folder.name.split("-")[0]
+        if kind not in STUDIES:
+            raise DataError(f"{folder}: not a study folder (known: {', '.join(STUDIES)})")
+        combine, figures_of = STUDIES[kind]
+        results[folder.name] = combine(folder)
+        figures |= figures_of(results[folder.name], folder.name)
+    return figures, results
+
+
+def marked_figures(text: str) -> list[tuple[str, int]]:
+    """The marked figures of a markdown ``text``: (key, offset of the figure's first character), in order."""
+    return [(m.group(1), m.end()) for m in MARKER.finditer(text)]
+
+
+def check_markdown(text: str, figures: Mapping[str, str], name: str = "markdown") -> list[str]:
+    """One line per marked figure of ``text`` (:func:`marked_figures`) that no study recomputes or that differs from
+    the recomputed ``figures`` (key → text); empty when every marked figure is what the data say."""
+    problems = []
+    for key, at in marked_figures(text):
+        if key not in figures:
+            problems.append(f"{name}: {key}: no study in results/ recomputes it")
+        elif not text.startswith(figures[key], at):
+            quoted = text[at : at + len(figures[key])]
+            problems.append(f"{name}: {key}: quoted {quoted!r}, recomputed {figures[key]!r}")
+    return problems
+
+
+def write_recomputed(results: Mapping[str, dict], figures: Mapping[str, str], out: Path) -> None:
+    """Write each study's recomputed result into ``out``/<study>/: ``summary.json``, ``figures.json`` (its figures by
+    key) and, for an attribution study, ``decomposition.md`` (its report); each file atomically."""
+    from graspaug.experiments.ap.attribution import decomposition_markdown
+    from graspaug.io.atomic import atomic_path
+
+    for study, result in results.items():
+        folder = Path(out) / study
+        folder.mkdir(parents=True, exist_ok=True)
+        own = {k: v for k, v in figures.items() if k.startswith(f"{study}/")}
+        files = {"summary.json": json.dumps(result, indent=1), "figures.json": json.dumps(own, indent=1)}
+        if study.split("-")[0] == "attribution":
+            command = f"graspaug results (results/{study})"
+            files["decomposition.md"] = decomposition_markdown(result, result["augment_base_sizes"], command)
+        for name, text in files.items():
+            with atomic_path(folder / name) as tmp:
+                tmp.write_text(text + ("" if text.endswith("\n") else "\n"))
+
+
+def write_lifelong(folder: Path, rounds: Mapping[int, Mapping], labels, object_ids, meta: dict) -> None:
+    """Write the lifelong study's tables into ``folder``: ``predictions.parquet`` (one float32 column per round, draw,
+    training seed and arm, ``r<k>/<draw>/<seed>/<arm>``), ``test.parquet`` (``label``, ``object``) and ``meta.json``
+    (``meta``: ``command``, ``commit``, ``date``, ``n_resamples``, ``seed``; written last).
+
+    Parameters
+    ----------
+    rounds : round → :func:`~graspaug.experiments.lifelong.numbers.arm_contrasts`'s ``networks`` of that round
+        (draw → seed → arm → network folder)
+    labels, object_ids : (N,) — the test datapoints' labels and objects, in the predictions' order
+    """
+    from graspaug.experiments.lifelong.numbers import network_predictions
+    from graspaug.io.atomic import atomic_path
+
+    columns = {
+        f"r{k}/{d}/{s}/{arm}": network_predictions(network).astype(np.float32)
+        for k, networks in rounds.items()
+        for d, by_seed in networks.items()
+        for s, by_arm in by_seed.items()
+        for arm, network in by_arm.items()
+    }
+    folder.mkdir(parents=True, exist_ok=True)
+    (folder / "meta.json").unlink(missing_ok=True)  # a folder without meta.json is an unfinished one
+    test = pd.DataFrame({"label": np.asarray(labels, dtype=np.int8), "object": np.asarray(object_ids)})
+    for name, frame in {"predictions.parquet": pd.DataFrame(columns), "test.parquet": test}.items():
+        with atomic_path(folder / name) as tmp:
+            frame.to_parquet(tmp, index=False)
+    with atomic_path(folder / "meta.json") as tmp:
+        tmp.write_text(json.dumps(dict(meta), indent=1) + "\n")
+
+
+def combine_lifelong(folder: Path) -> dict:
+    """Round → :func:`~graspaug.experiments.lifelong.numbers.arm_contrasts` of the tables :func:`write_lifelong` wrote
+    in ``folder``, with the resamples and seed of its ``meta.json``: the study's ``summary.json``, figure for figure."""
+    from graspaug.experiments.lifelong.numbers import arm_contrasts
+
+    missing = [name for name in ("predictions.parquet", "test.parquet", "meta.json") if not (folder / name).is_file()]
+    if missing:
+        raise DataError(f"{folder}: no {', '.join(missing)} (an unfinished or foreign results folder)")
+    meta = json.loads((folder / "meta.json").read_text())
+    predictions, test = pd.read_parquet(folder / "predictions.parquet"), pd.read_parquet(folder / "test.parquet")
+    rounds: dict = {}
+    for name in predictions.columns:
+        k, d, s, arm = name.split("/")
+        by_arm = rounds.setdefault(int(k[1:]), {}).setdefault(int(d), {}).setdefault(int(s), {})
+        by_arm[arm] = predictions[name].to_numpy()
+    labels, objects = test.label.to_numpy(), test.object.to_numpy()
+    return {
+        k: arm_contrasts(networks, labels, objects, meta["n_resamples"], meta["seed"])
+        for k, networks in sorted(rounds.items())
+    }
+
+
+def lifelong_figures(result: dict, study: str = "lifelong") -> dict[str, str]:
+    """Every figure of a lifelong result (:func:`combine_lifelong`) by key: ``<study>/r<k>/<contrast>``,
+    ``<study>/r<k>/ap/<arm>`` (``mean [low, high]``, AP) and ``<study>/r<k>/share`` (its interval by test inversion,
+    or ``[unbounded]``)."""
+    out = {}
+    for k, r in result.items():
+        out |= {f"{study}/r{k}/ap/{arm}": interval_text(c, ".4f") for arm, c in r["ap"].items()}
+        out |= {f"{study}/r{k}/{name}": interval_text(c) for name, c in r["contrasts"].items()}
+        if "share" in r:
+            out[f"{study}/r{k}/share"] = share_text(r["share"])
+    return out
+
+
+STUDIES = {
+    "attribution": (combine_attribution, attribution_figures),
+    "lifelong": (combine_lifelong, lifelong_figures),
+}
+"""Study name → (read and combine its ``results/<study>/`` folder, its figures by key)."""

@@ -1,0 +1,121 @@
+"""Results as data (issue #58): the studies' per-network tables in results/ recompute every figure the README and
+docs/results.md quote."""
+
+import json
+import re
+from pathlib import Path
+
+from typer.testing import CliRunner
+
+from graspaug.experiments.ap.attribution import combine_draws
+from graspaug.experiments.results import (
+    DOCUMENTS,
+    attribution_figures,
+    check_markdown,
+    combine_attribution,
+    recompute,
+    write_attribution,
+)
+from graspaug.pipeline.cli import app
+from tests.experiments.test_attribution import GENERATE, GQCNN, LABELS, OBJECTS, make_draws
+
+ROOT = Path(__file__).resolve().parents[2]
+META = {"command": "python studies/attribution.py --draws 0 1", "commit": "0" * 40, "date": "2026-11-28"}
+
+
+def _results(tmp_path, real_noise=0.1):
+    draws = make_draws(tmp_path / "networks", seeds=(0, 1, 2), real_noise=real_noise)
+    result = combine_draws(draws, LABELS, OBJECTS, GENERATE, GQCNN, n_resamples=200, seed=3)
+    folder = tmp_path / "repo" / "results" / "attribution"
+    write_attribution(folder, draws, LABELS, OBJECTS, GENERATE, GQCNN, META | {"n_resamples": 200, "seed": 3})
+    return result, folder
+
+
+def test_the_results_tables_recompute_the_studys_result_figure_for_figure(tmp_path):
+    result, folder = _results(tmp_path)
+    assert json.loads((folder / "meta.json").read_text())["commit"] == "0" * 40  # the code that made them
+    again = combine_attribution(folder)
+    assert again["contrasts"] == result["contrasts"] and again["shares"] == result["shares"]
+    figures = attribution_figures(result)
+    assert figures["attribution/share/recon@10"] == "+100% [+100%, +100%]"  # the real gain is clear here
+    real = result["shares"]["recon"]["10"]["real_gain"]
+    assert (
+        figures["attribution/real_gain@10"]
+        == f"{real['mean']:+.4f} [{real['draws_low']:+.4f}, {real['draws_high']:+.4f}]"
+    )
+    assert recompute(folder.parent)[0] == figures
+
+
+def test_a_marked_figure_that_differs_or_that_no_study_recomputes_is_named(tmp_path):
+    figures = {"attribution/targeted_vs_none@10": "+0.0100 [+0.0010, +0.0210]"}
+    good = "gain <!-- results:attribution/targeted_vs_none@10 -->+0.0100 [+0.0010, +0.0210] at B = 10"
+    assert check_markdown(good, figures, "README.md") == []
+    bad = good.replace("+0.0210]", "+0.0200]") + " and <!-- results:attribution/share/targeted@10 -->+78%"
+    problems = check_markdown(bad, figures, "README.md")
+    assert problems == [
+        "README.md: attribution/targeted_vs_none@10: quoted '+0.0100 [+0.0010, +0.0200]', "
+        "recomputed '+0.0100 [+0.0010, +0.0210]'",
+        "README.md: attribution/share/targeted@10: no study in results/ recomputes it",
+    ]
+
+
+def test_graspaug_results_recomputes_and_checks_the_documents(tmp_path):
+    result, folder = _results(tmp_path)
+    repo = folder.parents[1]
+    quoted = attribution_figures(result)["attribution/targeted_vs_blend@10"]
+    (repo / "docs").mkdir()
+    (repo / "docs/results.md").write_text("nothing marked\n")
+    (repo / "README.md").write_text(f"<!-- results:attribution/targeted_vs_blend@10 -->{quoted}\n")
+    ok = CliRunner().invoke(app, ["results", "--root", str(repo), "--check"])
+    assert ok.exit_code == 0, ok.output
+    assert f"attribution/targeted_vs_blend@10: {quoted}" in ok.output
+    written = json.loads((repo / "reports/results/attribution/figures.json").read_text())
+    assert written["attribution/targeted_vs_blend@10"] == quoted
+    assert "## What to add" in (repo / "reports/results/attribution/decomposition.md").read_text()
+    (repo / "README.md").write_text("<!-- results:attribution/targeted_vs_blend@10 -->+0.5000 [+0.4000, +0.6000]\n")
+    bad = CliRunner().invoke(app, ["results", "--root", str(repo), "--check"])
+    assert bad.exit_code == 2 and "attribution/targeted_vs_blend@10" in bad.output
+
+
+def test_the_readme_and_results_quote_only_what_the_committed_results_recompute():
+    """Every marked figure of the README and docs/results.md equals what `graspaug results` recomputes from the
+    committed results/; and the README's Results section quotes no share of the real-shape gain (the three-draw
+    shares were withdrawn: their per-network results were not kept, and the sound interval needs them)."""
+    figures, _ = recompute(ROOT / "results")
+    for doc in DOCUMENTS:
+        assert check_markdown((ROOT / doc).read_text(), figures, doc) == []
+    readme = (ROOT / "README.md").read_text()
+    results = readme.split("## Results", 1)[1].split("\n## ", 1)[0]
+    shares = re.findall(r"[+−-]?\d+% \[[+−-]?\d+%, [+−-]?\d+%\]", results)  # e.g. "+78% [+1%, +200%]"
+    assert shares == [], f"the README quotes shares no committed result recomputes: {shares}"
+    assert "not recomputable from committed data (measured 2026-11-27, commit 960d70e)" in results
+
+
+def test_the_lifelong_tables_recompute_every_rounds_figures(tmp_path):
+    import numpy as np
+
+    from graspaug.experiments.lifelong.numbers import arm_contrasts
+    from graspaug.experiments.results import combine_lifelong, lifelong_figures, write_lifelong
+
+    rng = np.random.default_rng(4)
+    objects = np.repeat([f"o{i}" for i in range(30)], 8)
+    labels = rng.integers(0, 2, size=len(objects))
+    skill = {"none": 0.5, "failure": 0.7, "random": 0.6, "real": 1.5}
+    networks = {}
+    for d in (0, 1):
+        for s in (0, 1):
+            for arm, k in skill.items():
+                folder = tmp_path / f"d{d}" / f"s{s}" / arm
+                folder.mkdir(parents=True)
+                p = 1 / (1 + np.exp(-(k * (2 * labels - 1) + rng.normal(size=len(labels)))))
+                np.save(folder / "test_predictions.npy", p.astype(np.float32))
+                networks.setdefault(d, {}).setdefault(s, {})[arm] = folder
+    rounds = {0: {d: {s: {"none": a["none"]} for s, a in by.items()} for d, by in networks.items()}, 1: networks}
+    study = {k: arm_contrasts(n, labels, objects, 200, 7) for k, n in rounds.items()}
+    folder = tmp_path / "results" / "lifelong"
+    write_lifelong(folder, rounds, labels, objects, META | {"n_resamples": 200, "seed": 7})
+    again = combine_lifelong(folder)
+    assert again == study  # float32 predictions, as the networks saved them: figure for figure
+    figures = lifelong_figures(study)
+    assert figures["lifelong/r1/share"].endswith("]") and "lifelong/r0/ap/none" in figures
+    assert recompute(tmp_path / "results")[0] == figures
