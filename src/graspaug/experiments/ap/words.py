@@ -6,13 +6,8 @@ import numpy as np
 import pandas as pd
 
 from graspaug.experiments.ap.attribution import share_sentence
-from graspaug.experiments.stats import (
-    draw_scope,
-    interval_text,
-)
-from graspaug.experiments.stats import (
-    verdict as contrast_verdict,
-)
+from graspaug.experiments.stats import draw_scope, interval, interval_text
+from graspaug.experiments.stats import verdict as contrast_verdict
 
 
 def gain_sentences(
@@ -57,6 +52,9 @@ def verdict(name: str, c: dict) -> str:
     scoped to the run's one draw of the data (:func:`~graspaug.experiments.stats.draw_verdict`)."""
     if c["mean"] is None:
         return f"`{name}` ({c['meaning']}): no value (a test set with one class?)."
+    if None in interval(c):  # no usable interval: say so rather than print one
+        seeds = "one seed" if c.get("n_seeds") == 1 else "too few seeds"
+        return f"`{name}` ({c['meaning']}): {c['mean']:+.4f} AP, {seeds}, no interval: nothing we can claim."
     return f"`{name}` ({c['meaning']}): {interval_text(c)} AP, {contrast_verdict(c)}."
 
 

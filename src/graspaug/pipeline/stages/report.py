@@ -2,14 +2,13 @@
 
 Reads every network of every seed (``models/gqcnn/s<seed>/``). Writes ``metrics/ap/<contrast>.json`` (``mean``,
 ``lo``, ``hi``: the 95% bootstrap over seeds × test objects, the one interval every report quotes) and, in
-``reports/gqcnn/``: ``ap.json`` (per declared contrast a :func:`~graspaug.experiments.stats.contrast`: ``mean``,
-``draws_low``/``draws_high`` (the judged one), secondary ``seeds_low``/``seeds_high``, ``objects_low``/``objects_high``,
-``over``, ``n_seeds``, ``sd``; test, validation and per-object AP per network; ``chosen_ratio`` per base size, picked
-on validation AP), ``ap_table.csv``, ``report.md``, ``decomposition.{md,json}`` (the gap to real shapes step by step,
-real → recon → blend → targeted / random, intervals over the seeds and test objects of this run's one draw of the
-data), ``ap_vs_ratio.png`` (Fig. 7), ``improvement_by_score.png`` (Fig. 8: per-object AP change of the chosen ratio
-over 1:0 at the largest base size, by rarity and graspness interval) and ``tsne_graspness.png`` (Fig. 1); the .md
-reports open with the profile and corpus that made them."""
+``reports/gqcnn/``: ``ap.json`` (per declared contrast a :func:`~graspaug.experiments.stats.contrast`, judged by
+``draws_low``/``draws_high``; AP per network and object; ``chosen_ratio`` per base size, picked on validation AP),
+``ap_table.csv``, ``report.md``, ``decomposition.{md,json}`` (the gap to real shapes step by step, real → recon →
+blend → targeted / random, over this run's seeds and test objects), ``ap_vs_ratio.png`` (Fig. 7),
+``improvement_by_score.png`` (Fig. 8: per-object AP change of the chosen ratio over 1:0 at the largest base size, by
+rarity and graspness interval) and ``tsne_graspness.png`` (Fig. 1); the .md reports open with the profile and corpus
+that made them."""
 
 from __future__ import annotations
 
