@@ -93,3 +93,9 @@ def run(params: Params) -> None:
     )
     text = contrast_text(metrics["contrast"]["critic_vs_control"], keys)
     log.info("critic_eval: critic AUC %s; AE-Critic − control outlier %% at α %s: %s", critic["auc"], keys, text)
+
+
+if __name__ == "__main__":
+    from graspaug.pipeline.entry import stage_main
+
+    stage_main(__spec__.name)

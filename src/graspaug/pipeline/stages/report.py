@@ -96,3 +96,9 @@ def run(params: Params) -> None:
         tmp.write_text(report_markdown(table, results, chosen, extras, seeds, positive_share, words, params.data_seed))
     for name, c in results.items():
         log.info("report: %s", verdict(name, c))
+
+
+if __name__ == "__main__":
+    from graspaug.pipeline.entry import stage_main
+
+    stage_main(__spec__.name)
