@@ -182,10 +182,10 @@ def test_every_stage_lists_exactly_its_code():
 
 
 def test_a_stage_depends_only_on_the_settings_it_reads():
-    """Settings modules are plain data and the CLI loads a stage's params lazily: the robot cell's
+    """Settings modules are plain data and a stage imports only the params sections it reads: the robot cell's
     settings are code of the stages that run the cell (`sim`, `grasp_calibration`) alone, so editing them re-runs
-    nothing before them. `check_params` reads every section (the whole params model, `config.py`) and writes nothing,
-    so editing any settings module re-runs it and nothing else."""
+    nothing before them. `check_params` reads every section (the whole params model, `params/model.py`) and writes
+    nothing, so editing any settings module re-runs it and nothing else."""
     deps = expected_code_deps()
     cell = {name for name, files in deps.items() if "src/graspaug/sim/settings.py" in files}
     assert cell == {"sim", "grasp_calibration", "check_params"}
