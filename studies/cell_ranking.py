@@ -12,8 +12,8 @@ once (``--grasps``, the ``grasps.csv`` of a ``grasp_calibration`` run): they do 
 networks. Arms: ``before`` (targeted B-0), ``after`` and ``real`` (B at each project's ratio chosen
 on validation AP: its AP report, or its targeted B networks' validation AP), ``more_real`` (targeted
 ``--more-real``-0, by default the largest base size). Each project's ``params.yaml`` is read;
-``--models`` names the networks' folder in it (``studies/train_networks.py --out`` writes one).
-Prints one JSON line.
+``--models`` names the networks' folder in it (``studies/train_networks.py --out`` wrote one; removed in
+[house], see git history at commit 35c607b). Prints one JSON line.
 
     python studies/cell_ranking.py --grasps reports/grasp_calibration/grasps.csv \\
         --projects . ../draw1 ../draw2 [--models models/gqcnn] [--seeds 0 1 2 3] [--base-size 50] [--more-real 200]

@@ -1,11 +1,11 @@
 """Every dvc.yaml stage lists exactly the graspaug source it runs: no more, no less.
 
-A stage's code is the import closure (found with ``ast``, nothing is imported) of the CLI entry point
-plus the stage module that its ``cmd`` names: ``graspaug x-y ...`` runs ``graspaug.pipeline.stages.x_y``.
-dvc.yaml lists it by room (:func:`dvc_deps`): a library package (``geometry/``, ``augment/``, ...) as its folder,
-the pipeline's modules and the top-level ones as files. ``python tests/test_dvc_deps.py --write`` rewrites every
-stage's ``src/`` deps in dvc.yaml from the import graph (the one source of truth this test checks against);
-without ``--write`` it prints them.
+A stage's code is the import closure (found with ``ast``, nothing is imported) of the stage module that its
+``cmd`` runs, ``python -m graspaug.pipeline.stages.x_y ...`` (its ``__main__`` block imports
+``graspaug.pipeline.entry``); the CLI that lists every command is no stage's code. dvc.yaml lists it module by
+module (:func:`dvc_deps`), a library package as its folder only where the stage reaches every module in it.
+``python tests/test_dvc_deps.py --write`` rewrites every stage's ``src/`` deps in dvc.yaml from the import graph
+(the one source of truth this test checks against); without ``--write`` it prints them.
 """
 
 from __future__ import annotations
@@ -19,7 +19,6 @@ import yaml
 REPO = Path(__file__).resolve().parents[1]
 SRC = REPO / "src"
 DVC_YAML = REPO / "dvc.yaml"
-CLI = "graspaug.pipeline.cli"
 STAGES = "graspaug.pipeline.stages."
 
 
@@ -45,13 +44,40 @@ def _is_inert(tree: ast.Module) -> bool:
     )
 
 
+def _run_nodes(tree: ast.Module):
+    """Every node of ``tree`` but those under ``if TYPE_CHECKING:`` (imports for type checkers, never run)."""
+    todo: list[ast.AST] = [tree]
+    while todo:
+        node = todo.pop()
+        yield node
+        checking = isinstance(node, ast.If) and "TYPE_CHECKING" in {getattr(node.test, a, None) for a in ("id", "attr")}
+        todo.extend(node.orelse if checking else ast.iter_child_nodes(node))
+
+
+def lazy_exports(package: str, src: Path) -> dict[str, str]:
+    """Name -> module of the names a package's ``__init__.py`` imports only ``if TYPE_CHECKING:``: the names it loads
+    on first use (a module ``__getattr__``, as ``graspaug.planning`` does), run only by whoever imports one."""
+    file = module_file(package, src)
+    if file is None or file.name != "__init__.py":
+        return {}
+    tree = ast.parse(file.read_text())
+    run = {id(n) for n in _run_nodes(tree)}
+    return {
+        alias.asname or alias.name: node.module
+        for node in ast.walk(tree)
+        if isinstance(node, ast.ImportFrom) and node.module and not node.level and id(node) not in run
+        for alias in node.names
+    }
+
+
 def module_imports(module: str, src: Path) -> set[str]:
-    """Modules of the same top package that ``module`` imports anywhere (function bodies too), with
-    every package they sit in: ``from a.b import c`` gives ``a``, ``a.b``, and ``a.b.c`` if it is a module."""
+    """Modules of the same top package that ``module`` imports anywhere (function bodies too, not imports for type
+    checkers), with every package they sit in: ``from a.b import c`` gives ``a``, ``a.b``, and ``a.b.c`` if it is a
+    module, or the module ``a.b`` loads ``c`` from on first use (:func:`lazy_exports`)."""
     root, file = module.split(".")[0], module_file(module, src)
     package = module if file.name == "__init__.py" else module.rpartition(".")[0]
     names: set[str] = set()
-    for node in ast.walk(ast.parse(file.read_text(), str(file))):
+    for node in _run_nodes(ast.parse(file.read_text(), str(file))):
         if isinstance(node, ast.Import):
             names.update(alias.name for alias in node.names)
         elif isinstance(node, ast.ImportFrom):
@@ -59,6 +85,8 @@ def module_imports(module: str, src: Path) -> set[str]:
             origin = ".".join(base + ([node.module] if node.module else []))
             names.add(origin)
             names.update(f"{origin}.{alias.name}" for alias in node.names if alias.name != "*")
+            lazy = lazy_exports(origin, src)
+            names.update(lazy[alias.name] for alias in node.names if alias.name in lazy)
     return {m for n in names for m in _with_packages(n) if m.split(".")[0] == root and module_file(m, src)}
 
 
@@ -82,45 +110,27 @@ def import_closure(module: str, src: Path) -> set[str]:
     return _closure({module}, src)
 
 
-CLI_SHARED = ("_load", "_run")  # the cli.py functions every stage command runs (and its module-level imports)
-
-
-def cli_imports(src: Path) -> set[str]:
-    """What cli.py imports for every stage command: its module-level imports and those inside
-    the functions and classes of :data:`CLI_SHARED` (other commands' lazy imports run only for those commands)."""
-    tree = ast.parse(module_file(CLI, src).read_text())
-    shared = [node for node in tree.body if not isinstance(node, (ast.FunctionDef, ast.ClassDef))]
-    shared += [n for n in tree.body if isinstance(n, (ast.FunctionDef, ast.ClassDef)) and n.name in CLI_SHARED]
-    names: set[str] = set()
-    for node in (n for top in shared for n in ast.walk(top)):
-        if isinstance(node, ast.Import):
-            names.update(alias.name for alias in node.names)
-        elif isinstance(node, ast.ImportFrom) and node.module:
-            names.add(node.module)
-            names.update(f"{node.module}.{alias.name}" for alias in node.names)
-    return {m for n in names for m in _with_packages(n) if m.startswith("graspaug") and module_file(m, src)}
-
-
 def stage_code(cmd: str, src: Path = SRC) -> set[str]:
-    """The code a ``graspaug <command> ...`` cmd runs: cli.py with what it imports for every command
-    (:func:`cli_imports`), and the stage module's closure."""
-    program, command = cmd.split()[:2]
-    stage_module = STAGES + command.replace("-", "_")
-    if program != "graspaug" or module_file(stage_module, src) is None:
-        raise ValueError(f"cmd {cmd!r} does not run a graspaug stage module ({stage_module})")
-    cli_file = module_file(CLI, src).relative_to(src.parent).as_posix()
-    return _closure({stage_module} | cli_imports(src), src) | {cli_file}
+    """The code a ``python -m graspaug.pipeline.stages.<stage> ...`` cmd runs: the stage module's closure."""
+    words = cmd.split()
+    module = words[2] if words[:2] == ["python", "-m"] and len(words) > 2 else ""
+    if not module.startswith(STAGES) or module_file(module, src) is None:
+        raise ValueError(f"cmd {cmd!r} does not run a stage module (python -m {STAGES}<stage>)")
+    return _closure({module}, src)
 
 
-def dvc_deps(files: set[str]) -> set[str]:
-    """``files`` (repo-relative ``src/graspaug/...`` paths) as dvc.yaml lists them: a module of a library package
-    as the package's folder (``src/graspaug/geometry``: editing any of its modules re-runs the stage), a module
-    of ``pipeline/`` or at the top of the package as its file (a stage re-runs for its own adapter and params
-    sections, not every stage's)."""
-    out = set()
-    for path in files:
-        parts = path.split("/")
-        out.add("/".join(parts[:3]) if len(parts) > 3 and parts[2] != "pipeline" else path)
+def dvc_deps(files: set[str], src: Path = SRC) -> set[str]:
+    """``files`` (repo-relative ``src/graspaug/...`` paths) as dvc.yaml lists them: each file, except that a
+    library package (``src/graspaug/geometry``) every one of whose modules is in ``files`` is listed as its folder.
+    A stage re-runs for the modules it runs, not for the rest of their package (ingest for ``augment/corpus.py``,
+    not ``augment/pools.py``)."""
+    out = set(files)
+    for package in {"/".join(p.split("/")[:3]) for p in files if len(p.split("/")) > 3}:
+        if package.endswith("/pipeline"):
+            continue
+        modules = {f.relative_to(src.parent).as_posix() for f in (src.parent / package).rglob("*.py")}
+        if modules <= files:
+            out = (out - modules) | {package}
     return out
 
 
@@ -146,7 +156,7 @@ def compare_code_deps(dvc: dict, src: Path = SRC) -> dict[str, dict[str, set[str
             for d in (d if isinstance(d, str) else next(iter(d)) for d in body.get("deps", []))
             if d.startswith("src/")
         }
-        expected = dvc_deps(stage_code(body["cmd"], src))
+        expected = dvc_deps(stage_code(body["cmd"], src), src)
         missing, extra = expected - listed, listed - expected
         if missing or extra:
             problems[name] = {"missing": missing, "extra": extra}
@@ -172,10 +182,10 @@ def test_every_stage_lists_exactly_its_code():
 
 
 def test_a_stage_depends_only_on_the_settings_it_reads():
-    """Settings modules are plain data and the CLI loads a stage's params lazily: the robot cell's
+    """Settings modules are plain data and a stage imports only the params sections it reads: the robot cell's
     settings are code of the stages that run the cell (`sim`, `grasp_calibration`) alone, so editing them re-runs
-    nothing before them. `check_params` reads every section (the whole params model, `config.py`) and writes nothing,
-    so editing any settings module re-runs it and nothing else."""
+    nothing before them. `check_params` reads every section (the whole params model, `params/model.py`) and writes
+    nothing, so editing any settings module re-runs it and nothing else."""
     deps = expected_code_deps()
     cell = {name for name, files in deps.items() if "src/graspaug/sim/settings.py" in files}
     assert cell == {"sim", "grasp_calibration", "check_params"}
@@ -197,14 +207,35 @@ def test_a_planted_missing_dep_is_caught():
 
 
 def test_a_folder_the_stage_does_not_run_is_caught():
-    """A library folder the stage never imports is an extra dep; a library module is listed as its folder."""
+    """A library folder the stage never imports is an extra dep; a package is listed as its folder only when the
+    stage runs every module in it, else module by module (ingest runs augment's corpus code, not its pools)."""
     dvc = _real_dvc()
     dvc_stages(dvc)["voxelize"]["deps"].append("src/graspaug/sim")
     assert "src/graspaug/sim" in compare_code_deps(dvc)["voxelize"]["extra"]
-    assert dvc_deps({"src/graspaug/geometry/voxelize.py", "src/graspaug/pipeline/stages/voxelize.py"}) == {
-        "src/graspaug/geometry",
-        "src/graspaug/pipeline/stages/voxelize.py",
-    }
+    some = {"src/graspaug/geometry/voxelize.py", "src/graspaug/pipeline/stages/voxelize.py"}
+    assert dvc_deps(some) == some
+    whole = {f.relative_to(REPO).as_posix() for f in (SRC / "graspaug/geometry").rglob("*.py")}
+    assert dvc_deps(whole | some) == {"src/graspaug/geometry", "src/graspaug/pipeline/stages/voxelize.py"}
+    ingest = expected_code_deps()["ingest"]
+    assert "src/graspaug/augment/corpus.py" in ingest and "src/graspaug/augment/pools.py" not in ingest
+
+
+def test_no_stage_runs_the_cli_or_another_stage():
+    """A stage's code is its own module's closure: editing cli.py (a help text, a user's command) or another stage's
+    adapter re-runs nothing; check_params reads the params model, not the libraries that use it."""
+    for name, files in expected_code_deps().items():
+        assert "src/graspaug/pipeline/cli.py" not in files, name
+        stages = {f for f in files if f.startswith("src/graspaug/pipeline/stages/") and not f.endswith("__init__.py")}
+        assert len(stages) == 1, (name, sorted(stages))
+    check = expected_code_deps()["check_params"]
+    assert not {
+        f
+        for f in check
+        if f.startswith("src/graspaug/")
+        and f.count("/") > 2
+        and "/pipeline/" not in f
+        and not f.endswith(("/settings.py", "/__init__.py", "/gripper.py", "/catalog.py"))
+    }, sorted(check)
 
 
 WIDTH = 118  # dvc.yaml's lines, as ruff's for the code
@@ -287,13 +318,31 @@ def test_import_closure_follows_every_import_form(tmp_path):
     assert "src/pkg/__init__.py" in import_closure("pkg.a.sibling", tmp_path / "src")
 
 
+def test_imports_for_type_checkers_count_only_where_their_name_is_imported(tmp_path):
+    """``if TYPE_CHECKING:`` imports never run, except as a package's lazily loaded names: ``from pkg import Heavy``
+    runs ``pkg/heavy.py``, ``from pkg.settings import x`` does not."""
+    files = {
+        "pkg/__init__.py": "from typing import TYPE_CHECKING\nif TYPE_CHECKING:\n    from pkg.heavy import Heavy\n",
+        "pkg/heavy.py": "Heavy = 1\n",
+        "pkg/settings.py": "x = 1\n",
+        "pkg/light.py": "from pkg.settings import x\n",
+        "pkg/user.py": "from pkg import Heavy\n",
+    }
+    for path, text in files.items():
+        (tmp_path / "src" / path).parent.mkdir(parents=True, exist_ok=True)
+        (tmp_path / "src" / path).write_text(text)
+    assert "src/pkg/heavy.py" not in import_closure("pkg.light", tmp_path / "src")
+    assert "src/pkg/heavy.py" in import_closure("pkg.user", tmp_path / "src")
+
+
 def test_stages_are_thin_adapters_that_import_no_stage():
     """A stage reads its params, calls library code and writes outputs: at most ~100 lines as ruff formats them, and
     what a test or another stage needs lives in a library module, not in a stage."""
     for path in sorted((SRC / "graspaug/pipeline/stages").glob("*.py")):
         if path.name == "__init__.py":
             continue
-        assert len(path.read_text().splitlines()) <= 100, f"{path.name} is {len(path.read_text().splitlines())} lines"
+        lines = path.read_text().split('\nif __name__ == "__main__":')[0].rstrip().splitlines()  # the entry point aside
+        assert len(lines) <= 100, f"{path.name} is {len(lines)} lines"
         imported = module_imports(f"graspaug.pipeline.stages.{path.stem}", SRC)
         assert not {m for m in imported if m.startswith(STAGES)}, (
             f"{path.name} imports a stage: {sorted(m for m in imported if m.startswith(STAGES))}"

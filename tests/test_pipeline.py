@@ -982,6 +982,32 @@ def test_editing_a_sim_setting_reruns_only_sim(tiny_repo):
     assert json.loads(run(["dvc", "status", "--json"], work, env).stdout) == {}
 
 
+def test_editing_the_cli_or_a_stage_reruns_only_what_runs_it(tiny_repo):
+    """Each stage runs its own module: an edit of cli.py (a help text, a user's command) leaves the finished run up
+    to date, an edit of one stage's adapter changes that stage alone, and one of augment's pools not ingest."""
+    import json
+
+    work, env = tiny_repo
+    run(["dvc", "repro"], work, env)  # the pipeline is complete
+    for rel, expected in [
+        ("src/graspaug/pipeline/cli.py", set()),
+        ("src/graspaug/pipeline/stages/sim.py", {"sim"}),
+        ("src/graspaug/augment/pools.py", None),
+    ]:
+        path = work / rel
+        original = path.read_text()
+        path.write_text(original + "# edited\n")
+        try:
+            changed = set(json.loads(run(["dvc", "status", "--json"], work, env).stdout))
+        finally:
+            path.write_text(original)
+        if expected is None:
+            assert changed and "ingest" not in changed, (rel, changed)
+        else:
+            assert changed == expected, (rel, changed)
+    assert json.loads(run(["dvc", "status", "--json"], work, env).stdout) == {}
+
+
 def test_a_bad_params_file_stops_dvc_repro_before_any_stage_deletes_outputs(tiny_repo):
     """A mistyped top-level key, and a bad value, stop `dvc repro` in `check_params` (the first stage) with one line
     naming the key: no other stage runs and every output stays, even when nothing else would have run."""

@@ -1,8 +1,9 @@
-"""``graspaug``: one command per pipeline stage (``dvc.yaml`` calls these), and the user's commands.
+"""``graspaug``: one command per pipeline stage, and the user's commands.
 
-A stage command imports its stage module, and through it only the params sections that stage
-reads, when it runs (``tests/test_dvc_deps.py`` derives each stage's code deps from that); the
-params tables in ``--help`` are filled in when help is shown.
+A stage command runs what the stage's own entry point runs (``python -m graspaug.pipeline.stages.<stage>``, the
+``cmd`` of its ``dvc.yaml`` stage, through :mod:`graspaug.pipeline.entry`), importing its stage module when it runs;
+this module is no stage's code, so editing it re-runs nothing. The params tables in ``--help`` are filled in when
+help is shown.
 
 Over 400 lines because it is a table: 26 commands (one per stage, and ``plan``, ``from-failures``, ``evaluate``,
 ``export-model``, ``profile``, ``schema``), each a few lines of options with the help text a user reads; the work
@@ -13,15 +14,14 @@ is elsewhere (``pipeline/stages/``, ``planning/report.py``) and errors go throug
 from __future__ import annotations
 
 import importlib
-import logging
 import os
-import sys
 from pathlib import Path
 
 import typer
 from typer.core import TyperCommand
 
 from graspaug.pipeline.command import EXIT_CODES, Command, debug_mode
+from graspaug.pipeline.entry import load_params, round_number, run_stage
 
 app = typer.Typer(
     help="graspaug: augment a grasp planner's training objects with generated shapes.\n\n"
@@ -43,10 +43,7 @@ ForceOption = typer.Option(
 
 def _load(path: Path, stage):
     """The params ``stage`` (a stage module) reads from the file at ``path`` (a bad one: ParamsError, exit 2)."""
-    from graspaug.pipeline.params.base import load
-
-    logging.basicConfig(level=logging.INFO, format="%(asctime)s %(levelname)s %(name)s: %(message)s", stream=sys.stderr)
-    return load(path, stage.Params)
+    return load_params(path, stage.Params)
 
 
 def _stage(module: str):
@@ -70,10 +67,7 @@ def _with_params(module: str, *sections: str) -> type[TyperCommand]:
 
 
 def _run(stage_run, params) -> None:
-    from graspaug.device import keep_freed_memory
-
-    keep_freed_memory()  # no page faults for every freed tensor (GQ-CNN training: bench/gqcnn_train_speed.py)
-    stage_run(params)
+    run_stage(stage_run, params)
 
 
 def stage_command(name: str, help: str, *sections: str) -> None:
@@ -237,14 +231,13 @@ def fidelity_command(
     "generation step from a folder of its failure meshes.",
 )
 def lifelong_command(
-    round_: str = typer.Option(..., "--round", "-r", help="The round: r<k> (or k), one of lifelong.rounds."),
+    round_: int = typer.Option(
+        ..., "--round", "-r", parser=round_number, help="The round: r<k> (or k), one of lifelong.rounds."
+    ),
     params: Path = ParamsOption,
 ) -> None:
-    text = round_.removeprefix("r")
-    if not text.isdigit() or int(text) < 1:
-        raise typer.BadParameter(f"a round r<k> with k >= 1; got {round_!r}", param_hint="--round")
     stage = _stage("lifelong")
-    _run(lambda p: stage.run(p, int(text)), _load(params, stage))
+    _run(lambda p: stage.run(p, round_), _load(params, stage))
 
 
 @app.command(

@@ -18,3 +18,9 @@ __all__ = ["Params", "run"]
 
 def run(params: Params) -> None:
     log.info("check_params: every key of params.yaml is known and every value valid (seed %d)", params.seed)
+
+
+if __name__ == "__main__":
+    from graspaug.pipeline.entry import stage_main
+
+    stage_main(__spec__.name)

@@ -94,3 +94,9 @@ def run(params: Params) -> None:
     text = contrast_text(metrics["contrast"]["critic_vs_control"], keys)
     auc = "undefined" if critic["auc"] is None else f"{critic['auc']:.3f}"
     log.info("critic_eval: critic AUC %s; AE-Critic − control outlier %% at α %s: %s", auc, keys, text)
+
+
+if __name__ == "__main__":
+    from graspaug.pipeline.entry import stage_main
+
+    stage_main(__spec__.name)

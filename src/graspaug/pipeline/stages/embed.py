@@ -40,3 +40,9 @@ def run(params: Params) -> None:
     write_csv(pd.DataFrame({"shape_id": shape_ids, "split": split, "x": xy[:, 0], "y": xy[:, 1]}), TSNE_CSV)
     scatter_2d(xy, split, TSNE_PNG, f"t-SNE of AE-Critic latents ({len(z)} shapes)")
     log.info("embed: %d latents of size %d, t-SNE written", len(z), z.shape[1])
+
+
+if __name__ == "__main__":
+    from graspaug.pipeline.entry import stage_main
+
+    stage_main(__spec__.name)

@@ -96,3 +96,11 @@ def run(params: Params, base_size: int) -> None:
     log.info(
         "fidelity %d: %d pools, %d real shapes, %.1f s", b, len(pools), len(reference), time.perf_counter() - start
     )
+
+
+if __name__ == "__main__":
+    import typer
+
+    from graspaug.pipeline.entry import stage_main
+
+    stage_main(__spec__.name, base_size=(int, typer.Option(..., "--base-size", "-b", help="The base set size B.")))

@@ -95,3 +95,11 @@ def run(params: Params, base_size: int) -> None:
     write_json({"seconds": seconds}, paths.timing_file("generate", str(base_size)))
     counts = " + ".join(f"{out.summary[p]['kept']} {p} ({out.summary[p]['tried']} tried)" for p in pools)
     log.info("generate %d: %s shapes, %d rejected, in %.1f s", base_size, counts, len(out.rejects), seconds)
+
+
+if __name__ == "__main__":
+    import typer
+
+    from graspaug.pipeline.entry import stage_main
+
+    stage_main(__spec__.name, base_size=(int, typer.Option(..., "--base-size", "-b", help="The base set size B.")))

@@ -63,3 +63,9 @@ def run(params: Params) -> None:
         label_calibration(by_eps, table, out / "calibration.png", title)
     write_json_files(calibration_headline(summary), CALIBRATION_METRICS)
     log.info("grasp_calibration: %s; %.0f s", summary_line(summary), summary["seconds"])
+
+
+if __name__ == "__main__":
+    from graspaug.pipeline.entry import stage_main
+
+    stage_main(__spec__.name)

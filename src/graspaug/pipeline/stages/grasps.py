@@ -51,3 +51,12 @@ def run(params: Params, corpus: str = "original") -> None:
         100 * (summary["success_share"] or 0),
         seconds,
     )
+
+
+if __name__ == "__main__":
+    import typer
+
+    from graspaug.pipeline.entry import stage_main
+
+    corpus = typer.Option("original", "--corpus", "-c", help="`original` (ingested corpus) or `gen_<B>` (generated).")
+    stage_main(__spec__.name, corpus=(str, corpus))

@@ -97,3 +97,9 @@ def run(params: Params) -> None:
         cfg.surface.face_budget,
         time.perf_counter() - start,
     )
+
+
+if __name__ == "__main__":
+    from graspaug.pipeline.entry import stage_main
+
+    stage_main(__spec__.name)

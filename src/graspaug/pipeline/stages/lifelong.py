@@ -98,3 +98,12 @@ def run(params: Params, round_: int) -> None:
         curve = write_round(round_, networks, labels, objects, curve, history, params, voxels, *reports, header)
         curve.to_csv(folder / "curve.csv", index=False)
     log.info("%s: %d new shapes per arm, %d generated datapoints in all", label, len(index) // 2, total)
+
+
+if __name__ == "__main__":
+    import typer
+
+    from graspaug.pipeline.entry import round_number, stage_main
+
+    round_ = typer.Option(..., "--round", "-r", parser=round_number, help="The round r<k>, one of lifelong.rounds.")
+    stage_main(__spec__.name, round_=(int, round_))

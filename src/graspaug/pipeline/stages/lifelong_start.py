@@ -56,3 +56,9 @@ def run(params: Params) -> None:
         curve = write_round(0, networks, labels, objects, None, history, params, voxels, *reports, header=header)
         curve.to_csv(folder / "curve.csv", index=False)
     log.info("lifelong r0: failures %s (validation AP %s)", chosen, np.round(errors.ap.loc[chosen].to_numpy(), 3))
+
+
+if __name__ == "__main__":
+    from graspaug.pipeline.entry import stage_main
+
+    stage_main(__spec__.name)

@@ -97,3 +97,12 @@ def run(params: Params, corpus: str = "original") -> None:
         100 * summary["collision_free_share"],
         seconds,
     )
+
+
+if __name__ == "__main__":
+    import typer
+
+    from graspaug.pipeline.entry import stage_main
+
+    corpus = typer.Option("original", "--corpus", "-c", help="`original` (train and test) or `gen_<B>` (generated).")
+    stage_main(__spec__.name, corpus=(str, corpus))

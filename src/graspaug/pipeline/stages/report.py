@@ -14,14 +14,8 @@ from __future__ import annotations
 
 import logging
 
+from graspaug.experiments.ap import figures
 from graspaug.experiments.ap.attribution import combine_draws, decomposition_markdown, losing_step
-from graspaug.experiments.ap.figures import (
-    draw_ap_vs_ratio,
-    draw_improvement,
-    draw_latent_map,
-    draw_pr_roc,
-    improvement_data,
-)
 from graspaug.experiments.ap.numbers import ap_headline, ap_metrics, evaluate_networks, ratio_curves
 from graspaug.experiments.ap.words import gain_sentences, report_markdown, training_words, verdict
 from graspaug.io.atomic import atomic_path
@@ -66,7 +60,7 @@ def run(params: Params) -> None:
     table, chosen, results, labels = ev.table, ev.chosen, ev.contrasts, ev.labels
     write_csv(table, REPORT_DIR / "ap_table.csv")
     write_csv(ratio_curves(table), REPORT_DIR / "ap_vs_ratio.csv")  # the curves of ap_vs_ratio.png, one column each
-    draw_ap_vs_ratio(table, seeds, REPORT_DIR / "ap_vs_ratio.png")
+    figures.draw_ap_vs_ratio(table, seeds, REPORT_DIR / "ap_vs_ratio.png")
     # real → recon → blend → targeted / random, step by step, on this run's one draw of the data (the same
     # resamples as evaluate_networks': every contrast and share is quoted with one interval in both reports)
     steps = combine_draws({params.data_seed: seed_dirs}, labels, ev.object_ids, gen, cfg, 1000, params.seed)
@@ -79,17 +73,17 @@ def run(params: Params) -> None:
     base = max(cfg.augment_base_sizes)
     compare = chosen.get(base, max(gen.ratios))
     # the networks sim compares (and the ceiling): PR and ROC curves of their test predictions
-    draw_pr_roc(labels, seed_dirs[seeds[0]], seeds[0], base, compare, cfg.ceiling, REPORT_DIR / "pr_roc.png")
+    figures.draw_pr_roc(labels, seed_dirs[seeds[0]], seeds[0], base, compare, cfg.ceiling, REPORT_DIR / "pr_roc.png")
     scores, latents = read_table(SCORES).set_index("shape_id"), read_table(LATENTS).set_index("shape_id")
     base_set, generated = read_table(base_set_table(base)), read_table(generated_index(base))
     grasps = read_table(grasps_table(f"gen_{base}"))
-    improvement, augmentation, panels, generated_graspness = improvement_data(
+    improvement, augmentation, panels, generated_graspness = figures.improvement_data(
         ev.by_network, seeds, base, compare, base_set, generated, grasps, latents, scores, params.score.k
     )
-    draw_improvement(panels, improvement, base, compare, REPORT_DIR / "improvement_by_score.png")
+    figures.draw_improvement(panels, improvement, base, compare, REPORT_DIR / "improvement_by_score.png")
     # Fig. 1: t-SNE of original train and generated latents by graspness
     tsne, perplexity = REPORT_DIR / "tsne_graspness.png", params.embed.perplexity
-    draw_latent_map(latents, scores, augmentation, generated_graspness, base, perplexity, params.seed, tsne)
+    figures.draw_latent_map(latents, scores, augmentation, generated_graspness, base, perplexity, params.seed, tsne)
     positives = float(labels.mean())  # the share of positive test grasps: AP without skill
     ap_report = ap_metrics(results, table, chosen, positives, seeds)
     write_json(ap_report, AP_REPORT)
@@ -99,3 +93,9 @@ def run(params: Params) -> None:
         tmp.write_text(header + report_markdown(table, results, chosen, extras, seeds, positives, words, data_seed))
     for name, c in results.items():
         log.info("report: %s", verdict(name, c))
+
+
+if __name__ == "__main__":
+    from graspaug.pipeline.entry import stage_main
+
+    stage_main(__spec__.name)

@@ -83,3 +83,9 @@ def run(params: Params) -> None:
         summary["graspness_train_mean"],
         summary["rarity_train_median"],
     )
+
+
+if __name__ == "__main__":
+    from graspaug.pipeline.entry import stage_main
+
+    stage_main(__spec__.name)

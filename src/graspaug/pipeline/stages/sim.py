@@ -98,3 +98,9 @@ def run(params: Params) -> None:
         write_json(metrics, out / "summary.json")
     write_json_files(sim_headline(metrics), paths.SIM_METRICS)
     log.info("sim: %s; %.0f s", outcome_words(metrics, timing), time.perf_counter() - start)
+
+
+if __name__ == "__main__":
+    from graspaug.pipeline.entry import stage_main
+
+    stage_main(__spec__.name)

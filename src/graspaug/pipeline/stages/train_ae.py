@@ -91,3 +91,9 @@ def run(params: Params) -> None:
         summary["critic_auc"],
         timing["train_s"],
     )
+
+
+if __name__ == "__main__":
+    from graspaug.pipeline.entry import stage_main
+
+    stage_main(__spec__.name)

@@ -98,3 +98,11 @@ def run(params: Params, seed: int) -> None:
     for line in result_lines(results):
         log.info("train_gqcnn seed %d %s", seed, line)
     log.info("train_gqcnn seed %d: %d networks in %.1f s", seed, len(results), time.perf_counter() - start)
+
+
+if __name__ == "__main__":
+    import typer
+
+    from graspaug.pipeline.entry import stage_main
+
+    stage_main(__spec__.name, seed=(int, typer.Option(0, "--seed", "-s", help="Training seed (one of gqcnn.seeds).")))
