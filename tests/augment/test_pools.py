@@ -219,3 +219,12 @@ def test_the_procedural_pool_adds_procedural_objects_outside_the_corpus_and_refu
 
     with pytest.raises(DataError, match="procedural pool: 4 shapes needed, the procedural corpus holds 0"):
         generate_pools(base, cfg, 0, some_rejected, 2, pools, controls=controls, procedural_ids=[])
+
+
+def test_control_ratios_size_the_other_pools_by_their_own_ratios():
+    """With targeted at 1:0.5, 1:1 and 1:2 and the other pools at 1:1 only (gqcnn.control_ratios), targeted holds
+    2 B shapes and the random pool B."""
+    base, cfg = make_base(4), GenerateParams(base_sizes=(4,), ratios=(0.0, 0.5, 1.0, 2.0))
+    out = generate_pools(base, cfg, 0, some_rejected, 2, ("targeted", "random"), control_ratios=(1.0,))
+    counts = out.index.pool.value_counts().to_dict()
+    assert counts == {"targeted": 8, "random": 4}

@@ -22,6 +22,7 @@ def test_the_declared_contrasts():
         "targeted_vs_none_chosen@50",
         "warp_vs_none@50",
         "primitives_vs_none@50",
+        "procedural_vs_none@50",
         "targeted_vs_random@50",
         "targeted_vs_real@50",
         "recon_vs_real@50",
@@ -32,6 +33,7 @@ def test_the_declared_contrasts():
         "targeted_vs_warp@50",
         "primitives_vs_real@50",
         "targeted_vs_primitives@50",
+        "targeted_vs_procedural@50",
     ]
     baseline = {c.name: c for c in declared_contrasts([50, 200], [0.0, 0.5, 1.0], [50], {})}["warp_vs_none@50"]
     assert dict((k, w) for w, k in baseline.terms) == {
@@ -172,7 +174,9 @@ def test_evaluate_networks_is_the_report_chain_step_by_step(tmp_path):
     import pandas as pd
 
     generate = SimpleNamespace(base_sizes=[10, 20], ratios=[0.0, 1.0])
-    gqcnn = SimpleNamespace(augment_base_sizes=[10], ceiling=True, val_shapes=1, pools=("targeted", "recon", "real"))
+    gqcnn = SimpleNamespace(
+        augment_base_sizes=[10], ceiling=True, val_shapes=1, pools=("targeted", "recon", "real"), control_ratios=None
+    )
     variants = seed_variants(generate.base_sizes, generate.ratios, gqcnn.augment_base_sizes, gqcnn.ceiling, gqcnn.pools)
     seed_dirs, index = _seed_folders(tmp_path, variants)
     ev = numbers.evaluate_networks(seed_dirs, tmp_path / "original", generate, gqcnn, seed=5, n_resamples=50)
@@ -290,3 +294,28 @@ def test_the_report_scopes_its_verdicts_to_its_one_draw_of_the_data():
     assert "`targeted_vs_random@50` (m): -0.0340 [-0.0600, -0.0100] AP, a loss in this draw of the data." in text
     two = loss | {"seeds_low": None, "seeds_high": None, "n_seeds": 2}  # a t-interval past [-1, 1]: none
     assert "| too few seeds |" in words.report_markdown(table, {"x": two}, {}, [], [0, 1], 0.3, "Words.", 1)
+
+
+def test_control_ratios_give_the_other_pools_their_own_ratios_and_pairs_the_ratios_both_have():
+    """The real-objects design: targeted at the paper's 1:0.5, 1:1 and 1:2, the other pools at 1:1 only; the
+    declared contrasts compare like with like, and the issue's contrasts are all declared."""
+    pools = ("targeted", "random", "real", "recon", "procedural")
+    ratios, control = [0.0, 0.5, 1.0, 2.0], (1.0,)
+    names = [v.name for v in seed_variants([50, 100], ratios, [50, 100], False, pools, control)]
+    assert names.count("targeted/50-0.5") == 1 and "targeted/100-2" in names
+    assert "real/100-1" in names and "real/100-2" not in names and "procedural/50-0.5" not in names
+    assert len(names) == 2 + 2 * 3 + 2 * 4  # 1:0 at both sizes, targeted at 3 ratios, 4 controls at 1:1
+    declared = {c.name: c for c in declared_contrasts([50, 100], ratios, [50, 100], {}, pools, control)}
+    for b in (50, 100):
+        for name in ("targeted_vs_none", "targeted_vs_real", "recon_vs_real", "procedural_vs_none"):
+            assert f"{name}@{b}" in declared
+        assert f"targeted_vs_procedural@{b}" in declared
+    assert "real_data" in declared
+    assert {k[2] for _, k in declared["targeted_vs_none@100"].terms} == {0.0, 0.5, 1.0, 2.0}
+    assert {k for _, k in declared["targeted_vs_real@100"].terms} == {("targeted", 100, 1.0), ("real", 100, 1.0)}
+    assert {k for _, k in declared["procedural_vs_none@50"].terms} == {("procedural", 50, 1.0), ("targeted", 50, 0.0)}
+    for c in declared.values():
+        assert sum(w for w, _ in c.terms) == pytest.approx(0)
+    # without control ratios every pool runs at every ratio, as before
+    every = [v.name for v in seed_variants([50, 100], ratios, [50, 100], False, pools)]
+    assert "procedural/50-0.5" in every and len(every) == 2 + 2 * 3 * 5

@@ -13,7 +13,9 @@ from graspaug.experiments.stats import contrast, interval_text, verdict
 from graspaug.training.variants import seed_variants
 
 GENERATE = SimpleNamespace(base_sizes=[10, 20], ratios=[0.0, 1.0])
-GQCNN = SimpleNamespace(augment_base_sizes=[10], pools=("targeted", "random", "real", "recon", "blend"))
+GQCNN = SimpleNamespace(
+    augment_base_sizes=[10], pools=("targeted", "random", "real", "recon", "blend"), control_ratios=None
+)
 LABELS = (np.arange(60) % 4 == 0).astype(int)
 OBJECTS = np.array([f"o{i % 12}" for i in range(60)])
 DATAPOINTS = {"targeted/10-0": 300, "targeted/20-0": 1200, "real/10-1": 600}  # the real-shape curve

@@ -232,3 +232,14 @@ def test_a_duplicated_key_is_refused_naming_the_key_and_its_line(tmp_path, repo_
         "c": {"y": 1},
         "d": {"y": 2},
     }
+
+
+def test_control_ratios_must_be_ratios_of_generate(repo_root):
+    """gqcnn.control_ratios names ratios of generate.ratios (the real-objects profile: 1:1 of 0, 0.5, 1, 2)."""
+    real_objects = profile_params("real_objects", repo_root / "profiles")
+    assert real_objects.gqcnn.control_ratios == (1.0,) and 2.0 in real_objects.generate.ratios
+    assert real_objects.ingest.surface.size == "fit" and "procedural" in real_objects.gqcnn.pools
+    with pytest.raises(ParamsError, match=r"gqcnn\.control_ratios: must be among generate\.ratios"):
+        parse_params(merge(params_dict(), {"gqcnn": {"control_ratios": [3.0]}}))
+    with pytest.raises(ParamsError, match=r"gqcnn\.control_ratios"):
+        parse_params(merge(params_dict(), {"gqcnn": {"control_ratios": [0.0]}}))

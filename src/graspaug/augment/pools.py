@@ -112,9 +112,11 @@ def fill_pools(
     recon: ReconSource | None = None,
     controls: dict[str, Runner] | None = None,
     procedural: int = 0,
+    control_ratios: Sequence[float] | None = None,
 ) -> tuple[Pools, TargetedStream, int]:
     """Fill each of ``pools`` (of :data:`GENERATED_POOLS`; the targeted one always) to
-    ``pool_size(cfg.ratios, B)`` kept shapes: ``targeted`` and ``random`` (seeded by
+    ``pool_size(cfg.ratios, B)`` kept shapes (the pools but targeted: ``pool_size(control_ratios, B)`` when
+    ``control_ratios`` is given, ``gqcnn.control_ratios``): ``targeted`` and ``random`` (seeded by
     ``[seed, BASE_SEED, B]``) with ``run_batch`` (:func:`.decode.mesh_batches` over the base set),
     ``recon`` from ``recon`` (the real pool's shapes, each decoded from its own latent), and the
     no-network pools with their runner in ``controls``: ``blend`` (:func:`.decode.blend_batches`) and
@@ -129,6 +131,7 @@ def fill_pools(
     """
     base_size = len(base.ids)
     needed = pool_size(cfg.ratios, base_size)
+    control = needed if control_ratios is None else pool_size(control_ratios, base_size)  # the other pools' size
     targeted_stream = TargetedStream(
         base.z, base.rarity, base.graspness, cfg.percentile, cfg.first_neighbour, cfg.extra_neighbours, cfg.alphas
     )
@@ -138,9 +141,9 @@ def fill_pools(
     for name in ("blend", "warp", "primitives", "procedural"):
         if name in pools and name not in controls:
             raise DataError(f"generate {base_size}: the {name} pool needs its runner (the base set's meshes)")
-    if "procedural" in pools and procedural < needed:
+    if "procedural" in pools and procedural < control:
         raise DataError(
-            f"generate {base_size}, procedural pool: {needed} shapes needed, the procedural corpus holds {procedural} "
+            f"generate {base_size}, procedural pool: {control} shapes needed, the procedural corpus holds {procedural} "
             "objects outside this experiment's corpus (the pool adds pybullet's random_urdfs to a corpus of your own; "
             "with data.source: pybullet it has nothing to add)"
         )
@@ -148,7 +151,7 @@ def fill_pools(
         "targeted": (targeted_stream, run_batch),
         "random": (RandomStream(base_size, cfg.alphas, np.random.default_rng([seed, BASE_SEED, base_size])), run_batch),
         "recon": (ReconStream(len(recon.shapes.ids)), recon.run_batch) if recon else None,
-        "primitives": (PrimitiveStream(PRIMITIVE_TRIES * needed), controls.get("primitives")),
+        "primitives": (PrimitiveStream(PRIMITIVE_TRIES * control), controls.get("primitives")),
         "procedural": (ProceduralStream(procedural), controls.get("procedural")),
     }
     out = {}
@@ -157,7 +160,7 @@ def fill_pools(
             streams[name] = (FollowStream([d.candidate for d in out["targeted"][0]], targeted_stream), controls[name])
         stream, runner = streams[name]
         try:
-            out[name] = fill_pool(stream, needed, runner)
+            out[name] = fill_pool(stream, needed if name == "targeted" else control, runner)
         except PoolExhausted as exc:
             raise DataError(f"generate {base_size}, {name} pool: {exc}") from None
     return out, targeted_stream, needed
@@ -251,10 +254,13 @@ def generate_pools(
     recon: ReconSource | None = None,
     controls: dict[str, Runner] | None = None,
     procedural_ids: Sequence[str] = (),
+    control_ratios: Sequence[float] | None = None,
 ) -> GeneratedSet:
     """:func:`fill_pools` then :func:`generated_set` (``k``: the rarity's neighbours; ``procedural_ids``: the
-    procedural pool's objects in stream order)."""
-    filled, targeted, needed = fill_pools(base, cfg, seed, run_batch, pools, recon, controls, len(procedural_ids))
+    procedural pool's objects in stream order; ``control_ratios``: the ratios of the pools but targeted)."""
+    filled, targeted, needed = fill_pools(
+        base, cfg, seed, run_batch, pools, recon, controls, len(procedural_ids), control_ratios
+    )
     recon_shapes = recon.shapes if recon else None
     return generated_set(base, filled, targeted, needed, k, cfg.n_examples, recon_shapes, procedural_ids)
 

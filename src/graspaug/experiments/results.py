@@ -11,7 +11,8 @@ README and docs/results.md quote, recomputed from them (issue #58).
 * ``test.parquet`` — one row per test datapoint, in the same order: ``label`` (1: a successful grasp), ``object``
   (its test shape);
 * ``meta.json`` — the exact ``command`` and code ``commit`` that made them, the date, and the params the combination
-  reads (``base_sizes``, ``ratios``, ``augment_base_sizes``, ``pools``, ``n_resamples``, ``seed``), written last.
+  reads (``base_sizes``, ``ratios``, ``augment_base_sizes``, ``pools``, ``control_ratios``, ``n_resamples``,
+  ``seed``), written last.
 
 ``results/lifelong/`` (written by ``studies/lifelong.py``, :func:`write_lifelong`): ``predictions.parquet`` (one
 float32 column per round, draw, training seed and arm, ``r<k>/<draw>/<seed>/<arm>``), ``test.parquet`` and
@@ -65,7 +66,9 @@ def write_attribution(
     from graspaug.io.atomic import atomic_path
     from graspaug.training.variants import seed_variants
 
-    variants = seed_variants(generate.base_sizes, generate.ratios, gqcnn.augment_base_sizes, False, gqcnn.pools)
+    variants = seed_variants(
+        generate.base_sizes, generate.ratios, gqcnn.augment_base_sizes, False, gqcnn.pools, gqcnn.control_ratios
+    )
     tables, columns = [], {}
     for d, seed_dirs in draws.items():
         runs = collect(seed_dirs, variants)
@@ -89,6 +92,7 @@ def write_attribution(
         "ratios": [float(r) for r in generate.ratios],
         "augment_base_sizes": list(gqcnn.augment_base_sizes),
         "pools": list(gqcnn.pools),
+        "control_ratios": None if gqcnn.control_ratios is None else list(gqcnn.control_ratios),
     }
     with atomic_path(folder / "meta.json") as tmp:
         tmp.write_text(json.dumps(meta | keep, indent=1) + "\n")
@@ -115,7 +119,10 @@ def combine_attribution(folder: Path) -> dict:
         return predictions[name].to_numpy()
 
     generate = SimpleNamespace(base_sizes=meta["base_sizes"], ratios=meta["ratios"])
-    gqcnn = SimpleNamespace(augment_base_sizes=meta["augment_base_sizes"], pools=tuple(meta["pools"]))
+    control = meta.get("control_ratios")  # absent from tables written before gqcnn.control_ratios: every ratio
+    gqcnn = SimpleNamespace(
+        augment_base_sizes=meta["augment_base_sizes"], pools=tuple(meta["pools"]), control_ratios=control
+    )
     labels, objects = test.label.to_numpy(), test.object.to_numpy()
     result = combine_runs(runs, network, labels, objects, generate, gqcnn, meta["n_resamples"], meta["seed"])
     return result | {"augment_base_sizes": meta["augment_base_sizes"]}

@@ -34,9 +34,24 @@ def network_variant(pool: str, base_size: int, ratio: float) -> Variant:
     return Variant("targeted" if pool != "ceiling" and float(ratio) == 0.0 else pool, base_size, ratio)
 
 
-def seed_variants(base_sizes, ratios, augment_base_sizes, ceiling: bool, pools=POOLS) -> list[Variant]:
-    """Every network of a seed: 1:0 at every base size; each of ``pools`` (in :data:`POOLS` order)
-    at every nonzero ratio of ``augment_base_sizes``; the ceiling."""
+def pool_ratios(pool: str, ratios, control_ratios=None) -> tuple[float, ...]:
+    """The nonzero ratios at which ``pool`` gets networks: every nonzero one of ``ratios`` (``generate.ratios``) for
+    the targeted pool, and for the others too unless ``control_ratios`` (``gqcnn.control_ratios``) names theirs."""
+    nonzero = tuple(float(r) for r in ratios if r > 0)
+    if pool == "targeted" or control_ratios is None:
+        return nonzero
+    return tuple(r for r in nonzero if r in {float(c) for c in control_ratios})
+
+
+def seed_variants(base_sizes, ratios, augment_base_sizes, ceiling: bool, pools=POOLS, control_ratios=None) -> list:
+    """Every network of a seed (a list of :class:`Variant`): 1:0 at every base size; each of ``pools`` (in
+    :data:`POOLS` order) at each of its :func:`pool_ratios` at ``augment_base_sizes``; the ceiling."""
     out = [Variant("targeted", b, 0.0) for b in base_sizes]
-    out += [Variant(p, b, float(r)) for p in POOLS if p in pools for b in augment_base_sizes for r in ratios if r > 0]
+    out += [
+        Variant(p, b, r)
+        for p in POOLS
+        if p in pools
+        for b in augment_base_sizes
+        for r in pool_ratios(p, ratios, control_ratios)
+    ]
     return out + ([Variant("ceiling")] if ceiling else [])

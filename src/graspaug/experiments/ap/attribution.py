@@ -41,7 +41,7 @@ from graspaug.experiments.stats import (
     share_text,
     verdict,
 )
-from graspaug.training.variants import seed_variants
+from graspaug.training.variants import pool_ratios, seed_variants
 
 STEPS = ("recon_vs_real", "blend_vs_recon", "targeted_vs_blend", "targeted_vs_random")
 
@@ -51,8 +51,9 @@ def draw_contrasts(runs: pd.DataFrame, generate, gqcnn) -> list[Contrast]:
     ones without the validation-chosen ratio (it may differ between draws), and the
     datapoint-matched ones (their weights come from the draw's own datapoint counts)."""
     base_sizes, ratios, augment = generate.base_sizes, generate.ratios, gqcnn.augment_base_sizes
-    return declared_contrasts(base_sizes, ratios, augment, {}, gqcnn.pools) + datapoint_matched_contrasts(
-        runs, base_sizes, ratios, augment, gqcnn.pools
+    control = gqcnn.control_ratios
+    return declared_contrasts(base_sizes, ratios, augment, {}, gqcnn.pools, control) + datapoint_matched_contrasts(
+        runs, base_sizes, ratios, augment, gqcnn.pools, control
     )
 
 
@@ -92,7 +93,9 @@ def combine_draws(
     seeds = sorted({s for d in draws.values() for s in d})
     if any(sorted(d) != seeds for d in draws.values()):
         raise DataError("every draw needs the same training seeds")
-    variants = seed_variants(generate.base_sizes, generate.ratios, gqcnn.augment_base_sizes, False, gqcnn.pools)
+    variants = seed_variants(
+        generate.base_sizes, generate.ratios, gqcnn.augment_base_sizes, False, gqcnn.pools, gqcnn.control_ratios
+    )
     runs = {d: collect(seed_dirs, variants) for d, seed_dirs in draws.items()}
     predictions = lambda d, s, key: test_predictions(draws[d][s], key)  # noqa: E731
     return combine_runs(runs, predictions, labels, object_ids, generate, gqcnn, n_resamples, seed)
@@ -153,32 +156,31 @@ def combine_runs(
     }
     indices = nested_indices(len(draws), len(seeds), n_resamples, rng())  # those of every nested_interval above
     shares: dict[str, dict[str, dict]] = {}  # pool → base size → the share of the real-shape gain
-    nonzero = [float(r) for r in generate.ratios if r > 0]
-    for b in gqcnn.augment_base_sizes if "real" in gqcnn.pools and nonzero else ():
-        gains = {  # a pool's gain over no augmentation, mean over ratios, from the same networks as the contrasts
-            pool: arrays(
-                lambda _, pool=pool: (
-                    [(1 / len(nonzero), (pool, b, r)) for r in nonzero] + [(-1.0, ("targeted", b, 0.0))]
-                )
-            )
-            for pool in gqcnn.pools
-        }
-        real_full, real_resampled = gains["real"]
-        real_gain = nested_contrast(nested_interval(real_full, real_resampled, rng()))
-        for pool, (f, r) in gains.items():
-            if pool == "real":
+    real_ratios = pool_ratios("real", generate.ratios, gqcnn.control_ratios)
+
+    def gain(pool: str, b: int, rs) -> tuple[np.ndarray, np.ndarray]:
+        """A pool's gain over no augmentation at base size ``b``, mean over ratios ``rs`` (the contrasts' networks)."""
+        return arrays(lambda _: [(1 / len(rs), (pool, b, r)) for r in rs] + [(-1.0, ("targeted", b, 0.0))])
+
+    for b in gqcnn.augment_base_sizes if "real" in gqcnn.pools and real_ratios else ():
+        for pool in (p for p in gqcnn.pools if p != "real"):
+            own = pool_ratios(pool, generate.ratios, gqcnn.control_ratios)
+            rs = [r for r in own if r in real_ratios]  # like with like: the ratios both pools were trained at
+            if not rs:
                 continue
+            (f, r), (real_full, real_resampled) = gain(pool, b, rs), gain("real", b, rs)
+            real_gain = nested_contrast(nested_interval(real_full, real_resampled, rng()))  # the share's denominator
             share = ratio_interval(
                 f.mean(), real_full.mean(), nested_means(r, indices), nested_means(real_resampled, indices)
             )
-            declared = out.get(f"{pool}_vs_none@{b}")  # the same terms and resamples: one interval for one gain
-            gain = declared if declared is not None else nested_contrast(nested_interval(f, r, rng()))
+            declared = out.get(f"{pool}_vs_none@{b}") if list(rs) == list(own) else None  # the same terms: one interval
+            pool_gain = declared if declared is not None else nested_contrast(nested_interval(f, r, rng()))
             shares.setdefault(pool, {})[str(b)] = {
                 "share": share["share"],
                 "low": share["low"],
                 "high": share["high"],
                 "bounded": share["bounded"],
-                "gain": gain,
+                "gain": pool_gain,
                 "real_gain": real_gain,
             }
     return {

@@ -12,13 +12,17 @@ network is read:
   shapes must help);
 * ``targeted_vs_none@B``: mean over R > 0 of AP(targeted, B, R) − AP(B, 1:0);
 * ``targeted_vs_none_chosen@B``: the same at the ratio chosen on mean validation AP;
-* ``warp_vs_none@B``, ``primitives_vs_none@B``: the same for the no-network baselines when trained;
+* ``warp_vs_none@B``, ``primitives_vs_none@B``, ``procedural_vs_none@B``: the same for the no-network baselines
+  when trained;
 * ``<a>_vs_<b>@B`` for the pool pairs of :data:`PAIRS` whose pools are trained: mean over R > 0 of
   AP(a, B, R) − AP(b, B, R), equal shape counts (``targeted_vs_random``, ``targeted_vs_real``,
   ``recon_vs_real``: what decoding alone costs, ``targeted_vs_recon``: what interpolation and
   selection add to a decoded shape, ``blend_vs_recon``, ``targeted_vs_blend``: what the latent
   space adds over mixing the same parents' signed distance fields; ``warp_vs_real``, ``targeted_vs_warp``,
-  ``primitives_vs_real``, ``targeted_vs_primitives``: the baselines a researcher tries first);
+  ``primitives_vs_real``, ``targeted_vs_primitives``, ``targeted_vs_procedural``: the baselines a researcher tries
+  first);
+* with ``gqcnn.control_ratios``, a pool's mean runs over its own ratios (:func:`graspaug.training.variants.pool_ratios`)
+  and a pair's over the ratios both pools have;
 * ``<pool>_vs_real_datapoints@B``: the same pools against real shapes at as many training
   datapoints (:func:`datapoint_matched_contrasts`), since a generated shape yields fewer.
 
@@ -50,7 +54,7 @@ from graspaug.experiments.stats import (
 )
 from graspaug.io.tables import read_table
 from graspaug.training.settings import POOLS
-from graspaug.training.variants import network_variant, seed_variants
+from graspaug.training.variants import network_variant, pool_ratios, seed_variants
 
 Key = tuple[str, int, float]  # (pool, base size, ratio); ratio 0 of any pool is ("targeted", B, 0.0)
 PAIRS = {  # pool a vs pool b at equal shape counts: what the difference measures
@@ -64,8 +68,13 @@ PAIRS = {  # pool a vs pool b at equal shape counts: what the difference measure
     ("targeted", "warp"): "the paper's method vs deforming the same parents by hand",
     ("primitives", "real"): "random assemblies of primitives vs as many more real shapes",
     ("targeted", "primitives"): "the paper's method vs procedural objects",
+    ("targeted", "procedural"): "the paper's method vs the procedural corpus' objects added as they are",
 }
-NONE_CONTRASTS = ("warp", "primitives")  # pools whose own `<pool>_vs_none@B` is declared beside targeted's
+NONE_CONTRASTS = (
+    "warp",
+    "primitives",
+    "procedural",
+)  # pools whose own `<pool>_vs_none@B` is declared beside targeted's
 
 
 def _key(pool: str, base: int, ratio: float) -> Key:
@@ -82,11 +91,17 @@ class Contrast:
     chosen_on_validation: bool = field(default=False)
 
 
-def declared_contrasts(base_sizes, ratios, augment_base_sizes, chosen: dict[int, float], pools=POOLS) -> list[Contrast]:
+def declared_contrasts(
+    base_sizes, ratios, augment_base_sizes, chosen: dict[int, float], pools=POOLS, control_ratios=None
+) -> list[Contrast]:
     """The experiment's contrasts (module docstring); ``chosen``: base size → ratio chosen on
-    validation; ``pools``: the pools trained (``gqcnn.pools``)."""
+    validation; ``pools``: the pools trained (``gqcnn.pools``); ``control_ratios``: ``gqcnn.control_ratios``."""
     out, nonzero = [], [float(r) for r in ratios if r > 0]
     small, large = min(base_sizes), max(base_sizes)
+
+    def over(rs) -> str:
+        return ", ".join(f"1:{r:g}" for r in rs)
+
     if large > small:
         out.append(
             Contrast(
@@ -102,7 +117,7 @@ def declared_contrasts(base_sizes, ratios, augment_base_sizes, chosen: dict[int,
             Contrast(
                 f"targeted_vs_none@{b}",
                 tuple((1 / len(nonzero), _key("targeted", b, r)) for r in nonzero) + ((-1.0, _key("targeted", b, 0)),),
-                f"targeted augmentation vs none at B = {b}, mean over ratios {', '.join(f'1:{r:g}' for r in nonzero)}",
+                f"targeted augmentation vs none at B = {b}, mean over ratios {over(nonzero)}",
             )
         )
         if b in chosen:
@@ -115,41 +130,49 @@ def declared_contrasts(base_sizes, ratios, augment_base_sizes, chosen: dict[int,
                 )
             )
     for b in augment_base_sizes:
-        for pool in (p for p in NONE_CONTRASTS if p in pools and nonzero):
-            terms = tuple((1 / len(nonzero), _key(pool, b, r)) for r in nonzero) + ((-1.0, _key("targeted", b, 0)),)
-            words = f"{pool} augmentation vs none at B = {b}, mean over ratios {', '.join(f'1:{r:g}' for r in nonzero)}"
-            out.append(Contrast(f"{pool}_vs_none@{b}", terms, words))
+        for pool in (p for p in NONE_CONTRASTS if p in pools):
+            rs = pool_ratios(pool, ratios, control_ratios)
+            if rs:
+                terms = tuple((1 / len(rs), _key(pool, b, r)) for r in rs) + ((-1.0, _key("targeted", b, 0)),)
+                words = f"{pool} augmentation vs none at B = {b}, mean over ratios {over(rs)}"
+                out.append(Contrast(f"{pool}_vs_none@{b}", terms, words))
         for one, other in PAIRS:
-            if nonzero and one in pools and other in pools:
+            both = [
+                r for r in pool_ratios(one, ratios, control_ratios) if r in pool_ratios(other, ratios, control_ratios)
+            ]
+            if both and one in pools and other in pools:
                 terms = tuple(
-                    t
-                    for r in nonzero
-                    for t in ((1 / len(nonzero), _key(one, b, r)), (-1 / len(nonzero), _key(other, b, r)))
+                    t for r in both for t in ((1 / len(both), _key(one, b, r)), (-1 / len(both), _key(other, b, r)))
                 )
                 words = f"{one} vs {other} shapes at B = {b}, equal counts, mean over ratios: {PAIRS[one, other]}"
                 out.append(Contrast(f"{one}_vs_{other}@{b}", terms, words))
     return out
 
 
-def datapoint_matched_contrasts(runs: pd.DataFrame, base_sizes, ratios, augment_base_sizes, pools) -> list[Contrast]:
+def datapoint_matched_contrasts(
+    runs: pd.DataFrame, base_sizes, ratios, augment_base_sizes, pools, control_ratios=None
+) -> list[Contrast]:
     """Per augmented base size B and pool (but ``real``): ``<pool>_vs_real_datapoints@B``, the pool's
     AP minus the AP that real shapes give at as many training datapoints, mean over ratios R > 0.
     The real-shape curve is AP against training datapoints through the real-shape networks (1:0 at
     every base size, ``real`` at B and every R), linear between neighbouring points; the weights
     come from the datapoint counts (the same in every seed: they are design, not outcome). A
     network outside the curve's range, or without a count (``runs.train_datapoints``), gives no
-    contrast. So a pool is not penalised for yielding fewer datapoints per shape."""
+    contrast. So a pool is not penalised for yielding fewer datapoints per shape. With ``control_ratios``, each pool's
+    mean runs over its own ratios (:func:`graspaug.training.variants.pool_ratios`)."""
     counts = runs.groupby(["pool", "base_size", "ratio"]).train_datapoints.first()
-    nonzero, out = [float(r) for r in ratios if r > 0], []
+    out = []
     for b in augment_base_sizes:
-        curve = [("targeted", int(x), 0.0) for x in base_sizes] + [("real", int(b), r) for r in nonzero]
+        real = pool_ratios("real", ratios, control_ratios)
+        curve = [("targeted", int(x), 0.0) for x in base_sizes] + [("real", int(b), r) for r in real]
         points = sorted((float(counts[k]), k) for k in curve if k in counts and pd.notna(counts[k]))
         if len(points) < 2 or "real" not in pools:
             continue
         xs = np.array([x for x, _ in points])
         for pool in (p for p in pools if p != "real"):
             terms: list[tuple[float, Key]] = []
-            for r in nonzero:
+            own = pool_ratios(pool, ratios, control_ratios)
+            for r in own:
                 key = (pool, int(b), r)
                 x = counts.get(key)
                 if x is None or pd.isna(x) or not xs[0] <= x <= xs[-1]:
@@ -158,7 +181,7 @@ def datapoint_matched_contrasts(runs: pd.DataFrame, base_sizes, ratios, augment_
                 hi = min(int(np.searchsorted(xs, x, side="left")), len(xs) - 1)
                 lo = max(hi - 1, 0)
                 share = 0.0 if xs[hi] == xs[lo] else (x - xs[lo]) / (xs[hi] - xs[lo])
-                n = len(nonzero)
+                n = len(own)
                 terms += [(1 / n, key), (-(1 - share) / n, points[lo][1]), (-share / n, points[hi][1])]
             if terms:
                 words = (
@@ -264,11 +287,13 @@ def evaluate_networks(
     global ``seed``) on the test datapoints of the first seed in the original corpus's dataset
     folder ``original`` (its ``index.parquet``), and tabulate AP and per-object AP per network."""
     base_sizes, ratios, augment_base_sizes = generate.base_sizes, generate.ratios, gqcnn.augment_base_sizes
-    variants = seed_variants(base_sizes, ratios, augment_base_sizes, gqcnn.ceiling, gqcnn.pools)
+    variants = seed_variants(base_sizes, ratios, augment_base_sizes, gqcnn.ceiling, gqcnn.pools, gqcnn.control_ratios)
     runs = collect(seed_dirs, variants)
     chosen = choose_ratios(runs, augment_base_sizes)
-    contrasts = declared_contrasts(base_sizes, ratios, augment_base_sizes, chosen, gqcnn.pools)
-    contrasts += datapoint_matched_contrasts(runs, base_sizes, ratios, augment_base_sizes, gqcnn.pools)
+    contrasts = declared_contrasts(base_sizes, ratios, augment_base_sizes, chosen, gqcnn.pools, gqcnn.control_ratios)
+    contrasts += datapoint_matched_contrasts(
+        runs, base_sizes, ratios, augment_base_sizes, gqcnn.pools, gqcnn.control_ratios
+    )
     index = read_table(Path(original) / "index.parquet")
     labels, object_ids = test_labels(index, seed_dirs[next(iter(seed_dirs))])
     results = evaluate_contrasts(contrasts, runs, seed_dirs, labels, object_ids, n_resamples=n_resamples, seed=seed)

@@ -50,7 +50,7 @@ def _get(params: Any, key: str) -> Any:
 def _subset(key: str, other: str) -> Callable[[Any], str | None]:
     def check(p: Any) -> str | None:
         value, allowed = _get(p, key), _get(p, other)
-        if not set(value) <= set(allowed):
+        if value is not None and not set(value) <= set(allowed):
             return f"{key}: must be among {other} {list(allowed)}; got {list(value)}"
         return None
 
@@ -80,6 +80,7 @@ CROSS_CHECKS: tuple[tuple[tuple[str, ...], Callable[[Any], str | None]], ...] = 
     (("gqcnn", "render"), _equal("gqcnn.net.image_size", "render.crop.out_size")),
     (("sim", "grasps"), _equal("sim.sampler.max_width", "grasps.gripper.max_width")),
     (("gqcnn", "generate"), _subset("gqcnn.augment_base_sizes", "generate.base_sizes")),
+    (("gqcnn", "generate"), _subset("gqcnn.control_ratios", "generate.ratios")),
     (("sim", "gqcnn"), _member("sim.base_size", "gqcnn.augment_base_sizes")),
 )
 

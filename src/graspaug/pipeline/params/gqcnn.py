@@ -57,6 +57,12 @@ class GQCNNParams:
         "`generate` makes the generated "
         "ones. `targeted` is always trained.",
     )
+    control_ratios: tuple[float, ...] | None = Field(
+        None,
+        description="Ratios at which the pools other than targeted get networks and shapes (each one of "
+        "generate.ratios); null: every nonzero ratio, as targeted. The real-objects profile: [1.0] (the paper's ratios "
+        "for targeted, the controls at 1:1); contrasts between two pools use the ratios both have.",
+    )
     members: int = Field(
         2,
         ge=1,
@@ -73,5 +79,7 @@ class GQCNNParams:
             raise ValueError(
                 f"gqcnn.pools: distinct names of {list(POOLS)}, targeted among them; got {list(self.pools)}"
             )
+        if self.control_ratios is not None and (not self.control_ratios or min(self.control_ratios) <= 0):
+            raise ValueError(f"gqcnn.control_ratios: null or ratios > 0; got {list(self.control_ratios)}")
         if not self.seeds or len(set(self.seeds)) != len(self.seeds) or min(self.seeds) < 0:
             raise ValueError(f"gqcnn.seeds: must be distinct seeds >= 0; got {list(self.seeds)}")

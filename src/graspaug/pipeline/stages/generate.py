@@ -73,7 +73,8 @@ def run(params: Params, base_size: int) -> None:
     procedural = procedural_sources(list(shapes.source), key) if "procedural" in pools else []
     controls = control_runners(pools, solids, cfg, surface, params.data_seed, base_size, params.workers, procedural)
     run_batch, procedural_ids = meshes(base, label=f"generate {base_size}"), [s.shape_id for s in procedural]
-    out = generate_pools(base, cfg, params.data_seed, run_batch, params.score.k, pools, recon, controls, procedural_ids)
+    inputs = (base, cfg, params.data_seed, run_batch, params.score.k, pools, recon, controls, procedural_ids)
+    out = generate_pools(*inputs, control_ratios=gq.control_ratios)  # the pools but targeted at their own ratios
     for level, message in [(logging.INFO, n) for n in out.notes] + [(logging.WARNING, w) for w in out.warnings]:
         log.log(level, "generate %d: %s", base_size, message)
 

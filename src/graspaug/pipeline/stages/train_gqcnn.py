@@ -71,21 +71,20 @@ def run(params: Params, seed: int) -> None:
     corpora = Corpora(gqcnn_dir("original"), {b: gqcnn_dir(f"gen_{b}") for b in cfg.augment_base_sizes})
     shapes = read_table(SHAPES_TABLE)  # too few for the validation set: a DataError, printed in one line
     split = load_split(corpora.original, shapes, list(gen.base_sizes), cfg.val_shapes, params.data_seed)
-    variants = seed_variants(gen.base_sizes, gen.ratios, cfg.augment_base_sizes, cfg.ceiling, cfg.pools)
+    sizes = (gen.base_sizes, gen.ratios, cfg.augment_base_sizes)
+    variants = seed_variants(*sizes, cfg.ceiling, cfg.pools, cfg.control_ratios)
     device = resolve_device(params.device)
     inits, noise_seeds = seed_members(cfg.net, params.seed, seed, cfg.members)
     val, val_rows = shapes_datapoints(corpora.original, split.validation)
     test, test_rows = test_set(corpora.original)
     plan = seed_plan(variants, cfg.members, len(split.validation), val_rows, test_rows, device)
     log.info("train_gqcnn seed %d: %s", seed, plan)
-    if (warning := precision_warning(cfg.train.precision, device)) is not None:
+    if (warning := precision_warning(cfg.train.precision, device)) is not None:  # bfloat16 emulated: slower
         log.warning("%s", warning)
     with atomic_path(gqcnn_seed_dir(seed), directory=True) as folder:
         card = seed_card(params.render, params.grasps, params.seed)
-        jobs = [
-            NetworkJob(v, split, cfg.net, cfg.train, inits, noise_seeds, seed, str(device), folder, corpora, card)
-            for v in variants
-        ]
+        shared = (split, cfg.net, cfg.train, inits, noise_seeds, seed, str(device), folder, corpora, card)
+        jobs = [NetworkJob(v, *shared) for v in variants]
         results = train_jobs(jobs, val, test, f"train GQ-CNNs (seed {seed})", network_workers(params.workers))
         save_seed_split(folder, split, test_rows, val_rows)
         history = read_history(folder, variants)
