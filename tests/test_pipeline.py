@@ -30,6 +30,9 @@ def copy_repo(src: Path, dst: Path) -> None:
         shutil.copy2(src / rel, dst / rel)
 
 
+GRASPAUG = [sys.executable, "-m", "graspaug.pipeline.cli"]  # the CLI of the package under test
+
+
 def run(cmd, cwd, env):
     result = subprocess.run(cmd, cwd=cwd, env=env, capture_output=True, text=True)
     assert result.returncode == 0, f"{cmd} failed:\n{result.stdout}\n{result.stderr}"
@@ -353,7 +356,7 @@ def test_heldout_fidelity_study_labels_the_originals_as_the_stages_do(tiny_repo,
     work, env = tiny_repo
     run(["dvc", "repro", "embed", "render@original"], work, env)
     out = tmp_path / "heldout"
-    cmd = [sys.executable, "studies/heldout_fidelity.py", "--project", str(work), "--shapes", "3", "--workers", "1"]
+    cmd = [*GRASPAUG, "study", "heldout-fidelity", "--project", str(work), "--shapes", "3", "--workers", "1"]
     run([*cmd, "--out", str(out)], work, env)
     per_shape = pd.read_csv(out / "per_shape.csv").set_index("shape_id")
     summary = json.loads((out / "summary.json").read_text())
@@ -721,6 +724,102 @@ def test_dvc_repro_grasp_calibration(tiny_repo):
     assert (out / "calibration.png").stat().st_size > 0 and len(pd.read_csv(out / "by_eps.csv")) > 0
     again = run(["dvc", "repro", "grasp_calibration"], work, env)
     assert "Running stage" not in again.stdout
+
+
+def test_roundtrip_ceiling_study_labels_the_originals_as_the_grasps_stage_does(tiny_repo, tmp_path):
+    """`graspaug study roundtrip-ceiling` at its smallest: 2 train shapes, every variant a row, the originals'
+    graspness the grasps stage's own."""
+    import json
+
+    work, env = tiny_repo
+    run(["dvc", "repro", "grasps@original"], work, env)
+    out = tmp_path / "roundtrip"
+    cmd = [*GRASPAUG, "study", "roundtrip-ceiling", "--project", str(work), "--shapes", "2", "--workers", "1"]
+    printed = run([*cmd, "--out", str(out)], work, env).stdout
+    per_shape = pd.read_csv(out / "per_shape.csv")
+    shapes = pd.read_parquet(work / "data/shapes.parquet").set_index("shape_id")
+    assert per_shape.shape_id.nunique() == 2 and (shapes.loc[per_shape.shape_id, "split"] == "train").all()
+    assert sorted(per_shape.variant.unique()) == sorted(
+        ["original", "occupancy 32", "occupancy 64", "tsdf 32", "tsdf 64"]
+    )
+    original = per_shape[per_shape.variant == "original"].set_index("shape_id")
+    grasps = pd.read_parquet(work / "data/grasps/original.parquet")
+    expected = grasps[grasps.shape_id.isin(original.index)].groupby("shape_id").success.mean()
+    assert np.allclose(original.graspness, expected.reindex(original.index, fill_value=0))
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["settings"]["shapes"] == 2 and len(summary["rows"]) == 5 and "| original |" in printed
+    assert set(json.loads((out / "timing.json").read_text())) == {"seconds", "per_shape_mean", "per_shape_median"}
+
+
+def test_grasp_calibration_study_without_changes_is_the_stage(tiny_repo, tmp_path):
+    """`graspaug study grasp-calibration` with no `--set` executes the stage's grasps with the stage's outcomes; a
+    `--set` naming no sim key is one line and exit 2."""
+    import json
+
+    work, env = tiny_repo
+    run(["dvc", "repro", "grasp_calibration"], work, env)
+    table = tmp_path / "grasps.csv"
+    cmd = [*GRASPAUG, "study", "grasp-calibration", "--n", "6", "--workers", "1", "--table", str(table)]
+    summary = json.loads(run(cmd, work, env).stdout.strip().splitlines()[-1])
+    stage = pd.read_csv(work / "reports/grasp_calibration/grasps.csv")
+    study = pd.read_csv(table)
+    assert study.datapoint.tolist() == stage.datapoint.tolist()
+    assert study.outcome.tolist() == stage.outcome.tolist()
+    assert summary["n_grasps"] == 6 and summary["changes"] == []
+    bad = subprocess.run([*cmd, "--set", "hand.no_such_key=1"], cwd=work, env=env, capture_output=True, text=True)
+    assert bad.returncode == 2 and "no_such_key" in bad.stderr and len(bad.stderr.strip().splitlines()) == 1
+
+
+def test_cell_ranking_study_ranks_the_calibration_grasps_with_one_project(tiny_repo):
+    """`graspaug study cell-ranking` on the tiny run's calibration grasps and its own networks (one draw): each arm's
+    AUC per seed, the top picks per seed, no pooled interval over one draw."""
+    import json
+
+    work, env = tiny_repo
+    run(["dvc", "repro", "report", "grasp_calibration"], work, env)
+    cmd = [*GRASPAUG, "study", "cell-ranking", "--grasps", "reports/grasp_calibration/grasps.csv", "--projects", "."]
+    result = json.loads(run([*cmd, "--base-size", "6", "--seeds", "0", "1"], work, env).stdout.strip().splitlines()[-1])
+    assert result["grasps"] == 6 and list(result["draws"]) == ["."]
+    draw = result["draws"]["."]
+    assert draw["arms_networks"]["before"] == ["targeted", 0.0, 6]
+    assert all(len(picks) == 2 and all(0 <= p <= 1 for p in picks) for picks in draw["top_pick"].values())
+    assert all(value is None for value in result["pooled"].values())
+
+
+def test_attribution_study_combines_a_finished_draw(tiny_repo, tmp_path):
+    """`graspaug study attribution --combine-only` over one draw (the tiny run, linked as draw0): the decomposition
+    and the per-network tables, recorded with the command that made them."""
+    import json
+
+    work, env = tiny_repo
+    run(["dvc", "repro", "report"], work, env)
+    (tmp_path / "draw0").symlink_to(work)
+    cmd = [*GRASPAUG, "study", "attribution", "--draws", "0", "--workdir", str(tmp_path), "--profile", "tiny"]
+    printed = run([*cmd, "--combine-only", "--resamples", "50", "--results", "tiny-study"], work, env).stdout
+    assert (tmp_path / "decomposition.md").read_text() in printed
+    assert json.loads((tmp_path / "summary.json").read_text())["draws"] == [0]
+    meta = json.loads((work / "results/tiny-study/meta.json").read_text())
+    assert meta["command"].startswith("graspaug study attribution --draws 0") and meta["n_resamples"] == 50
+    networks = pd.read_parquet(work / "results/tiny-study/networks.parquet")
+    assert set(networks.seed) == {0, 1} and set(networks.draw) == {0} and networks.test_ap.between(0, 1).all()
+
+
+def test_lifelong_study_combines_a_finished_draw(tiny_repo, tmp_path):
+    """`graspaug study lifelong --combine-only` over one draw (the tiny run's rounds, linked as draw0): every
+    round's arms, the curves, the predictions recorded with the command."""
+    import json
+
+    work, env = tiny_repo
+    run(["dvc", "repro", "lifelong@r2"], work, env)
+    (tmp_path / "draw0").symlink_to(work)
+    cmd = [*GRASPAUG, "study", "lifelong", "--draws", "0", "--workdir", str(tmp_path), "--profile", "tiny"]
+    printed = run([*cmd, "--combine-only", "--resamples", "50", "--results", "tiny-lifelong"], work, env).stdout
+    assert "# The lifelong loop over draws of the data" in printed and "| 2 |" in printed
+    assert set(json.loads((tmp_path / "summary.json").read_text())) == {"0", "1", "2"}
+    assert len(pd.read_csv(tmp_path / "followed.csv")) == 2
+    assert (tmp_path / "curve.png").stat().st_size > 0 and (tmp_path / "gain.png").stat().st_size > 0
+    meta = json.loads((work / "results/tiny-lifelong/meta.json").read_text())
+    assert meta["command"].startswith("graspaug study lifelong --draws 0") and meta["draws"] == [0]
 
 
 def test_metrics_hold_few_scalars_and_fit_a_terminal(tiny_repo):

@@ -287,7 +287,7 @@ def test_the_report_scopes_its_verdicts_to_its_one_draw_of_the_data():
     )
     text = words.report_markdown(table, {"targeted_vs_random@50": loss}, {}, [], [0, 1, 2, 3], 0.3, "Words.", 1)
     assert "over training seeds [0, 1, 2, 3] of one draw of the data (`data_seed` = 1)" in text
-    assert "does not cover other draws" in text and "`python studies/attribution.py --draws 0 1 2`" in text
+    assert "does not cover other draws" in text and "`graspaug study attribution --draws 0 1 2`" in text
     assert "Over three draws of the data" in text
     assert "a loss in this draw of the data" in text and "a real loss" not in text
     assert "a real gain" not in words.verdict("x", loss | {"mean": 0.03, "draws_low": 0.01, "draws_high": 0.05})

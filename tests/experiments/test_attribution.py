@@ -67,7 +67,7 @@ def test_combine_draws_gives_every_contrast_one_interval_over_draws_seeds_and_ob
     assert step["per_draw"] == pytest.approx([(ap[d, 0] + ap[d, 1]) / 2 for d in draws], abs=1e-5)
     assert step["n_draws"] == 2 and step["n_seeds"] == 2 and step["draws_low"] < step["draws_high"]
     assert set(result["share"]) == {"10"} and result["draws"] == [0, 1] and result["seeds"] == [0, 1]
-    text = decomposition_markdown(result, [10], "python studies/attribution.py")
+    text = decomposition_markdown(result, [10], "graspaug study attribution")
     assert "| `targeted_vs_blend@10` |" in text and "B = 10" in text
     shares = result["shares"]  # every pool but real, as a share of the real pool's gain over no augmentation
     assert set(shares) == {"targeted", "random", "recon", "blend"} and shares["targeted"] == result["share"]
@@ -134,7 +134,7 @@ def test_one_draw_gives_intervals_over_seeds_and_objects_and_says_they_miss_othe
     assert step["n_draws"] == 1 and step["n_seeds"] == 3 and step["draws_low"] < step["mean"] < step["draws_high"]
     text = decomposition_markdown(result, [10], "dvc repro report")
     assert "One draw of the data" in text and "does not cover other draws" in text and "Draws (data_seed)" not in text
-    assert "`data_seed` = 0 and training seeds [0, 1, 2]" in text and "studies/attribution.py --draws 0 1 2" in text
+    assert "`data_seed` = 0 and training seeds [0, 1, 2]" in text and "graspaug study attribution --draws 0 1 2" in text
     c = {"recon_vs_real@50": contrast(-0.03, "draws", 4, 1, draws=(-0.05, -0.01))}
     assert "over 4 seeds of one draw and the test objects, a loss in this draw of the data." in losing_step(c, 50)
 

@@ -20,7 +20,7 @@ from graspaug.pipeline.cli import app
 from tests.experiments.test_attribution import GENERATE, GQCNN, LABELS, OBJECTS, make_draws
 
 ROOT = Path(__file__).resolve().parents[2]
-META = {"command": "python studies/attribution.py --draws 0 1", "commit": "0" * 40, "date": "2026-11-28"}
+META = {"command": "graspaug study attribution --draws 0 1", "commit": "0" * 40, "date": "2026-11-28"}
 
 
 def _results(tmp_path, real_noise=0.1):

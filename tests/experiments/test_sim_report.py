@@ -111,7 +111,7 @@ def test_contrast_interval_excludes_zero_for_a_clear_effect_and_report_says_so()
     assert "`after_vs_before` excludes zero: after succeeds less often than before" in text
     assert "paired drops): a loss in this draw of the data." in text  # the picks' networks come from one draw
     assert "`data_seed` = 2 and training seeds [0]" in text and "does not cover other draws" in text
-    assert "python studies/cell_ranking.py" in text
+    assert "graspaug study cell-ranking" in text
     assert "| o11 | test_shape | 3 | 0.00 | n/a |" in text  # no labels for o10, o11
     assert "Grip 20 N, the object shaken at 5 g after the lift." in text
     headline = sim_headline(metrics)  # the metrics files: one per contrast, its mean and bootstrap interval

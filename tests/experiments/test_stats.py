@@ -146,8 +146,8 @@ def test_a_one_draw_interval_is_a_gain_or_loss_in_this_draw_only_and_says_where_
     scope = draw_scope(2, [0, 1, 2, 3], "ap")
     assert "`data_seed` = 2" in scope and "training seeds [0, 1, 2, 3] (`gqcnn.seeds`)" in scope
     assert "does not cover other draws" in scope
-    assert "`python studies/attribution.py --draws 0 1 2`" in scope and '"Over three draws of the data"' in scope
-    assert "studies/lifelong.py --draws 0 1 2" in draw_scope(0, [0], "lifelong")
+    assert "`graspaug study attribution --draws 0 1 2`" in scope and '"Over three draws of the data"' in scope
+    assert "graspaug study lifelong --draws 0 1 2" in draw_scope(0, [0], "lifelong")
 
 
 def test_one_contrast_type_names_each_interval_by_what_it_covers():

@@ -1,7 +1,7 @@
 """Results as data: each study's per-network, per-test-datapoint tables in ``results/<study>/``, and every figure the
 README and docs/results.md quote, recomputed from them (issue #58).
 
-``results/attribution/`` (written by ``studies/attribution.py``, read by :func:`recompute`):
+``results/attribution/`` (written by ``graspaug study attribution``, read by :func:`recompute`):
 
 * ``networks.parquet`` — one row per draw, training seed and network: ``draw`` (``data_seed``), ``pool``,
   ``base_size``, ``ratio``, ``seed``, ``val_ap``, ``test_ap``, ``test_roc_auc``, ``train_datapoints``
@@ -14,7 +14,7 @@ README and docs/results.md quote, recomputed from them (issue #58).
   reads (``base_sizes``, ``ratios``, ``augment_base_sizes``, ``pools``, ``control_ratios``, ``n_resamples``,
   ``seed``), written last.
 
-``results/lifelong/`` (written by ``studies/lifelong.py``, :func:`write_lifelong`): ``predictions.parquet`` (one
+``results/lifelong/`` (written by ``graspaug study lifelong``, :func:`write_lifelong`): ``predictions.parquet`` (one
 float32 column per round, draw, training seed and arm, ``r<k>/<draw>/<seed>/<arm>``), ``test.parquet`` and
 ``meta.json`` as above.
 

@@ -239,13 +239,13 @@ def headline(c: dict) -> dict[str, float | None]:
 
 #: Where each experiment is run over several draws of the data: (command, section of docs/results.md).
 OVER_DRAWS = {
-    "ap": ("python studies/attribution.py --draws 0 1 2", "Over three draws of the data"),
+    "ap": ("graspaug study attribution --draws 0 1 2", "Over three draws of the data"),
     "lifelong": (
-        "python studies/lifelong.py --draws 0 1 2",
+        "graspaug study lifelong --draws 0 1 2",
         "The lifelong loop: generating from the planner's failures",
     ),
     "sim": (
-        "python studies/cell_ranking.py --grasps reports/grasp_calibration/grasps.csv --projects . <draw1> <draw2>",
+        "graspaug study cell-ranking --grasps reports/grasp_calibration/grasps.csv --projects . <draw1> <draw2>",
         "The networks rank the cell's outcomes: the positive control shows",
     ),
 }

@@ -6,7 +6,8 @@ this module is no stage's code, so editing it re-runs nothing. The params tables
 help is shown.
 
 Over 400 lines because it is a table: 26 commands (one per stage, and ``plan``, ``from-failures``, ``evaluate``,
-``export-model``, ``profile``, ``schema``), each a few lines of options with the help text a user reads; the work
+``export-model``, ``profile``, ``schema``; ``graspaug study …`` is mounted from :mod:`graspaug.pipeline.study_cli`),
+each a few lines of options with the help text a user reads; the work
 is elsewhere (``pipeline/stages/``, ``planning/report.py``) and errors go through one handler
 (:mod:`graspaug.pipeline.command`).
 """
@@ -569,7 +570,7 @@ def profile_command(
     cls=Command,
     name="results",
     help="Recompute every figure the README and docs/results.md quote from the studies' per-network tables in "
-    "`results/<study>/` (written by `python studies/attribution.py`): writes `<out>/<study>/summary.json`, "
+    "`results/<study>/` (written by `graspaug study attribution`): writes `<out>/<study>/summary.json`, "
     "`decomposition.md` and `figures.json` (key → the quoted text) and prints each figure. `--check`: a figure the "
     "markdown marks (`<!-- results:KEY -->` before it) that differs from the recomputed one, or that no study "
     "recomputes, is an error naming it (exit 2).",
@@ -606,6 +607,11 @@ def schema_command(out: Path = typer.Option(Path("params.schema.json"), "--out",
 
     out.write_text(json_schema())
     typer.echo(f"wrote {out}")
+
+
+from graspaug.pipeline.study_cli import study_app  # noqa: E402 - the studies' commands, after the stages'
+
+app.add_typer(study_app, name="study")
 
 
 def _version(value: bool) -> None:

@@ -16,7 +16,7 @@ point clouds sampled from the meshes' surfaces:
 Chamfer distance here: the mean, over both clouds' points, of the distance to the nearest point
 of the other cloud (m, not squared), the clouds centered on their centroids.
 
-Also the round trip's figure (``studies/roundtrip_ceiling.py``, ``studies/paper_scale.py``): how much of each shape's
+Also the round trip's figure (``graspaug study roundtrip-ceiling``, ``bench/paper_scale.py``): how much of each shape's
 graspness its reconstruction keeps, labelled as the ``grasps`` stage labels it (:func:`mesh_graspness`,
 :func:`paired_graspness_kept`).
 """

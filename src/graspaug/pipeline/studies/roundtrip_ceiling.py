@@ -1,6 +1,7 @@
-"""What could a perfect decoder hand over? Graspness kept when a shape goes through a grid and back to a mesh.
+"""``graspaug study roundtrip-ceiling``: what could a perfect decoder hand over? Graspness kept when a shape goes
+through a grid and back to a mesh.
 
-For ``--shapes`` random train shapes of a project (``--seed`` picks them), each shape's grasps are labelled as
+For ``shapes`` random train shapes of a project (``seed`` picks them), each shape's grasps are labelled as
 the ``grasps`` stage labels them (:func:`graspaug.grasping.labelled.grasps_of_shape`, the project's ``grasps``
 params and ``seed``, the shape's own random stream) on
 
@@ -9,7 +10,7 @@ params and ``seed``, the shape's own random stream) on
   ``voxelize`` stage makes it) meshed by :func:`graspaug.geometry.from_voxels.mesh_decoded` with the project's
   ``generate.decode`` settings, as if the grid were a perfect decode;
 - ``tsdf R``: its exact truncated signed distance at R³ on the same grid
-  (:func:`graspaug.geometry.sdf.truncated_distance_grid`, ``--truncation`` voxels) meshed by
+  (:func:`graspaug.geometry.sdf.truncated_distance_grid`, ``truncation`` voxels) meshed by
   :func:`graspaug.geometry.sdf.mesh_from_sdf` (marching cubes at 0, no opening, no smoothing; the same
   ``min_voxels`` and ``min_main_share`` rejections), centred on its centre of mass as a decode would be;
 
@@ -17,18 +18,13 @@ for R = 32 and 64. Each reconstruction is written as a generated shape is (OBJ) 
 Graspness is a shape's share of positive grasps (:func:`graspaug.augment.scores.graspness`; 0 without grasps).
 Per row, over the shapes that meshed: graspness kept = mean after / mean before (Fieller 95% interval of the
 ratio of paired means), the paired difference after − before with its 95% t-interval over shapes, and how
-many meshed. Prints a markdown table and writes ``rows.csv``, ``per_shape.csv``, ``summary.json`` (the rows and
-the run's settings) and ``timing.json`` (seconds per shape of each grid and mesh step) into ``--out``.
-
-Run it on a project where ``ingest`` has run (``data/shapes.parquet``, ``data/shapes/``)::
-
-    .venv/bin/python studies/roundtrip_ceiling.py --project PROJECT [--shapes 80] [--seed 0] [--workers 2]
-                                                  [--truncation 3] [--out studies/out/roundtrip_ceiling]
+many meshed. Writes ``rows.csv``, ``per_shape.csv``, ``summary.json`` (the rows and the run's settings) and
+``timing.json`` (seconds per shape of each grid and mesh step) into its output folder and returns the markdown
+table it prints. Runs on a project where ``ingest`` has run (``data/shapes.parquet``, ``data/shapes/``).
 """
 
 from __future__ import annotations
 
-import argparse
 import dataclasses
 import logging
 import tempfile
@@ -44,15 +40,13 @@ from graspaug.geometry.from_voxels import mesh_decoded
 from graspaug.geometry.sdf import mesh_from_sdf, truncated_distance_grid
 from graspaug.geometry.voxelize import fit_grid, voxelize_solid
 from graspaug.io.meshes import mesh_path, read_mesh, write_obj
-from graspaug.io.tables import read_table, write_json
+from graspaug.io.tables import read_table, write_csv, write_json
 from graspaug.parallel import parallel_map
 from graspaug.pipeline.params.model import load_params
 from graspaug.pipeline.paths import GENERATED_SUFFIX, corpus_files
 
-log = logging.getLogger("roundtrip_ceiling")
+log = logging.getLogger(__name__)
 
-HERE = Path(__file__).resolve().parent
-OUT = HERE / "out" / "roundtrip_ceiling"
 RESOLUTIONS = (32, 64)
 VARIANTS = ("original", *(f"{recipe} {r}" for recipe in ("occupancy", "tsdf") for r in RESOLUTIONS))
 
@@ -114,31 +108,23 @@ def summarize(per_shape: pd.DataFrame) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--project", type=Path, default=Path("."), help="a project where ingest has run")
-    parser.add_argument("--shapes", type=int, default=80, help="train shapes drawn (%(default)s)")
-    parser.add_argument("--seed", type=int, default=0, help="which shapes are drawn (%(default)s)")
-    parser.add_argument("--workers", type=int, default=None, help="processes (default: the project's n_jobs)")
-    parser.add_argument("--truncation", type=float, default=3.0, help="TSDF truncation, voxels (%(default)s)")
-    parser.add_argument("--out", type=Path, default=OUT, help="where the results go (%(default)s)")
-    args = parser.parse_args()
-    logging.basicConfig(level=logging.INFO, format="%(message)s")
-
-    project = args.project.resolve()
+def run(project: Path, n_shapes: int, seed: int, workers: int | None, truncation: float, out: Path) -> str:
+    """The study (module docstring) on ``n_shapes`` train shapes of ``project`` drawn with ``seed``, on ``workers``
+    processes (None: the project's ``n_jobs``); writes its tables into the folder ``out``; the markdown table."""
+    project = project.resolve()
     params = load_params(project / "params.yaml")
     table_path, mesh_dir, suffix = corpus_files("original")
     shapes = read_table(project / table_path)
     train = shapes.shape_id[shapes.split == "train"].to_numpy()
-    chosen = sorted(np.random.default_rng(args.seed).choice(train, size=min(args.shapes, len(train)), replace=False))
+    chosen = sorted(np.random.default_rng(seed).choice(train, size=min(n_shapes, len(train)), replace=False))
     jobs = [(mesh_path(project / mesh_dir, shape_id, suffix), shape_id) for shape_id in chosen]
     margin, decode = params.voxelize.margin, params.generate.decode
 
     start = time.perf_counter()
     results = parallel_map(
-        lambda job: shape_rows(job, margin, decode, params.grasps, params.seed, args.truncation),
+        lambda job: shape_rows(job, margin, decode, params.grasps, params.seed, truncation),
         jobs,
-        args.workers or params.workers,
+        workers or params.workers,
         "round trips",
     )
     seconds = time.perf_counter() - start
@@ -146,34 +132,27 @@ def main() -> None:
     rows = summarize(per_shape)
     steps = pd.DataFrame([s for _, s in results])
 
-    args.out.mkdir(parents=True, exist_ok=True)
-    per_shape.to_csv(args.out / "per_shape.csv", index=False)
-    rows.to_csv(args.out / "rows.csv", index=False)
+    write_csv(per_shape, out / "per_shape.csv")
+    write_csv(rows, out / "rows.csv")
     settings = {
         "project": str(project),
         "shapes": len(chosen),
-        "seed": args.seed,
-        "truncation_voxels": args.truncation,
+        "seed": seed,
+        "truncation_voxels": truncation,
         "margin": margin,
         "decode": dataclasses.asdict(decode),
         "grasps_seed": params.seed,
         "n_grasps": params.grasps.sampler.n_grasps,
     }
-    write_json(
-        {"settings": settings, "rows": rows.replace({np.nan: None}).to_dict("records")}, args.out / "summary.json"
-    )
+    write_json({"settings": settings, "rows": rows.replace({np.nan: None}).to_dict("records")}, out / "summary.json")
     timing = {
         "seconds": round(seconds, 1),
         "per_shape_mean": {step: round(float(steps[step].mean()), 3) for step in steps},
         "per_shape_median": {step: round(float(steps[step].median()), 3) for step in steps},
     }
-    write_json(timing, args.out / "timing.json")
+    write_json(timing, out / "timing.json")
     reasons = per_shape[~per_shape.meshed].groupby("variant").reason.value_counts()
     if len(reasons):
         log.info("not meshed:\n%s", reasons.to_string())
     log.info("%d shapes in %.0f s; seconds per shape (mean): %s", len(chosen), seconds, timing["per_shape_mean"])
-    print(paired_graspness_kept_markdown(rows))
-
-
-if __name__ == "__main__":
-    main()
+    return paired_graspness_kept_markdown(rows)

@@ -1,27 +1,23 @@
-"""The lifelong loop over several draws of the data (issue #36): run the ``lifelong`` profile's rounds once per data
-seed and give every round's arms and contrasts one interval over draws, training seeds and test objects.
+"""``graspaug study lifelong``: the lifelong loop over several draws of the data (issue #36).
 
-Each draw k is a clone of this repository's HEAD in ``--workdir``/draw<k> with params.yaml written from the profile
-plus ``data_seed: k``. By default it runs ``dvc repro lifelong@r<K>`` there (the whole pipeline up to the last round,
-sharing this repository's DVC cache). With ``--reuse DIR`` the stages before the loop are not run again: their
-outputs are linked from DIR/draw<k> (an attribution study's draws: the same profile's data, the same data seed) and
-the rounds run as ``graspaug lifelong-start`` and ``graspaug lifelong --round r<k>``, the commands the DVC stages
-run. A finished round is not run again. Then :func:`~graspaug.experiments.lifelong.numbers.arm_contrasts` combines
-the draws per round and ``summary.json``, ``lifelong.md``, ``followed.csv``, ``curve.png`` (test AP) and ``gain.png``
-(the gain over round 0) are written into ``--workdir``, and every network's test predictions with the command and
-commit into this repository's ``results/<--results>/`` (``graspaug results`` recomputes every figure from them).
-
-    python studies/lifelong.py [--draws 0 1 2] [--workdir ../lifelong] [--profile lifelong] [--reuse ../attribution]
-        [--resamples 2000] [--combine-only] [--results lifelong]
+Runs the ``lifelong`` profile's rounds once per data seed and gives every round's arms and contrasts one interval
+over draws, training seeds and test objects. Each draw k is a clone of the project's HEAD in ``workdir``/draw<k>
+with params.yaml written from the profile plus ``data_seed: k``. By default it runs ``dvc repro lifelong@r<K>``
+there (the whole pipeline up to the last round, sharing the project's DVC cache). With ``reuse`` the stages before
+the loop are not run again: their outputs are linked from ``reuse``/draw<k> (an attribution study's draws: the same
+profile's data, the same data seed) and the rounds run as ``graspaug lifelong-start`` and ``graspaug lifelong
+--round r<k>``, the commands the DVC stages run. A finished round is not run again. Then
+:func:`~graspaug.experiments.lifelong.numbers.arm_contrasts` combines the draws per round and ``summary.json``,
+``lifelong.md``, ``followed.csv``, ``curve.png`` (test AP) and ``gain.png`` (the gain over round 0) are written
+into ``workdir``, and every network's test predictions with the command and commit into the project's
+``results/<results>/`` (``graspaug results`` recomputes every figure from them).
 """
 
 from __future__ import annotations
 
-import argparse
 import json
+import logging
 import os
-import subprocess
-import sys
 import time
 from pathlib import Path
 
@@ -32,48 +28,34 @@ from graspaug.experiments.lifelong.figures import curve_series
 from graspaug.experiments.lifelong.numbers import ARMS, arm_contrasts, arm_variant, curve_rows, round_networks
 from graspaug.experiments.results import write_lifelong
 from graspaug.experiments.stats import interval_text, share_text
-from graspaug.io.tables import read_table
-from graspaug.pipeline.params.profiles import merge, params_yaml, read_overlay
+from graspaug.io.atomic import atomic_path
+from graspaug.io.tables import read_table, write_csv
+from graspaug.pipeline.paths import AE_CRITIC_MODEL, LATENTS, SHAPES_TABLE, VOXELS, gqcnn_dir
+from graspaug.pipeline.studies.draws import checked, draw_params, prepare_draw, provenance
 from graspaug.plots import lines
 
-ROOT = Path(__file__).resolve().parents[1]
+log = logging.getLogger(__name__)
+
 REUSED = (  # the loop's inputs, made by the stages before it
-    "data/shapes.parquet",
-    "data/latents.parquet",
+    str(SHAPES_TABLE),
+    str(LATENTS),
     "data/scores.parquet",
-    "data/voxels.npz",
-    "models/ae_critic.pt",
-    "data/gqcnn/original",
+    str(VOXELS),
+    str(AE_CRITIC_MODEL),
+    str(gqcnn_dir("original")),
     "models/gqcnn",
 )
 
 
-def draw_params(profile: str, data_seed: int):
-    from graspaug.pipeline.params.model import params_dict, parse_params
-
-    return parse_params(merge(params_dict(), read_overlay(profile, ROOT / "profiles") | {"data_seed": data_seed}))
-
-
-def run_draw(folder: Path, params, profile: str, reuse: Path | None) -> None:
-    """Clone HEAD into ``folder`` (once), write params.yaml and run the rounds (module docstring)."""
-    if not folder.exists():
-        subprocess.run(["git", "clone", "--quiet", str(ROOT), str(folder)], check=True)
-    header = f"graspaug params, profile `{profile}` with data_seed {params.data_seed}: written by studies/lifelong.py"
-    (folder / "params.yaml").write_text(params_yaml(params, header))
+def run_draw(project: Path, folder: Path, params, profile: str, reuse: Path | None) -> None:
+    """Clone ``project``'s HEAD into ``folder`` (once), write params.yaml and run the rounds (module docstring)."""
+    header = (
+        f"graspaug params, profile `{profile}` with data_seed {params.data_seed}: written by `graspaug study lifelong`"
+    )
+    prepare_draw(project, folder, params, header, share_cache=reuse is None)
     rounds = params.lifelong.round_numbers()
-    env = {
-        **os.environ,
-        "DVC_NO_ANALYTICS": "1",
-        "PATH": f"{Path(sys.executable).parent}{os.pathsep}{os.environ['PATH']}",
-    }
     if reuse is None:
-        cache = subprocess.run(
-            [sys.executable, "-m", "dvc", "cache", "dir"], cwd=ROOT, check=True, capture_output=True, text=True
-        ).stdout.strip()
-        subprocess.run([sys.executable, "-m", "dvc", "cache", "dir", "--local", cache], cwd=folder, check=True)
-        subprocess.run(
-            [sys.executable, "-m", "dvc", "repro", f"lifelong@r{max(rounds)}"], cwd=folder, env=env, check=True
-        )
+        checked(["dvc", "repro", f"lifelong@r{max(rounds)}"], folder, f"draw {params.data_seed}")
         return
     for path in REUSED:
         (folder / path).parent.mkdir(parents=True, exist_ok=True)
@@ -82,7 +64,7 @@ def run_draw(folder: Path, params, profile: str, reuse: Path | None) -> None:
     for k in [0, *rounds]:
         if not (folder / f"data/lifelong/r{k}").exists():
             command = ["graspaug", "lifelong-start"] if k == 0 else ["graspaug", "lifelong", "--round", f"r{k}"]
-            subprocess.run(command, cwd=folder, env=env, check=True)
+            checked(command, folder, f"draw {params.data_seed}")
 
 
 def combine(folders: dict[int, Path], params, n_resamples: int, results: Path, meta: dict) -> dict:
@@ -91,7 +73,7 @@ def combine(folders: dict[int, Path], params, n_resamples: int, results: Path, m
     recomputes every figure from them)."""
     cfg, seeds = params.lifelong, params.gqcnn.seeds
     first = next(iter(folders.values()))
-    index = read_table(first / "data/gqcnn/original/index.parquet")
+    index = read_table(first / gqcnn_dir("original") / "index.parquet")
     labels, objects = test_labels(index, first / "models/gqcnn/s0")
     start = arm_variant("none", cfg.base_size, 0).name
     out, rounds = {}, {}
@@ -127,6 +109,8 @@ def followed(folders: dict[int, Path], rounds: list[int]) -> pd.DataFrame:
 
 
 def markdown(result: dict, params, command: str, seconds: float, follow: pd.DataFrame) -> str:
+    """``lifelong.md``: per round the contrasts and the share of the real gain, the arms' test AP, and the failure
+    objects followed (:func:`followed`), with the ``command`` and its ``seconds``."""
     cfg = params.lifelong
     lines_ = [
         "# The lifelong loop over draws of the data",
@@ -160,41 +144,42 @@ def markdown(result: dict, params, command: str, seconds: float, follow: pd.Data
     return "\n".join(lines_ + ["", f"Command: `{command}` ({seconds / 60:.0f} min).", ""])
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--draws", type=int, nargs="+", default=[0, 1, 2], help="data seeds, one loop each")
-    parser.add_argument("--workdir", type=Path, default=ROOT.parent / "lifelong")
-    parser.add_argument("--profile", default="lifelong")
-    parser.add_argument("--reuse", type=Path, default=None, help="a study's workdir whose draws hold the inputs")
-    parser.add_argument("--resamples", type=int, default=2000)
-    parser.add_argument("--combine-only", action="store_true", help="combine finished draws, run nothing")
-    parser.add_argument("--results", default="lifelong", help="results/<this>/: the networks' test predictions")
-    args = parser.parse_args()
+def run(
+    project: Path,
+    draws: list[int],
+    workdir: Path,
+    profile: str,
+    reuse: Path | None,
+    resamples: int,
+    combine_only: bool,
+    results: str,
+    command: str,
+) -> str:
+    """Run (unless ``combine_only``) and combine the lifelong loops of the draws ``draws`` (data seeds) of
+    ``profile`` in ``workdir``; the text of ``lifelong.md`` (module docstring). ``command``: the line recorded with
+    the predictions in ``project``/results/``results``."""
     start = time.perf_counter()
-    params = {k: draw_params(args.profile, k) for k in args.draws}
-    folders = {k: args.workdir.resolve() / f"draw{k}" for k in args.draws}
-    for k in args.draws:
-        if not args.combine_only:
-            reuse = args.reuse.resolve() / f"draw{k}" if args.reuse else None
-            run_draw(folders[k], params[k], args.profile, reuse)
-        print(f"draw {k}: done ({time.perf_counter() - start:.0f} s)", flush=True)
-    p = params[args.draws[0]]
-    command = "python studies/lifelong.py " + " ".join(sys.argv[1:])
-    commit = subprocess.run(["git", "rev-parse", "HEAD"], cwd=ROOT, capture_output=True, text=True).stdout.strip()
-    meta = {"command": command, "commit": commit, "date": time.strftime("%Y-%m-%d"), "draws": args.draws}
-    result = combine(folders, p, args.resamples, ROOT / "results" / args.results, meta)
-    (args.workdir / "summary.json").write_text(json.dumps({str(k): r for k, r in result.items()}, indent=1) + "\n")
+    project, workdir = project.resolve(), workdir.resolve()
+    params = {k: draw_params(project, profile, k) for k in draws}
+    folders = {k: workdir / f"draw{k}" for k in draws}
+    for k in draws:
+        if not combine_only:
+            run_draw(project, folders[k], params[k], profile, reuse.resolve() / f"draw{k}" if reuse else None)
+        log.info("draw %d: done (%.0f s)", k, time.perf_counter() - start)
+    p = params[draws[0]]
+    meta = provenance(project, command) | {"draws": draws}
+    result = combine(folders, p, resamples, project / "results" / results, meta)
     follow = followed(folders, p.lifelong.round_numbers())
-    follow.to_csv(args.workdir / "followed.csv", index=False)
-    (args.workdir / "lifelong.md").write_text(markdown(result, p, command, time.perf_counter() - start, follow))
+    text = markdown(result, p, command, time.perf_counter() - start, follow)
     curve = pd.concat([curve_rows(k, r) for k, r in result.items()])
-    design = f"{len(args.draws)} draws × {len(p.gqcnn.seeds)} seeds × test objects, 95% intervals"
+    design = f"{len(draws)} draws × {len(p.gqcnn.seeds)} seeds × test objects, 95% intervals"
     for figure, label, name in (("ap", "test AP", "curve.png"), ("gain", "test AP − round 0's", "gain.png")):
         rounds, series, bands = curve_series(curve, ARMS, figure)
         what = "Test AP per round" if figure == "ap" else "Gain over round 0, paired"
-        lines(rounds, series, args.workdir / name, "round", label, f"{what} ({design})", bands)
-    print((args.workdir / "lifelong.md").read_text())
-
-
-if __name__ == "__main__":
-    main()
+        lines(rounds, series, workdir / name, "round", label, f"{what} ({design})", bands)  # written atomically
+    write_csv(follow, workdir / "followed.csv")
+    with atomic_path(workdir / "summary.json") as tmp:
+        tmp.write_text(json.dumps({str(k): r for k, r in result.items()}, indent=1) + "\n")
+    with atomic_path(workdir / "lifelong.md") as tmp:
+        tmp.write_text(text)
+    return text

@@ -19,22 +19,22 @@ Everything goes to ``--out``: ``summary.json`` (settings, per-phase figures, sec
 held-out ids, pitches and both reconstructions at 0.5, bit-packed) and, from a project, ``meshes/``. On a CPU keep
 it small (the defaults take about 15 minutes on 2 cores); on a GPU raise every count::
 
-    python studies/paper_scale.py --project PROJECT [--device auto] [--train-shapes 24] [--test-shapes 12]
-        [--epochs-ae 6] [--epochs-critic 3] [--gqcnn-steps 20] [--batch-size B] [--out studies/out/paper_scale]
+    python bench/paper_scale.py --project PROJECT [--device auto] [--train-shapes 24] [--test-shapes 12]
+        [--epochs-ae 6] [--epochs-critic 3] [--gqcnn-steps 20] [--batch-size B] [--out bench/out/paper_scale]
 
 A GPU machine with no project (and no pybullet or trimesh) takes the inputs packed on the CPU side: ``--pack FILE``
 writes the chosen shapes' grids bit-packed and ``--crops`` rendered train crops in float16 into one .npz (700 + 260
 shapes at 64³ and 8,000 crops: a few MB compressed), and ``--packed FILE`` trains from it::
 
-    python studies/paper_scale.py --project PROJECT --train-shapes 700 --test-shapes 260 --pack inputs.npz
-    python studies/paper_scale.py --packed inputs.npz --device cuda --epochs-ae 150 --epochs-critic 20 ...
+    python bench/paper_scale.py --project PROJECT --train-shapes 700 --test-shapes 260 --pack inputs.npz
+    python bench/paper_scale.py --packed inputs.npz --device cuda --epochs-ae 150 --epochs-critic 20 ...
 
 Back on the CPU, ``--label reconstructions.npz --project PROJECT`` (the project the pack came from) meshes each
 held-out reconstruction by ``generate``'s recipe (the profile's ``generate.decode``), labels its grasps and the
 original's as the ``grasps`` stage does (the project's ``grasps`` params and ``seed``) and writes, per phase,
 the graspness kept (after / before over the shapes that meshed, Fieller 95%) to ``--out``/``label.json``::
 
-    python studies/paper_scale.py --label OUT/reconstructions.npz --project PROJECT [--workers 2]
+    python bench/paper_scale.py --label OUT/reconstructions.npz --project PROJECT [--workers 2]
 """
 
 from __future__ import annotations

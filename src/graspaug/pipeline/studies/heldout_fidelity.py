@@ -1,8 +1,9 @@
-"""What a trained AutoEncoder keeps of real shapes it never trained on: the recon pool's fidelity, on the test split.
+"""``graspaug study heldout-fidelity``: what a trained AutoEncoder keeps of real shapes it never trained on: the recon
+pool's fidelity, on the test split.
 
 The ``fidelity`` stage measures the ``recon`` pool: train-split shapes (the AutoEncoder learns every train shape)
 decoded from their own latents. This study asks the same of held-out shapes. On a project where ``embed`` and
-``render@original`` have run, for ``--shapes`` random test-split shapes (``--seed``), it
+``render@original`` have run, for ``shapes`` random test-split shapes (``seed``), it
 
 1. decodes each shape's latent (``data/latents.parquet``) with ``models/ae_critic.pt`` and meshes it at the shape's
    own pitch (``data/voxels.npz``) with the recon pool's own runner (``generate``'s recipe, ``generate.decode``; a
@@ -12,16 +13,12 @@ decoded from their own latents. This study asks the same of held-out shapes. On 
 3. gives, over the shapes that meshed, the graspness kept and the datapoints kept (after / before, ratios of paired
    means, Fieller 95%), the datapoints' positive share (the render stage's label), and how many meshed.
 
-It prints a table and writes ``summary.json`` and ``per_shape.csv`` to ``--out``::
-
-    python studies/heldout_fidelity.py --project PROJECT [--shapes 100] [--seed 0] [--workers 2] [--out DIR]
+It writes ``summary.json`` and ``per_shape.csv`` to its output folder and returns the table it prints.
 """
 
 from __future__ import annotations
 
-import argparse
 import json
-import logging
 import tempfile
 import time
 from pathlib import Path
@@ -33,13 +30,14 @@ from graspaug.augment.candidates import Candidate
 from graspaug.augment.decode import mesh_batches
 from graspaug.augment.pools import BaseSet
 from graspaug.augment.scores import graspness
+from graspaug.errors import DataError
 from graspaug.experiments.fidelity.numbers import paired_graspness_kept
 from graspaug.experiments.fidelity.words import paired_graspness_kept_markdown
 from graspaug.experiments.stats import fieller_interval
 from graspaug.grasping.labelled import grasps_of_shapes
 from graspaug.io.checkpoints import load_autoencoder
 from graspaug.io.meshes import mesh_path, write_obj
-from graspaug.io.tables import read_table
+from graspaug.io.tables import read_table, write_csv, write_json
 from graspaug.io.voxels import read_voxels
 from graspaug.pipeline.params.model import load_params
 from graspaug.pipeline.paths import AE_CRITIC_MODEL, GENERATED_SUFFIX, LATENTS, VOXELS, corpus_files
@@ -74,7 +72,7 @@ def label_and_render(shapes: pd.DataFrame, folder: Path, suffix: str, params, wo
     ``grasps`` and ``render`` stages make them."""
     ids = list(shapes.shape_id)
     if not ids:
-        raise SystemExit("heldout_fidelity: no reconstruction meshed, nothing to label")
+        raise DataError("heldout-fidelity: no reconstruction meshed, nothing to label")
     grasps, _ = grasps_of_shapes(folder, ids, suffix, params.grasps, params.seed, workers, f"grasps ({label})")
     index = {s: i for i, s in enumerate(ids)}
     score, count = graspness(grasps.success.to_numpy(), grasps.shape_id.map(index).to_numpy(), len(ids))
@@ -124,53 +122,42 @@ def summarize(per_shape: pd.DataFrame) -> dict:
     } | {f"{k}_{w}": float(np.nanmean(meshed[f"{k}_{w}"])) for k in ("stable_poses", "grasps_rendered") for w in WHEN}
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--project", type=Path, default=Path("."), help="a project where embed and render ran")
-    parser.add_argument("--shapes", type=int, default=100, help="random test shapes (%(default)s)")
-    parser.add_argument("--seed", type=int, default=0, help="which test shapes (%(default)s)")
-    parser.add_argument("--workers", type=int, default=2)
-    parser.add_argument("--out", type=Path, default=Path("studies/out/heldout_fidelity"))
-    args = parser.parse_args()
-    logging.basicConfig(level=logging.WARNING)
-    project = args.project.resolve()
+def run(project: Path, n_shapes: int, seed: int, workers: int, out: Path) -> str:
+    """The study (module docstring) on ``n_shapes`` test shapes of ``project`` drawn with ``seed``; writes
+    ``per_shape.csv`` and ``summary.json`` into the folder ``out``; the text to print."""
+    project = project.resolve()
     params = load_params(project / "params.yaml")
     table, mesh_dir, suffix = corpus_files("original")
     shapes = read_table(project / table)
     test = shapes.shape_id[shapes.split == "test"].to_numpy()
-    rng = np.random.default_rng(args.seed)
-    ids = sorted(rng.choice(test, size=min(args.shapes, len(test)), replace=False).tolist())
+    rng = np.random.default_rng(seed)
+    ids = sorted(rng.choice(test, size=min(n_shapes, len(test)), replace=False).tolist())
     start = time.perf_counter()
     with tempfile.TemporaryDirectory() as tmp:
         folder = Path(tmp)
-        reasons = reconstruct(project, ids, params, folder, args.workers)
+        reasons = reconstruct(project, ids, params, folder, workers)
         made = [s for s in ids if reasons[s] is None]
         rows = shapes.set_index("shape_id", drop=False)
-        before = label_and_render(rows.loc[ids], project / mesh_dir, suffix, params, args.workers, "originals")
-        after = label_and_render(rows.loc[made], folder, GENERATED_SUFFIX, params, args.workers, "reconstructions")
+        before = label_and_render(rows.loc[ids], project / mesh_dir, suffix, params, workers, "originals")
+        after = label_and_render(rows.loc[made], folder, GENERATED_SUFFIX, params, workers, "reconstructions")
     per_shape = before.merge(after, on="shape_id", how="left", suffixes=("_before", "_after"))
     per_shape["meshed"] = per_shape.shape_id.map(lambda s: reasons[s] is None)
     per_shape["reason"] = per_shape.shape_id.map(reasons)
     summary = summarize(per_shape) | {
         "decoder": params.ae.net.output,
         "project": str(project),
-        "shape_seed": args.seed,
+        "shape_seed": seed,
         "seconds": round(time.perf_counter() - start, 1),
     }
-    args.out.mkdir(parents=True, exist_ok=True)
-    per_shape.to_csv(args.out / "per_shape.csv", index=False)
-    (args.out / "summary.json").write_text(json.dumps(summary, indent=1, default=float) + "\n")
-    print(paired_graspness_kept_markdown(pd.DataFrame([{"variant": f"{summary['decoder']} recon, test"} | summary])))
+    write_csv(per_shape, out / "per_shape.csv")
+    write_json(json.loads(json.dumps(summary, default=float)), out / "summary.json")
+    table = paired_graspness_kept_markdown(pd.DataFrame([{"variant": f"{summary['decoder']} recon, test"} | summary]))
     ends = (summary[f"datapoints_kept{e}"] for e in ("", "_low", "_high"))
     kept = ["n/a" if v is None else f"{v:.1%}" for v in ends]
-    print(
-        f"datapoints / shape {summary['datapoints_before']:.1f} -> {summary['datapoints_after']:.1f}: kept {kept[0]} "
-        f"[{kept[1]}, {kept[2]}]; positive share {summary['positive_before']:.3f} -> {summary['positive_after']:.3f}; "
-        f"stable poses {summary['stable_poses_before']:.2f} -> {summary['stable_poses_after']:.2f}; grasps with a "
-        f"datapoint {summary['grasps_rendered_before']:.1f} -> {summary['grasps_rendered_after']:.1f}; "
-        f"{summary['seconds']} s"
+    return table + (
+        f"\ndatapoints / shape {summary['datapoints_before']:.1f} -> {summary['datapoints_after']:.1f}: kept "
+        f"{kept[0]} [{kept[1]}, {kept[2]}]; positive share {summary['positive_before']:.3f} -> "
+        f"{summary['positive_after']:.3f}; stable poses {summary['stable_poses_before']:.2f} -> "
+        f"{summary['stable_poses_after']:.2f}; grasps with a datapoint {summary['grasps_rendered_before']:.1f} -> "
+        f"{summary['grasps_rendered_after']:.1f}; {summary['seconds']} s"
     )
-
-
-if __name__ == "__main__":
-    main()

@@ -1,0 +1,239 @@
+"""``graspaug study <name>``: the studies a researcher reruns outside ``dvc repro``, one command each.
+
+Each command is a few lines of options with the help a user reads (what it runs and what it costs on 2 cores, the
+times measured in docs/results.md); the work is in :mod:`graspaug.pipeline.studies`, imported when the command runs.
+Errors go through the CLI's one handler (:class:`graspaug.pipeline.command.Command`).
+"""
+
+from __future__ import annotations
+
+import logging
+import shlex
+import sys
+from pathlib import Path
+
+import typer
+
+from graspaug.pipeline.command import Command
+
+study_app = typer.Typer(
+    help="The studies a researcher reruns outside `dvc repro`: experiments over several draws of the data, the robot "
+    "cell with changed settings, what a decoder keeps of a shape. Each command's help says what it runs and its cost "
+    "on 2 cores.",
+    rich_markup_mode="markdown",
+    no_args_is_help=True,
+)
+
+ProjectOption = typer.Option(Path("."), "--project", help="The project (a clone of this repository) it reads.")
+ForceOption = typer.Option(False, "--force", help="Write into an --out folder that holds files it did not write.")
+DRAWS_HELP = "Data seeds, one experiment each (`data_seed`), e.g. `--draws 0 1 2`."
+#: The options that take several values after one flag, as `--draws 0 1 2` (argparse's nargs="+").
+MANY = frozenset({"--draws", "--projects", "--seeds"})
+
+
+def spread(args: list[str], names=MANY) -> list[str]:
+    """``args`` with each value that follows an option of ``names`` given its own flag: ``--draws 0 1`` becomes
+    ``--draws 0 --draws 1`` (click repeats a list option's flag; the studies' users write the values after one)."""
+    out, current = [], None
+    for arg in args:
+        if arg.startswith("-"):
+            current = arg if arg in names else None
+        elif current is not None and out[-1] != current:
+            out.append(current)
+        out.append(arg)
+    return out
+
+
+class StudyCommand(Command):
+    """A study's command: the CLI's exit-code contract, and several values after one flag (:func:`spread`)."""
+
+    def parse_args(self, ctx, args: list[str]) -> list[str]:
+        return super().parse_args(ctx, spread(args))
+
+
+def _command_line() -> str:
+    """The command as the user typed it, recorded with the tables a study writes to `results/`."""
+    return shlex.join(["graspaug", *sys.argv[1:]])
+
+
+def _logging() -> None:
+    logging.basicConfig(level=logging.INFO, format="%(asctime)s %(levelname)s %(name)s: %(message)s", stream=sys.stderr)
+
+
+@study_app.command(
+    cls=StudyCommand,
+    name="attribution",
+    help="Why generated shapes add nothing, over several draws of the data (issue #33): for each data seed k, a clone "
+    "of the project's HEAD in `<workdir>/draw<k>` (sharing its DVC cache) with the `--profile` params plus "
+    "`data_seed: k` and every `--set`, runs `dvc repro report`; then one interval per contrast over draws, training "
+    "seeds and test objects (hierarchical bootstrap). Writes `<workdir>/summary.json`, `decomposition.md` and the "
+    "per-network tables with this command and the commit to `results/<results>/` (`graspaug results` recomputes every "
+    "quoted figure from them). A finished draw is not run again.\n\nCost on 2 cores: the `attribution` profile, about "
+    "40 min per draw (three draws: 121 min); with the distance decoder and seven pools, about 65 s per network (three "
+    "draws, 204 networks: about 4 h). `--combine-only`: seconds to minutes.",
+)
+def attribution_command(
+    draws: list[int] = typer.Option([0, 1, 2], "--draws", help=DRAWS_HELP),
+    workdir: Path = typer.Option(None, "--workdir", help="Where the draws' clones go (default: ../attribution)."),
+    profile: str = typer.Option(
+        "attribution", "--profile", help="The profile each draw runs (`profiles/<name>.yaml`)."
+    ),
+    changes: list[str] = typer.Option([], "--set", help="key.path=value (YAML), e.g. 'gqcnn.augment_base_sizes=[50]'."),
+    resamples: int = typer.Option(2000, "--resamples", min=1, help="Bootstrap resamples."),
+    combine_only: bool = typer.Option(False, "--combine-only", help="Combine finished draws, run nothing."),
+    results: str = typer.Option("attribution", "--results", help="`results/<this>/`: the per-network tables."),
+    project: Path = ProjectOption,
+) -> None:
+    from graspaug.pipeline.studies import attribution
+
+    _logging()
+    workdir = workdir or project.resolve().parent / "attribution"
+    text = attribution.run(project, draws, workdir, profile, changes, resamples, combine_only, results, _command_line())
+    typer.echo(text)
+
+
+@study_app.command(
+    cls=StudyCommand,
+    name="lifelong",
+    help="The lifelong loop over several draws of the data (issue #36): for each data seed k, a clone of the "
+    "project's HEAD in `<workdir>/draw<k>` with the `--profile` params plus `data_seed: k` runs `dvc repro "
+    "lifelong@r<K>`, or with `--reuse DIR` links the loop's inputs from `DIR/draw<k>` (an attribution study's draws) "
+    "and runs the rounds alone; then every round's arms and contrasts over draws, training seeds and test objects. "
+    "Writes `<workdir>/summary.json`, `lifelong.md`, `followed.csv`, `curve.png`, `gain.png` and every network's test "
+    "predictions with this command and the commit to `results/<results>/`. A finished round is not run again.\n\n"
+    "Cost on 2 cores: with `--reuse`, about 6 min per round and draw (rounds 0-2 of three draws: 53 min); without it, "
+    "the stages before the loop as well (an attribution draw's). `--combine-only`: seconds to minutes.",
+)
+def lifelong_command(
+    draws: list[int] = typer.Option([0, 1, 2], "--draws", help=DRAWS_HELP),
+    workdir: Path = typer.Option(None, "--workdir", help="Where the draws' clones go (default: ../lifelong)."),
+    profile: str = typer.Option("lifelong", "--profile", help="The profile each draw runs (`profiles/<name>.yaml`)."),
+    reuse: Path = typer.Option(None, "--reuse", help="A study's workdir whose draws hold the loop's inputs."),
+    resamples: int = typer.Option(2000, "--resamples", min=1, help="Bootstrap resamples."),
+    combine_only: bool = typer.Option(False, "--combine-only", help="Combine finished draws, run nothing."),
+    results: str = typer.Option("lifelong", "--results", help="`results/<this>/`: the networks' test predictions."),
+    project: Path = ProjectOption,
+) -> None:
+    from graspaug.pipeline.studies import lifelong
+
+    _logging()
+    workdir = workdir or project.resolve().parent / "lifelong"
+    text = lifelong.run(project, draws, workdir, profile, reuse, resamples, combine_only, results, _command_line())
+    typer.echo(text)
+
+
+@study_app.command(
+    cls=StudyCommand,
+    name="cell-ranking",
+    help="Do networks trained on more real shapes rank the cell's outcomes better, over draws of the training data? "
+    "Scores the `sim` stage's network arms (before, after, real, more_real) of each of `--projects` (one per draw, "
+    "sharing the rendered dataset and the cell) on the grasps a `grasp_calibration` run executed (`--grasps`): ROC "
+    "AUC against the outcomes per draw, pooled over draws in one interval over draws, seeds and shapes; and each "
+    "network's top-scored grasp per shape (exploratory). Prints one JSON line.\n\nCost on 2 cores: seconds (1,000 "
+    "grasps, three projects of 4 seeds: 3 s).",
+)
+def cell_ranking_command(
+    grasps: Path = typer.Option(..., "--grasps", help="grasps.csv of a grasp_calibration run."),
+    projects: list[Path] = typer.Option(
+        ..., "--projects", help="One project folder per draw, e.g. `--projects . ../draw1 ../draw2`."
+    ),
+    models: Path = typer.Option(Path("models/gqcnn"), "--models", help="The networks' folder in each project."),
+    seeds: list[int] = typer.Option(
+        None, "--seeds", help="Training seeds, e.g. `--seeds 0 1` (default: each project's `gqcnn.seeds`)."
+    ),
+    base_size: int = typer.Option(50, "--base-size", help="B of the before, after and real arms."),
+    more_real: int = typer.Option(None, "--more-real", help="B of the more_real arm (default: the largest)."),
+) -> None:
+    import json
+
+    from graspaug.pipeline.studies import cell_ranking
+
+    _logging()
+    result = cell_ranking.run(grasps, list(projects), models, list(seeds) if seeds else None, base_size, more_real)
+    typer.echo(json.dumps(result))
+
+
+@study_app.command(
+    cls=StudyCommand,
+    name="grasp-calibration",
+    help="Do the cell's outcomes follow the labels, with changed cell settings? The `grasp_calibration` stage's "
+    "work with the project's `sim` params changed by `--set section.key=value` (`hand`, `trial`, `physics`, `cell`): "
+    "`--n` datapoints of the rendered test split (half labelled positive; `--split train` to choose settings without "
+    "looking at the test split) executed in the cell. Prints one JSON line (success per label, ROC AUCs with "
+    "bootstrap intervals over shapes, outcome counts, seconds); `--table` writes the per-grasp table (.csv). Run it "
+    "where `render@original` has run.\n\nCost on 2 cores: 1,000 grasps 162 s.",
+)
+def grasp_calibration_command(
+    n: int = typer.Option(1000, "--n", min=1, help="Grasps executed (half labelled positive)."),
+    workers: int = typer.Option(2, "--workers", min=1, help="Processes."),
+    table: Path = typer.Option(None, "--table", help="Write the per-grasp table here (.csv)."),
+    changes: list[str] = typer.Option([], "--set", help="section.key=value (YAML), e.g. hand.grip_force=20."),
+    split: str = typer.Option("test", "--split", help="Whose datapoints: test or train (tune the cell on train)."),
+    project: Path = ProjectOption,
+) -> None:
+    import json
+
+    from graspaug.io.tables import write_csv
+    from graspaug.pipeline.params.base import ParamsError
+    from graspaug.pipeline.studies import grasp_calibration
+
+    if split not in ("test", "train"):
+        raise ParamsError(f"--split {split}: test or train")
+    _logging()
+    summary, executed = grasp_calibration.run(project, n, workers, list(changes), split)
+    if table is not None:
+        write_csv(executed, table)
+    typer.echo(json.dumps(summary))
+
+
+@study_app.command(
+    cls=StudyCommand,
+    name="heldout-fidelity",
+    help="What a trained AutoEncoder keeps of real shapes it never trained on: `--shapes` random test-split shapes "
+    "decoded from their latents by `models/ae_critic.pt` and meshed as the recon pool is, their grasps labelled and "
+    "datapoints rendered as the stages do, originals beside them: graspness and datapoints kept (Fieller 95%), "
+    "positive share, how many meshed. Prints a table; writes `summary.json` and `per_shape.csv` to `--out`. Run it "
+    "where `embed` and `render@original` have run.\n\nCost on 2 cores: 260 shapes about 70 s.",
+)
+def heldout_fidelity_command(
+    project: Path = ProjectOption,
+    shapes: int = typer.Option(100, "--shapes", min=1, help="Random test shapes."),
+    seed: int = typer.Option(0, "--seed", help="Which test shapes."),
+    workers: int = typer.Option(2, "--workers", min=1, help="Processes."),
+    out: Path = typer.Option(Path("reports/study/heldout_fidelity"), "--out", help="Folder for the tables."),
+    force: bool = ForceOption,
+) -> None:
+    from graspaug.io.outputs import output_folder
+    from graspaug.pipeline.studies import heldout_fidelity
+
+    _logging()
+    with output_folder(out, "study heldout-fidelity", force=force) as tmp:
+        text = heldout_fidelity.run(project, shapes, seed, workers, tmp)
+    typer.echo(text)
+
+
+@study_app.command(
+    cls=StudyCommand,
+    name="roundtrip-ceiling",
+    help="What could a perfect decoder hand over? For `--shapes` random train shapes, graspness kept when each goes "
+    "through a grid and back to a mesh: solid occupancy and exact truncated signed distances at 32³ and 64³, meshed "
+    "as `generate` meshes a decode, grasps labelled as the `grasps` stage does (Fieller 95%, paired t). Prints a "
+    "table; writes `rows.csv`, `per_shape.csv`, `summary.json`, `timing.json` to `--out`. Run it where `ingest` has "
+    "run.\n\nCost on 2 cores: 160 shapes 202 s.",
+)
+def roundtrip_ceiling_command(
+    project: Path = ProjectOption,
+    shapes: int = typer.Option(80, "--shapes", min=1, help="Train shapes drawn."),
+    seed: int = typer.Option(0, "--seed", help="Which shapes are drawn."),
+    workers: int = typer.Option(None, "--workers", min=1, help="Processes (default: the project's n_jobs)."),
+    truncation: float = typer.Option(3.0, "--truncation", min=0.5, help="TSDF truncation, voxels."),
+    out: Path = typer.Option(Path("reports/study/roundtrip_ceiling"), "--out", help="Folder for the tables."),
+    force: bool = ForceOption,
+) -> None:
+    from graspaug.io.outputs import output_folder
+    from graspaug.pipeline.studies import roundtrip_ceiling
+
+    _logging()
+    with output_folder(out, "study roundtrip-ceiling", force=force) as tmp:
+        text = roundtrip_ceiling.run(project, shapes, seed, workers, truncation, tmp)
+    typer.echo(text)
