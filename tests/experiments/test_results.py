@@ -119,3 +119,50 @@ def test_the_lifelong_tables_recompute_every_rounds_figures(tmp_path):
     figures = lifelong_figures(study)
     assert figures["lifelong/r1/share"].endswith("]") and "lifelong/r0/ap/none" in figures
     assert recompute(tmp_path / "results")[0] == figures
+
+
+def test_held_out_fidelity_runs_are_kept_per_autoencoder_and_recompute_their_figures(tmp_path):
+    """Two AutoEncoders' per-shape tables in one results/fidelity-<label>/ folder; a rerun of one replaces its rows;
+    the figures are the study's summary (heldout_summary), key by key."""
+    import numpy as np
+    import pandas as pd
+
+    from graspaug.experiments.fidelity.numbers import heldout_summary
+    from graspaug.experiments.results import combine_fidelity, fidelity_figures, write_fidelity
+
+    rng = np.random.default_rng(0)
+
+    def per_shape(n, keep):
+        before = rng.uniform(0.05, 0.2, n)
+        points = rng.integers(50, 120, n).astype(float)
+        return pd.DataFrame(
+            {
+                "shape_id": [f"s{i}" for i in range(n)],
+                "meshed": [True] * (n - 1) + [False],
+                "graspness_before": before,
+                "graspness_after": before * keep + rng.normal(0, 0.01, n),
+                "datapoints_before": points,
+                "datapoints_after": points * keep,
+                "positives_before": points * 0.1,
+                "positives_after": points * keep * 0.1,
+                **{
+                    f"{k}_{w}": rng.uniform(2, 6, n)
+                    for k in ("stable_poses", "grasps_rendered")
+                    for w in ("before", "after")
+                },
+            }
+        )
+
+    folder = tmp_path / "results" / "fidelity-real"
+    first, second = per_shape(20, 0.9), per_shape(20, 0.6)
+    write_fidelity(folder, "own", per_shape(20, 0.5), META)
+    write_fidelity(folder, "own", first, META)  # a rerun replaces the AutoEncoder's rows
+    write_fidelity(folder, "default", second, META)
+    result = combine_fidelity(folder)
+    assert set(result) == {"own", "default"} and result["own"] == heldout_summary(first)
+    assert json.loads((folder / "meta.json").read_text())["runs"]["own"] == META
+    figures = fidelity_figures(result, "fidelity-real")
+    assert figures["fidelity-real/own/meshed"] == "19 of 20"
+    assert figures["fidelity-real/own/datapoints_kept"].startswith("90.0% [")
+    assert re.match(r"60\.0% \[", figures["fidelity-real/default/datapoints_kept"])
+    assert figures == recompute(tmp_path / "results")[0]

@@ -18,6 +18,10 @@ README and docs/results.md quote, recomputed from them (issue #58).
 float32 column per round, draw, training seed and arm, ``r<k>/<draw>/<seed>/<arm>``), ``test.parquet`` and
 ``meta.json`` as above.
 
+``results/fidelity-<label>/`` (from ``graspaug study heldout-fidelity``, one run per AutoEncoder compared):
+``per_shape.parquet`` (each run's ``per_shape.csv``, stacked, its ``ae`` column naming the AutoEncoder) and
+``meta.json`` (the commands and commit); :func:`combine_fidelity` gives each AutoEncoder's figures.
+
 A quoted figure is marked in the markdown by an html comment naming its key, the figure right after it::
 
     <!-- results:attribution/targeted_vs_none@100 -->+0.0100 [+0.0010, +0.0210]
@@ -258,8 +262,60 @@ def lifelong_figures(result: dict, study: str = "lifelong") -> dict[str, str]:
     return out
 
 
+def write_fidelity(folder: Path, ae: str, per_shape: pd.DataFrame, meta: dict) -> None:
+    """Add (or replace) AutoEncoder ``ae``'s rows of a held-out fidelity run (``per_shape``: the study's per-shape
+    table) in ``folder``'s ``per_shape.parquet``, and its ``meta`` (``command``, ``commit``, ``date``, where the
+    project was) under ``meta.json``'s ``runs``; ``meta.json`` is written last."""
+    from graspaug.io.atomic import atomic_path
+
+    folder.mkdir(parents=True, exist_ok=True)
+    table, meta_file = folder / "per_shape.parquet", folder / "meta.json"
+    runs = json.loads(meta_file.read_text())["runs"] if meta_file.is_file() else {}
+    meta_file.unlink(missing_ok=True)  # a folder without meta.json is an unfinished one
+    old = pd.read_parquet(table) if table.is_file() else pd.DataFrame({"ae": []})
+    rows = per_shape.assign(ae=ae)
+    new = pd.concat([old[old.ae != ae], rows], ignore_index=True) if len(old) else rows
+    with atomic_path(table) as tmp:
+        new.to_parquet(tmp, index=False)
+    with atomic_path(meta_file) as tmp:
+        tmp.write_text(json.dumps({"runs": runs | {ae: dict(meta)}}, indent=1) + "\n")
+
+
+def combine_fidelity(folder: Path) -> dict:
+    """AutoEncoder → :func:`~graspaug.experiments.fidelity.numbers.heldout_summary` of its held-out shapes, from the
+    ``per_shape.parquet`` of ``folder`` (one row per AutoEncoder and shape, its ``ae`` column naming the
+    AutoEncoder; ``graspaug study heldout-fidelity``'s ``per_shape.csv`` of each, stacked) and its ``meta.json``."""
+    from graspaug.experiments.fidelity.numbers import heldout_summary
+
+    missing = [name for name in ("per_shape.parquet", "meta.json") if not (folder / name).is_file()]
+    if missing:
+        raise DataError(f"{folder}: no {', '.join(missing)} (an unfinished or foreign results folder)")
+    per_shape = pd.read_parquet(folder / "per_shape.parquet")
+    return {ae: heldout_summary(rows) for ae, rows in per_shape.groupby("ae", sort=True)}
+
+
+def fidelity_figures(result: dict, study: str = "fidelity") -> dict[str, str]:
+    """Every figure of a held-out fidelity result (:func:`combine_fidelity`) by key: ``<study>/<ae>/graspness_kept``
+    and ``<study>/<ae>/datapoints_kept`` (``kept [low, high]`` in %, Fieller 95%; ``[unbounded]`` without ends) and
+    ``<study>/<ae>/meshed`` (``meshed of shapes``)."""
+
+    def kept(value, low, high) -> str:
+        ends = "[unbounded]" if low is None or high is None else f"[{low:.1%}, {high:.1%}]"
+        return f"{value:.1%} {ends}"
+
+    out = {}
+    for ae, r in result.items():
+        out[f"{study}/{ae}/graspness_kept"] = kept(r["kept"], r["kept_low"], r["kept_high"])
+        out[f"{study}/{ae}/datapoints_kept"] = kept(
+            r["datapoints_kept"], r["datapoints_kept_low"], r["datapoints_kept_high"]
+        )
+        out[f"{study}/{ae}/meshed"] = f"{r['meshed']} of {r['shapes']}"
+    return out
+
+
 STUDIES = {
     "attribution": (combine_attribution, attribution_figures),
     "lifelong": (combine_lifelong, lifelong_figures),
+    "fidelity": (combine_fidelity, fidelity_figures),
 }
 """Study name → (read and combine its ``results/<study>/`` folder, its figures by key)."""

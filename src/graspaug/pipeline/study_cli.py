@@ -202,13 +202,31 @@ def heldout_fidelity_command(
     workers: int = typer.Option(2, "--workers", min=1, help="Processes."),
     out: Path = typer.Option(Path("reports/study/heldout_fidelity"), "--out", help="Folder for the tables."),
     force: bool = ForceOption,
+    results: str = typer.Option(
+        None,
+        "--results",
+        help="Also keep the per-shape table in the project's results/<NAME>/ (NAME: fidelity or fidelity-<label>), "
+        "under the AutoEncoder's name `--ae`, with this command and the commit: `graspaug results` recomputes it.",
+    ),
+    ae: str = typer.Option("ae", "--ae", help="With --results: the name of the AutoEncoder measured."),
 ) -> None:
+    import sys
+
+    import pandas as pd
+
+    from graspaug.experiments.results import write_fidelity
     from graspaug.io.outputs import output_folder
     from graspaug.pipeline.studies import heldout_fidelity
+    from graspaug.pipeline.studies.draws import provenance
 
+    if results is not None and results.split("-")[0] != "fidelity":
+        raise typer.BadParameter(f"must be fidelity or fidelity-<label>; got {results}", param_hint="--results")
     _logging()
     with output_folder(out, "study heldout-fidelity", force=force) as tmp:
         text = heldout_fidelity.run(project, shapes, seed, workers, tmp)
+    if results is not None:
+        meta = provenance(project, "graspaug " + " ".join(sys.argv[1:])) | {"project": str(project.resolve())}
+        write_fidelity(project / "results" / results, ae, pd.read_csv(out / "per_shape.csv"), meta)
     typer.echo(text)
 
 

@@ -310,3 +310,33 @@ def paired_graspness_kept(after: np.ndarray, before: np.ndarray) -> dict:
         "difference": diff["mean"],
         "difference_half_width": None if diff["high"] is None else diff["high"] - diff["mean"],
     }
+
+
+HELDOUT_WHEN = ("before", "after")
+
+
+def heldout_summary(per_shape: pd.DataFrame) -> dict:
+    """What an AutoEncoder keeps of held-out shapes, from the per-shape table ``graspaug study heldout-fidelity``
+    writes (one row per shape: ``meshed``, ``graspness_*``, ``datapoints_*``, ``positives_*``, ``stable_poses_*``,
+    ``grasps_rendered_*`` before and after): paired figures over the shapes whose reconstruction meshed: graspness
+    kept (Fieller 95%), datapoints kept (Fieller 95%), mean datapoints, the datapoints' positive share (pooled),
+    stable poses and grasps rendered, before and after."""
+    meshed = per_shape[per_shape.meshed.astype(bool)]
+    before, after = meshed.datapoints_before.to_numpy(float), meshed.datapoints_after.to_numpy(float)
+    dp = fieller_interval(after, before)
+    return {
+        "shapes": len(per_shape),
+        "meshed": len(meshed),
+        **paired_graspness_kept(meshed.graspness_after.to_numpy(float), meshed.graspness_before.to_numpy(float)),
+        "datapoints_before": float(before.mean()),
+        "datapoints_after": float(after.mean()),
+        "datapoints_kept": dp["ratio"],
+        "datapoints_kept_low": dp["low"],
+        "datapoints_kept_high": dp["high"],
+        "positive_before": float(meshed.positives_before.sum() / before.sum()),  # pooled, as the dataset's share
+        "positive_after": float(meshed.positives_after.sum() / after.sum()),
+    } | {
+        f"{k}_{w}": float(np.nanmean(meshed[f"{k}_{w}"]))
+        for k in ("stable_poses", "grasps_rendered")
+        for w in HELDOUT_WHEN
+    }

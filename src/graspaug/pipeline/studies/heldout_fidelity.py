@@ -31,9 +31,8 @@ from graspaug.augment.decode import mesh_batches
 from graspaug.augment.pools import BaseSet
 from graspaug.augment.scores import graspness
 from graspaug.errors import DataError
-from graspaug.experiments.fidelity.numbers import paired_graspness_kept
+from graspaug.experiments.fidelity.numbers import heldout_summary
 from graspaug.experiments.fidelity.words import paired_graspness_kept_markdown
-from graspaug.experiments.stats import fieller_interval
 from graspaug.grasping.labelled import grasps_of_shapes
 from graspaug.io.checkpoints import load_autoencoder
 from graspaug.io.meshes import mesh_path, write_obj
@@ -98,30 +97,6 @@ def label_and_render(shapes: pd.DataFrame, folder: Path, suffix: str, params, wo
     )
 
 
-WHEN = ("before", "after")
-
-
-def summarize(per_shape: pd.DataFrame) -> dict:
-    """Paired figures over the shapes whose reconstruction meshed: graspness kept (Fieller 95%), datapoints kept
-    (Fieller 95%), mean datapoints, the datapoints' positive share (pooled), stable poses and grasps rendered, before
-    and after."""
-    meshed = per_shape[per_shape.meshed]
-    before, after = meshed.datapoints_before.to_numpy(float), meshed.datapoints_after.to_numpy(float)
-    dp = fieller_interval(after, before)
-    return {
-        "shapes": len(per_shape),
-        "meshed": len(meshed),
-        **paired_graspness_kept(meshed.graspness_after.to_numpy(), meshed.graspness_before.to_numpy()),
-        "datapoints_before": float(before.mean()),
-        "datapoints_after": float(after.mean()),
-        "datapoints_kept": dp["ratio"],
-        "datapoints_kept_low": dp["low"],
-        "datapoints_kept_high": dp["high"],
-        "positive_before": float(meshed.positives_before.sum() / before.sum()),  # pooled, as the dataset's share
-        "positive_after": float(meshed.positives_after.sum() / after.sum()),
-    } | {f"{k}_{w}": float(np.nanmean(meshed[f"{k}_{w}"])) for k in ("stable_poses", "grasps_rendered") for w in WHEN}
-
-
 def run(project: Path, n_shapes: int, seed: int, workers: int, out: Path) -> str:
     """The study (module docstring) on ``n_shapes`` test shapes of ``project`` drawn with ``seed``; writes
     ``per_shape.csv`` and ``summary.json`` into the folder ``out``; the text to print."""
@@ -143,7 +118,7 @@ def run(project: Path, n_shapes: int, seed: int, workers: int, out: Path) -> str
     per_shape = before.merge(after, on="shape_id", how="left", suffixes=("_before", "_after"))
     per_shape["meshed"] = per_shape.shape_id.map(lambda s: reasons[s] is None)
     per_shape["reason"] = per_shape.shape_id.map(reasons)
-    summary = summarize(per_shape) | {
+    summary = heldout_summary(per_shape) | {
         "decoder": params.ae.net.output,
         "project": str(project),
         "shape_seed": seed,
