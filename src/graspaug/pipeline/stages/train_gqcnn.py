@@ -15,7 +15,7 @@ from __future__ import annotations
 import logging
 import time
 
-from graspaug.device import resolve_device
+from graspaug.device import resolve_device, resolve_precision
 from graspaug.io.atomic import atomic_path
 from graspaug.io.tables import read_table, write_csv, write_json
 from graspaug.pipeline.params.base import params_model
@@ -78,6 +78,7 @@ def run(params: Params, seed: int) -> None:
     test, test_rows = test_set(corpora.original)
     plan = seed_plan(variants, cfg.members, len(split.validation), val_rows, test_rows, device)
     log.info("train_gqcnn seed %d: %s", seed, plan)
+    log.info("train_gqcnn seed %d: precision %s", seed, resolve_precision(cfg.train.precision, device).label)
     if (warning := precision_warning(cfg.train.precision, device)) is not None:
         log.warning("%s", warning)
     with atomic_path(gqcnn_seed_dir(seed), directory=True) as folder:
