@@ -80,10 +80,16 @@ def test_an_unknown_precision_is_refused_naming_it():
         choose_precision("float16", "cpu", True)
 
 
-def test_emulated_bfloat16_is_warned_about_naming_the_key():
+def test_emulated_bfloat16_is_warned_about_naming_the_key(caplog):
+    import logging
+
     import torch
 
-    from graspaug.device import precision_warning
+    from graspaug.device import log_precision, precision_warning
+
+    with caplog.at_level(logging.INFO, logger="graspaug.device"):
+        assert log_precision("train_ae", "ae.train.precision", "float32", torch.device("cpu")).dtype == "float32"
+    assert caplog.messages == ["train_ae: precision float32"]  # once
 
     meta = torch.device("meta")  # no bfloat16 hardware behind it
     assert precision_warning("bfloat16", meta, "ae.train.precision").startswith("ae.train.precision: bfloat16, but")

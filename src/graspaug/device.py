@@ -1,14 +1,18 @@
-"""The torch device the ``device`` param names, and the process's memory allocator (glibc).
+"""The torch device the ``device`` param names, the precision a network trains in there (``precision``
+settings: :func:`resolve_precision`), and the process's memory allocator (glibc).
 
 torch is imported inside the functions that need it: per-shape worker processes import this module
 for :func:`release_freed_memory` alone."""
 
 from __future__ import annotations
 
+import logging
 from typing import TYPE_CHECKING, NamedTuple
 
 if TYPE_CHECKING:
     import torch
+
+log = logging.getLogger(__name__)
 
 
 def resolve_device(device: str) -> torch.device:
@@ -130,6 +134,16 @@ def precision_warning(precision: str, device: torch.device, key: str) -> str | N
             f"and slower than float32 (-S {key}=float32, or auto)"
         )
     return None
+
+
+def log_precision(stage: str, key: str, precision: str, device: torch.device) -> Precision:
+    """The setting ``key`` (value ``precision``) resolved on ``device`` (:func:`resolve_precision`), said once in
+    the log as ``<stage>: precision <label>``, with :func:`precision_warning` where it asks for emulated bfloat16."""
+    resolved = resolve_precision(precision, device)
+    log.info("%s: precision %s", stage, resolved.label)
+    if (warning := precision_warning(precision, device, key)) is not None:
+        log.warning("%s", warning)
+    return resolved
 
 
 def training_autocast(precision: Precision, device: torch.device) -> torch.autocast:

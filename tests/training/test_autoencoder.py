@@ -393,5 +393,7 @@ def test_checkpoints_record_precision_as_resolved_on_the_device():
 
     auto = checkpoint_params(train_settings(precision="auto"), CPU)["precision"]
     native = has_native_bfloat16(CPU)
-    assert auto == ("bfloat16 (auto: native on this CPU)" if native else "float32 (auto: no native bfloat16 on this CPU)")
+    assert auto == (
+        "bfloat16 (auto: native on this CPU)" if native else "float32 (auto: no native bfloat16 on this CPU)"
+    )
     assert checkpoint_params(train_settings(), CPU)["precision"] == "float32"  # the default

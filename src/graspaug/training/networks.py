@@ -32,7 +32,6 @@ import pandas as pd
 import torch
 from tqdm import tqdm
 
-from graspaug.device import precision_warning as emulation_warning
 from graspaug.device import resolve_precision
 from graspaug.errors import DataError
 from graspaug.io.checkpoints import finish_gqcnn_card, gqcnn_card, operating_point, save_gqcnn, training_range
@@ -311,11 +310,6 @@ def seed_plan(variants: list[Variant], members: int, n_validation: int, val_rows
         "validation %d shapes (%d datapoints), test %d datapoints; on %s"
         % (len(variants), members, n_validation, len(val_rows), len(test_rows), device)
     )
-
-
-def precision_warning(precision: str, device: torch.device) -> str | None:
-    """:func:`graspaug.device.precision_warning` for ``gqcnn.train.precision``."""
-    return emulation_warning(precision, device, "gqcnn.train.precision")
 
 
 def save_seed_split(seed_dir: Path, split: ExperimentSplit, test_rows: np.ndarray, val_rows: np.ndarray) -> None:

@@ -14,7 +14,7 @@ import time
 
 import torch
 
-from graspaug.device import precision_warning, resolve_device
+from graspaug.device import log_precision, resolve_device
 from graspaug.io.checkpoints import save_autoencoder
 from graspaug.io.tables import write_json
 from graspaug.nets.ae_critic import AutoEncoder, Critic
@@ -66,9 +66,7 @@ def run(params: Params) -> None:
         cfg.widths,
     )
     train_params = checkpoint_params(tcfg, device)  # precision as resolved here
-    log.info("train_ae: precision %s", train_params["precision"])
-    if (warning := precision_warning(tcfg.precision, device, "ae.train.precision")) is not None:
-        log.warning("%s", warning)
+    log_precision("train_ae", "ae.train.precision", tcfg.precision, device)
     arms = ArmTrainer(TRAIN_AE_LIVE, train, test, device)
     summary, timing = arms.summary, arms.timing
 
