@@ -1,8 +1,10 @@
 """The process setting every stage makes (freed tensors are reused, not faulted in again) and
 what the device computes natively."""
 
+import platform
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 
@@ -48,4 +50,48 @@ def test_native_bfloat16_is_a_property_of_the_device():
 
     assert has_native_bfloat16(torch.device("meta")) is False  # no hardware behind it
     cpu = has_native_bfloat16(torch.device("cpu"))
-    assert cpu is bool(torch.ops.mkldnn._is_mkldnn_bf16_supported())  # what oneDNN dispatches on
+    assert isinstance(cpu, bool)
+    if platform.machine() == "x86_64" and Path("/proc/cpuinfo").exists():  # the kernel's word on the instructions
+        flags = set(Path("/proc/cpuinfo").read_text().split())
+        assert cpu is bool(flags & {"avx512_bf16", "amx_bf16"})  # not oneDNN's: yes on any AVX-512 CPU
+
+
+@pytest.mark.parametrize(
+    ("precision", "device_type", "native", "expected"),
+    [
+        ("auto", "cpu", True, ("bfloat16", "bfloat16 (auto: native on this CPU)")),
+        ("auto", "cpu", False, ("float32", "float32 (auto: no native bfloat16 on this CPU)")),
+        ("auto", "cuda", True, ("bfloat16", "bfloat16 (auto: native on this GPU)")),
+        ("auto", "cuda", False, ("float32", "float32 (auto: no native bfloat16 on this GPU)")),
+        ("float32", "cpu", True, ("float32", "float32")),
+        ("bfloat16", "cpu", False, ("bfloat16", "bfloat16")),  # as asked: emulated, and the stage warns
+    ],
+)
+def test_auto_precision_is_bfloat16_only_where_the_device_has_it(precision, device_type, native, expected):
+    from graspaug.device import choose_precision
+
+    assert tuple(choose_precision(precision, device_type, native)) == expected
+
+
+def test_an_unknown_precision_is_refused_naming_it():
+    from graspaug.device import choose_precision
+
+    with pytest.raises(ValueError, match="'float16' is not one of auto, float32, bfloat16"):
+        choose_precision("float16", "cpu", True)
+
+
+def test_emulated_bfloat16_is_warned_about_naming_the_key(caplog):
+    import logging
+
+    import torch
+
+    from graspaug.device import log_precision, precision_warning
+
+    with caplog.at_level(logging.INFO, logger="graspaug.device"):
+        assert log_precision("train_ae", "ae.train.precision", "float32", torch.device("cpu")).dtype == "float32"
+    assert caplog.messages == ["train_ae: precision float32"]  # once
+
+    meta = torch.device("meta")  # no bfloat16 hardware behind it
+    assert precision_warning("bfloat16", meta, "ae.train.precision").startswith("ae.train.precision: bfloat16, but")
+    assert precision_warning("auto", meta, "ae.train.precision") is None  # auto is float32 there
+    assert precision_warning("float32", meta, "ae.train.precision") is None

@@ -1,14 +1,18 @@
-"""The torch device the ``device`` param names, and the process's memory allocator (glibc).
+"""The torch device the ``device`` param names, the precision a network trains in there (``precision``
+settings: :func:`resolve_precision`), and the process's memory allocator (glibc).
 
 torch is imported inside the functions that need it: per-shape worker processes import this module
 for :func:`release_freed_memory` alone."""
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+import logging
+from typing import TYPE_CHECKING, NamedTuple
 
 if TYPE_CHECKING:
     import torch
+
+log = logging.getLogger(__name__)
 
 
 def resolve_device(device: str) -> torch.device:
@@ -71,15 +75,80 @@ def release_freed_memory() -> bool:
 
 
 def has_native_bfloat16(device: torch.device) -> bool:
-    """Whether ``device`` computes bfloat16 convolutions and matrix products in hardware (a
-    CUDA GPU that supports it; a CPU with AVX512-BF16 or AMX, as oneDNN reports); elsewhere
-    ``torch.autocast`` emulates bfloat16, slower than float32."""
+    """Whether ``device`` computes bfloat16 convolutions and matrix products in hardware: a CUDA GPU
+    with bfloat16 units (compute capability 8.0 on, not torch's emulation on older ones); an x86 CPU
+    with AVX512-BF16 or AMX (cpuinfo, as torch reads it); another CPU where oneDNN reports bfloat16
+    (on ARM: the BF16 extension). Elsewhere ``torch.autocast`` emulates bfloat16, slower than float32.
+    oneDNN's own report is not used on x86: it says yes on any AVX-512 CPU, whose bfloat16 is emulated."""
+    import platform
+
     import torch
 
     if device.type == "cuda":
-        return torch.cuda.is_bf16_supported()
-    return (
-        device.type == "cpu"
-        and torch.backends.mkldnn.is_available()
-        and bool(torch.ops.mkldnn._is_mkldnn_bf16_supported())
-    )
+        return torch.cuda.is_available() and torch.cuda.is_bf16_supported(including_emulation=False)
+    if device.type != "cpu":
+        return False
+    if platform.machine().lower() in ("x86_64", "amd64", "i386", "i686"):
+        return bool(torch.cpu._is_avx512_bf16_supported() or torch.cpu._is_amx_tile_supported())
+    return torch.backends.mkldnn.is_available() and bool(torch.ops.mkldnn._is_mkldnn_bf16_supported())
+
+
+PRECISIONS = ("auto", "float32", "bfloat16")
+"""The values of a ``precision`` setting (``gqcnn.train.precision``, ``ae.train.precision``)."""
+
+
+class Precision(NamedTuple):
+    """The arithmetic a training loop's steps run in, as :func:`choose_precision` resolved it."""
+
+    dtype: str  # "float32" or "bfloat16" (torch.autocast on the training steps)
+    label: str  # how the log, the checkpoint and the model card say it, e.g. "bfloat16 (auto: native on this CPU)"
+
+
+def choose_precision(precision: str, device_type: str, native_bfloat16: bool) -> Precision:
+    """The precision a ``precision`` setting (:data:`PRECISIONS`) gives on a device of ``device_type``
+    (``cpu``, ``cuda``) that does (``native_bfloat16``) or does not compute bfloat16 in hardware
+    (:func:`has_native_bfloat16`): ``auto`` → bfloat16 where native, float32 elsewhere; ``float32`` and
+    ``bfloat16`` as asked, labelled as written (bfloat16 on a device without it is emulated, slower than float32:
+    the stage warns). A pure function of those facts, so a test can give it any device."""
+    if precision not in PRECISIONS:
+        raise ValueError(f"precision: {precision!r} is not one of {', '.join(PRECISIONS)}")
+    where = "this GPU" if device_type == "cuda" else f"this {device_type.upper()}"
+    if precision == "auto":
+        if native_bfloat16:
+            return Precision("bfloat16", f"bfloat16 (auto: native on {where})")
+        return Precision("float32", f"float32 (auto: no native bfloat16 on {where})")
+    return Precision(precision, precision)
+
+
+def resolve_precision(precision: str, device: torch.device) -> Precision:
+    """:func:`choose_precision` of ``precision`` on ``device`` (:func:`has_native_bfloat16` asked here)."""
+    return choose_precision(precision, device.type, has_native_bfloat16(device))
+
+
+def precision_warning(precision: str, device: torch.device, key: str) -> str | None:
+    """The warning for the setting ``key`` asking for bfloat16 (``precision``) on a ``device`` without bfloat16
+    instructions (emulated: slower than float32), else None."""
+    if precision == "bfloat16" and not has_native_bfloat16(device):
+        return (
+            f"{key}: bfloat16, but this {device.type.upper()} has no bfloat16 instructions: training is emulated "
+            f"and slower than float32 (-S {key}=float32, or auto)"
+        )
+    return None
+
+
+def log_precision(stage: str, key: str, precision: str, device: torch.device) -> Precision:
+    """The setting ``key`` (value ``precision``) resolved on ``device`` (:func:`resolve_precision`), said once in
+    the log as ``<stage>: precision <label>``, with :func:`precision_warning` where it asks for emulated bfloat16."""
+    resolved = resolve_precision(precision, device)
+    log.info("%s: precision %s", stage, resolved.label)
+    if (warning := precision_warning(precision, device, key)) is not None:
+        log.warning("%s", warning)
+    return resolved
+
+
+def training_autocast(precision: Precision, device: torch.device) -> torch.autocast:
+    """The ``torch.autocast`` context of a training step's forward pass and loss: bfloat16 on ``device``
+    for a bfloat16 ``precision``, a no-op for float32. Weights, optimizer and evaluation stay float32."""
+    import torch
+
+    return torch.autocast(device.type, dtype=torch.bfloat16, enabled=precision.dtype == "bfloat16")

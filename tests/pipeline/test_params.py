@@ -89,6 +89,14 @@ def test_schema_file_is_up_to_date(repo_root):
             "sim.sampler.max_depth_offset: must be >= min_depth_offset (0.05); got 0.04",
         ),
         ({"sim": {"attempts": 0}}, "sim.attempts: Input should be greater than or equal to 1; got 0"),
+        (
+            {"ae": {"train": {"precision": "float16"}}},
+            "ae.train.precision: Input should be 'auto', 'float32' or 'bfloat16'; got 'float16'",
+        ),
+        (
+            {"gqcnn": {"train": {"precision": "half"}}},
+            "gqcnn.train.precision: Input should be 'auto', 'float32' or 'bfloat16'; got 'half'",
+        ),
     ],
 )
 def test_bad_params_name_the_key(raw, message):
@@ -96,6 +104,12 @@ def test_bad_params_name_the_key(raw, message):
         parse_params(raw)
     assert str(exc.value).startswith(message)
     assert "\n" not in str(exc.value)
+
+
+@pytest.mark.parametrize("precision", ["auto", "float32", "bfloat16"])
+def test_both_networks_take_every_precision(precision):
+    params = parse_params({"ae": {"train": {"precision": precision}}, "gqcnn": {"train": {"precision": precision}}})
+    assert params.ae.train.precision == params.gqcnn.train.precision == precision
 
 
 def test_ints_are_accepted_for_floats_and_null_for_optionals():

@@ -345,3 +345,55 @@ def test_the_paper_profiles_critic_does_not_diverge_at_64():
         lambda epoch, logs: losses.append(logs["loss_critic"]),
     )
     assert len(losses) == 3 and np.isfinite(losses).all() and max(losses) <= 10 * losses[0], losses
+
+
+def _bfloat16_run(tmp_path, name: str) -> tuple[dict, bytes]:
+    """Two steps of each phase (batches of 4 of the 8 primitives) under bfloat16: the checkpoint's
+    train_params and its bytes."""
+    from graspaug.training.autoencoder import checkpoint_params
+
+    torch.manual_seed(0)
+    x = primitive_grids(16)
+    cfg = AEConfig(resolution=16, z_dim=16, base_width=4, top_width=16, output="occupancy")
+    ae, critic = AutoEncoder(cfg), Critic(cfg)
+    tcfg = train_settings(batch_size=4, epochs_ae=1, epochs_critic=1, critic_warmup=0, precision="bfloat16")
+    gen = torch.Generator().manual_seed(0)
+    train_autoencoder(ae, x, tcfg, CPU, gen)
+    train_ae_critic(ae, critic, x, tcfg, CPU, gen)
+    assert all(p.dtype == torch.float32 for p in [*ae.parameters(), *critic.parameters()])  # weights stay float32
+    assert encode(ae, x, CPU).dtype == np.float32
+    path = tmp_path / f"{name}.pt"
+    save_autoencoder(path, ae, critic, checkpoint_params(tcfg, CPU))
+    return load_autoencoder(path, cfg)[2], path.read_bytes()
+
+
+def test_an_autoencoder_trains_under_bfloat16_and_its_checkpoint_says_so(tmp_path):
+    """Both phases under bfloat16 autocast: float32 weights, the checkpoint's train_params name bfloat16, and the
+    same seed gives the same bytes; the weights differ from float32 training (the setting acts)."""
+    params, data = _bfloat16_run(tmp_path, "a")
+    assert params["precision"] == "bfloat16"
+    assert _bfloat16_run(tmp_path, "b")[1] == data  # same precision, same bytes
+
+    torch.manual_seed(0)
+    x = primitive_grids(16)
+    cfg = AEConfig(resolution=16, z_dim=16, base_width=4, top_width=16, output="occupancy")
+    ae, critic = AutoEncoder(cfg), Critic(cfg)
+    tcfg = train_settings(batch_size=4, epochs_ae=1, epochs_critic=1, critic_warmup=0, precision="float32")
+    gen = torch.Generator().manual_seed(0)
+    train_autoencoder(ae, x, tcfg, CPU, gen)
+    train_ae_critic(ae, critic, x, tcfg, CPU, gen)
+    half = torch.load(tmp_path / "a.pt", weights_only=True)["autoencoder"]
+    assert any(not torch.equal(half[k], v) for k, v in ae.state_dict().items())
+
+
+def test_checkpoints_record_precision_as_resolved_on_the_device():
+    """``auto`` is written as what it became here, with the reason; float32 as written."""
+    from graspaug.device import has_native_bfloat16
+    from graspaug.training.autoencoder import checkpoint_params
+
+    auto = checkpoint_params(train_settings(precision="auto"), CPU)["precision"]
+    native = has_native_bfloat16(CPU)
+    assert auto == (
+        "bfloat16 (auto: native on this CPU)" if native else "float32 (auto: no native bfloat16 on this CPU)"
+    )
+    assert checkpoint_params(train_settings(), CPU)["precision"] == "float32"  # the default

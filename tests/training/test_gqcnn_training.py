@@ -208,3 +208,26 @@ def test_a_member_trained_in_a_stack_ends_as_it_would_alone():
         np.testing.assert_allclose(predict(members[m], val, cpu), predict(alone, val, cpu), atol=1e-3)
     # the members differ: each has its own initial weights and noise
     assert not np.allclose(predict(members[0], val, cpu), predict(members[1], val, cpu), atol=1e-3)
+
+
+def test_auto_precision_trains_as_the_precision_it_resolves_to():
+    """``auto`` gives the weights of bfloat16 where this CPU has it natively, of float32 elsewhere, bit for bit."""
+    from graspaug.device import resolve_precision
+
+    rng = np.random.default_rng(3)
+    train = toy_set(300, rng)
+    torch.manual_seed(0)
+    init = GQCNN(GQCNNConfig(filters=8, fc=32, pose_fc=4)).state_dict()
+
+    def trained(precision: str) -> dict[str, torch.Tensor]:
+        net = GQCNN(GQCNNConfig(filters=8, fc=32, pose_fc=4))
+        net.load_state_dict(init)
+        settings = TrainSettings(min_steps=5, max_steps=5, batch_size=32, evals=1, precision=precision)
+        train_gqcnn(net, train, None, settings, torch.device("cpu"), torch.Generator().manual_seed(0), progress=False)
+        return net.state_dict()
+
+    resolved = resolve_precision("auto", torch.device("cpu")).dtype
+    other = {"bfloat16": "float32", "float32": "bfloat16"}[resolved]
+    auto, same, different = trained("auto"), trained(resolved), trained(other)
+    assert all(torch.equal(auto[k], same[k]) for k in auto)
+    assert any(not torch.equal(auto[k], different[k]) for k in auto)

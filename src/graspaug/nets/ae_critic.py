@@ -174,7 +174,8 @@ def critic_loss(
     through the critic in one pass (it has no batch statistics, so this changes nothing).
     """
     real_mix = gamma * x + (1 - gamma) * x_hat.detach()  # (B, 1, R, R, R): a non-interpolated grid
-    c_interp, c_real = critic(torch.cat([x_alpha.detach(), real_mix])).split(len(x))
+    # float32 scores: under bfloat16 autocast the loss itself stays float32
+    c_interp, c_real = critic(torch.cat([x_alpha.detach(), real_mix])).float().split(len(x))
     return (c_interp - alpha).pow(2).mean() + c_real.pow(2).mean()  # eq. (1)
 
 

@@ -2,11 +2,15 @@
 
 Grids travel as ``(N, 1, R, R, R)`` tensors, uint8 occupancy (0/1) or float32 signed distance / truncation
 (``ae.net.output``: :mod:`graspaug.nets.ae_critic`), and are turned into float batches on the device. Every
-random choice (batch order, flips, α) comes from one ``torch.Generator``.
+random choice (batch order, flips, α) comes from one ``torch.Generator``. With ``ae.train.precision`` bfloat16
+(or ``auto`` on a device with native bfloat16: :func:`graspaug.device.resolve_precision`) the training steps'
+forward passes and losses run under ``torch.autocast``; the network outputs are cast back to float32 before
+their loss, and weights, optimizers, evaluation, embedding and decoding stay float32.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from collections.abc import Callable
@@ -15,6 +19,7 @@ import numpy as np
 import torch
 from tqdm import tqdm
 
+from graspaug.device import resolve_precision, training_autocast
 from graspaug.nets.ae_critic import (
     AutoEncoder,
     Critic,
@@ -54,8 +59,9 @@ def train_autoencoder(
 ) -> float:
     """Phase 1: minimize the reconstruction loss (:func:`~graspaug.nets.ae_critic.reconstruction_loss`: BCE of
     occupancy, or the weighted L1 of signed distances) with Adam, its rate set per epoch by :func:`phase_1_schedule`.
-    Returns shapes/s."""
+    The forward pass and loss run in ``cfg.precision`` (module docstring). Returns shapes/s."""
     ae.to(device)
+    precision = resolve_precision(cfg.precision, device)
     opt = torch.optim.Adam(ae.parameters(), lr=cfg.lr_ae)
     schedule = phase_1_schedule(opt, cfg)
     seen, elapsed = 0, 0.0
@@ -67,7 +73,8 @@ def train_autoencoder(
             x = _as_float(voxels[idx], device)
             if cfg.flips:
                 x = _flip(x, gen)
-            loss = reconstruction_loss(ae(x), x, ae.cfg.output)
+            with training_autocast(precision, device):
+                loss = reconstruction_loss(ae(x).float(), x, ae.cfg.output)
             opt.zero_grad(set_to_none=True)
             loss.backward()
             opt.step()
@@ -79,6 +86,13 @@ def train_autoencoder(
         if on_epoch:
             on_epoch(epoch, {"loss_recon": total / max(1, sum(len(b) for b in batches))})
     return seen / max(elapsed, 1e-9)
+
+
+def checkpoint_params(cfg: AETrainConfig, device: torch.device) -> dict:
+    """The training params a checkpoint of a model trained with ``cfg`` on ``device`` records: ``cfg``'s fields
+    (``lam`` for λ), ``precision`` as resolved there (:func:`graspaug.device.resolve_precision`'s label, e.g.
+    ``"bfloat16 (auto: native on this CPU)"``)."""
+    return dataclasses.asdict(cfg) | {"precision": resolve_precision(cfg.precision, device).label}
 
 
 def phase_1_schedule(opt: torch.optim.Optimizer, cfg: AETrainConfig) -> torch.optim.lr_scheduler.LambdaLR:
@@ -112,9 +126,11 @@ def train_ae_critic(
     only the critic (the AE in eval mode; the control arm idles through them), so eq. (2)
     starts from a critic that has learned something. The decoder's BatchNorm layers stay in eval mode: real and
     interpolated latents are decoded with phase 1's running statistics (as every later
-    decode is), and interpolated latents never enter those statistics. Returns shapes/s.
+    decode is), and interpolated latents never enter those statistics. Both losses' forward passes run in
+    ``cfg.precision`` (module docstring). Returns shapes/s.
     """
     ae.to(device)
+    precision = resolve_precision(cfg.precision, device)
     opt_ae = torch.optim.Adam(ae.parameters(), lr=cfg.lr_ae_critic)
     if critic is not None:
         critic.to(device)
@@ -140,14 +156,14 @@ def train_ae_critic(
             if critic is None and not train_ae:
                 continue  # the control's warm-up: nothing learns, the same random numbers are drawn
 
-            with torch.set_grad_enabled(train_ae):
+            with torch.set_grad_enabled(train_ae), training_autocast(precision, device):
                 z = ae.encoder(x)
-                recon = ae.decoder(z)
+                recon = ae.decoder(z).float()
                 c_interp = None
                 if critic is not None:
                     with torch.set_grad_enabled(train_ae and lam > 0):
-                        x_alpha = ae.grid(ae.interpolate(z, z[partner], alpha))
-                        c_interp = critic(x_alpha)
+                        x_alpha = ae.grid(ae.interpolate(z, z[partner], alpha)).float()
+                        c_interp = critic(x_alpha).float()
                 loss_ae, bce, reg = autoencoder_loss(recon, x, c_interp, lam, ae.cfg.output)  # eq. (2)
             if train_ae:
                 opt_ae.zero_grad(set_to_none=True)
@@ -155,7 +171,8 @@ def train_ae_critic(
                 opt_ae.step()
 
             if critic is not None:
-                loss_c = critic_loss(critic, x, ae.grid(recon), x_alpha, alpha, cfg.gamma)  # eq. (1)
+                with training_autocast(precision, device):
+                    loss_c = critic_loss(critic, x, ae.grid(recon), x_alpha, alpha, cfg.gamma)  # eq. (1)
                 opt_c.zero_grad(set_to_none=True)
                 loss_c.backward()
                 opt_c.step()

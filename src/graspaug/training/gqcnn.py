@@ -22,6 +22,7 @@ from sklearn.metrics import accuracy_score, average_precision_score, roc_auc_sco
 from torch.optim.swa_utils import AveragedModel, get_ema_multi_avg_fn
 from tqdm import tqdm
 
+from graspaug.device import resolve_precision, training_autocast
 from graspaug.nets.gqcnn import GQCNN, GQCNNStack
 from graspaug.training.settings import NoiseSettings, TrainSettings
 
@@ -155,7 +156,8 @@ def train_members(
     k draws its batch order and noise from ``gens[k]`` alone and its gradient is that of its own
     loss, so it is trained as it would be alone (up to float rounding; a test checks it). Each
     net ends with the weights of its best evaluation (the last ones without ``val``).
-    With ``settings.precision = "bfloat16"`` the training steps' forward and backward run in
+    With ``settings.precision = "bfloat16"`` (or ``auto`` on a device with native bfloat16:
+    :func:`graspaug.device.resolve_precision`) the training steps' forward and backward run in
     bfloat16 mixed precision (``torch.autocast``); the weights, the optimizer, the loss and every
     evaluation stay float32. With ``settings.ema_decay > 0`` the evaluated and kept weights are
     an exponential moving average of the trained ones (``torch.optim.swa_utils.AveragedModel``),
@@ -168,6 +170,7 @@ def train_members(
         raise ValueError(f"need at least 2 training datapoints, got {len(train)}")
     if len(gens) != len(nets):
         raise ValueError(f"one generator per member: {len(nets)} members, {len(gens)} generators")
+    precision = resolve_precision(settings.precision, device)
     stats = normalization(nets[0], train)
     for net in nets:
         net.set_normalization(*stats)
@@ -204,7 +207,7 @@ def train_members(
             depths.append(depth)
             targets.append(labels[idx])
         stack.train()
-        with torch.autocast(device.type, dtype=torch.bfloat16, enabled=settings.precision == "bfloat16"):
+        with training_autocast(precision, device):
             logits = stack(torch.stack(crops).to(device), torch.stack(depths).to(device)).float()  # (K, B, 2)
         target = torch.stack(targets).to(device)
         # one call per member: a single member's loss is then computed exactly as before the stack

@@ -32,7 +32,7 @@ import pandas as pd
 import torch
 from tqdm import tqdm
 
-from graspaug.device import has_native_bfloat16
+from graspaug.device import resolve_precision
 from graspaug.errors import DataError
 from graspaug.io.checkpoints import finish_gqcnn_card, gqcnn_card, operating_point, save_gqcnn, training_range
 from graspaug.nets.gqcnn import GQCNN, GQCNNEnsemble, GQCNNStack
@@ -157,7 +157,7 @@ def train_network(job: NetworkJob, val: GraspArrays | None = None, test: GraspAr
             "steps": fits[0]["steps"],
             "best_step": fits[0]["best_step"] if single else [f["best_step"] for f in fits],
             "batch_size": job.train.batch_size,
-            "precision": job.train.precision,
+            "precision": resolve_precision(job.train.precision, device).label,  # as resolved where it trained
             **({} if single else {"members": len(members)}),
         },
         "parameters": net.describe()["parameters"],
@@ -310,17 +310,6 @@ def seed_plan(variants: list[Variant], members: int, n_validation: int, val_rows
         "validation %d shapes (%d datapoints), test %d datapoints; on %s"
         % (len(variants), members, n_validation, len(val_rows), len(test_rows), device)
     )
-
-
-def precision_warning(precision: str, device: torch.device) -> str | None:
-    """The warning for ``gqcnn.train.precision`` bfloat16 on a ``device`` without bfloat16
-    instructions (emulated: slower than float32), else None."""
-    if precision == "bfloat16" and not has_native_bfloat16(device):
-        return (
-            "gqcnn.train.precision: bfloat16, but this %s has no bfloat16 instructions: training is emulated "
-            "and slower than float32 (-S gqcnn.train.precision=float32)" % device.type.upper()
-        )
-    return None
 
 
 def save_seed_split(seed_dir: Path, split: ExperimentSplit, test_rows: np.ndarray, val_rows: np.ndarray) -> None:

@@ -46,6 +46,15 @@ class AETrainConfig:
         0.5, ge=0, alias="lambda", description="λ of eq. (2): weight of the critic term in the AE loss (ACAI: 0.5)."
     )
     flips: bool = Field(True, description="Flip training grids along random axes (the AE learns shape, not pose).")
+    precision: Literal["auto", "float32", "bfloat16"] = Field(
+        "float32",
+        description=(
+            "Arithmetic of both phases' training steps (forward pass and loss): float32 (the default), bfloat16 "
+            "mixed precision (torch.autocast; weights, optimizer, evaluation, embedding and decoding stay float32), "
+            "or auto: bfloat16 where the device computes it natively, float32 elsewhere. The stage logs what it "
+            "resolved to; the checkpoints' train_params record it."
+        ),
+    )
 
 
 @settings
@@ -110,12 +119,13 @@ class TrainSettings:
             "validation, the kept checkpoint and the test use the averaged weights (0: off, the raw weights)."
         ),
     )
-    precision: Literal["float32", "bfloat16"] = Field(
+    precision: Literal["auto", "float32", "bfloat16"] = Field(
         "float32",
         description=(
-            "Arithmetic of the training steps' convolutions and matrix products: float32 (the default), or bfloat16 "
-            "mixed precision (torch.autocast; weights, optimizer, loss, validation and test stay float32). "
-            "bfloat16 needs a CPU with AVX512-BF16 (elsewhere it is emulated)."
+            "Arithmetic of the training steps' convolutions and matrix products: float32 (the default), bfloat16 "
+            "mixed precision (torch.autocast; weights, optimizer, loss, validation and test stay float32), or auto: "
+            "bfloat16 where the device computes it natively (a CPU with AVX512-BF16 or AMX, a GPU from compute "
+            "capability 8.0), float32 elsewhere. The stage logs what it resolved to; the card records it."
         ),
     )
     evals: int = Field(

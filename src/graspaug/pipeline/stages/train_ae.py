@@ -9,13 +9,12 @@ critic's AUC), every figure in ``reports/train_ae/summary.json``.
 from __future__ import annotations
 
 import copy
-import dataclasses
 import logging
 import time
 
 import torch
 
-from graspaug.device import resolve_device
+from graspaug.device import log_precision, resolve_device
 from graspaug.io.checkpoints import save_autoencoder
 from graspaug.io.tables import write_json
 from graspaug.nets.ae_critic import AutoEncoder, Critic
@@ -35,7 +34,13 @@ from graspaug.pipeline.paths import (
 )
 from graspaug.pipeline.stages import StageError
 from graspaug.training.ae_arms import ArmTrainer, rounded_summary, summary_headline
-from graspaug.training.autoencoder import critic_separation, grids_by_split, train_ae_critic, train_autoencoder
+from graspaug.training.autoencoder import (
+    checkpoint_params,
+    critic_separation,
+    grids_by_split,
+    train_ae_critic,
+    train_autoencoder,
+)
 
 log = logging.getLogger(__name__)
 
@@ -60,23 +65,25 @@ def run(params: Params) -> None:
         device,
         cfg.widths,
     )
+    train_params = checkpoint_params(tcfg, device)  # precision as resolved here
+    log_precision("train_ae", "ae.train.precision", tcfg.precision, device)
     arms = ArmTrainer(TRAIN_AE_LIVE, train, test, device)
     summary, timing = arms.summary, arms.timing
 
     ae = AutoEncoder(cfg)
     arms.fit("ae", ae, None, lambda cb: train_autoencoder(ae, train, tcfg, device, gen, cb), 5, tcfg.epochs_ae)
-    save_autoencoder(AE_MODEL, ae, None, dataclasses.asdict(tcfg))
+    save_autoencoder(AE_MODEL, ae, None, train_params)
 
     # phase 2, two arms from the same phase-1 weights and the same random numbers
     phase2_rng = gen.get_state()
     extra = copy.deepcopy(ae)
     arms.fit("ae_extra", extra, None, lambda cb: train_ae_critic(extra, None, train, tcfg, device, gen, cb))
-    save_autoencoder(AE_EXTRA_MODEL, extra, None, dataclasses.asdict(dataclasses.replace(tcfg, lam=0.0)))
+    save_autoencoder(AE_EXTRA_MODEL, extra, None, train_params | {"lam": 0.0})
 
     gen.set_state(phase2_rng)
     critic = Critic(cfg)
     arms.fit("ae_critic", ae, critic, lambda cb: train_ae_critic(ae, critic, train, tcfg, device, gen, cb))
-    save_autoencoder(AE_CRITIC_MODEL, ae, critic, dataclasses.asdict(tcfg))
+    save_autoencoder(AE_CRITIC_MODEL, ae, critic, train_params)
     summary["critic_auc"] = critic_separation(ae, critic, test, device)["auc"]
 
     timing["train_s"] = time.perf_counter() - start

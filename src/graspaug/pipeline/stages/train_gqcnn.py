@@ -15,7 +15,7 @@ from __future__ import annotations
 import logging
 import time
 
-from graspaug.device import resolve_device
+from graspaug.device import log_precision, resolve_device
 from graspaug.io.atomic import atomic_path
 from graspaug.io.tables import read_table, write_csv, write_json
 from graspaug.pipeline.params.base import params_model
@@ -38,7 +38,6 @@ from graspaug.training.gqcnn_data import Corpora, load_split, shapes_datapoints,
 from graspaug.training.networks import (
     NetworkJob,
     network_workers,
-    precision_warning,
     read_history,
     result_lines,
     save_seed_split,
@@ -79,8 +78,7 @@ def run(params: Params, seed: int) -> None:
     test, test_rows = test_set(corpora.original)
     plan = seed_plan(variants, cfg.members, len(split.validation), val_rows, test_rows, device)
     log.info("train_gqcnn seed %d: %s", seed, plan)
-    if (warning := precision_warning(cfg.train.precision, device)) is not None:  # bfloat16 emulated: slower
-        log.warning("%s", warning)
+    log_precision(f"train_gqcnn seed {seed}", "gqcnn.train.precision", cfg.train.precision, device)
     with atomic_path(gqcnn_seed_dir(seed), directory=True) as folder:
         card = seed_card(params.render, params.grasps, params.seed)
         shared = (split, cfg.net, cfg.train, inits, noise_seeds, seed, str(device), folder, corpora, card)
