@@ -257,3 +257,15 @@ def test_control_ratios_must_be_ratios_of_generate(repo_root):
         parse_params(merge(params_dict(), {"gqcnn": {"control_ratios": [3.0]}}))
     with pytest.raises(ParamsError, match=r"gqcnn\.control_ratios"):
         parse_params(merge(params_dict(), {"gqcnn": {"control_ratios": [0.0]}}))
+
+
+def test_a_draw_of_the_real_objects_profile_reads_the_corpus_from_the_project(repo_root):
+    """A draw runs in a clone elsewhere: the profile's relative corpus path is made absolute from the project."""
+    from pathlib import Path
+
+    from graspaug.pipeline.studies.draws import draw_params
+
+    params = draw_params(repo_root, "real_objects", 2)
+    assert params.data_seed == 2 and Path(params.data.path).is_absolute()
+    assert Path(params.data.path) == (repo_root / "../shared/corpora/gso300").resolve()
+    assert draw_params(repo_root, "attribution", 0).data.path is None

@@ -18,7 +18,8 @@ from graspaug.pipeline.params.profiles import merge, params_yaml, read_overlay
 
 def draw_params(project: Path, profile: str, data_seed: int, changes: list[str] = ()):
     """The validated params of ``profile`` (``project``/profiles) with ``data_seed`` and ``changes``
-    (``key.path=yaml value``, e.g. ``gqcnn.augment_base_sizes=[50]``)."""
+    (``key.path=yaml value``, e.g. ``gqcnn.augment_base_sizes=[50]``); a relative ``data.path`` (the real-objects
+    profile's ``../shared/corpora/gso300``) is made absolute from ``project``, as a draw runs in a clone elsewhere."""
     overlay = read_overlay(profile, project / "profiles") | {"data_seed": data_seed}
     for change in changes:
         key, _, value = change.partition("=")
@@ -27,7 +28,10 @@ def draw_params(project: Path, profile: str, data_seed: int, changes: list[str] 
         for part in path:
             node = node.setdefault(part, {})
         node[last] = yaml.safe_load(value)
-    return parse_params(merge(params_dict(), overlay))
+    merged = merge(params_dict(), overlay)
+    if merged["data"].get("path") and not Path(merged["data"]["path"]).is_absolute():
+        merged["data"]["path"] = str((project / merged["data"]["path"]).resolve())
+    return parse_params(merged)
 
 
 def study_env() -> dict[str, str]:
