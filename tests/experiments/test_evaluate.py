@@ -146,3 +146,23 @@ def test_gso300_objects_keep_their_real_size(tmp_path):
             assert (
                 abs(row["scale"] - 1.0) < 1e-12 and 0.01 <= max(row["extent_x"], row["extent_y"], row["extent_z"]) < 1
             )
+
+
+def test_the_test_set_keeps_real_size_or_fits_as_the_projects_ingest_does():
+    """evaluate's objects keep their real size (too wide: rejected), or, where the project's ingest fits objects to
+    the gripper (the real-objects profile), are fitted as ingest fits them; the card's gripper sets the width."""
+    import dataclasses
+
+    from graspaug.experiments.evaluate.testset import CARD_KEYS, recipe_for
+    from graspaug.geometry.settings import SurfaceSettings
+    from graspaug.grasping.settings import GraspsSettings
+    from graspaug.planning.card import ModelCard
+    from graspaug.render.settings import RenderSettings
+
+    raw = gqcnn_card(CropGeometry(), Intrinsics(), ViewpointRanges(), ParallelJawGripper(max_width=0.07), 0.0005, 0)
+    card = ModelCard.from_dict(raw, "depth")
+    values = {k: getattr(card, k) for k in CARD_KEYS}
+    for asked, used in (("normalize", "real"), ("real", "real"), ("fit", "fit")):
+        surface = dataclasses.replace(SurfaceSettings(), size=asked)
+        recipe = recipe_for(surface, 10**6, 100.0, GraspsSettings(), RenderSettings(), 0, values)
+        assert recipe.surface.size == used and recipe.surface.max_width == pytest.approx(0.07)

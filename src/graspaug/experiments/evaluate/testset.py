@@ -67,7 +67,8 @@ def recipe_for(
     card: dict,
 ) -> TestSetRecipe:
     """The test set a model with ``card`` (:data:`CARD_KEYS` → the card's values) is tested on: the given settings,
-    real size (shapes wider than the card's gripper rejected), and the card's camera (intrinsics px, distance m, tilt
+    real size (shapes wider than the card's gripper rejected; with ``surface.size`` ``fit``, the real-objects
+    profile's, scaled down until they fit, as ingest does), and the card's camera (intrinsics px, distance m, tilt
     deg), crop (px), gripper (m) and label threshold (robust ε; ``grasps.threshold`` where the card has none)."""
     gripper = ParallelJawGripper(**card["gripper"])
     threshold = grasps.threshold if card["label_threshold"] is None else card["label_threshold"]
@@ -75,7 +76,9 @@ def recipe_for(
         render.viewpoints, distance=tuple(card["camera_distance"]), tilt_deg=tuple(card["camera_tilt_deg"])
     )
     return TestSetRecipe(
-        surface=dataclasses.replace(surface, size="real", max_width=gripper.max_width),
+        surface=dataclasses.replace(
+            surface, size="fit" if surface.size == "fit" else "real", max_width=gripper.max_width
+        ),
         max_faces=max_faces,
         max_file_mb=max_file_mb,
         grasps=dataclasses.replace(grasps, gripper=gripper, threshold=threshold),
