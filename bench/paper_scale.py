@@ -52,14 +52,12 @@ import torch
 
 from graspaug.device import resolve_device
 from graspaug.geometry.voxelize import pack_bits, unpack_bits
-from graspaug.nets.ae_critic import AutoEncoder, Critic
+from graspaug.nets.ae_critic import AutoEncoder, Critic, decode, encode
 from graspaug.nets.gqcnn import GQCNN
 from graspaug.parallel import parallel_map
 from graspaug.pipeline.params.profiles import profile_params
 from graspaug.training.autoencoder import (
     critic_separation,
-    decode,
-    encode,
     occupied,
     reconstruction_iou,
     train_ae_critic,

@@ -123,6 +123,43 @@ def test_rooms_point_down():
     assert not {m for m in reached if _room(m) == "experiments"}, "training reaches the experiments"
 
 
+def room_cycles(graph: nx.DiGraph) -> list[list[str]]:
+    """Rooms (packages under graspaug) that import each other, directly or through other rooms: each cycle's rooms,
+    sorted; the root package (``graspaug`` itself) is no room."""
+    rooms = nx.DiGraph(
+        (_room(a), _room(b)) for a, b in graph.edges if _room(a) != _room(b) and "" not in (_room(a), _room(b))
+    )
+    return sorted(sorted(c) for c in nx.strongly_connected_components(rooms) if len(c) > 1)
+
+
+def test_no_cycle_between_rooms():
+    """Arrows point one way between rooms too: no module of ``training`` imports ``augment`` while one of ``augment``
+    imports ``training`` (a cycle of modules it is not, but of the layers it is)."""
+    graph = import_graph(SRC)
+    cycles = room_cycles(graph)
+    edges = sorted(
+        (a, b) for a, b in graph.edges if any({_room(a), _room(b)} <= set(c) for c in cycles) and _room(a) != _room(b)
+    )
+    assert not cycles, f"rooms that import each other: {cycles}, through {edges}"
+
+
+def test_a_planted_room_cycle_is_found(tmp_path):
+    for name, text in {
+        "graspaug/__init__.py": "",
+        "graspaug/training/__init__.py": "",
+        "graspaug/training/data.py": "from graspaug.augment.sets import f\n",
+        "graspaug/augment/__init__.py": "",
+        "graspaug/augment/sets.py": "def f():\n    pass\n",
+        "graspaug/augment/decode.py": "from graspaug.training.loop import g\n",
+        "graspaug/training/loop.py": "def g():\n    pass\n",
+    }.items():
+        (tmp_path / name).parent.mkdir(parents=True, exist_ok=True)
+        (tmp_path / name).write_text(text)
+    graph = import_graph(tmp_path)
+    assert not [c for c in nx.strongly_connected_components(graph) if len(c) > 1]  # no module cycle
+    assert room_cycles(graph) == [["augment", "training"]]
+
+
 def test_a_planted_upward_import_is_found(tmp_path):
     for name, text in {
         "graspaug/__init__.py": "",

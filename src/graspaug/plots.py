@@ -1,8 +1,9 @@
-"""Figures as PNG files (matplotlib, Agg backend): what the stages show a person.
+"""Figures as PNG files (matplotlib, Agg backend): what the figures share, and the stages' own pictures.
 
-The shared primitives (lines with bands, bars, scatter maps, voxel and mesh rows, depth crops, pick stories): over
-400 lines because each is a small function that several stages' figures call; what an experiment draws is decided in
-its own ``figures`` module (``experiments/<name>/figures.py``)."""
+The saving (:func:`pyplot`, :func:`save_figure`, :data:`DPI`), the primitives several figures call (lines with bands,
+a scatter map, voxel rows) and the pictures of the pipeline's stages (score histograms and grasps, depth crops,
+validation curves, generated pairs). An experiment's figure is drawn in its own ``figures`` module
+(``experiments/<name>/figures.py``), beside its data and caption."""
 
 from __future__ import annotations
 
@@ -10,7 +11,6 @@ import os
 from collections.abc import Sequence
 
 import numpy as np
-import pandas as pd
 
 from graspaug.io.atomic import atomic_path
 
@@ -203,61 +203,6 @@ def crop_grid(
     save_figure(fig, path)
 
 
-def ap_vs_ratio(figure: dict, path: str | os.PathLike, title: str) -> None:
-    """The paper's Fig. 7 as :func:`graspaug.experiments.ap.figures.ratio_panels` lays it out (``figure``): one panel
-    per augmented base size, one line per pool (targeted solid, random dashed, real dotted, recon dash-dotted) with
-    its interval as error bars, each reference (a base size alone, the ceiling) a horizontal line with its band on
-    every panel; the AP axis ``figure["ylim"]``, shared."""
-    plt = pyplot()
-    panels = figure["panels"]
-    fig, axes = plt.subplots(
-        1, len(panels), figsize=(3.6 * len(panels) + 0.8, 3.8), sharey=True, squeeze=False, layout="constrained"
-    )
-    styles = {
-        "targeted": ("-", "tab:blue"),
-        "random": ("--", "tab:orange"),
-        "real": (":", "tab:green"),
-        "recon": ("-.", "tab:purple"),
-    }
-    reference_colors = ["tab:brown", "tab:pink", "tab:olive", "tab:cyan"]
-    for ax, panel in zip(axes[0], panels):
-        for curve in panel["curves"]:
-            style, color = styles.get(curve["pool"], ("-", "tab:blue"))
-            ax.errorbar(
-                curve["x"],
-                curve["ap"],
-                yerr=np.stack([curve["ap"] - curve["low"], curve["high"] - curve["ap"]]),  # (2, n), clipped
-                marker="o",
-                markersize=4,
-                capsize=3,
-                linestyle=style,
-                color=color,
-                label=curve["pool"],
-            )
-        others = iter(reference_colors)
-        for ref in panel["references"]:
-            color = "grey" if ref["label"].startswith("ceiling") else next(others, "black")
-            ax.axhline(ref["ap"], color=color, linewidth=1, linestyle=(0, (6, 2)), label=ref["label"])
-            ax.axhspan(ref["low"], ref["high"], color=color, alpha=0.12, linewidth=0)
-        ax.set_title(panel["title"], fontsize=9)
-        ax.set_xlabel(panel["xlabel"])
-        xs = sorted({float(v) for c in panel["curves"] for v in c["x"]})
-        if xs:
-            ax.set_xticks(xs)
-            pad = 0.08 * (xs[-1] - xs[0]) if xs[-1] > xs[0] else 0.5
-            ax.set_xlim(xs[0] - pad, xs[-1] + pad)
-        ax.grid(alpha=0.3)
-    axes[0, 0].set_ylim(*figure["ylim"])
-    axes[0, 0].set_ylabel("test Average Precision")
-    legend = {}  # every label once, from whichever panel has it
-    for ax in axes[0]:
-        for handle, label in zip(*ax.get_legend_handles_labels()):
-            legend.setdefault(label, handle)
-    axes[0, 0].legend(legend.values(), legend.keys(), fontsize=7, loc="best")
-    fig.suptitle(title, fontsize=9)
-    save_figure(fig, path)
-
-
 def validation_curves(history, path: str | os.PathLike, title: str) -> None:
     """Validation AP against SGD step, one line per network (``history``: columns network,
     step, val_ap), a dot at each network's best evaluation (the weights it keeps)."""
@@ -274,144 +219,6 @@ def validation_curves(history, path: str | os.PathLike, title: str) -> None:
     ax.set_title(title, fontsize=9)
     ax.grid(alpha=0.3)
     ax.legend(fontsize=6, ncol=2)
-    save_figure(fig, path)
-
-
-def improvement_by_interval(panels: list[dict], path: str | os.PathLike, title: str) -> None:
-    """The paper's Fig. 8: per panel (a score: rarity or graspness), normalized histograms of
-    the selected and the generated shapes and the mean per-object AP improvement of test
-    objects in each score interval. Each panel: ``name``, ``edges`` (bins + 1), ``selected``,
-    ``generated`` (score arrays), ``improvement`` (mean per bin, NaN where empty), ``objects`` (per bin)."""
-    plt = pyplot()
-    fig, axes = plt.subplots(1, len(panels), figsize=(6 * len(panels), 4.2), squeeze=False)
-    for ax, panel in zip(axes[0], panels):
-        edges = np.asarray(panel["edges"])
-        centers, width = (edges[:-1] + edges[1:]) / 2, np.diff(edges)
-        for name, values, color in (
-            ("selected", panel["selected"], "tab:orange"),
-            ("generated", panel["generated"], "tab:green"),
-        ):
-            counts, _ = np.histogram(np.clip(values, edges[0], edges[-1]), bins=edges)
-            share = counts / max(counts.sum(), 1)
-            ax.bar(centers, share, width=width * 0.9, alpha=0.45, color=color, label=f"{name} shapes ({len(values)})")
-        ax.set_xlabel(panel["name"])
-        ax.set_ylabel("share of shapes")
-        twin = ax.twinx()
-        improvement = np.asarray(panel["improvement"], dtype=float)
-        twin.plot(centers, improvement, marker="o", color="tab:blue", label="mean AP improvement of test objects")
-        for x, y, n in zip(centers, improvement, panel["objects"]):
-            if np.isfinite(y):
-                twin.annotate(
-                    str(n), (x, y), textcoords="offset points", xytext=(0, 5), ha="center", fontsize=7, color="tab:blue"
-                )
-        twin.axhline(0, color="gray", linewidth=0.8)
-        twin.set_ylabel("per-object AP improvement")
-        lines, labels = ax.get_legend_handles_labels()
-        more, more_labels = twin.get_legend_handles_labels()
-        ax.legend(lines + more, labels + more_labels, fontsize=7, loc="upper left")
-    fig.suptitle(title, fontsize=9)
-    fig.subplots_adjust(wspace=0.45)
-    save_figure(fig, path)
-
-
-def scatter_colored(
-    xy: np.ndarray, values: np.ndarray, markers: Sequence[str], path: str | os.PathLike, title: str, colorbar: str
-) -> None:
-    """(N, 2) points colored by ``values``, one marker style per group in ``markers`` (the paper's Fig. 1)."""
-    plt = pyplot()
-    fig, ax = plt.subplots(figsize=(6.5, 6))
-    markers = np.asarray(markers)
-    styles = ["o", "^", "s", "D"]
-    art = None
-    for style, name in zip(styles, sorted(set(markers))):
-        sel = markers == name
-        art = ax.scatter(
-            xy[sel, 0],
-            xy[sel, 1],
-            c=values[sel],
-            s=10 if style == "o" else 16,
-            marker=style,
-            cmap="viridis",
-            vmin=float(np.nanmin(values)),
-            vmax=float(np.nanmax(values)),
-            label=f"{name} ({sel.sum()})",
-            edgecolors="none",
-        )
-    if art is not None:
-        fig.colorbar(art, ax=ax, label=colorbar)
-    ax.set_title(title, fontsize=9)
-    ax.set_xticks([])
-    ax.set_yticks([])
-    ax.legend(fontsize=8)
-    save_figure(fig, path)
-
-
-BARS_PER_ROW = 12  # success_bars wraps its objects into rows of at most this many (about 1,400 px wide)
-
-
-def success_bars(
-    names: Sequence[str],
-    arms: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]],
-    path: str | os.PathLike,
-    title: str,
-) -> None:
-    """Grouped bars of success rate per object and arm; ``arms[label] = (rate, low, high)``,
-    each (len(names),), drawn with the interval as error bars. The objects wrap into as few rows as
-    hold at most :data:`BARS_PER_ROW` each, filled evenly, so many objects make a taller figure,
-    not a wider one."""
-    plt = pyplot()
-    n_rows = max(1, -(-len(names) // BARS_PER_ROW))
-    per_row = max(1, -(-len(names) // n_rows))
-    fig, axes = plt.subplots(
-        n_rows, 1, figsize=(max(6.0, 0.9 * per_row + 2), 3.2 * n_rows + 0.8), squeeze=False, layout="constrained"
-    )
-    width = 0.8 / max(1, len(arms))
-    for row, ax in enumerate(axes[:, 0]):
-        shown = slice(row * per_row, (row + 1) * per_row)
-        x = np.arange(len(names[shown]))
-        for i, (label, (rate, low, high)) in enumerate(arms.items()):
-            rate, low, high = (np.asarray(a, dtype=float)[shown] for a in (rate, low, high))
-            offset = x + (i - (len(arms) - 1) / 2) * width
-            ax.bar(offset, rate, width, yerr=[rate - low, high - rate], capsize=3, label=label)
-        ax.set_xticks(x)
-        ax.set_xticklabels(names[shown], rotation=30, ha="right")
-        ax.set_xlim(-0.5, per_row - 0.5)  # the same bar width in every row
-        ax.set_ylim(0, 1.25)
-        ax.set_yticks(np.linspace(0, 1, 6))
-        ax.set_ylabel("grasp success rate")
-    axes[0, 0].set_title(title)
-    axes[0, 0].legend(loc="upper center", ncol=min(len(arms), 3), fontsize=8)
-    save_figure(fig, path)
-
-
-def pick_story(
-    depth: np.ndarray,
-    jaw: np.ndarray | None,
-    window: tuple[int, int, int, int],
-    frames: Sequence[tuple[str, np.ndarray]],
-    path: str | os.PathLike,
-    title: str,
-) -> None:
-    """One trial: the depth image (m) inside ``window`` = (u0, v0, u1, v1) px with the chosen
-    grasp's jaw segment ``jaw`` (2, 2) as (u, v) rows drawn, then the RGB pick frames."""
-    plt = pyplot()
-    panels = 1 + len(frames)
-    fig, axes = plt.subplots(1, panels, figsize=(2.9 * panels, 2.9), layout="constrained")
-    axes = np.atleast_1d(axes)
-    u0, v0, u1, v1 = window
-    shown = axes[0].imshow(depth[v0:v1, u0:u1], cmap="viridis", extent=(u0 - 0.5, u1 - 0.5, v1 - 0.5, v0 - 0.5))
-    if jaw is not None:
-        axes[0].plot(jaw[:, 0], jaw[:, 1], "r-", lw=2)
-        axes[0].plot(jaw[:, 0], jaw[:, 1], "ro", ms=4)
-    fig.colorbar(shown, ax=axes[0], location="bottom", fraction=0.05, pad=0.02, label="depth (m)")
-    axes[0].set_title("depth image + grasp", fontsize=8)
-    for ax, (label, frame) in zip(axes[1:], frames):
-        ax.imshow(frame)
-        ax.set_title(label, fontsize=8)
-    for ax in axes:
-        ax.set_xticks([])
-        ax.set_yticks([])
-    fig.suptitle(title, fontsize=9)
     save_figure(fig, path)
 
 
@@ -432,76 +239,3 @@ def generated_pairs(base: np.ndarray, voxels, decoded: list, path: str | os.Path
         rows.append([parent(base[c.a]), (child, child), parent(base[c.b])])
         labels.append(f"{c.selected_by}, α={c.alpha:g}")
     voxel_rows(rows, labels, ["parent a", "generated", "parent b"], path, title)
-
-
-def precision_recall_roc(
-    labels: np.ndarray, predictions: dict[str, np.ndarray], path: str | os.PathLike, title: str
-) -> None:
-    """Precision-recall (left) and ROC (right) curves of several networks' test predictions
-    P(success) (N,) against the same 0/1 ``labels`` (N,); AP and ROC AUC in the legends. With
-    one class in ``labels`` there are no curves: the panels say so."""
-    from sklearn.metrics import average_precision_score, precision_recall_curve, roc_auc_score, roc_curve
-
-    plt = pyplot()
-    fig, (pr, roc) = plt.subplots(1, 2, figsize=(11, 4.5))
-    labels = np.asarray(labels).astype(int)
-    both = 0 < labels.sum() < len(labels)
-    for ax in (pr, roc) if not both else ():
-        ax.text(0.5, 0.5, "one class in the test labels: no curve", ha="center", va="center")
-    for name, p in predictions.items() if both else ():
-        precision, recall, _ = precision_recall_curve(labels, p)
-        pr.plot(recall, precision, label=f"{name} (AP {average_precision_score(labels, p):.3f})")
-        fpr, tpr, _ = roc_curve(labels, p)
-        roc.plot(fpr, tpr, label=f"{name} (AUC {roc_auc_score(labels, p):.3f})")
-    pr.axhline(labels.mean(), color="gray", ls=":", label=f"chance ({labels.mean():.3f})")
-    roc.plot([0, 1], [0, 1], color="gray", ls=":", label="chance")
-    for ax, (x, y) in ((pr, ("recall", "precision")), (roc, ("false positive rate", "true positive rate"))):
-        ax.set_xlabel(x)
-        ax.set_ylabel(y)
-        ax.set_xlim(0, 1)
-        ax.set_ylim(0, 1.02)
-        ax.grid(alpha=0.3)
-        ax.legend(fontsize=8)
-    fig.suptitle(title)
-    save_figure(fig, path)
-
-
-def label_calibration(by_eps: pd.DataFrame, grasps: pd.DataFrame, path: str | os.PathLike, title: str) -> None:
-    """Do executed grasps follow their labels? Left: success rate per robust-ε bin (``by_eps``:
-    ``collision_free``, ``eps_mid``, ``rate``, ``lo``, ``hi``), one line for grasps labelled
-    collision-free and one for colliding ones. Right: ROC curves of
-    the robust ε and of the label against the executed outcome (``grasps``: ``eps``, ``label``,
-    ``executed_success``), AUC in the legend."""
-    from sklearn.metrics import roc_auc_score, roc_curve
-
-    plt = pyplot()
-    fig, (rates, roc) = plt.subplots(1, 2, figsize=(11, 4.5))
-    for free, group in by_eps.groupby("collision_free"):
-        group = group.sort_values("eps_mid")
-        rate = group.rate.to_numpy(float)
-        rates.errorbar(
-            group.eps_mid * 1000,
-            rate,
-            yerr=[rate - group.lo.to_numpy(float), group.hi.to_numpy(float) - rate],
-            marker="o",
-            capsize=3,
-            label="labelled collision-free approach" if free else "labelled colliding approach",
-        )
-    rates.set_xlabel("robust ε (×1000), median of the bin")
-    rates.set_ylabel("executed success rate (95% Wilson)")
-    rates.set_ylim(0, 1.02)
-    y = grasps.executed_success.to_numpy(bool)
-    if 0 < y.sum() < len(y):
-        for name, score in (("robust ε", grasps.eps), ("label", grasps.label.astype(float))):
-            fpr, tpr, _ = roc_curve(y, score)
-            roc.plot(fpr, tpr, label=f"{name} (AUC {roc_auc_score(y, score):.3f})")
-    else:
-        roc.text(0.5, 0.5, "one outcome only: no curve", ha="center", va="center")
-    roc.plot([0, 1], [0, 1], color="gray", ls=":", label="chance")
-    roc.set_xlabel("false positive rate")
-    roc.set_ylabel("true positive rate")
-    for ax in (rates, roc):
-        ax.grid(alpha=0.3)
-        ax.legend(fontsize=8)
-    fig.suptitle(title)
-    save_figure(fig, path)

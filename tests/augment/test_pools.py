@@ -92,8 +92,7 @@ def test_a_recon_shape_is_the_autoencoders_reconstruction_meshed_at_its_own_scal
     from graspaug.augment.decode import mesh_batches
     from graspaug.geometry.from_voxels import clean_occupancy
     from graspaug.geometry.settings import DecodeSettings
-    from graspaug.nets.ae_critic import AEConfig, AutoEncoder
-    from graspaug.training.autoencoder import decode, encode
+    from graspaug.nets.ae_critic import AEConfig, AutoEncoder, decode, encode
 
     torch.manual_seed(0)
     ae = AutoEncoder(AEConfig(resolution=16, z_dim=8, base_width=4, top_width=16, output="occupancy"))

@@ -114,7 +114,8 @@ def test_each_round_adds_new_shapes_to_each_arm_and_never_a_pair_and_weight_made
     import trimesh
 
     from graspaug.augment.candidates import Decoded, candidate_key
-    from graspaug.augment.pools import BaseSet, loop_shapes
+    from graspaug.augment.failures import loop_shapes
+    from graspaug.augment.pools import BaseSet
     from graspaug.augment.scores import rarity
     from graspaug.pipeline.params.generate import GenerateParams
 

@@ -168,7 +168,7 @@ def test_the_success_bars_of_many_objects_wrap_into_rows_of_a_readable_width(tmp
     """29 objects (the default run) made a 2474 × 440 px strip; 100 objects now wrap into rows of at most 12."""
     from PIL import Image
 
-    from graspaug.plots import success_bars
+    from graspaug.experiments.cell.figures import success_bars
 
     chosen = {arm: ("targeted", 0.0, 50) for arm in ("before", "after", "real", "more_real")}
     chosen["antipodal"] = (None, None, None)

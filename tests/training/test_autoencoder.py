@@ -5,11 +5,10 @@ import trimesh
 
 from graspaug.geometry.voxelize import fit_grid, voxelize_solid
 from graspaug.io.checkpoints import CheckpointMismatch, load_autoencoder, save_autoencoder
-from graspaug.nets.ae_critic import AEConfig, AutoEncoder, Critic
+from graspaug.nets.ae_critic import AEConfig, AutoEncoder, Critic, decode, encode
 from graspaug.training.autoencoder import (
     AETrainConfig,
     critic_separation,
-    encode,
     phase_1_schedule,
     reconstruction_iou,
     train_ae_critic,
@@ -60,7 +59,6 @@ def test_a_tiny_model_overfits_eight_shapes():
 
     # the decoded sphere latent, and a sphere-box interpolation, mesh to closed one-piece surfaces
     from graspaug.geometry.from_voxels import clean_occupancy, mesh_from_occupancy
-    from graspaug.training.autoencoder import decode
 
     z = encode(ae, x, CPU)
     for latent in (z[1], 0.5 * z[1] + 0.5 * z[0]):
@@ -258,7 +256,6 @@ def test_a_decoder_of_signed_distances_learns_eight_shapes_and_meshes_them():
     near the surfaces; its decodes mesh by marching cubes at 0 with no opening or smoothing."""
     from graspaug.geometry.sdf import mesh_decoded_field
     from graspaug.geometry.settings import DecodeSettings
-    from graspaug.training.autoencoder import decode
 
     torch.manual_seed(0)
     x = primitive_fields(16)

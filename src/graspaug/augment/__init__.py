@@ -6,9 +6,13 @@
 - :mod:`~graspaug.augment.embedding`: the 2-D t-SNE map of the latents (Fig. 1);
 - :mod:`~graspaug.augment.candidates`: base sets, pairs of rare / graspable neighbours, the α schedule and the
   candidate streams of every pool (targeted, random, recon, failure), and the pool tables (III-C);
-- :mod:`~graspaug.augment.pools`: the pools decoded and meshed (decode → fill → open → marching cubes → smooth),
-  the blend pool with no network, and the failure-anchored shapes of the lifelong loop.
+- :mod:`~graspaug.augment.decode`: the batch runners that turn candidates into meshes (decode → fill → open →
+  marching cubes → smooth), and the no-network ones (blend, warp, primitives, procedural);
+- :mod:`~graspaug.augment.pools`: the ``generate`` stage's pools of one base set, filled and tabled;
+- :mod:`~graspaug.augment.failures`: shapes near the objects a planner fails on: the ``from-failures`` stream and
+  the lifelong loop's rounds (its failure and random arms).
 
-The AutoEncoder-Critic itself (III-B) is :mod:`graspaug.nets.ae_critic` with its training loop in
-:mod:`graspaug.training.autoencoder`; the decoded grid becomes a mesh in :mod:`graspaug.geometry.from_voxels`.
+The AutoEncoder-Critic itself (III-B) is :mod:`graspaug.nets.ae_critic`, with the batched ``encode`` / ``decode``
+that generation runs (augment imports no training code); its training loop is :mod:`graspaug.training.autoencoder`;
+the decoded grid becomes a mesh in :mod:`graspaug.geometry.from_voxels`.
 """

@@ -16,7 +16,7 @@ import numpy as np
 from graspaug.augment.candidates import Candidate, Decoded
 from graspaug.geometry.from_voxels import mesh_decoded
 from graspaug.geometry.sdf import mesh_decoded_field
-from graspaug.training.autoencoder import decode
+from graspaug.nets.ae_critic import decode
 
 if TYPE_CHECKING:
     from graspaug.augment.pools import BaseSet

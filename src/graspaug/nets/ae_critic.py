@@ -19,6 +19,10 @@ Grids: ``cfg.output`` says what a grid holds. ``occupancy``: 0/1 in, the decoder
 [-1, 1] and negative inside, in and out (tanh of the decoder's output). :meth:`AutoEncoder.grid` turns
 the decoder's output into a grid of the input's kind; the critic always sees such grids.
 
+Using a trained AutoEncoder: :func:`encode` (grids → latents) and :func:`decode` (latents → grids), in batches,
+eval mode, float32: what the training loop (:mod:`graspaug.training.autoencoder`), the embedding and the
+generated pools (:mod:`graspaug.augment.decode`) all call.
+
 Widths: layer i of the down path has ``min(base_width * 2**i, top_width)``
 channels and the stride-1 layer ``top_width``. Paper profile (R = 64): base 64 →
 64, 128, 256, 512, then 512. The CPU default (R = 32) is narrower.
@@ -26,6 +30,7 @@ channels and the stride-1 layer ``top_width``. Paper profile (R = 64): base 64 �
 
 from __future__ import annotations
 
+import numpy as np
 import torch
 import torch.nn.functional as F
 from torch import nn
@@ -217,3 +222,25 @@ def autoencoder_loss(
     if lam == 0:
         return bce, bce, reg.detach()
     return bce + lam * reg, bce, reg
+
+
+@torch.no_grad()
+def encode(ae: AutoEncoder, voxels: torch.Tensor, device: torch.device, batch_size: int = 64) -> np.ndarray:
+    """(N, z_dim) float32 latents of (N, 1, R, R, R) grids (eval mode)."""
+    ae.eval().to(device)
+    batches = (voxels[i : i + batch_size] for i in range(0, len(voxels), batch_size))
+    out = [ae.encoder(x.to(device=device, dtype=torch.float32, non_blocking=True)).cpu() for x in batches]
+    return torch.cat(out).numpy() if out else np.zeros((0, ae.cfg.z_dim), np.float32)
+
+
+@torch.no_grad()
+def decode(ae: AutoEncoder, z: np.ndarray, device: torch.device, batch_size: int = 64) -> np.ndarray:
+    """(N, R, R, R) float32 grids of (N, z_dim) latents (eval mode), of the input's kind (:meth:`AutoEncoder.grid`):
+    occupancy probabilities, or signed distances / truncation in [-1, 1]."""
+    ae.eval().to(device)
+    zt = torch.as_tensor(np.asarray(z, dtype=np.float32))
+    if len(zt) == 0:
+        r = ae.cfg.resolution
+        return np.zeros((0, r, r, r), np.float32)
+    out = [ae.grid(ae.decoder(zt[i : i + batch_size].to(device))).cpu() for i in range(0, len(zt), batch_size)]
+    return torch.cat(out)[:, 0].numpy()

@@ -1,4 +1,6 @@
-"""Training the AutoEncoder (phase 1) and the AE-Critic (phase 2), and using them.
+"""Training the AutoEncoder (phase 1) and the AE-Critic (phase 2), and using them (measures, meshes encoded as
+``voxelize`` grids them); the batched :func:`~graspaug.nets.ae_critic.encode` and
+:func:`~graspaug.nets.ae_critic.decode` they call live beside the network.
 
 Grids travel as ``(N, 1, R, R, R)`` tensors, uint8 occupancy (0/1) or float32 signed distance / truncation
 (``ae.net.output``: :mod:`graspaug.nets.ae_critic`), and are turned into float batches on the device. Every
@@ -25,6 +27,8 @@ from graspaug.nets.ae_critic import (
     Critic,
     autoencoder_loss,
     critic_loss,
+    decode,
+    encode,
     folded_alpha,
     reconstruction_loss,
     reversed_partners,
@@ -240,14 +244,6 @@ def critic_separation(
     }
 
 
-@torch.no_grad()
-def encode(ae: AutoEncoder, voxels: torch.Tensor, device: torch.device, batch_size: int = 64) -> np.ndarray:
-    """(N, z_dim) float32 latents of (N, 1, R, R, R) grids (eval mode)."""
-    ae.eval().to(device)
-    out = [ae.encoder(_as_float(voxels[i : i + batch_size], device)).cpu() for i in range(0, len(voxels), batch_size)]
-    return torch.cat(out).numpy() if out else np.zeros((0, ae.cfg.z_dim), np.float32)
-
-
 def mesh_grid(mesh, resolution: int, margin: int, output: str = "occupancy", truncation: float = 3.0) -> np.ndarray:
     """One mesh (trimesh, m) as the ``voxelize`` stage grids it (a ``resolution``³ grid fitted to its bounds with
     ``margin`` empty cells): (R, R, R) occupancy bool, or with ``output`` ``sdf`` its truncated signed distance /
@@ -271,19 +267,6 @@ def encode_meshes(ae: AutoEncoder, meshes, resolution: int, margin: int, device:
         return np.zeros((0, cfg.z_dim), np.float32)
     kind = np.float32 if cfg.output == "sdf" else np.uint8
     return encode(ae, torch.from_numpy(np.stack(grids)[:, None].astype(kind)), device)
-
-
-@torch.no_grad()
-def decode(ae: AutoEncoder, z: np.ndarray, device: torch.device, batch_size: int = 64) -> np.ndarray:
-    """(N, R, R, R) float32 grids of (N, z_dim) latents (eval mode), of the input's kind (:meth:`AutoEncoder.grid`):
-    occupancy probabilities, or signed distances / truncation in [-1, 1]."""
-    ae.eval().to(device)
-    zt = torch.as_tensor(np.asarray(z, dtype=np.float32))
-    if len(zt) == 0:
-        r = ae.cfg.resolution
-        return np.zeros((0, r, r, r), np.float32)
-    out = [ae.grid(ae.decoder(zt[i : i + batch_size].to(device))).cpu() for i in range(0, len(zt), batch_size)]
-    return torch.cat(out)[:, 0].numpy()
 
 
 def occupied(grids: np.ndarray, output: str = "occupancy", threshold: float = 0.5) -> np.ndarray:

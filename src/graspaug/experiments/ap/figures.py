@@ -1,14 +1,25 @@
-"""The GQ-CNN report's figures: what each draws (the panels, the improvement by score, the latent map), and the
-``draw_*`` functions, each drawing one figure with its title into the file ``path`` it is given."""
+"""The GQ-CNN report's figures, each in one place: what it draws (its data: the panels, the improvement by score,
+the latent map), its drawing (matplotlib, over the primitives of :mod:`graspaug.plots`) and its ``draw_*`` function,
+which draws it with its title into the file ``path`` it is given:
+
+- Fig. 7, AP against the ratio: :func:`ratio_panels`, :func:`ap_vs_ratio`, :func:`draw_ap_vs_ratio`;
+- PR and ROC curves: :func:`compared_predictions`, :func:`precision_recall_roc`, :func:`draw_pr_roc`;
+- Fig. 8, the improvement by score: :func:`improvement_data`, :func:`improvement_by_interval`,
+  :func:`draw_improvement`;
+- Fig. 1, the latent map: :func:`latent_map`, :func:`scatter_colored`, :func:`draw_latent_map`.
+"""
 
 from __future__ import annotations
 
+import os
+from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
 from graspaug.experiments.ap.numbers import object_improvement, test_predictions
+from graspaug.plots import pyplot, save_figure
 
 #: The range Average Precision lives in: intervals are clipped to it and the AP axis stays within it.
 AP_RANGE = (0.0, 1.0)
@@ -80,17 +91,102 @@ def ratio_panels(table: pd.DataFrame) -> dict:
     return {"panels": panels, "ylim": (max(AP_RANGE[0], low - margin), min(AP_RANGE[1], high + margin))}
 
 
+def ap_vs_ratio(figure: dict, path: str | os.PathLike, title: str) -> None:
+    """The paper's Fig. 7 as :func:`graspaug.experiments.ap.figures.ratio_panels` lays it out (``figure``): one panel
+    per augmented base size, one line per pool (targeted solid, random dashed, real dotted, recon dash-dotted) with
+    its interval as error bars, each reference (a base size alone, the ceiling) a horizontal line with its band on
+    every panel; the AP axis ``figure["ylim"]``, shared."""
+    plt = pyplot()
+    panels = figure["panels"]
+    fig, axes = plt.subplots(
+        1, len(panels), figsize=(3.6 * len(panels) + 0.8, 3.8), sharey=True, squeeze=False, layout="constrained"
+    )
+    styles = {
+        "targeted": ("-", "tab:blue"),
+        "random": ("--", "tab:orange"),
+        "real": (":", "tab:green"),
+        "recon": ("-.", "tab:purple"),
+    }
+    reference_colors = ["tab:brown", "tab:pink", "tab:olive", "tab:cyan"]
+    for ax, panel in zip(axes[0], panels):
+        for curve in panel["curves"]:
+            style, color = styles.get(curve["pool"], ("-", "tab:blue"))
+            ax.errorbar(
+                curve["x"],
+                curve["ap"],
+                yerr=np.stack([curve["ap"] - curve["low"], curve["high"] - curve["ap"]]),  # (2, n), clipped
+                marker="o",
+                markersize=4,
+                capsize=3,
+                linestyle=style,
+                color=color,
+                label=curve["pool"],
+            )
+        others = iter(reference_colors)
+        for ref in panel["references"]:
+            color = "grey" if ref["label"].startswith("ceiling") else next(others, "black")
+            ax.axhline(ref["ap"], color=color, linewidth=1, linestyle=(0, (6, 2)), label=ref["label"])
+            ax.axhspan(ref["low"], ref["high"], color=color, alpha=0.12, linewidth=0)
+        ax.set_title(panel["title"], fontsize=9)
+        ax.set_xlabel(panel["xlabel"])
+        xs = sorted({float(v) for c in panel["curves"] for v in c["x"]})
+        if xs:
+            ax.set_xticks(xs)
+            pad = 0.08 * (xs[-1] - xs[0]) if xs[-1] > xs[0] else 0.5
+            ax.set_xlim(xs[0] - pad, xs[-1] + pad)
+        ax.grid(alpha=0.3)
+    axes[0, 0].set_ylim(*figure["ylim"])
+    axes[0, 0].set_ylabel("test Average Precision")
+    legend = {}  # every label once, from whichever panel has it
+    for ax in axes[0]:
+        for handle, label in zip(*ax.get_legend_handles_labels()):
+            legend.setdefault(label, handle)
+    axes[0, 0].legend(legend.values(), legend.keys(), fontsize=7, loc="best")
+    fig.suptitle(title, fontsize=9)
+    save_figure(fig, path)
+
+
 def draw_ap_vs_ratio(table: pd.DataFrame, seeds: list[int], path: Path) -> None:
     """Fig. 7: test AP against the ratio per augmented base size and pool (``table``:
     :func:`~graspaug.experiments.ap.numbers.network_table`, over training ``seeds``), 95% t-interval bars clipped to
     [0, 1], base sizes without augmented networks as reference lines (:func:`ratio_panels`)."""
-    from graspaug.plots import ap_vs_ratio
-
     ap_vs_ratio(
         ratio_panels(table),
         path,
         f"Test AP vs augmentation ratio (seeds {seeds}; error bars: 95% t-interval, clipped to [0, 1])",
     )
+
+
+def precision_recall_roc(
+    labels: np.ndarray, predictions: dict[str, np.ndarray], path: str | os.PathLike, title: str
+) -> None:
+    """Precision-recall (left) and ROC (right) curves of several networks' test predictions
+    P(success) (N,) against the same 0/1 ``labels`` (N,); AP and ROC AUC in the legends. With
+    one class in ``labels`` there are no curves: the panels say so."""
+    from sklearn.metrics import average_precision_score, precision_recall_curve, roc_auc_score, roc_curve
+
+    plt = pyplot()
+    fig, (pr, roc) = plt.subplots(1, 2, figsize=(11, 4.5))
+    labels = np.asarray(labels).astype(int)
+    both = 0 < labels.sum() < len(labels)
+    for ax in (pr, roc) if not both else ():
+        ax.text(0.5, 0.5, "one class in the test labels: no curve", ha="center", va="center")
+    for name, p in predictions.items() if both else ():
+        precision, recall, _ = precision_recall_curve(labels, p)
+        pr.plot(recall, precision, label=f"{name} (AP {average_precision_score(labels, p):.3f})")
+        fpr, tpr, _ = roc_curve(labels, p)
+        roc.plot(fpr, tpr, label=f"{name} (AUC {roc_auc_score(labels, p):.3f})")
+    pr.axhline(labels.mean(), color="gray", ls=":", label=f"chance ({labels.mean():.3f})")
+    roc.plot([0, 1], [0, 1], color="gray", ls=":", label="chance")
+    for ax, (x, y) in ((pr, ("recall", "precision")), (roc, ("false positive rate", "true positive rate"))):
+        ax.set_xlabel(x)
+        ax.set_ylabel(y)
+        ax.set_xlim(0, 1)
+        ax.set_ylim(0, 1.02)
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8)
+    fig.suptitle(title)
+    save_figure(fig, path)
 
 
 def draw_pr_roc(
@@ -99,24 +195,89 @@ def draw_pr_roc(
     """PR and ROC curves of the test predictions of training seed ``seed`` (folder ``seed_dir``) of the
     networks the robot trials compare (:func:`~graspaug.experiments.ap.figures.compared_predictions`: targeted
     at 1:0 and 1:``ratio`` for ``base_size``, the ceiling when trained) against the test ``labels`` (N,)."""
-    from graspaug.plots import precision_recall_roc
-
     predictions = compared_predictions(seed_dir, base_size, ratio, ceiling)
     precision_recall_roc(labels, predictions, path, f"Test predictions of training seed {seed} ({len(labels)} grasps)")
+
+
+def improvement_by_interval(panels: list[dict], path: str | os.PathLike, title: str) -> None:
+    """The paper's Fig. 8: per panel (a score: rarity or graspness), normalized histograms of
+    the selected and the generated shapes and the mean per-object AP improvement of test
+    objects in each score interval. Each panel: ``name``, ``edges`` (bins + 1), ``selected``,
+    ``generated`` (score arrays), ``improvement`` (mean per bin, NaN where empty), ``objects`` (per bin)."""
+    plt = pyplot()
+    fig, axes = plt.subplots(1, len(panels), figsize=(6 * len(panels), 4.2), squeeze=False)
+    for ax, panel in zip(axes[0], panels):
+        edges = np.asarray(panel["edges"])
+        centers, width = (edges[:-1] + edges[1:]) / 2, np.diff(edges)
+        for name, values, color in (
+            ("selected", panel["selected"], "tab:orange"),
+            ("generated", panel["generated"], "tab:green"),
+        ):
+            counts, _ = np.histogram(np.clip(values, edges[0], edges[-1]), bins=edges)
+            share = counts / max(counts.sum(), 1)
+            ax.bar(centers, share, width=width * 0.9, alpha=0.45, color=color, label=f"{name} shapes ({len(values)})")
+        ax.set_xlabel(panel["name"])
+        ax.set_ylabel("share of shapes")
+        twin = ax.twinx()
+        improvement = np.asarray(panel["improvement"], dtype=float)
+        twin.plot(centers, improvement, marker="o", color="tab:blue", label="mean AP improvement of test objects")
+        for x, y, n in zip(centers, improvement, panel["objects"]):
+            if np.isfinite(y):
+                twin.annotate(
+                    str(n), (x, y), textcoords="offset points", xytext=(0, 5), ha="center", fontsize=7, color="tab:blue"
+                )
+        twin.axhline(0, color="gray", linewidth=0.8)
+        twin.set_ylabel("per-object AP improvement")
+        lines, labels = ax.get_legend_handles_labels()
+        more, more_labels = twin.get_legend_handles_labels()
+        ax.legend(lines + more, labels + more_labels, fontsize=7, loc="upper left")
+    fig.suptitle(title, fontsize=9)
+    fig.subplots_adjust(wspace=0.45)
+    save_figure(fig, path)
 
 
 def draw_improvement(panels: list[dict], improvement: pd.Series, base_size: int, ratio: float, path: Path) -> None:
     """Fig. 8: the per-object test AP change of 1:``ratio`` over 1:0 at ``base_size`` (``improvement``, by
     test object, mean over seeds) by rarity and graspness interval (``panels``:
     :func:`~graspaug.experiments.ap.figures.improvement_data`)."""
-    from graspaug.plots import improvement_by_interval
-
     improvement_by_interval(
         panels,
         path,
         f"B = {base_size}: per-object test AP, 1:{ratio:g} minus 1:0, mean over seeds "
         f"({len(improvement)} test objects with both labels)",
     )
+
+
+def scatter_colored(
+    xy: np.ndarray, values: np.ndarray, markers: Sequence[str], path: str | os.PathLike, title: str, colorbar: str
+) -> None:
+    """(N, 2) points colored by ``values``, one marker style per group in ``markers`` (the paper's Fig. 1)."""
+    plt = pyplot()
+    fig, ax = plt.subplots(figsize=(6.5, 6))
+    markers = np.asarray(markers)
+    styles = ["o", "^", "s", "D"]
+    art = None
+    for style, name in zip(styles, sorted(set(markers))):
+        sel = markers == name
+        art = ax.scatter(
+            xy[sel, 0],
+            xy[sel, 1],
+            c=values[sel],
+            s=10 if style == "o" else 16,
+            marker=style,
+            cmap="viridis",
+            vmin=float(np.nanmin(values)),
+            vmax=float(np.nanmax(values)),
+            label=f"{name} ({sel.sum()})",
+            edgecolors="none",
+        )
+    if art is not None:
+        fig.colorbar(art, ax=ax, label=colorbar)
+    ax.set_title(title, fontsize=9)
+    ax.set_xticks([])
+    ax.set_yticks([])
+    ax.legend(fontsize=8)
+    save_figure(fig, path)
 
 
 def draw_latent_map(
@@ -131,8 +292,6 @@ def draw_latent_map(
 ) -> None:
     """Fig. 1: t-SNE of the original train shapes' and the generated shapes' latents colored by
     graspness (:func:`~graspaug.experiments.ap.figures.latent_map`; ``latents`` and ``scores`` by shape id)."""
-    from graspaug.plots import scatter_colored
-
     xy, graspness, groups = latent_map(
         latents.reset_index(), scores, generated, generated_graspness, base_size, perplexity, seed
     )

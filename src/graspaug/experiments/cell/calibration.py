@@ -1,9 +1,12 @@
-"""Grasp calibration: does the cell hold what the labels call graspable? Executes chosen grasps with the Panda and
-summarizes success per label and the ROC AUC of ε and the label against the outcomes."""
+"""Grasp calibration: does the cell hold what the labels call graspable? Executes chosen grasps with the Panda,
+summarizes success per label and the ROC AUC of ε and the label against the outcomes, and draws them
+(``calibration.png``: its data :func:`success_by_eps`, its drawing :func:`label_calibration`, its caption
+:func:`draw_label_calibration`)."""
 
 from __future__ import annotations
 
 import functools
+import os
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -16,6 +19,7 @@ from graspaug.experiments.stats import (
     percentile_interval,
     wilson_interval,
 )
+from graspaug.plots import pyplot, save_figure
 from graspaug.rng import shape_rng
 from graspaug.sim.objects import prepare_objects
 
@@ -268,6 +272,53 @@ def success_by_eps(table: pd.DataFrame, n_bins: int = 8) -> pd.DataFrame:
             }
         )
     return pd.DataFrame(rows)
+
+
+def label_calibration(by_eps: pd.DataFrame, grasps: pd.DataFrame, path: str | os.PathLike, title: str) -> None:
+    """Do executed grasps follow their labels? Left: success rate per robust-ε bin (``by_eps``:
+    ``collision_free``, ``eps_mid``, ``rate``, ``lo``, ``hi``), one line for grasps labelled
+    collision-free and one for colliding ones. Right: ROC curves of
+    the robust ε and of the label against the executed outcome (``grasps``: ``eps``, ``label``,
+    ``executed_success``), AUC in the legend."""
+    from sklearn.metrics import roc_auc_score, roc_curve
+
+    plt = pyplot()
+    fig, (rates, roc) = plt.subplots(1, 2, figsize=(11, 4.5))
+    for free, group in by_eps.groupby("collision_free"):
+        group = group.sort_values("eps_mid")
+        rate = group.rate.to_numpy(float)
+        rates.errorbar(
+            group.eps_mid * 1000,
+            rate,
+            yerr=[rate - group.lo.to_numpy(float), group.hi.to_numpy(float) - rate],
+            marker="o",
+            capsize=3,
+            label="labelled collision-free approach" if free else "labelled colliding approach",
+        )
+    rates.set_xlabel("robust ε (×1000), median of the bin")
+    rates.set_ylabel("executed success rate (95% Wilson)")
+    rates.set_ylim(0, 1.02)
+    y = grasps.executed_success.to_numpy(bool)
+    if 0 < y.sum() < len(y):
+        for name, score in (("robust ε", grasps.eps), ("label", grasps.label.astype(float))):
+            fpr, tpr, _ = roc_curve(y, score)
+            roc.plot(fpr, tpr, label=f"{name} (AUC {roc_auc_score(y, score):.3f})")
+    else:
+        roc.text(0.5, 0.5, "one outcome only: no curve", ha="center", va="center")
+    roc.plot([0, 1], [0, 1], color="gray", ls=":", label="chance")
+    roc.set_xlabel("false positive rate")
+    roc.set_ylabel("true positive rate")
+    for ax in (rates, roc):
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8)
+    fig.suptitle(title)
+    save_figure(fig, path)
+
+
+def draw_label_calibration(by_eps: pd.DataFrame, grasps: pd.DataFrame, path: str | os.PathLike) -> None:
+    """``calibration.png``: :func:`label_calibration` of ``by_eps`` (:func:`success_by_eps`) and ``grasps`` (one row
+    per executed grasp), titled with how many grasps were executed."""
+    label_calibration(by_eps, grasps, path, f"{len(grasps)} labelled test grasps executed in the cell")
 
 
 def calibration_headline(summary: dict) -> dict[str, dict]:

@@ -8,8 +8,8 @@ import torch
 
 from graspaug.experiments.stats import PairBootstrap, headline, mean_interval, paired_contrast
 from graspaug.geometry.clusters import outlier_percentage
-from graspaug.nets.ae_critic import AutoEncoder
-from graspaug.training.autoencoder import decode, encode, occupied
+from graspaug.nets.ae_critic import AutoEncoder, decode, encode
+from graspaug.training.autoencoder import occupied
 
 # the three models of the study, in the order they are decoded, tabled and drawn
 MODEL_LABELS = {"ae": "AE", "ae_extra": "AE + extra epochs (λ = 0)", "ae_critic": "AE-Critic"}

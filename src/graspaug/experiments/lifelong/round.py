@@ -74,7 +74,7 @@ def grasp_and_render(
 
 
 def render_round(meshes: Path, dataset: Path, previous: Path | None, index, kept, grasps, render, seed, workers, label):
-    """Write a round's new shapes (``index``: :func:`graspaug.augment.pools.loop_shapes`, ``kept`` its decodes)
+    """Write a round's new shapes (``index``: :func:`graspaug.augment.failures.loop_shapes`, ``kept`` its decodes)
     into the empty folder ``meshes`` (``<shape_id>.obj``, m), label their grasps and render their crops as ``grasps``
     and ``render`` do (params sections; ``seed``, ``workers``, ``label``), and write into the empty folder
     ``dataset`` the datapoints of ``previous`` (the last round's dataset; None in round 1) followed by the new ones.

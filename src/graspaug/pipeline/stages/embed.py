@@ -15,12 +15,13 @@ from graspaug.augment.embedding import tsne_2d
 from graspaug.device import resolve_device
 from graspaug.io.checkpoints import load_autoencoder
 from graspaug.io.tables import write_csv, write_table
+from graspaug.nets.ae_critic import encode
 from graspaug.pipeline.params.ae import AEParams
 from graspaug.pipeline.params.base import params_model
 from graspaug.pipeline.params.embed import EmbedParams
 from graspaug.pipeline.paths import AE_CRITIC_MODEL, LATENTS, SHAPES_TABLE, TSNE_CSV, TSNE_PNG, VOXELS
 from graspaug.plots import scatter_2d
-from graspaug.training.autoencoder import encode, voxel_grids
+from graspaug.training.autoencoder import voxel_grids
 
 log = logging.getLogger(__name__)
 

@@ -20,7 +20,8 @@ import numpy as np
 import pandas as pd
 
 from graspaug.augment.decode import mesh_batches
-from graspaug.augment.pools import base_set, failure_shapes, failure_summary, log_failure_summary
+from graspaug.augment.failures import failure_shapes, failure_summary, log_failure_summary
+from graspaug.augment.pools import base_set
 from graspaug.device import resolve_device
 from graspaug.errors import DataError
 from graspaug.experiments.lifelong.numbers import failure_anchors, validation_errors
@@ -61,8 +62,7 @@ def run(params: Params, folder, network: str | None, worst: int, count: int, per
         raise DataError(f"--count, --per-failure, --worst must be at least 1; got {count}, {per_failure}, {worst}")
     inputs = [folder, "data", "models"]
     check_output_folder(out, COMMAND, inputs, force)
-    device = resolve_device(params.device)
-    ae, _, _ = load_autoencoder(paths.AE_CRITIC_MODEL, params.ae.net)
+    device, (ae, _, _) = resolve_device(params.device), load_autoencoder(paths.AE_CRITIC_MODEL, params.ae.net)
     shapes, latents = read_table(paths.SHAPES_TABLE), read_table(paths.LATENTS).set_index("shape_id")
     train, skipped = set(shapes.shape_id[shapes.split == "train"]), {}
     if network is not None:  # this project's network: its worst validation objects, never train shapes here

@@ -18,6 +18,7 @@ import time
 from graspaug.experiments.cell.calibration import (
     calibration_headline,
     choose_grasps,
+    draw_label_calibration,
     run_calibration,
     shape_jobs,
     success_by_eps,
@@ -30,7 +31,6 @@ from graspaug.pipeline.params.base import params_model
 from graspaug.pipeline.params.sim import SimParams
 from graspaug.pipeline.paths import CALIBRATION_METRICS, CALIBRATION_REPORT_DIR, SHAPES_DIR, gqcnn_dir, grasps_table
 from graspaug.pipeline.stages import StageError
-from graspaug.plots import label_calibration
 
 log = logging.getLogger(__name__)
 
@@ -59,8 +59,7 @@ def run(params: Params) -> None:
         write_csv(table, out / "grasps.csv")
         write_csv(by_eps, out / "by_eps.csv")
         write_json(summary, out / "summary.json")
-        title = f"{len(table)} labelled test grasps executed in the cell"
-        label_calibration(by_eps, table, out / "calibration.png", title)
+        draw_label_calibration(by_eps, table, out / "calibration.png")
     write_json_files(calibration_headline(summary), CALIBRATION_METRICS)
     log.info("grasp_calibration: %s; %.0f s", summary_line(summary), summary["seconds"])
 

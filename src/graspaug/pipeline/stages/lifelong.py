@@ -12,7 +12,8 @@ import numpy as np
 import pandas as pd
 
 from graspaug.augment.decode import mesh_batches
-from graspaug.augment.pools import base_set, loop_shapes
+from graspaug.augment.failures import loop_shapes
+from graspaug.augment.pools import base_set
 from graspaug.device import resolve_device
 from graspaug.experiments.ap.numbers import test_labels
 from graspaug.experiments.lifelong.numbers import ARMS, arm_variant, disjoint, failure_anchors, round_networks
@@ -85,14 +86,13 @@ def run(params: Params, round_: int) -> None:
         workers = network_workers(params.workers)
         train_paired(variants, split, gq, params.seed, device, nets, corpora, card, label, workers)
         seed_dirs, corpus = {s: nets / f"s{s}" for s in gq.seeds}, read_table(original / "index.parquet")
-        history = pd.read_csv(before / "history.csv")
+        history, curve = pd.read_csv(before / "history.csv"), pd.read_csv(before / "curve.csv")
         errors, history, followed = score_round(seed_dirs, variants, ARMS, corpus, failures, history, round_, cfg.worst)
         errors.to_csv(folder / "failures.csv")
         history.to_csv(folder / "history.csv", index=False)
         labels, objects = test_labels(corpus, seed_dirs[gq.seeds[0]])
         start = {s: paths.gqcnn_seed_dir(s) / arm_variant("none", b, 0).name for s in gq.seeds}
         networks = {params.data_seed: round_networks(start, seed_dirs, variants)}
-        curve = pd.read_csv(before / "curve.csv")
         reports = paths.lifelong_metrics(round_), paths.lifelong_reports(round_), followed
         header = report_header(params.file_text, shapes)  # the profile and corpus
         curve = write_round(round_, networks, labels, objects, curve, history, params, voxels, *reports, header)
