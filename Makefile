@@ -23,7 +23,7 @@ repro: install
 	dvc repro
 
 test: install lint
-	$(BIN)/python -m pytest -n 2 --dist loadfile -q
+	$(BIN)/python -m pytest -n 2 --dist loadfile -q --durations=15   # the 15 slowest tests, to keep the suite in its budget
 
 lint: install   # ruff: lint (pyflakes, pycodestyle at 120 columns, import order) and the format check
 	$(BIN)/ruff check .
