@@ -108,7 +108,7 @@ def fingerprint(sources: list[Source], recipe: TestSetRecipe) -> str:
 def build_test_set(sources: list[Source], recipe: TestSetRecipe, folder: Path, workers, shard_rows: int) -> dict:
     """Make the test set of ``sources`` in ``folder`` (an empty folder the caller writes atomically).
 
-    Returns its counts: ``files``, ``shapes`` (ingested), ``rejected``, ``with_datapoints``, ``datapoints``,
+    Returns its counts: ``files``, ``shapes`` (ingested), ``rejected``, ``with_datapoints``, ``datapoints``, ``size``,
     ``positives``. Raises :class:`DataError` when no file gives a datapoint (with the commonest reasons).
     """
     from graspaug.parallel import parallel_map
@@ -160,6 +160,7 @@ def build_test_set(sources: list[Source], recipe: TestSetRecipe, folder: Path, w
         "with_datapoints": int(index["shape_id"].nunique()),
         "datapoints": len(index),
         "positives": int(index["label"].sum()),
+        "size": recipe.surface.size,  # real, or fit: too wide for the gripper scaled down until it fits
     }
 
 

@@ -4,6 +4,11 @@ from __future__ import annotations
 
 from graspaug.experiments.stats import interval_text, verdict
 
+SIZE_WORDS = {
+    "real": "at real size",
+    "fit": "at real size, those too wide for the gripper scaled down until they fit",
+}
+
 
 def report_markdown(result: dict, corpus: str, counts: dict, camera: str) -> str:
     """report.md of :func:`graspaug.experiments.evaluate.numbers.test_ap`'s ``result`` on the test set of folder
@@ -11,7 +16,8 @@ def report_markdown(result: dict, corpus: str, counts: dict, camera: str) -> str
     lines = [
         f"# Test AP on {corpus}",
         "",
-        f"{counts['files']} files: {counts['shapes']} objects ingested at real size ({counts['rejected']} rejected, "
+        f"{counts['files']} files: {counts['shapes']} objects ingested {SIZE_WORDS[counts.get('size', 'real')]} "
+        f"({counts['rejected']} rejected, "
         f"see rejects.csv), {counts['with_datapoints']} with datapoints; {result['datapoints']} datapoints, "
         f"{result['positives']} positive ({result['positives'] / max(result['datapoints'], 1):.1%}), rendered for "
         f"{camera}. Intervals: 95% percentile bootstrap over the {result['objects']} objects (every datapoint of a "
