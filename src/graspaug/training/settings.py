@@ -47,12 +47,12 @@ class AETrainConfig:
     )
     flips: bool = Field(True, description="Flip training grids along random axes (the AE learns shape, not pose).")
     precision: Literal["auto", "float32", "bfloat16"] = Field(
-        "float32",
+        "auto",
         description=(
-            "Arithmetic of both phases' training steps (forward pass and loss): float32 (the default), bfloat16 "
-            "mixed precision (torch.autocast; weights, optimizer, evaluation, embedding and decoding stay float32), "
-            "or auto: bfloat16 where the device computes it natively, float32 elsewhere. The stage logs what it "
-            "resolved to; the checkpoints' train_params record it."
+            "Arithmetic of both phases' training steps (forward pass and loss): auto (the default: bfloat16 where "
+            "the device computes it natively, float32 elsewhere), float32, or bfloat16 mixed precision "
+            "(torch.autocast; weights, optimizer, evaluation, embedding and decoding stay float32). The stage logs "
+            "what it resolved to; the checkpoints' train_params record it."
         ),
     )
 
@@ -120,12 +120,12 @@ class TrainSettings:
         ),
     )
     precision: Literal["auto", "float32", "bfloat16"] = Field(
-        "float32",
+        "auto",
         description=(
-            "Arithmetic of the training steps' convolutions and matrix products: float32 (the default), bfloat16 "
-            "mixed precision (torch.autocast; weights, optimizer, loss, validation and test stay float32), or auto: "
-            "bfloat16 where the device computes it natively (a CPU with AVX512-BF16 or AMX, a GPU from compute "
-            "capability 8.0), float32 elsewhere. The stage logs what it resolved to; the card records it."
+            "Arithmetic of the training steps' convolutions and matrix products: auto (the default: bfloat16 where "
+            "the device computes it natively, a CPU with AVX512-BF16 or AMX or a GPU from compute capability 8.0; "
+            "float32 elsewhere), float32, or bfloat16 mixed precision (torch.autocast; weights, optimizer, loss, "
+            "validation and test stay float32). The stage logs what it resolved to; the card records it."
         ),
     )
     evals: int = Field(

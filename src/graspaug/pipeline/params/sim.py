@@ -18,7 +18,7 @@ class SimParams:
         description=f"Everyday objects of pybullet_data to pick (any of {', '.join(EVERYDAY_OBJECTS)}).",
     )
     n_test_objects: int = Field(
-        20, ge=0, description="Held-out test shapes (test split of data/shapes, a seeded choice) picked as well."
+        4, ge=0, description="Held-out test shapes (test split of data/shapes, a seeded choice) picked as well."
     )
     objects_path: str | None = Field(
         None,
@@ -41,7 +41,7 @@ class SimParams:
         "(after, and the `real` pool's network at that ratio); one of gqcnn.augment_base_sizes.",
     )
     calibration_grasps: int = Field(
-        1000,
+        500,
         ge=2,
         description="Labelled grasps of the rendered test split (half positive, spread over the test shapes) that the "
         "`grasp_calibration` stage executes in the cell, each shape in its datapoint's stable pose. The `sim` stage "
