@@ -1090,6 +1090,7 @@ def test_editing_the_cli_or_a_stage_reruns_only_what_runs_it(tiny_repo):
     run(["dvc", "repro"], work, env)  # the pipeline is complete
     for rel, expected in [
         ("src/graspaug/pipeline/cli.py", set()),
+        ("src/graspaug/pipeline/planner_cli.py", set()),
         ("src/graspaug/pipeline/stages/sim.py", {"sim"}),
         ("src/graspaug/augment/pools.py", None),
     ]:

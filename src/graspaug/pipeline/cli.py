@@ -5,11 +5,11 @@ A stage command runs what the stage's own entry point runs (``python -m graspaug
 this module is no stage's code, so editing it re-runs nothing. The params tables in ``--help`` are filled in when
 help is shown.
 
-Over 400 lines because it is a table: 26 commands (one per stage, and ``plan``, ``from-failures``, ``evaluate``,
-``export-model``, ``profile``, ``schema``; ``graspaug study …`` is mounted from :mod:`graspaug.pipeline.study_cli`),
-each a few lines of options with the help text a user reads; the work
-is elsewhere (``pipeline/stages/``, ``planning/report.py``) and errors go through one handler
-(:mod:`graspaug.pipeline.command`).
+A table: one command per stage, and ``profile``, ``results``, ``schema``, each a few lines of options with
+the help text a user reads; the work is elsewhere (``pipeline/stages/``) and errors go through one handler
+(:mod:`graspaug.pipeline.command`). The commands on a trained project's networks and data (``plan``, ``evaluate``,
+``from-failures``, ``export-model``, ``export-dexnet``) are mounted from :mod:`graspaug.pipeline.planner_cli`,
+``graspaug study …`` from :mod:`graspaug.pipeline.study_cli`.
 """
 
 from __future__ import annotations
@@ -21,8 +21,8 @@ from pathlib import Path
 import typer
 from typer.core import TyperCommand
 
-from graspaug.pipeline.command import EXIT_CODES, Command, debug_mode
-from graspaug.pipeline.entry import load_params, round_number, run_stage
+from graspaug.pipeline.command import EXIT_CODES, Command, ParamsOption, debug_mode, load_stage_params
+from graspaug.pipeline.entry import round_number, run_stage
 
 app = typer.Typer(
     help="graspaug: augment a grasp planner's training objects with generated shapes.\n\n"
@@ -32,19 +32,6 @@ app = typer.Typer(
     no_args_is_help=True,
     add_completion=False,
 )
-
-ParamsOption = typer.Option(Path("params.yaml"), "--params", "-p", help="The params file to read.")
-ForceOption = typer.Option(
-    False,
-    "--force",
-    help="Write into an output folder that holds files this command did not write: those of the names it writes are "
-    "replaced, the others kept.",
-)
-
-
-def _load(path: Path, stage):
-    """The params ``stage`` (a stage module) reads from the file at ``path`` (a bad one: ParamsError, exit 2)."""
-    return load_params(path, stage.Params)
 
 
 def _stage(module: str):
@@ -67,10 +54,6 @@ def _with_params(module: str, *sections: str) -> type[TyperCommand]:
     return StageCommand
 
 
-def _run(stage_run, params) -> None:
-    run_stage(stage_run, params)
-
-
 def stage_command(name: str, help: str, *sections: str) -> None:
     """Register ``graspaug <name>``: load params, run ``graspaug.pipeline.stages.<module>.run``; ``{params}`` in
     ``help`` becomes the keys of ``sections``."""
@@ -78,7 +61,7 @@ def stage_command(name: str, help: str, *sections: str) -> None:
 
     def command(params: Path = ParamsOption) -> None:
         stage = _stage(module)
-        _run(stage.run, _load(params, stage))
+        run_stage(stage.run, load_stage_params(params, stage))
 
     app.command(name=name, help=help, cls=_with_params(module, *sections))(command)
 
@@ -151,7 +134,7 @@ def grasps_command(
     params: Path = ParamsOption,
 ) -> None:
     stage = _stage("grasps")
-    _run(lambda p: stage.run(p, corpus), _load(params, stage))
+    run_stage(lambda p: stage.run(p, corpus), load_stage_params(params, stage))
 
 
 stage_command(
@@ -184,7 +167,7 @@ def generate_command(
     params: Path = ParamsOption,
 ) -> None:
     stage = _stage("generate")
-    _run(lambda p: stage.run(p, base_size), _load(params, stage))
+    run_stage(lambda p: stage.run(p, base_size), load_stage_params(params, stage))
 
 
 @app.command(
@@ -206,7 +189,7 @@ def fidelity_command(
     params: Path = ParamsOption,
 ) -> None:
     stage = _stage("fidelity")
-    _run(lambda p: stage.run(p, base_size), _load(params, stage))
+    run_stage(lambda p: stage.run(p, base_size), load_stage_params(params, stage))
 
 
 @app.command(
@@ -238,7 +221,7 @@ def lifelong_command(
     params: Path = ParamsOption,
 ) -> None:
     stage = _stage("lifelong")
-    _run(lambda p: stage.run(p, round_), _load(params, stage))
+    run_stage(lambda p: stage.run(p, round_), load_stage_params(params, stage))
 
 
 @app.command(
@@ -251,7 +234,7 @@ def lifelong_command(
 )
 def lifelong_start_command(params: Path = ParamsOption) -> None:
     stage = _stage("lifelong_start")
-    _run(stage.run, _load(params, stage))
+    run_stage(stage.run, load_stage_params(params, stage))
 
 
 @app.command(
@@ -277,39 +260,7 @@ def render_command(
     params: Path = ParamsOption,
 ) -> None:
     stage = _stage("render")
-    _run(lambda p: stage.run(p, corpus), _load(params, stage))
-
-
-@app.command(
-    cls=Command,
-    name="export-dexnet",
-    help="Export a rendered dataset in Dex-Net 2.0's tensor layout for Berkeley's gqcnn tools: "
-    "`<out>/tensors/{depth_ims_tf_table,hand_poses,robust_ferrari_canny,collision_free,obj_labels,pose_labels,"
-    "image_labels}_%05d.npz` "
-    "(key `arr_0`, 1000 rows per file) and `<out>/config.json`. As in Dex-Net, robust_ferrari_canny is 0 for colliding "
-    "grasps (so `metric > threshold` is the label); robust_ferrari_canny_raw keeps the robust ε. hand_poses rows are "
-    "(center row, center column, depth z, jaw angle, row − cy, column − cx, open jaws in px); obj_labels index "
-    "config.json's `obj_ids`, pose_labels its `pose_ids`. Run from the project folder after the render stage.",
-)
-def export_dexnet_command(
-    corpus: str = typer.Argument(..., help="Rendered corpus: `original` or `gen_<B>`."),
-    out: Path = typer.Argument(..., help="Folder to write (new, empty, or one export-dexnet wrote)."),
-    rows_per_file: int = typer.Option(1000, "--rows-per-file", min=1, help="Datapoints per .npz file (Dex-Net: 1000)."),
-    pool: str = typer.Option(
-        "all",
-        "--pool",
-        help="For a generated corpus: the one pool to export (`targeted`, `random`, `real`, ...; config.json names "
-        "it); `all`: every pool, each datapoint's in the `pool_labels` field.",
-    ),
-    force: bool = ForceOption,
-) -> None:
-    from graspaug.io.dexnet import export_dexnet
-    from graspaug.io.outputs import output_folder
-    from graspaug.pipeline.paths import gqcnn_dir
-
-    with output_folder(out, "export-dexnet", [gqcnn_dir(corpus)], force) as tmp:
-        n = export_dexnet(gqcnn_dir(corpus), tmp, rows_per_file, pool=None if pool == "all" else pool)
-    typer.echo(f"wrote {n} datapoints ({corpus}, pool {pool}) to {out}")
+    run_stage(lambda p: stage.run(p, corpus), load_stage_params(params, stage))
 
 
 @app.command(
@@ -336,7 +287,7 @@ def train_gqcnn_command(
     params: Path = ParamsOption,
 ) -> None:
     stage = _stage("train_gqcnn")
-    _run(lambda p: stage.run(p, seed), _load(params, stage))
+    run_stage(lambda p: stage.run(p, seed), load_stage_params(params, stage))
 
 
 stage_command(
@@ -384,154 +335,6 @@ stage_command(
     "grasp, `by_eps.csv` and `calibration.png`: success per robust-ε bin, ROC curves).\n\n{params}",
     "sim",
 )
-
-
-@app.command(
-    cls=Command,
-    name="plan",
-    help="Plan a grasp on one depth image with a trained GQ-CNN (the planner the simulated robot uses: antipodal pairs "
-    "on depth edges, GQ-CNN scores, cross-entropy refinement; a grasp is kept only if the image shows it antipodal and "
-    "reachable). DEPTH is a `.npy` array in meters or a 16-bit PNG in millimeters (0 = no reading), from a camera "
-    "looking (nearly) straight down. The model card in `model.pt` says which camera the network was trained for; "
-    "another focal length or camera distance is resampled to it where that is sound, else refused.\n\nWrites "
-    "`<out>/grasp.json` (the grasps, best first: image center, angle, depth, width; camera-frame pose and width in m; "
-    "quality; the model card) and `<out>/grasp.png` (the image with the grasps drawn). A best grasp below the quality "
-    "floor (`--min-quality`) is written and drawn as rejected, with exit code 1; a warning says where the image lies "
-    "outside the training data (camera distance, object height above the table, gripper depth) or the intrinsics look "
-    "like another image's (a principal point far from the image center).\n\n" + EXIT_CODES,
-)
-def plan_command(
-    depth: Path = typer.Argument(..., help="Depth image: .npy (meters) or 16-bit .png (millimeters)."),
-    model: Path = typer.Option(
-        ..., "--model", "-m", help="A trained GQ-CNN, e.g. models/gqcnn/s0/targeted/50-1/model.pt."
-    ),
-    intrinsics: Path | None = typer.Option(
-        None, "--intrinsics", "-i", help="JSON file with fx, fy, cx, cy (px); instead of the flags."
-    ),
-    fx: float | None = typer.Option(None, "--fx", help="Focal length along u (px)."),
-    fy: float | None = typer.Option(None, "--fy", help="Focal length along v (px; default: fx)."),
-    cx: float | None = typer.Option(None, "--cx", help="Principal point u (px; default: the image center)."),
-    cy: float | None = typer.Option(None, "--cy", help="Principal point v (px; default: the image center)."),
-    top: int = typer.Option(1, "--top", "-k", min=1, help="List the K best distinct grasps (near-duplicates dropped)."),
-    seed: int = typer.Option(0, "--seed", help="Seed of the sampler."),
-    camera_distance: float | None = typer.Option(
-        None, "--camera-distance", help="Camera to table along the optical axis (m; default: the image's median depth)."
-    ),
-    fill_missing: bool = typer.Option(
-        False, "--fill-missing", help="Give missing pixels (0, NaN) the nearest valid depth instead of stopping."
-    ),
-    min_quality: float | None = typer.Option(
-        None,
-        "--min-quality",
-        help="Reject the plan (exit code 1) when the best grasp's P(success) is below this floor, in [0, 1]; 0 accepts "
-        "every grasp. Default: the model card's validation operating point (the threshold that maximises F1 on the "
-        "network's validation predictions), or 0.1 for a model without one.",
-    ),
-    out: Path = typer.Option(
-        Path("."), "--out", "-o", help="Folder for grasp.json and grasp.png (an earlier plan's are replaced)."
-    ),
-    force: bool = typer.Option(False, "--force", help="Replace a grasp.json or grasp.png that plan did not write."),
-) -> None:
-    from graspaug.planning.report import plan_files
-
-    report = plan_files(
-        depth, model, intrinsics, (fx, fy, cx, cy), top, seed, camera_distance, fill_missing, min_quality, out, force
-    )
-    for line in report.lines:
-        typer.echo(line, err=line.startswith("warning: "))
-    raise typer.Exit(code=report.exit_code)
-
-
-@app.command(
-    cls=Command,
-    name="from-failures",
-    help="Generate new training shapes near objects a grasp planner fails on. The failure objects are either FOLDER, "
-    "meshes (.obj, .stl, .ply) of objects a planner trained anywhere missed (each closed and scaled as the corpus is, "
-    "voxelized and encoded by this project's AE-Critic), or with `--network` the `--worst` validation objects of one "
-    "of this project's GQ-CNNs (highest mean log loss of its validation predictions, averaged over `gqcnn.seeds`; the "
-    "test split never chooses). Each failure object's `--per-failure` nearest train shapes in latent space become "
-    "anchors, each interpolated with its nearest train shapes (`generate.first_neighbour`, `extra_neighbours`, "
-    "`alphas`), decoded and meshed as `generate` does, until `--count` shapes are kept. A failure object is never a "
-    "parent, and with `--network` no validation object is one either. Needs `dvc repro score` (and `train_gqcnn` for "
-    "`--network`).\n\nWrites `<out>/meshes/failure_<order>.obj` (m), `<out>/index.csv` (per shape: the failure "
-    "object it serves, anchor `parent_a`, neighbour `parent_b`, `alpha`, size), `<out>/failures.csv` (the failure "
-    "objects worst first, each with its `anchors`, `shapes` made, decodes `rejected` and, for one that got no shape, "
-    "`why_none`; with `--network` every validation object's datapoints, log loss and AP), `<out>/rejects.csv` (each "
-    "rejected decode, its reason and the `failure` it served) and `<out>/skipped.csv` (files that could not be used, "
-    "and why); the log has a line per failure object, a warning for one that got nothing. An existing `--out` holding "
-    "a file from-failures did not write is refused before any work (`--force` writes beside it, keeping it); a "
-    "symbolic link, or a folder inside FOLDER, is always refused. Feed the "
-    "meshes to your own pipeline, or to this one (`data.source: folder`, `data.path`).\n\n" + EXIT_CODES,
-)
-def from_failures_command(
-    folder: Path | None = typer.Argument(None, help="Folder of meshes of the objects the planner failed on."),
-    network: str | None = typer.Option(
-        None, "--network", help="Instead of FOLDER: a network of this project, <pool>/<B>-<R>, e.g. targeted/50-0."
-    ),
-    worst: int = typer.Option(10, "--worst", help="With --network: how many of its worst validation objects."),
-    count: int = typer.Option(20, "--count", "-n", help="Shapes to generate."),
-    per_failure: int = typer.Option(3, "--per-failure", help="Train shapes anchored near each failure object."),
-    out: Path = typer.Option(
-        Path("failures_generated"),
-        "--out",
-        "-o",
-        help="Folder to write: a new or empty one, or one from-failures wrote (its files from the last run are "
-        "replaced, nothing else). Never inside FOLDER, data/ or models/.",
-    ),
-    force: bool = ForceOption,
-    params: Path = ParamsOption,
-) -> None:
-    import graspaug.pipeline.stages.from_failures as command
-
-    _run(lambda p: command.run(p, folder, network, worst, count, per_failure, out, force), _load(params, command))
-
-
-@app.command(
-    cls=Command,
-    name="evaluate",
-    help="Test trained GQ-CNNs on your own objects: every mesh under --corpus (.obj .stl .ply .off .glb, metres "
-    "unless --unit-scale) is ingested at real size, its grasps sampled and labelled, its datapoints rendered for the "
-    "models' camera (their card), as the pipeline makes its test set; prints each model's test AP with a 95% interval "
-    "over objects and the paired difference of each model against the first. The test set is cached by the files' "
-    "content and those settings (--cache), so another model costs seconds. Writes report.md, evaluate.json and "
-    "rejects.csv into --out.",
-)
-def evaluate_command(
-    models: list[Path] = typer.Argument(..., help="Trained GQ-CNNs (model.pt); the first is the reference."),
-    corpus: Path = typer.Option(..., "--corpus", "-c", help="Folder of meshes (searched recursively)."),
-    out: Path = typer.Option(Path("reports/evaluate"), "--out", "-o", help="Folder to write (or one evaluate wrote)."),
-    cache: Path = typer.Option(Path(".graspaug-cache/evaluate"), "--cache", help="Folder of cached test sets."),
-    unit_scale: float = typer.Option(1.0, "--unit-scale", min=1e-9, help="Metres per file unit (0.001: mm files)."),
-    limit: int | None = typer.Option(None, "--limit", min=1, help="Use only the first N files in sorted order."),
-    resamples: int = typer.Option(1000, "--resamples", min=100, help="Bootstrap resamples of the objects."),
-    force: bool = ForceOption,
-    params: Path = ParamsOption,
-) -> None:
-    import graspaug.pipeline.stages.evaluate as command
-
-    for line in command.run(_load(params, command), models, corpus, out, cache, unit_scale, limit, resamples, force):
-        typer.echo(line)
-
-
-@app.command(
-    cls=Command,
-    name="export-model",
-    help="Export a trained GQ-CNN for use without graspaug: `<out>/model.ts` (TorchScript: images (N, 1, 32, 32) and "
-    "gripper depths (N,) in meters → P(success) (N,)), `<out>/card.json` (the model card: training camera, crop sizes, "
-    "gripper, label threshold, training set, AP; and the input contract), and `<out>/model.onnx` when the onnx package "
-    "is installed (it is not a dependency).",
-)
-def export_model_command(
-    model: Path = typer.Argument(..., help="A trained GQ-CNN, e.g. models/gqcnn/s0/targeted/50-1/model.pt."),
-    out: Path = typer.Argument(..., help="Folder to write (new, empty, or one export-model wrote)."),
-    force: bool = ForceOption,
-) -> None:
-    from graspaug.io.outputs import output_folder
-    from graspaug.planning import export_model
-
-    with output_folder(out, "export-model", force=force) as tmp:
-        info = export_model(model, tmp)
-    typer.echo(f"wrote {', '.join(str(out / f) for f in [*info['files'], 'card.json'])} (ONNX: {info['onnx']})")
 
 
 @app.command(
@@ -609,8 +412,10 @@ def schema_command(out: Path = typer.Option(Path("params.schema.json"), "--out",
     typer.echo(f"wrote {out}")
 
 
-from graspaug.pipeline.study_cli import study_app  # noqa: E402 - the studies' commands, after the stages'
+from graspaug.pipeline.planner_cli import planner_app  # noqa: E402 - the user's commands, after the stages'
+from graspaug.pipeline.study_cli import study_app  # noqa: E402
 
+app.add_typer(planner_app)
 app.add_typer(study_app, name="study")
 
 

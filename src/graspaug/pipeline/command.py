@@ -1,11 +1,12 @@
-"""The exit-code contract every ``graspaug`` command keeps, and the command class that keeps it (one error handler
-for the whole CLI)."""
+"""The exit-code contract every ``graspaug`` command keeps, the command class that keeps it (one error handler
+for the whole CLI), and the options the commands share."""
 
 from __future__ import annotations
 
 import errno
 import logging
 import warnings
+from pathlib import Path
 
 import typer
 from typer.core import TyperCommand
@@ -17,6 +18,22 @@ EXIT_CODES = (
     "`graspaug --debug <command> ...` shows its traceback), or the system failing the command (disk full, permission "
     "denied, an I/O error: its cause named)."
 )
+
+ParamsOption = typer.Option(Path("params.yaml"), "--params", "-p", help="The params file to read.")
+ForceOption = typer.Option(
+    False,
+    "--force",
+    help="Write into an output folder that holds files this command did not write: those of the names it writes are "
+    "replaced, the others kept.",
+)
+
+
+def load_stage_params(path: Path, stage):
+    """The params ``stage`` (a stage module) reads from the file at ``path`` (a bad one: ParamsError, exit 2)."""
+    from graspaug.pipeline.entry import load_params
+
+    return load_params(path, stage.Params)
+
 
 _debug = {"on": False}  # set by the root callback (--debug, GRASPAUG_DEBUG) on every invocation
 
