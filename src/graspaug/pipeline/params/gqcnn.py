@@ -64,13 +64,14 @@ class GQCNNParams:
         "for targeted, the controls at 1:1); contrasts between two pools use the ratios both have.",
     )
     members: int = Field(
-        2,
+        1,
         ge=1,
         le=64,
         description="GQ-CNNs trained per network, each from its own initial weights and noise stream (member m of "
-        "every network of a seed shares them, so the design stays paired); the network's P(success) is their mean "
-        "(an ensemble, validated, tested and planned with). More members narrow the seed-to-seed spread of the "
-        "contrasts; each costs one more network's training time (study and paper profiles: 1).",
+        "every network of a seed shares them, so the design stays paired; member 0 is the seed's own network); with "
+        "more than one the network's P(success) is their mean (an ensemble, validated, tested and planned with). "
+        "More members narrow the seed-to-seed spread of the contrasts; each costs one more network's training time "
+        "(the default: 1, to fit make repro's 30 minutes; 2 was the default until 2026-11-28).",
     )
 
     def __post_init__(self) -> None:
