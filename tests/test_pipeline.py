@@ -376,6 +376,34 @@ def test_heldout_fidelity_study_labels_the_originals_as_the_stages_do(tiny_repo,
     assert np.isclose(summary["graspness_before"], meshed.graspness_before.mean())
 
 
+def test_precision_study_of_a_run_against_itself_keeps_bfloat16_and_is_recomputed_from_results(tiny_repo, tmp_path):
+    """`graspaug study precision` on one finished tiny run as both arms: every paired difference is zero, both rules
+    keep, the AutoEncoder's held-out IoU is the train_ae stage's own, and `graspaug results` recomputes the same
+    figures from the tables it kept in results/."""
+    import json
+
+    from graspaug.experiments.stats import interval_text
+
+    work, env = tiny_repo
+    run(["dvc", "repro", "report"], work, env)
+    out = tmp_path / "precision"
+    cmd = [*GRASPAUG, "study", "precision", "--float32", str(work), "--bfloat16", str(work), "--out", str(out)]
+    run([*cmd, "--results", "precision-tiny"], tmp_path, env)
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["gqcnn_keeps_bfloat16"] and summary["ae_keeps_bfloat16"]
+    assert all(c["mean"] == 0 for c in summary["gqcnn"].values()) and "pooled" in summary["gqcnn"]
+    stage = json.loads((work / "reports/train_ae/summary.json").read_text())
+    assert summary["ae"]["ae"]["float32"]["mean"] == pytest.approx(stage["ae_iou_test"], abs=1e-5)
+    assert summary["ae"]["ae_critic"]["difference"]["mean"] == 0
+    networks = pd.read_csv(out / "networks.csv")
+    for seed in (0, 1):  # one row per arm and trained network
+        assert (networks.seed == seed).sum() == 2 * len(list((work / f"models/gqcnn/s{seed}").rglob("model.pt")))
+    run([*GRASPAUG, "results", "--root", str(tmp_path), "--out", "recomputed"], tmp_path, env)
+    recomputed = json.loads((tmp_path / "recomputed/precision-tiny/figures.json").read_text())
+    assert recomputed["precision-tiny/gqcnn/pooled"] == interval_text(summary["gqcnn"]["pooled"])
+    assert recomputed["precision-tiny/gqcnn/rule"] == recomputed["precision-tiny/ae/rule"] == "keep"
+
+
 def test_dvc_repro_gqcnn_matrix_and_report(tiny_repo):
     import json
 

@@ -384,7 +384,7 @@ def test_an_autoencoder_trains_under_bfloat16_and_its_checkpoint_says_so(tmp_pat
 
 
 def test_checkpoints_record_precision_as_resolved_on_the_device():
-    """``auto`` is written as what it became here, with the reason; float32 as written."""
+    """``auto`` (the default) is written as what it became here, with the reason; float32 as written."""
     from graspaug.device import has_native_bfloat16
     from graspaug.training.autoencoder import checkpoint_params
 
@@ -393,4 +393,5 @@ def test_checkpoints_record_precision_as_resolved_on_the_device():
     assert auto == (
         "bfloat16 (auto: native on this CPU)" if native else "float32 (auto: no native bfloat16 on this CPU)"
     )
-    assert checkpoint_params(train_settings(), CPU)["precision"] == "float32"  # the default
+    assert checkpoint_params(train_settings(), CPU)["precision"] == auto  # the default is auto
+    assert checkpoint_params(train_settings(precision="float32"), CPU)["precision"] == "float32"

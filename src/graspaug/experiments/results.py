@@ -22,6 +22,11 @@ float32 column per round, draw, training seed and arm, ``r<k>/<draw>/<seed>/<arm
 ``per_shape.parquet`` (each run's ``per_shape.csv``, stacked, its ``ae`` column naming the AutoEncoder) and
 ``meta.json`` (the commands and commit); :func:`combine_fidelity` gives each AutoEncoder's figures.
 
+``results/precision-<label>/`` (from ``graspaug study precision --results``): ``networks.parquet`` (member 0's
+validation AP per run, seed and network), ``ae_iou.parquet`` (held-out IoU per AutoEncoder and test shape, both
+precisions), ``recon.parquet`` (the recon pool's fidelity row of each run) and ``meta.json``;
+:func:`combine_precision` gives :func:`graspaug.experiments.precision.summarize` of them.
+
 A quoted figure is marked in the markdown by an html comment naming its key, the figure right after it::
 
     <!-- results:attribution/targeted_vs_none@100 -->+0.0100 [+0.0010, +0.0210]
@@ -313,9 +318,51 @@ def fidelity_figures(result: dict, study: str = "fidelity") -> dict[str, str]:
     return out
 
 
+PRECISION_FILES = ("networks.parquet", "ae_iou.parquet", "recon.parquet")
+
+
+def write_precision(folder: Path, tables: Mapping[str, pd.DataFrame], meta: dict) -> None:
+    """``tables`` (``networks``, ``ae_iou``, ``recon``: the precision study's) as parquet files in ``folder``, then
+    ``meta`` (``command``, ``commit``, ``date``, the projects) as ``meta.json``, last."""
+    from graspaug.io.atomic import atomic_path
+
+    folder.mkdir(parents=True, exist_ok=True)
+    (folder / "meta.json").unlink(missing_ok=True)  # a folder without meta.json is an unfinished one
+    for name in PRECISION_FILES:
+        with atomic_path(folder / name) as tmp:
+            tables[name.removesuffix(".parquet")].to_parquet(tmp, index=False)
+    with atomic_path(folder / "meta.json") as tmp:
+        tmp.write_text(json.dumps(meta, indent=1) + "\n")
+
+
+def combine_precision(folder: Path) -> dict:
+    """:func:`graspaug.experiments.precision.summarize` of a ``results/precision-<label>/`` folder."""
+    from graspaug.experiments.precision import summarize
+
+    missing = [name for name in (*PRECISION_FILES, "meta.json") if not (folder / name).is_file()]
+    if missing:
+        raise DataError(f"{folder}: no {', '.join(missing)} (an unfinished or foreign results folder)")
+    return summarize(*(pd.read_parquet(folder / name) for name in PRECISION_FILES))
+
+
+def precision_figures(result: dict, study: str = "precision") -> dict[str, str]:
+    """Every figure of a precision comparison by key: ``<study>/gqcnn/<network or pooled>`` (bfloat16 − float32 of
+    validation AP, t over seeds), ``<study>/gqcnn/rule`` and ``<study>/ae/rule`` (keep or reject),
+    ``<study>/ae/<ae>/<float32, bfloat16 or difference>`` (held-out IoU) and ``<study>/recon/<figure>/<precision>``."""
+    out = {f"{study}/gqcnn/{name}": interval_text(c) for name, c in result["gqcnn"].items()}
+    for ae, r in result["ae"].items():
+        for key in ("float32", "bfloat16", "difference"):
+            out[f"{study}/ae/{ae}/{key}"] = interval_text(r[key], "+.4f" if key == "difference" else ".4f")
+    out |= {f"{study}/recon/{key}": interval_text(c, ".3f") for key, c in result["recon"].items()}
+    out[f"{study}/gqcnn/rule"] = "keep" if result["gqcnn_keeps_bfloat16"] else "reject"
+    out[f"{study}/ae/rule"] = "keep" if result["ae_keeps_bfloat16"] else "reject"
+    return out
+
+
 STUDIES = {
     "attribution": (combine_attribution, attribution_figures),
     "lifelong": (combine_lifelong, lifelong_figures),
     "fidelity": (combine_fidelity, fidelity_figures),
+    "precision": (combine_precision, precision_figures),
 }
 """Study name → (read and combine its ``results/<study>/`` folder, its figures by key)."""

@@ -188,6 +188,47 @@ def grasp_calibration_command(
 
 @study_app.command(
     cls=StudyCommand,
+    name="precision",
+    help="Does bfloat16 training keep what float32 training gives? Compares two finished runs of one project that "
+    "differ only in `gqcnn.train.precision` and `ae.train.precision` (and perhaps `gqcnn.members`: member 0 is "
+    "compared) on validation: each GQ-CNN's validation AP paired by seed (the rule: keep bfloat16 if the mean over "
+    "the networks whose data the AutoEncoder does not make is above −0.005 AP and its 95% t-interval does not lie "
+    "below zero), each AutoEncoder's held-out IoU per test shape and the recon pool's graspness and datapoints kept "
+    "(the rule: bfloat16's within float32's intervals). Prints the tables; writes them to `--out`.\n\nCost on 2 "
+    "cores: about 30 s, after the two runs (a default `make repro` each).",
+)
+def precision_command(
+    float32: Path = typer.Option(..., "--float32", help="The project trained in float32 (its `dvc repro` done)."),
+    bfloat16: Path = typer.Option(..., "--bfloat16", help="The same project trained in bfloat16."),
+    out: Path = typer.Option(Path("reports/study/precision"), "--out", help="Folder for the tables."),
+    force: bool = ForceOption,
+    results: str = typer.Option(
+        None,
+        "--results",
+        help="Also keep the tables in results/<NAME>/ of the current folder (NAME: precision or precision-<label>) "
+        "with this command and the commit: `graspaug results` recomputes the figures from them.",
+    ),
+) -> None:
+    from graspaug.experiments.results import write_precision
+    from graspaug.io.outputs import output_folder
+    from graspaug.pipeline.studies import precision
+    from graspaug.pipeline.studies.draws import provenance
+
+    if results is not None and results.split("-")[0] != "precision":
+        raise typer.BadParameter(f"must be precision or precision-<label>; got {results}", param_hint="--results")
+    _logging()
+    with output_folder(out, "study precision", force=force) as tmp:
+        text, tables = precision.run(float32, bfloat16, tmp)
+    if results is not None:
+        meta = provenance(Path("."), _command_line())
+        for name, project in (("float32", float32), ("bfloat16", bfloat16)):
+            meta |= {name: str(project.resolve()), f"{name}_commit": provenance(project, "")["commit"] or None}
+        write_precision(Path("results") / results, tables, meta)
+    typer.echo(text)
+
+
+@study_app.command(
+    cls=StudyCommand,
     name="heldout-fidelity",
     help="What a trained AutoEncoder keeps of real shapes it never trained on: `--shapes` random test-split shapes "
     "decoded from their latents by `models/ae_critic.pt` and meshed as the recon pool is, their grasps labelled and "

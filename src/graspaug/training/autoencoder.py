@@ -276,16 +276,25 @@ def occupied(grids: np.ndarray, output: str = "occupancy", threshold: float = 0.
     return grids < 0 if output == "sdf" else grids > threshold
 
 
-def reconstruction_iou(ae: AutoEncoder, voxels: torch.Tensor, device: torch.device, threshold: float = 0.5) -> float:
-    """Mean over shapes of IoU(inside of decode(encode(x)), inside of x) (:func:`occupied`)."""
+def reconstruction_ious(
+    ae: AutoEncoder, voxels: torch.Tensor, device: torch.device, threshold: float = 0.5
+) -> np.ndarray:
+    """(N,) IoU(inside of decode(encode(x)), inside of x) (:func:`occupied`) of each of the (N, 1, R, R, R) grids
+    ``voxels``; 1 where both are empty."""
     if len(voxels) == 0:
-        return float("nan")
+        return np.zeros(0)
     output = ae.cfg.output
     recon = occupied(decode(ae, encode(ae, voxels, device), device), output, threshold)
     x = occupied(voxels[:, 0].numpy(), output, threshold)
     inter = (recon & x).sum(axis=(1, 2, 3))
     union = (recon | x).sum(axis=(1, 2, 3))
-    return float(np.mean(np.where(union > 0, inter / np.maximum(union, 1), 1.0)))
+    return np.where(union > 0, inter / np.maximum(union, 1), 1.0)
+
+
+def reconstruction_iou(ae: AutoEncoder, voxels: torch.Tensor, device: torch.device, threshold: float = 0.5) -> float:
+    """Mean over shapes of :func:`reconstruction_ious` (NaN for no shape)."""
+    ious = reconstruction_ious(ae, voxels, device, threshold)
+    return float(ious.mean()) if len(ious) else float("nan")
 
 
 def voxel_grids(voxels_path, shapes_path, output: str = "occupancy") -> tuple[np.ndarray, np.ndarray, torch.Tensor]:
