@@ -73,6 +73,16 @@ def test_auto_precision_is_bfloat16_only_where_the_device_has_it(precision, devi
     assert tuple(choose_precision(precision, device_type, native)) == expected
 
 
+def test_auto_keeps_the_gqcnn_in_float32_on_a_gpu_where_bfloat16_slowed_it():
+    from graspaug.device import GQCNN_GPU_BFLOAT16, choose_precision
+
+    assert not GQCNN_GPU_BFLOAT16
+    on_gpu = choose_precision("auto", "cuda", True, GQCNN_GPU_BFLOAT16)
+    assert on_gpu == ("float32", "float32 (auto: bfloat16 is slower for this network on a GPU)")
+    assert choose_precision("auto", "cpu", True, GQCNN_GPU_BFLOAT16).dtype == "bfloat16"  # the CPU gains
+    assert choose_precision("bfloat16", "cuda", True, GQCNN_GPU_BFLOAT16).dtype == "bfloat16"  # asked: as asked
+
+
 def test_an_unknown_precision_is_refused_naming_it():
     from graspaug.device import choose_precision
 

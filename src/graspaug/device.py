@@ -104,15 +104,18 @@ class Precision(NamedTuple):
     label: str  # how the log, the checkpoint and the model card say it, e.g. "bfloat16 (auto: native on this CPU)"
 
 
-def choose_precision(precision: str, device_type: str, native_bfloat16: bool) -> Precision:
+def choose_precision(precision: str, device_type: str, native_bfloat16: bool, gpu_bfloat16: bool = True) -> Precision:
     """The precision a ``precision`` setting (:data:`PRECISIONS`) gives on a device of ``device_type``
     (``cpu``, ``cuda``) that does (``native_bfloat16``) or does not compute bfloat16 in hardware
-    (:func:`has_native_bfloat16`): ``auto`` → bfloat16 where native, float32 elsewhere; ``float32`` and
-    ``bfloat16`` as asked, labelled as written (bfloat16 on a device without it is emulated, slower than float32:
-    the stage warns). A pure function of those facts, so a test can give it any device."""
+    (:func:`has_native_bfloat16`): ``auto`` → bfloat16 where native, float32 elsewhere, and float32 on a GPU for a
+    network that bfloat16 does not speed up there (``gpu_bfloat16`` False: the GQ-CNN, :data:`GQCNN_GPU_BFLOAT16`);
+    ``float32`` and ``bfloat16`` as asked, labelled as written (bfloat16 on a device without it is emulated, slower
+    than float32: the stage warns). A pure function of those facts, so a test can give it any device."""
     if precision not in PRECISIONS:
         raise ValueError(f"precision: {precision!r} is not one of {', '.join(PRECISIONS)}")
     where = "this GPU" if device_type == "cuda" else f"this {device_type.upper()}"
+    if precision == "auto" and device_type == "cuda" and native_bfloat16 and not gpu_bfloat16:
+        return Precision("float32", "float32 (auto: bfloat16 is slower for this network on a GPU)")
     if precision == "auto":
         if native_bfloat16:
             return Precision("bfloat16", f"bfloat16 (auto: native on {where})")
@@ -120,9 +123,14 @@ def choose_precision(precision: str, device_type: str, native_bfloat16: bool) ->
     return Precision(precision, precision)
 
 
-def resolve_precision(precision: str, device: torch.device) -> Precision:
+GQCNN_GPU_BFLOAT16 = False
+"""Whether bfloat16 speeds the GQ-CNN up on a GPU: no, measured on an H200 (bfloat16 autocast 11,469 samples/s against
+float32's 13,081; docs/results.md, "Training on a CUDA GPU"), so its ``auto`` stays float32 there."""
+
+
+def resolve_precision(precision: str, device: torch.device, gpu_bfloat16: bool = True) -> Precision:
     """:func:`choose_precision` of ``precision`` on ``device`` (:func:`has_native_bfloat16` asked here)."""
-    return choose_precision(precision, device.type, has_native_bfloat16(device))
+    return choose_precision(precision, device.type, has_native_bfloat16(device), gpu_bfloat16)
 
 
 def precision_warning(precision: str, device: torch.device, key: str) -> str | None:
@@ -136,10 +144,10 @@ def precision_warning(precision: str, device: torch.device, key: str) -> str | N
     return None
 
 
-def log_precision(stage: str, key: str, precision: str, device: torch.device) -> Precision:
+def log_precision(stage: str, key: str, precision: str, device: torch.device, gpu_bfloat16: bool = True) -> Precision:
     """The setting ``key`` (value ``precision``) resolved on ``device`` (:func:`resolve_precision`), said once in
     the log as ``<stage>: precision <label>``, with :func:`precision_warning` where it asks for emulated bfloat16."""
-    resolved = resolve_precision(precision, device)
+    resolved = resolve_precision(precision, device, gpu_bfloat16)
     log.info("%s: precision %s", stage, resolved.label)
     if (warning := precision_warning(precision, device, key)) is not None:
         log.warning("%s", warning)

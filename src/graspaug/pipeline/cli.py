@@ -21,8 +21,8 @@ from pathlib import Path
 import typer
 from typer.core import TyperCommand
 
-from graspaug.pipeline.command import EXIT_CODES, Command, ParamsOption, debug_mode, load_stage_params
-from graspaug.pipeline.entry import round_number, run_stage
+from graspaug.pipeline.command import EXIT_CODES, Command, ParamsOption, debug_mode
+from graspaug.pipeline.entry import load_stage_params, round_number, run_stage
 
 app = typer.Typer(
     help="graspaug: augment a grasp planner's training objects with generated shapes.\n\n"

@@ -28,13 +28,6 @@ ForceOption = typer.Option(
 )
 
 
-def load_stage_params(path: Path, stage):
-    """The params ``stage`` (a stage module) reads from the file at ``path`` (a bad one: ParamsError, exit 2)."""
-    from graspaug.pipeline.entry import load_params
-
-    return load_params(path, stage.Params)
-
-
 _debug = {"on": False}  # set by the root callback (--debug, GRASPAUG_DEBUG) on every invocation
 
 

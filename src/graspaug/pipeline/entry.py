@@ -85,3 +85,8 @@ def stage_main(module: str, **options: tuple[type, Any]) -> None:
     app = typer.Typer(add_completion=False, rich_markup_mode="markdown")
     app.command(cls=Command, help=(stage.__doc__ or "").split("\n\n")[0])(command)
     app(prog_name=f"python -m {module}")
+
+
+def load_stage_params(path: Path, stage):
+    """The params ``stage`` (a stage module) reads from the file at ``path`` (a bad one: ParamsError, exit 2)."""
+    return load_params(path, stage.Params)

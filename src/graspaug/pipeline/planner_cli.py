@@ -11,8 +11,8 @@ from pathlib import Path
 
 import typer
 
-from graspaug.pipeline.command import EXIT_CODES, Command, ForceOption, ParamsOption, load_stage_params
-from graspaug.pipeline.entry import run_stage
+from graspaug.pipeline.command import EXIT_CODES, Command, ForceOption, ParamsOption
+from graspaug.pipeline.entry import load_stage_params, run_stage
 
 planner_app = typer.Typer()
 

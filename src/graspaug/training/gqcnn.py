@@ -22,7 +22,7 @@ from sklearn.metrics import accuracy_score, average_precision_score, roc_auc_sco
 from torch.optim.swa_utils import AveragedModel, get_ema_multi_avg_fn
 from tqdm import tqdm
 
-from graspaug.device import resolve_precision, training_autocast
+from graspaug.device import GQCNN_GPU_BFLOAT16, resolve_precision, training_autocast
 from graspaug.nets.gqcnn import GQCNN, GQCNNStack
 from graspaug.training.settings import NoiseSettings, TrainSettings
 
@@ -170,7 +170,7 @@ def train_members(
         raise ValueError(f"need at least 2 training datapoints, got {len(train)}")
     if len(gens) != len(nets):
         raise ValueError(f"one generator per member: {len(nets)} members, {len(gens)} generators")
-    precision = resolve_precision(settings.precision, device)
+    precision = resolve_precision(settings.precision, device, GQCNN_GPU_BFLOAT16)
     stats = normalization(nets[0], train)
     for net in nets:
         net.set_normalization(*stats)

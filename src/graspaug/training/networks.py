@@ -32,7 +32,7 @@ import pandas as pd
 import torch
 from tqdm import tqdm
 
-from graspaug.device import resolve_precision
+from graspaug.device import GQCNN_GPU_BFLOAT16, resolve_precision
 from graspaug.errors import DataError
 from graspaug.io.checkpoints import finish_gqcnn_card, gqcnn_card, operating_point, save_gqcnn, training_range
 from graspaug.nets.gqcnn import GQCNN, GQCNNEnsemble, GQCNNStack
@@ -157,7 +157,9 @@ def train_network(job: NetworkJob, val: GraspArrays | None = None, test: GraspAr
             "steps": fits[0]["steps"],
             "best_step": fits[0]["best_step"] if single else [f["best_step"] for f in fits],
             "batch_size": job.train.batch_size,
-            "precision": resolve_precision(job.train.precision, device).label,  # as resolved where it trained
+            "precision": resolve_precision(
+                job.train.precision, device, GQCNN_GPU_BFLOAT16
+            ).label,  # as resolved where it trained
             **({} if single else {"members": len(members)}),
         },
         "parameters": net.describe()["parameters"],

@@ -122,10 +122,11 @@ class TrainSettings:
     precision: Literal["auto", "float32", "bfloat16"] = Field(
         "auto",
         description=(
-            "Arithmetic of the training steps' convolutions and matrix products: auto (the default: bfloat16 where "
-            "the device computes it natively, a CPU with AVX512-BF16 or AMX or a GPU from compute capability 8.0; "
-            "float32 elsewhere), float32, or bfloat16 mixed precision (torch.autocast; weights, optimizer, loss, "
-            "validation and test stay float32). The stage logs what it resolved to; the card records it."
+            "Arithmetic of the training steps' convolutions and matrix products: auto (the default: bfloat16 on a "
+            "CPU that computes it natively, AVX512-BF16 or AMX; float32 elsewhere, and on a GPU, where bfloat16 was "
+            "measured slower for this network), float32, or bfloat16 mixed precision (torch.autocast; weights, "
+            "optimizer, loss, validation and test stay float32). The stage logs what it resolved to; the card "
+            "records it."
         ),
     )
     evals: int = Field(

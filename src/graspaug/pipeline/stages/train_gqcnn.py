@@ -15,7 +15,7 @@ from __future__ import annotations
 import logging
 import time
 
-from graspaug.device import log_precision, resolve_device
+from graspaug.device import GQCNN_GPU_BFLOAT16, log_precision, resolve_device
 from graspaug.io.atomic import atomic_path
 from graspaug.io.tables import read_table, write_csv, write_json
 from graspaug.pipeline.params.base import params_model
@@ -78,7 +78,7 @@ def run(params: Params, seed: int) -> None:
     test, test_rows = test_set(corpora.original)
     plan = seed_plan(variants, cfg.members, len(split.validation), val_rows, test_rows, device)
     log.info("train_gqcnn seed %d: %s", seed, plan)
-    log_precision(f"train_gqcnn seed {seed}", "gqcnn.train.precision", cfg.train.precision, device)
+    log_precision(f"train_gqcnn seed {seed}", "gqcnn.train.precision", cfg.train.precision, device, GQCNN_GPU_BFLOAT16)
     with atomic_path(gqcnn_seed_dir(seed), directory=True) as folder:
         card = seed_card(params.render, params.grasps, params.seed)
         shared = (split, cfg.net, cfg.train, inits, noise_seeds, seed, str(device), folder, corpora, card)
