@@ -27,16 +27,14 @@ from graspaug.experiments.stats import (
 PRECISIONS = ("float32", "bfloat16")
 RULE_MEAN = -0.005
 """The smallest mean paired difference of validation AP (bfloat16 − float32) that keeps bfloat16."""
+RECON_KEPT = ("graspness_kept", "datapoints_kept")
+"""The recon pool's figures (the ``fidelity`` stage's table) the AutoEncoder's rule reads."""
 
 
 def ae_free(network: str) -> bool:
     """Whether the AutoEncoder makes none of ``network``'s training data (``pool/B-R``): a 1:0 network, the ``real``
     pool's, the ceiling."""
     return network.endswith("-0") or network.startswith("real/") or network == "ceiling"
-
-
-RECON_KEPT = ("graspness_kept", "datapoints_kept")
-"""The recon pool's figures (the ``fidelity`` stage's table) the AutoEncoder's rule reads."""
 
 
 def gqcnn_contrasts(networks: pd.DataFrame) -> dict[str, dict]:
@@ -102,7 +100,7 @@ def recon_contrasts(recon: pd.DataFrame) -> dict[str, dict]:
             float(rows.loc[p, figure]), "objects", objects=(rows.loc[p, f"{figure}_lo"], rows.loc[p, f"{figure}_hi"])
         )
         for figure in RECON_KEPT
-        for p in ("float32", "bfloat16")
+        for p in PRECISIONS
     }
 
 
