@@ -24,7 +24,8 @@ from graspaug.experiments.stats import (
     t_interval,
 )
 
-PRECISIONS = ("float32", "bfloat16")
+COMPARED = ("float32", "bfloat16")
+"""The two runs compared, reference first."""
 RULE_MEAN = -0.005
 """The smallest mean paired difference of validation AP (bfloat16 − float32) that keeps bfloat16."""
 RECON_KEPT = ("graspness_kept", "datapoints_kept")
@@ -100,7 +101,7 @@ def recon_contrasts(recon: pd.DataFrame) -> dict[str, dict]:
             float(rows.loc[p, figure]), "objects", objects=(rows.loc[p, f"{figure}_lo"], rows.loc[p, f"{figure}_hi"])
         )
         for figure in RECON_KEPT
-        for p in PRECISIONS
+        for p in COMPARED
     }
 
 
@@ -140,12 +141,12 @@ def markdown(summary: dict) -> str:
     ]
     for name, r in summary["ae"].items():
         f32, bf16, d = (
-            interval_text(r[k], spec) for k, spec in zip(PRECISIONS + ("difference",), (".4f", ".4f", "+.4f"))
+            interval_text(r[k], spec) for k, spec in zip(COMPARED + ("difference",), (".4f", ".4f", "+.4f"))
         )
         lines.append(f"| {name} | {f32} | {bf16} | {d} |")
     lines += ["", "| recon pool | float32 | bfloat16 |", "|---|---|---|"]
     for figure in ("graspness_kept", "datapoints_kept"):
-        f32, bf16 = (interval_text(summary["recon"][f"{figure}/{p}"], ".3f") for p in PRECISIONS)
+        f32, bf16 = (interval_text(summary["recon"][f"{figure}/{p}"], ".3f") for p in COMPARED)
         lines.append(f"| {figure.replace('_', ' ')} of parents | {f32} | {bf16} |")
     lines += ["", f"AutoEncoder rule: {'keep' if summary['ae_keeps_bfloat16'] else 'reject'} bfloat16."]
     return "\n".join(lines) + "\n"

@@ -373,7 +373,8 @@ def profile_command(
     cls=Command,
     name="results",
     help="Recompute every figure the README and docs/results.md quote from the studies' per-network tables in "
-    "`results/<study>/` (written by `graspaug study attribution`): writes `<out>/<study>/summary.json`, "
+    "`results/<study>/` (written by `graspaug study attribution`, `lifelong`, `heldout-fidelity` and `precision` with "
+    "`--results`): writes `<out>/<study>/summary.json`, "
     "`decomposition.md` and `figures.json` (key → the quoted text) and prints each figure. `--check`: a figure the "
     "markdown marks (`<!-- results:KEY -->` before it) that differs from the recomputed one, or that no study "
     "recomputes, is an error naming it (exit 2).",

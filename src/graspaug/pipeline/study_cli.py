@@ -56,6 +56,12 @@ def _command_line() -> str:
     return shlex.join(["graspaug", *sys.argv[1:]])
 
 
+def _check_results_name(results: str | None, kind: str) -> None:
+    """A ``--results`` folder name that `graspaug results` reads as a ``kind`` study: ``kind`` or ``kind-<label>``."""
+    if results is not None and results.split("-")[0] != kind:
+        raise typer.BadParameter(f"must be {kind} or {kind}-<label>; got {results}", param_hint="--results")
+
+
 def _logging() -> None:
     logging.basicConfig(level=logging.INFO, format="%(asctime)s %(levelname)s %(name)s: %(message)s", stream=sys.stderr)
 
@@ -214,8 +220,7 @@ def precision_command(
     from graspaug.pipeline.studies import precision
     from graspaug.pipeline.studies.draws import provenance
 
-    if results is not None and results.split("-")[0] != "precision":
-        raise typer.BadParameter(f"must be precision or precision-<label>; got {results}", param_hint="--results")
+    _check_results_name(results, "precision")
     _logging()
     with output_folder(out, "study precision", force=force) as tmp:
         text, tables = precision.run(float32, bfloat16, tmp)
@@ -260,8 +265,7 @@ def heldout_fidelity_command(
     from graspaug.pipeline.studies import heldout_fidelity
     from graspaug.pipeline.studies.draws import provenance
 
-    if results is not None and results.split("-")[0] != "fidelity":
-        raise typer.BadParameter(f"must be fidelity or fidelity-<label>; got {results}", param_hint="--results")
+    _check_results_name(results, "fidelity")
     _logging()
     with output_folder(out, "study heldout-fidelity", force=force) as tmp:
         text = heldout_fidelity.run(project, shapes, seed, workers, tmp)
