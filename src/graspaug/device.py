@@ -48,7 +48,7 @@ def keep_freed_memory() -> bool:
 
     A CPU training step allocates and frees dozens of MB-sized tensors; glibc serves each from
     fresh ``mmap`` pages (above its mmap threshold) or trims the heap after a free, so every
-    step pays page faults (a default GQ-CNN step on one batch: 1,400–6,300 by machine; 0–400 with this).
+    step pays page faults (a default GQ-CNN step on one batch: 1,400–7,100 by machine; 0–400 with this).
     Raising the mmap and trim thresholds to 1 GiB (``mallopt``) keeps those pages, as jemalloc
     or tcmalloc would. Process-wide and idempotent; returns False where there is no glibc
     (macOS, musl), which changes nothing there."""
