@@ -326,6 +326,22 @@ def test_dvc_repro_render(tiny_repo):
     assert "Running stage" not in again.stdout
 
 
+def test_a_second_clone_takes_every_stage_no_data_seed_reaches_from_the_run_cache(tiny_repo, tmp_path):
+    """A study's second draw (a clone of the same commit sharing the DVC cache) runs nothing before `generate`: DVC
+    keeps no run cache for a stage with an uncached plain output, so every stage's outs are cached (metrics and
+    plots may stay uncached)."""
+    work, env = tiny_repo
+    run(["dvc", "repro", "render@original", "score"], work, env)
+    clone = tmp_path / "draw1"
+    run(["git", "clone", "-q", str(work), str(clone)], tmp_path, env)
+    run(["dvc", "cache", "dir", "--local", str(work / ".dvc" / "cache")], clone, env)
+    again = run(["dvc", "repro", "render@original", "score"], clone, env).stdout
+    assert "Running stage" not in again, again
+    for stage in ("ingest", "voxelize", "train_ae", "embed", "grasps@original", "score", "render@original"):
+        assert f"Stage '{stage}' is cached - skipping run" in again, stage
+    assert (clone / "reports/train_ae/summary.json").is_file() and (clone / "metrics/score.json").is_file()
+
+
 def test_dvc_repro_fidelity(tiny_repo):
     import json
 
@@ -814,22 +830,38 @@ def test_cell_ranking_study_ranks_the_calibration_grasps_with_one_project(tiny_r
     assert all(value is None for value in result["pooled"].values())
 
 
-def test_attribution_study_combines_a_finished_draw(tiny_repo, tmp_path):
-    """`graspaug study attribution --combine-only` over one draw (the tiny run, linked as draw0): the decomposition
-    and the per-network tables, recorded with the command that made them."""
+def test_attribution_study_records_a_finished_draw_then_combines_from_results_alone(tiny_repo, tmp_path):
+    """`graspaug study attribution` over one finished draw (the tiny run, linked as draw0) adds its tables to
+    results/ at once; `--combine-only` then combines from results/ alone, with the clone gone."""
     import json
 
     work, env = tiny_repo
     run(["dvc", "repro", "report"], work, env)
     (tmp_path / "draw0").symlink_to(work)
     cmd = [*GRASPAUG, "study", "attribution", "--draws", "0", "--workdir", str(tmp_path), "--profile", "tiny"]
-    printed = run([*cmd, "--combine-only", "--resamples", "50", "--results", "tiny-study"], work, env).stdout
+    printed = run([*cmd, "--resamples", "50", "--results", "tiny-study"], work, env).stdout
     assert (tmp_path / "decomposition.md").read_text() in printed
-    assert json.loads((tmp_path / "summary.json").read_text())["draws"] == [0]
     meta = json.loads((work / "results/tiny-study/meta.json").read_text())
     assert meta["command"].startswith("graspaug study attribution --draws 0") and meta["n_resamples"] == 50
+    assert meta["draws"]["0"]["seconds"] >= 0 and len(meta["draws"]["0"]["commit"]) == 40
     networks = pd.read_parquet(work / "results/tiny-study/networks.parquet")
     assert set(networks.seed) == {0, 1} and set(networks.draw) == {0} and networks.test_ap.between(0, 1).all()
+    assert (work / "results/tiny-study/predictions-d0.parquet").is_file()
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    (tmp_path / "draw0").unlink()
+    (tmp_path / "summary.json").unlink()
+    again = run([*cmd, "--combine-only", "--resamples", "50", "--results", "tiny-study"], work, env).stdout
+    assert json.loads((tmp_path / "summary.json").read_text()) == summary and "# Why generated shapes help" in again
+    assert not (tmp_path / "draw0").exists()  # nothing was cloned
+    two = [*GRASPAUG, "study", "attribution", "--draws", "0", "--draws", "1", "--workdir", str(tmp_path)]
+    missing = subprocess.run(
+        [*two, "--profile", "tiny", "--combine-only", "--results", "tiny-study"],
+        cwd=work,
+        env=env,
+        capture_output=True,
+        text=True,
+    )
+    assert missing.returncode != 0 and "no draw 1" in missing.stderr + missing.stdout
 
 
 def test_lifelong_study_combines_a_finished_draw(tiny_repo, tmp_path):

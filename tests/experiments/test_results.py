@@ -166,3 +166,31 @@ def test_held_out_fidelity_runs_are_kept_per_autoencoder_and_recompute_their_fig
     assert figures["fidelity-real/own/datapoints_kept"].startswith("90.0% [")
     assert re.match(r"60\.0% \[", figures["fidelity-real/default/datapoints_kept"])
     assert figures == recompute(tmp_path / "results")[0]
+
+
+def test_draws_added_one_at_a_time_combine_as_the_whole_study_and_other_params_are_refused(tmp_path):
+    """Each finished draw is written at once (a study that stops keeps it); the folder then combines as if every draw
+    had been written together, and a draw run with other params is refused, naming the key."""
+    from types import SimpleNamespace
+
+    import pytest
+
+    from graspaug.errors import DataError
+    from graspaug.experiments.results import add_attribution_draw
+
+    result, _ = _results(tmp_path)
+    draws = make_draws(tmp_path / "again", seeds=(0, 1, 2), real_noise=0.1)  # the same networks (seeded)
+    folder = tmp_path / "stepwise" / "attribution"
+    meta = META | {"n_resamples": 200, "seed": 3}
+    for d in reversed(list(draws)):  # in any order
+        add_attribution_draw(folder, d, draws[d], LABELS, OBJECTS, GENERATE, GQCNN, meta | {"seconds": 10 + d})
+        assert sorted(json.loads((folder / "meta.json").read_text())["draws"]) >= [str(d)]
+    again = combine_attribution(folder)
+    assert again["contrasts"] == result["contrasts"] and again["shares"] == result["shares"]
+    first = sorted(draws)[0]
+    assert combine_attribution(folder, [first])["draws"] == [first]
+    with pytest.raises(DataError, match="no draw 99"):
+        combine_attribution(folder, [first, 99])
+    other = SimpleNamespace(**vars(GQCNN) | {"pools": ("targeted",)})
+    with pytest.raises(DataError, match="pools"):
+        add_attribution_draw(folder, first, draws[first], LABELS, OBJECTS, GENERATE, other, meta)

@@ -249,10 +249,12 @@ def test_a_duplicated_key_is_refused_naming_the_key_and_its_line(tmp_path, repo_
 
 
 def test_control_ratios_must_be_ratios_of_generate(repo_root):
-    """gqcnn.control_ratios names ratios of generate.ratios (the real-objects profile: 1:1 of 0, 0.5, 1, 2)."""
+    """gqcnn.control_ratios names ratios of generate.ratios (1:1 of 0, 0.5, 1, 2)."""
+    chosen = {"generate": {"ratios": [0.0, 0.5, 1.0, 2.0]}, "gqcnn": {"control_ratios": [1.0]}}
+    assert parse_params(merge(params_dict(), chosen)).gqcnn.control_ratios == (1.0,)
     real_objects = profile_params("real_objects", repo_root / "profiles")
-    assert real_objects.gqcnn.control_ratios == (1.0,) and 2.0 in real_objects.generate.ratios
     assert real_objects.ingest.surface.size == "fit" and "procedural" in real_objects.gqcnn.pools
+    assert real_objects.render.images_per_pose == 5 and real_objects.generate.base_sizes == (50, 100, 150)
     with pytest.raises(ParamsError, match=r"gqcnn\.control_ratios: must be among generate\.ratios"):
         parse_params(merge(params_dict(), {"gqcnn": {"control_ratios": [3.0]}}))
     with pytest.raises(ParamsError, match=r"gqcnn\.control_ratios"):
@@ -267,5 +269,5 @@ def test_a_draw_of_the_real_objects_profile_reads_the_corpus_from_the_project(re
 
     params = draw_params(repo_root, "real_objects", 2)
     assert params.data_seed == 2 and Path(params.data.path).is_absolute()
-    assert Path(params.data.path) == (repo_root / "../shared/corpora/gso300").resolve()
+    assert Path(params.data.path) == (repo_root / "../shared/corpora").resolve()
     assert draw_params(repo_root, "attribution", 0).data.path is None

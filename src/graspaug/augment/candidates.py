@@ -259,7 +259,8 @@ class RandomStream(CandidateStream):
 
 class ReconStream(CandidateStream):
     """The ``recon`` pool's stream: shape k of a list of real shapes reconstructed alone
-    (parents k and k, weight 0), in the list's order, so a rejected decode is replaced by the next shape."""
+    (parents k and k, weight 0), in the list's order; the pool decodes each once (:func:`decode_each`), so a
+    rejected decode leaves a gap rather than taking the next shape."""
 
     def __init__(self, n_shapes: int) -> None:
         super().__init__()
@@ -336,6 +337,20 @@ def fill_pool(
             )
         for outcome in run_batch(batch):
             (rejected if outcome.reason else kept).append(outcome)
+    return kept, rejected
+
+
+def decode_each(
+    stream: CandidateStream, count: int, run_batch: Callable[[list[Candidate]], list[D]]
+) -> tuple[list[D], list[D]]:
+    """Decode the stream's first ``count`` candidates once each, with no replacement: the kept (``reason`` None) and
+    the rejected, in stream order. A pool whose shape k stands for shape k of a list (the ``recon`` pool: the real
+    pool's extra shapes) keeps its failures as gaps instead of taking the next shape, so it is the same shapes as
+    that list's first ``count`` less the ones that did not mesh."""
+    kept: list[D] = []
+    rejected: list[D] = []
+    for outcome in run_batch(stream.take(0, count)) if count else []:
+        (rejected if outcome.reason else kept).append(outcome)
     return kept, rejected
 
 

@@ -32,8 +32,9 @@ def pool_tables(
     rows, rejects = [], []
     for pool, (kept, rejected) in pools.items():
         ids, z = sources[pool]
-        for order, d in enumerate(kept):
+        for position, d in enumerate(kept):
             c, m = d.candidate, d.mesh
+            order = c.a if pool == "recon" else position  # recon: the real pool's position (a failed decode a gap)
             rows.append(
                 {
                     "shape_id": f"gen_{base_size}_{ID_LETTERS[pool]}{order:04d}",

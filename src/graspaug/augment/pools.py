@@ -25,6 +25,7 @@ from graspaug.augment.candidates import (
     RandomStream,
     ReconStream,
     TargetedStream,
+    decode_each,
     draw_base_sets,
     fill_pool,
     pool_size,
@@ -114,7 +115,9 @@ def fill_pools(
     ``pool_size(cfg.ratios, B)`` kept shapes (the pools but targeted: ``pool_size(control_ratios, B)`` when
     ``control_ratios`` is given, ``gqcnn.control_ratios``): ``targeted`` and ``random`` (seeded by
     ``[seed, BASE_SEED, B]``) with ``run_batch`` (:func:`.decode.mesh_batches` over the base set),
-    ``recon`` from ``recon`` (the real pool's shapes, each decoded from its own latent), and the
+    ``recon`` from ``recon`` (the real pool's first shapes, each decoded once from its own latent: a shape that
+    does not mesh is dropped, not replaced, so the recon pool of ratio R is the real pool's set of R less its
+    failures, and never runs out), and the
     no-network pools with their runner in ``controls``: ``blend`` (:func:`.decode.blend_batches`) and
     ``warp`` (:func:`.decode.warp_batches`) on the targeted pool's candidates (its kept ones first: the same
     parents and weights), ``primitives`` (:func:`.decode.primitive_batches`) on assemblies 0, 1, … of
@@ -155,6 +158,9 @@ def fill_pools(
         if name in FOLLOWERS:
             streams[name] = (FollowStream([d.candidate for d in out["targeted"][0]], targeted_stream), controls[name])
         stream, runner = streams[name]
+        if name == "recon":  # the real pool's first shapes, each decoded once: a failed decode is a gap, not replaced
+            out[name] = decode_each(stream, min(control, len(recon.shapes.ids)), runner)
+            continue
         try:
             out[name] = fill_pool(stream, needed if name == "targeted" else control, runner)
         except PoolExhausted as exc:

@@ -6,13 +6,16 @@ README and docs/results.md quote, recomputed from them (issue #58).
 * ``networks.parquet`` — one row per draw, training seed and network: ``draw`` (``data_seed``), ``pool``,
   ``base_size``, ``ratio``, ``seed``, ``val_ap``, ``test_ap``, ``test_roc_auc``, ``train_datapoints``
   (:func:`~graspaug.experiments.ap.numbers.collect`'s columns);
-* ``predictions.parquet`` — one row per test datapoint, one float32 column per network,
-  ``<draw>/<seed>/<pool>/<B>-<R>``: its P(success);
+* ``predictions-d<draw>.parquet`` — one per draw, one row per test datapoint, one float32 column per network of
+  that draw, ``<draw>/<seed>/<pool>/<B>-<R>``: its P(success);
 * ``test.parquet`` — one row per test datapoint, in the same order: ``label`` (1: a successful grasp), ``object``
   (its test shape);
-* ``meta.json`` — the exact ``command`` and code ``commit`` that made them, the date, and the params the combination
-  reads (``base_sizes``, ``ratios``, ``augment_base_sizes``, ``pools``, ``control_ratios``, ``n_resamples``,
-  ``seed``), written last.
+* ``meta.json`` — the exact ``command`` and code ``commit`` that made them, the date (and per draw, ``draws``), and
+  the params the combination reads (``base_sizes``, ``ratios``, ``augment_base_sizes``, ``pools``,
+  ``control_ratios``, ``n_resamples``, ``seed``), written last.
+
+Each draw is added as it finishes (:func:`add_attribution_draw`), so a study that stops keeps what it finished, and
+``graspaug study attribution --combine-only`` combines from these files alone, on any machine.
 
 ``results/lifelong/`` (written by ``graspaug study lifelong``, :func:`write_lifelong`): ``predictions.parquet`` (one
 float32 column per round, draw, training seed and arm, ``r<k>/<draw>/<seed>/<arm>``), ``test.parquet`` and
@@ -38,7 +41,7 @@ from __future__ import annotations
 
 import json
 import re
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from types import SimpleNamespace
 
@@ -49,7 +52,7 @@ from graspaug.errors import DataError
 from graspaug.experiments.stats import interval_text, share_text
 
 MARKER = re.compile(r"<!-- results:([\w@./+-]+) -->")
-FILES = ("networks.parquet", "predictions.parquet", "test.parquet", "meta.json")
+FILES = ("networks.parquet", "test.parquet", "meta.json")  # and predictions-d<draw>.parquet per draw
 DOCUMENTS = ("README.md", "docs/results.md")  # the markdown whose marked figures must equal the recomputed ones
 
 
@@ -62,7 +65,8 @@ def _column(draw: int, seed: int, key: tuple) -> str:
 def write_attribution(
     folder: Path, draws: Mapping[int, Mapping[int, Path]], labels, object_ids, generate, gqcnn, meta: dict
 ) -> None:
-    """Write the attribution study's tables (module docstring) into ``folder`` from its networks' folders.
+    """Write the attribution study's tables (module docstring) into ``folder`` from its networks' folders: one
+    :func:`add_attribution_draw` per draw.
 
     Parameters
     ----------
@@ -71,45 +75,89 @@ def write_attribution(
     generate, gqcnn : the params sections the draws ran with
     meta : ``command``, ``commit``, ``date``, ``n_resamples``, ``seed`` — kept in ``meta.json``
     """
+    for d, seed_dirs in draws.items():
+        add_attribution_draw(folder, d, seed_dirs, labels, object_ids, generate, gqcnn, meta)
+
+
+def _kept_params(generate, gqcnn) -> dict:
+    """The params an attribution combination reads, as ``meta.json`` keeps them."""
+    return {
+        "base_sizes": [int(b) for b in generate.base_sizes],
+        "ratios": [float(r) for r in generate.ratios],
+        "augment_base_sizes": [int(b) for b in gqcnn.augment_base_sizes],
+        "pools": list(gqcnn.pools),
+        "control_ratios": None if gqcnn.control_ratios is None else [float(r) for r in gqcnn.control_ratios],
+    }
+
+
+def add_attribution_draw(
+    folder: Path, draw: int, seed_dirs: Mapping[int, Path], labels, object_ids, generate, gqcnn, meta: dict
+) -> None:
+    """Add (or replace) one finished draw's tables in ``folder`` at once, so a study that stops keeps every draw it
+    finished: ``predictions-d<draw>.parquet`` (one float32 column per network, ``<draw>/<seed>/<pool>/<B>-<R>``), its
+    rows of ``networks.parquet``, ``test.parquet`` (written by the first draw, checked by the others) and
+    ``meta.json`` (written last; ``draws``: draw → its ``command``, ``commit``, ``date`` and ``seconds``).
+
+    Parameters
+    ----------
+    draw : int — the draw's data seed
+    seed_dirs : training seed → the folder of that seed's networks (``summary.json``, ``test_predictions.npy``)
+    labels, object_ids : (N,) — the test datapoints' labels and objects, in the predictions' order
+    generate, gqcnn : the params sections the draw ran with; a folder of other params is refused, naming the key
+    meta : ``command``, ``commit``, ``date``, ``n_resamples``, ``seed`` (and the draw's wall time, ``seconds``)
+    """
     from graspaug.experiments.ap.numbers import collect, test_predictions
     from graspaug.io.atomic import atomic_path
     from graspaug.training.variants import seed_variants
 
+    folder.mkdir(parents=True, exist_ok=True)
+    keep = _kept_params(generate, gqcnn)
+    test = pd.DataFrame({"label": np.asarray(labels, dtype=np.int8), "object": np.asarray(object_ids)})
+    meta_file, networks_file, test_file = folder / "meta.json", folder / "networks.parquet", folder / "test.parquet"
+    old = json.loads(meta_file.read_text()) if meta_file.is_file() else {}
+    for key, value in keep.items():
+        if key in old and old[key] != value:
+            raise DataError(f"{folder}: its draws ran with {key} = {old[key]}, draw {draw} with {value}")
+    if test_file.is_file() and not pd.read_parquet(test_file).equals(test):
+        raise DataError(f"{folder}: draw {draw} was tested on other datapoints than the draws already there")
     variants = seed_variants(
         generate.base_sizes, generate.ratios, gqcnn.augment_base_sizes, False, gqcnn.pools, gqcnn.control_ratios
     )
-    tables, columns = [], {}
-    for d, seed_dirs in draws.items():
-        runs = collect(seed_dirs, variants)
-        tables.append(runs.assign(draw=d)[["draw", *runs.columns]])
-        for s, folder_s in seed_dirs.items():
-            for v in variants:
-                key = (v.pool, v.base_size, float(v.ratio))
-                columns[_column(d, s, key)] = test_predictions(folder_s, key).astype(np.float32)
-    folder.mkdir(parents=True, exist_ok=True)
-    frames = {
-        "networks.parquet": pd.concat(tables, ignore_index=True),
-        "predictions.parquet": pd.DataFrame(columns),
-        "test.parquet": pd.DataFrame({"label": np.asarray(labels, dtype=np.int8), "object": np.asarray(object_ids)}),
+    runs = collect(seed_dirs, variants)
+    columns = {
+        _column(draw, s, (v.pool, v.base_size, float(v.ratio))): test_predictions(
+            folder_s, (v.pool, v.base_size, float(v.ratio))
+        ).astype(np.float32)
+        for s, folder_s in seed_dirs.items()
+        for v in variants
     }
-    (folder / "meta.json").unlink(missing_ok=True)  # a folder without meta.json is an unfinished one
+    networks = runs.assign(draw=draw)[["draw", *runs.columns]]
+    if networks_file.is_file():
+        others = pd.read_parquet(networks_file)
+        networks = pd.concat([others[others.draw != draw], networks], ignore_index=True)
+        networks = networks.sort_values("draw", kind="stable")
+    meta_file.unlink(missing_ok=True)  # a folder without meta.json is an unfinished one
+    frames = {
+        f"predictions-d{draw}.parquet": pd.DataFrame(columns),
+        "networks.parquet": networks.reset_index(drop=True),
+        "test.parquet": test,
+    }
     for name, frame in frames.items():
         with atomic_path(folder / name) as tmp:
             frame.to_parquet(tmp, index=False)
-    keep = {
-        "base_sizes": list(generate.base_sizes),
-        "ratios": [float(r) for r in generate.ratios],
-        "augment_base_sizes": list(gqcnn.augment_base_sizes),
-        "pools": list(gqcnn.pools),
-        "control_ratios": None if gqcnn.control_ratios is None else list(gqcnn.control_ratios),
+    by_draw = old.get("draws", {}) | {
+        str(draw): {k: meta[k] for k in ("command", "commit", "date", "seconds") if k in meta}
     }
-    with atomic_path(folder / "meta.json") as tmp:
-        tmp.write_text(json.dumps(meta | keep, indent=1) + "\n")
+    by_draw = dict(sorted(by_draw.items(), key=lambda kv: int(kv[0])))
+    with atomic_path(meta_file) as tmp:  # command, commit and date at the top: the latest draw's
+        top = {k: v for k, v in meta.items() if k != "seconds"}
+        tmp.write_text(json.dumps(old | top | keep | {"draws": by_draw}, indent=1) + "\n")
 
 
-def combine_attribution(folder: Path) -> dict:
+def combine_attribution(folder: Path, draws: Sequence[int] | None = None) -> dict:
     """:func:`~graspaug.experiments.ap.attribution.combine_runs` of the tables in ``folder`` (module docstring), with
-    the resamples and seed its ``meta.json`` names: the study's ``summary.json``, figure for figure."""
+    the resamples and seed its ``meta.json`` names: the study's ``summary.json``, figure for figure. ``draws``: the
+    draws to combine (default: every draw the folder holds)."""
     from graspaug.experiments.ap.attribution import combine_runs
 
     missing = [name for name in FILES if not (folder / name).is_file()]
@@ -117,14 +165,23 @@ def combine_attribution(folder: Path) -> dict:
         raise DataError(f"{folder}: no {', '.join(missing)} (an unfinished or foreign results folder)")
     meta = json.loads((folder / "meta.json").read_text())
     networks = pd.read_parquet(folder / "networks.parquet")
-    predictions = pd.read_parquet(folder / "predictions.parquet")
     test = pd.read_parquet(folder / "test.parquet")
     runs = {int(d): g.drop(columns="draw").reset_index(drop=True) for d, g in networks.groupby("draw", sort=True)}
+    if draws is not None:
+        absent = sorted(set(draws) - set(runs))
+        if absent:
+            raise DataError(f"{folder}: no draw {', '.join(map(str, absent))} (it holds {sorted(runs)})")
+        runs = {d: runs[d] for d in sorted(draws)}
+    files = {d: folder / f"predictions-d{d}.parquet" for d in runs}
+    missing = [str(f.name) for f in files.values() if not f.is_file()]
+    if missing:
+        raise DataError(f"{folder}: no {', '.join(missing)} (an unfinished or foreign results folder)")
+    predictions = pd.concat([pd.read_parquet(f) for f in files.values()], axis=1)
 
     def network(d: int, s: int, key: tuple) -> np.ndarray:
         name = _column(d, s, key)
         if name not in predictions:
-            raise DataError(f"{folder / 'predictions.parquet'}: no column {name!r}")
+            raise DataError(f"{folder / f'predictions-d{d}.parquet'}: no column {name!r}")
         return predictions[name].to_numpy()
 
     generate = SimpleNamespace(base_sizes=meta["base_sizes"], ratios=meta["ratios"])

@@ -6,7 +6,8 @@ random: random pairs; recon: the real pool's shapes (the GQ-CNN experiment's ord
 latents; blend: the targeted pairs with no network; warp: each targeted pair's nearer parent randomly deformed;
 primitives: random assemblies of primitives; procedural: pybullet's random_urdfs objects as they are (beside a
 corpus of your own). ``gqcnn.pools`` says which; each holds ``ceil(max ratio × B)`` kept shapes, the first
-``round(R × B)`` ratio R's set; a failed shape is replaced by the next candidate. Writes
+``round(R × B)`` ratio R's set; a failed shape is replaced by the next candidate, except in the recon pool, whose
+shape k is the real pool's shape k (a failed decode is dropped, and said in the summary). Writes
 ``data/generated/<B>/`` (``meshes/``, ``index``, ``rejects`` and ``base.parquet``), ``metrics/generate/<B>.json``,
 ``reports/generate/<B>/`` (summary, pictures)."""
 
