@@ -202,3 +202,15 @@ def test_the_advice_reads_every_base_size():
         "At B = 100 the pools that add AP with an interval above zero: targeted; targeted adds the most, +80% [+60%, "
         "+100%] of as many real shapes' gain."
     )
+
+
+def test_an_exchange_rate_is_the_share_times_the_real_shapes_added_and_unbounded_with_it():
+    from graspaug.experiments.ap.attribution import exchange_rate, exchange_text
+
+    gain = {"mean": 0.01}
+    bounded = {"share": 0.4, "low": 0.1, "high": 0.9, "bounded": True, "gain": gain, "real_gain": gain, "shapes": 50.0}
+    assert exchange_rate(bounded) == {"worth": 20.0, "low": 5.0, "high": 45.0, "bounded": True, "shapes": 50.0}
+    assert exchange_text(exchange_rate(bounded)) == "+20 [+5, +45]"
+    unbounded = bounded | {"low": None, "high": None, "bounded": False}
+    assert exchange_text(exchange_rate(unbounded)) == "+20 [unbounded]"
+    assert exchange_text(exchange_rate(bounded | {"share": None})) == "n/a"

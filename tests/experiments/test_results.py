@@ -38,6 +38,7 @@ def test_the_results_tables_recompute_the_studys_result_figure_for_figure(tmp_pa
     assert again["contrasts"] == result["contrasts"] and again["shares"] == result["shares"]
     figures = attribution_figures(result)
     assert figures["attribution/share/recon@10"] == "+100% [+100%, +100%]"  # the real gain is clear here
+    assert figures["attribution/worth/recon@10"] == "+10 [+10, +10]"  # its 10 shapes at 1:1 are worth 10 real ones
     real = result["shares"]["recon"]["10"]["real_gain"]
     assert (
         figures["attribution/real_gain@10"]

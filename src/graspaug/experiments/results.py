@@ -197,12 +197,17 @@ def combine_attribution(folder: Path, draws: Sequence[int] | None = None) -> dic
 def attribution_figures(result: dict, study: str = "attribution") -> dict[str, str]:
     """Every figure of an attribution result (:func:`combine_attribution`) as the text a document quotes, by key:
     ``<study>/<contrast>`` (``mean [low, high]``, AP, 4 decimals), ``<study>/share/<pool>@<B>`` (the share with its
-    interval by test inversion, or ``[unbounded]``), ``<study>/real_gain@<B>`` (the shares' denominator)."""
+    interval by test inversion, or ``[unbounded]``), ``<study>/real_gain@<B>`` (the shares' denominator) and
+    ``<study>/worth/<pool>@<B>`` (what the pool's shapes are worth in real shapes: ``exchange_rate``)."""
+    from graspaug.experiments.ap.attribution import exchange_rate, exchange_text
+
     out = {f"{study}/{name}": interval_text(c) for name, c in result["contrasts"].items()}
     for pool, by_size in result["shares"].items():
         for b, s in by_size.items():
             out[f"{study}/share/{pool}@{b}"] = share_text(s)
             out[f"{study}/real_gain@{b}"] = interval_text(s["real_gain"])
+            if "shapes" in s:
+                out[f"{study}/worth/{pool}@{b}"] = exchange_text(exchange_rate(s))
     return out
 
 

@@ -20,6 +20,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from graspaug.augment.candidates import ratio_count
 from graspaug.errors import DataError
 from graspaug.experiments.ap.numbers import (
     Contrast,
@@ -182,6 +183,7 @@ def combine_runs(
                 "bounded": share["bounded"],
                 "gain": pool_gain,
                 "real_gain": real_gain,
+                "shapes": float(np.mean([ratio_count(r, b) for r in rs])),  # the pool's shapes = the real ones added
             }
     return {
         "contrasts": out,
@@ -248,7 +250,67 @@ def decomposition_markdown(result: dict, augment_base_sizes: Sequence[int], comm
     lines += [f"- {losing_step(result['contrasts'], b)}" for b in augment_base_sizes]
     if result.get("shares"):
         lines += ["", "## What to add: each pool's share of the real-shape gain", "", *recommendation(result)]
+        lines += [
+            "",
+            "## The exchange rate: what a pool's shapes are worth in real shapes",
+            "",
+            *exchange_lines(result),
+        ]
     return "\n".join(lines) + "\n"
+
+
+def exchange_rate(s: dict) -> dict:
+    """How many real shapes a pool's shapes are worth at one base size, from its share of the real-shape gain (an
+    entry of :func:`combine_runs`'s ``shares``): ``worth`` = share × ``shapes``, the real shapes that the share's
+    denominator adds (as many as the pool's shapes), with the share's interval scaled alike (``low``, ``high``;
+    None when unbounded: the real shapes' own gain is not clearly nonzero), ``bounded`` and ``shapes``. It reads
+    the real-shape curve as a line between B and B + ``shapes`` real shapes: a worth above ``shapes`` is an
+    extrapolation beyond that segment."""
+    shapes = s.get("shapes")
+    if s.get("share") is None or not shapes:
+        return {"worth": None, "low": None, "high": None, "bounded": False, "shapes": shapes}
+    scale = lambda v: None if v is None else float(v) * shapes  # noqa: E731
+    return {
+        "worth": scale(s["share"]),
+        "low": scale(s["low"]) if s["bounded"] else None,
+        "high": scale(s["high"]) if s["bounded"] else None,
+        "bounded": bool(s["bounded"]),
+        "shapes": shapes,
+    }
+
+
+def exchange_text(rate: dict) -> str:
+    """An :func:`exchange_rate` in words: ``N [lo, hi]`` real shapes (``N [unbounded]``; ``n/a`` without one)."""
+    if rate["worth"] is None:
+        return "n/a"
+    if not rate["bounded"]:
+        return f"{rate['worth']:+.0f} [unbounded]"
+    return f"{rate['worth']:+.0f} [{rate['low']:+.0f}, {rate['high']:+.0f}]"
+
+
+def exchange_lines(result: dict) -> list[str]:
+    """The exchange-rate table of a result (:func:`combine_runs`): per pool, what its shapes at each augmented base
+    size are worth in real shapes, with the 95% interval of its share."""
+    shares = result.get("shares", {})
+    sizes = sorted({b for by_size in shares.values() for b in by_size}, key=int)
+    if not sizes:
+        return []
+    lines = [
+        "| pool | " + " | ".join(f"B = {b}: its shapes are worth (real shapes) [95%]" for b in sizes) + " |",
+        "|---|" + "---|" * len(sizes),
+    ]
+    for pool, by_size in shares.items():
+        cells = []
+        for b in sizes:
+            s = by_size.get(b)
+            cells.append("-" if s is None else f"{exchange_text(exchange_rate(s))} for {s['shapes']:.0f}")
+        lines.append(f"| {pool} | " + " | ".join(cells) + " |")
+    return lines + [
+        "",
+        "N of a pool's shapes are worth W real shapes when they raise AP as much as W more real shapes would, read "
+        "off the line between B and B + N real shapes (W = its share × N; the interval is the share's, by test "
+        "inversion; unbounded when the real shapes' own gain is not clearly nonzero; W above N extrapolates).",
+    ]
 
 
 def share_sentence(pool: str, base_size, s: dict) -> str:
