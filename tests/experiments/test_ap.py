@@ -116,7 +116,8 @@ def test_networks_are_read_from_the_seed_folders_given(tmp_path):
     seed_dirs = {3: tmp_path / "s3"}
     folder = seed_dirs[3] / "targeted" / "50-0"
     folder.mkdir(parents=True)
-    summary = {"validation": {"ap": 0.5}, "test": {"ap": 0.4, "roc_auc": 0.7}, "train": {"datapoints": 3550}}
+    train = {"datapoints": 3550, "positive_share": 0.02, "steps": 500, "generated_shapes_asked": 0}
+    summary = {"validation": {"ap": 0.5}, "test": {"ap": 0.4, "roc_auc": 0.7}, "train": train}
     (folder / "summary.json").write_text(json.dumps(summary))
     np.save(folder / "test_predictions.npy", np.array([0.1, 0.9], dtype=np.float32))
     runs = collect(seed_dirs, variants)
@@ -130,6 +131,10 @@ def test_networks_are_read_from_the_seed_folders_given(tmp_path):
             "test_ap": 0.4,
             "test_roc_auc": 0.7,
             "train_datapoints": 3550,
+            "train_positive_share": 0.02,
+            "train_steps": 500,
+            "generated_shapes_asked": 0,
+            "generated_shapes": None,  # what a summary does not say
         }
     ]
     # ratio 0 of any pool is the targeted network

@@ -199,7 +199,8 @@ def network_folder(seed_dir: Path, key: Key) -> Path:
 
 def collect(seed_dirs: Mapping[int, Path], variants) -> pd.DataFrame:
     """One row per network and seed: pool, base_size, ratio, seed, val_ap, test_ap, test_roc_auc,
-    train_datapoints (None when its summary does not say).
+    train_datapoints, train_positive_share, train_steps, generated_shapes_asked and generated_shapes (the pool's shapes
+    it was given: fewer when some did not mesh or yield datapoints; each None when its summary does not say).
     ``seed_dirs``: training seed → the folder of its networks (the seeds in this order)."""
     rows = []
     for seed, seed_dir in seed_dirs.items():
@@ -218,6 +219,10 @@ def collect(seed_dirs: Mapping[int, Path], variants) -> pd.DataFrame:
                     "test_ap": s["test"]["ap"],
                     "test_roc_auc": s["test"]["roc_auc"],
                     "train_datapoints": s.get("train", {}).get("datapoints"),
+                    "train_positive_share": s.get("train", {}).get("positive_share"),
+                    "train_steps": s.get("train", {}).get("steps"),
+                    "generated_shapes_asked": s.get("train", {}).get("generated_shapes_asked"),
+                    "generated_shapes": s.get("train", {}).get("generated_shapes"),
                 }
             )
     return pd.DataFrame(rows)

@@ -62,7 +62,7 @@ def run(
             read_table(clone / gqcnn_dir("original") / "index.parquet"), networks[p.gqcnn.seeds[0]]
         )
         seconds = round(time.perf_counter() - began)
-        meta = provenance(project, command) | {"profile": profile, "n_resamples": resamples, "seed": p.seed}
+        meta = provenance(clone, command) | {"profile": profile, "n_resamples": resamples, "seed": p.seed}  # its code
         add_attribution_draw(folder, k, networks, labels, objects, p.generate, p.gqcnn, meta | {"seconds": seconds})
         log.info("draw %d: done in %d s; its tables are in %s (commit them)", k, seconds, folder)
     result = combine_attribution(folder, draws)
