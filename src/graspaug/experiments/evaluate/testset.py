@@ -18,11 +18,11 @@ import pandas as pd
 
 from graspaug.augment.corpus import ingest_source
 from graspaug.errors import DataError
-from graspaug.geometry.loading import sha256_of
 from graspaug.geometry.settings import SurfaceSettings
 from graspaug.grasping.gripper import ParallelJawGripper
 from graspaug.grasping.labelled import grasps_of_shapes
 from graspaug.grasping.settings import GraspsSettings
+from graspaug.io.digest import sha256_of
 from graspaug.io.gqcnn import write_grasp_images
 from graspaug.io.meshes import MESH_SUFFIX
 from graspaug.io.sources import Source
