@@ -171,6 +171,13 @@ def check_output_folder(
             f"the output folder {out} is a symbolic link (to {os.readlink(out)}); give the folder itself, or a new one"
         )
     target = out.resolve()
+    for what, folder in [("the working folder", Path.cwd()), *homes]:
+        home = Path(folder).resolve()
+        if target == home or target in home.parents:
+            raise DataError(
+                f"the output folder {out} {'is' if target == home else 'holds'} {what} ({folder}); choose a folder "
+                "inside it or elsewhere"
+            )
     for folder in inputs:
         if folder is None:
             continue
@@ -180,13 +187,6 @@ def check_output_folder(
             raise DataError(
                 f"the output folder {out} {where} the input {folder}: writing it could delete the input; "
                 "choose an output folder outside it"
-            )
-    for what, folder in [("the working folder", Path.cwd()), *homes]:
-        home = Path(folder).resolve()
-        if target == home or target in home.parents:
-            raise DataError(
-                f"the output folder {out} {'is' if target == home else 'holds'} {what} ({folder}); choose a folder "
-                "inside it or elsewhere"
             )
     if out.exists() and not out.is_dir():
         raise DataError(f"the output folder {out} is a file; give a folder")

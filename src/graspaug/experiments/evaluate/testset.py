@@ -11,6 +11,7 @@ from __future__ import annotations
 import dataclasses
 import hashlib
 import json
+import logging
 from pathlib import Path
 
 import numpy as np
@@ -22,14 +23,17 @@ from graspaug.geometry.settings import SurfaceSettings
 from graspaug.grasping.gripper import ParallelJawGripper
 from graspaug.grasping.labelled import grasps_of_shapes
 from graspaug.grasping.settings import GraspsSettings
+from graspaug.io.atomic import atomic_path, exclusive_lock
 from graspaug.io.digest import sha256_of
 from graspaug.io.gqcnn import write_grasp_images
 from graspaug.io.meshes import MESH_SUFFIX
-from graspaug.io.sources import Source
-from graspaug.io.tables import write_table
+from graspaug.io.sources import Source, tag_cache
+from graspaug.io.tables import write_json, write_table
 from graspaug.render.corpus_dataset import datapoints_table, render_corpus, with_pool_columns
 from graspaug.render.dataset import datapoints_index
 from graspaug.render.settings import CropGeometry, Intrinsics, RenderSettings
+
+log = logging.getLogger(__name__)
 
 #: Bump when the layout of a test set folder changes, so older cached sets are not reused (a change to the code that
 #: makes one changes its key by itself: :func:`code_fingerprint`).
@@ -40,6 +44,7 @@ TESTSET_FORMAT = "graspaug.evaluate-testset/1"
 #: read from an older cached set.
 BUILDERS = (
     "graspaug.augment.corpus",
+    "graspaug.device",
     "graspaug.errors",
     "graspaug.experiments.evaluate.testset",
     "graspaug.geometry",
@@ -146,6 +151,39 @@ def fingerprint(sources: list[Source], recipe: TestSetRecipe, code: str) -> str:
             content = f"unreadable: {exc}"
         digest.update(f"{source.shape_id}\0{source.unit_scale!r}\0{content}\n".encode())
     return digest.hexdigest()
+
+
+def cached_test_set(sources: list[Source], recipe: TestSetRecipe, cache: Path, workers, shard_rows: int) -> Path:
+    """The folder of the test set of ``sources`` made by ``recipe``: ``<cache>/<key>/`` (the first 16 hex of
+    :func:`fingerprint`), built there by :func:`build_test_set` (its counts in ``counts.json``) unless it is. One writer
+    per key at a time: a second process asking for the same key waits for the first, then reads its set. The cache
+    folder is tagged (:func:`~graspaug.io.sources.tag_cache`), so no corpus walk reads its meshes as objects."""
+    folder = cache / fingerprint(sources, recipe, code_fingerprint())[:16]
+    tag_cache(cache)
+    with exclusive_lock(cache / f".{folder.name}.lock"):
+        if (folder / "counts.json").is_file():
+            log.info("evaluate: the test set is cached in %s", folder)
+            return folder
+        with atomic_path(folder, directory=True) as tmp:
+            write_json(build_test_set(sources, recipe, tmp, workers, shard_rows), tmp / "counts.json")
+    return folder
+
+
+def shaped_by(recipe: TestSetRecipe, counts: dict, params_file: Path | None, unit_scale: float) -> dict:
+    """What made a test set, for its report: ``params`` (the file, or "built-in defaults") and its ``params_sha256``,
+    the ``recipe`` fingerprint (16 hex), ``label_threshold`` (robust ε), ``size`` rule, ``max_width`` (m),
+    ``unit_scale`` (m per file unit), and from ``counts`` the objects ``fitted`` and their ``fit_scale`` range."""
+    return {
+        "params": "built-in defaults" if params_file is None else str(params_file),
+        "params_sha256": None if params_file is None else sha256_of(params_file),
+        "recipe": recipe_fingerprint(recipe)[:16],
+        "label_threshold": recipe.grasps.threshold,
+        "size": recipe.surface.size,
+        "max_width": recipe.surface.max_width,
+        "unit_scale": unit_scale,
+        "fitted": counts.get("fitted", 0),
+        "fit_scale": counts.get("fit_scale"),
+    }
 
 
 def build_test_set(sources: list[Source], recipe: TestSetRecipe, folder: Path, workers, shard_rows: int) -> dict:
