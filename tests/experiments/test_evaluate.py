@@ -267,3 +267,23 @@ def _recipe():
     )
     values = {k: getattr(card, k) for k in CARD_KEYS}
     return recipe_for(SurfaceSettings(), 10**6, 100.0, GraspsSettings(), RenderSettings(), 0, values)
+
+
+def test_the_report_says_how_many_objects_were_fitted_and_by_what_scale():
+    from graspaug.experiments.evaluate.words import shaped_by_text
+
+    made = {
+        "params": "params.yaml",
+        "params_sha256": "ab" * 32,
+        "recipe": "0123456789abcdef",
+        "label_threshold": 0.002,
+        "size": "fit",
+        "max_width": 0.08,
+        "unit_scale": 0.001,
+        "fitted": 3,
+        "fit_scale": [0.52, 0.91],
+    }
+    text = shaped_by_text(made, {"shapes": 12})
+    assert "params params.yaml (sha256 abababababab), recipe 0123456789abcdef; label: robust ε > 0.002" in text
+    assert "size rule `fit` (max width 0.08 m, unit scale 0.001 m per file unit); 3 of 12 objects fitted" in text
+    assert text.endswith("scaled by 0.52–0.91.")
