@@ -3,8 +3,10 @@ model's test AP with an interval over objects, the paired difference, the cached
 
 from __future__ import annotations
 
+import ast
 import json
 import os
+import shutil
 import time
 from pathlib import Path
 
@@ -85,11 +87,11 @@ def project(tmp_path_factory, repo_root):
     return root, corpus, models
 
 
-def _evaluate(root: Path, *args: str):
+def _evaluate(root: Path, *args: str, params: str | None = "params.yaml"):
     cwd = os.getcwd()
     os.chdir(root)
     try:
-        return CliRunner().invoke(app, ["evaluate", *args])
+        return CliRunner().invoke(app, ["evaluate", *args, *([] if params is None else ["--params", params])])
     finally:
         os.chdir(cwd)
 
@@ -106,16 +108,22 @@ def test_evaluate_prints_each_models_ap_and_the_paired_difference(project):
     assert first["over"] == "objects" and (first["mean"] is None or 0 <= first["mean"] <= 1)
     rejects = (root / "reports/evaluate/rejects.csv").read_text()
     assert "crate.stl" in rejects and "too large for the gripper" in rejects
-    assert "Test AP on" in (root / "reports/evaluate/report.md").read_text()
+    report_md = (root / "reports/evaluate/report.md").read_text()
+    assert "Test AP on" in report_md and "Test set shaped by: params params.yaml (sha256" in report_md
+    assert "label: robust ε > 0.0005; size rule `real` (max width 0.08 m" in report_md
+    shaped_by = report["shaped_by"]
+    assert shaped_by["params"] == "params.yaml" and shaped_by["label_threshold"] == 0.0005
+    assert shaped_by["size"] == "real" and shaped_by["fitted"] == 0 and shaped_by["fit_scale"] is None
 
-    cached = list((root / ".graspaug-cache/evaluate").iterdir())
+    cached = [p for p in (root / ".graspaug-cache/evaluate").iterdir() if p.is_dir()]
     assert len(cached) == 1
     made = cached[0].stat().st_mtime
     start = time.perf_counter()
     again = _evaluate(root, str(models[1]), "--corpus", str(corpus), "--resamples", "200")
     assert again.exit_code == 0, again.output
     assert time.perf_counter() - start < 20  # the cached test set: only the predictions
-    assert list((root / ".graspaug-cache/evaluate").iterdir()) == cached and cached[0].stat().st_mtime == made
+    assert [p for p in (root / ".graspaug-cache/evaluate").iterdir() if p.is_dir()] == cached
+    assert cached[0].stat().st_mtime == made
     second = json.loads((root / "reports/evaluate/evaluate.json").read_text())["models"][str(models[1])]
     assert second == report["models"][str(models[1])]  # the same test set, the same resamples
 
@@ -166,3 +174,116 @@ def test_the_test_set_keeps_real_size_or_fits_as_the_projects_ingest_does():
         surface = dataclasses.replace(SurfaceSettings(), size=asked)
         recipe = recipe_for(surface, 10**6, 100.0, GraspsSettings(), RenderSettings(), 0, values)
         assert recipe.surface.size == used and recipe.surface.max_width == pytest.approx(0.07)
+
+
+def test_evaluate_never_deletes_a_users_file_nor_writes_over_its_inputs(project, tmp_path):
+    """The issue's cases: `--out mine --force` deleted mine/notes.txt; `--out . --force` emptied the working folder;
+    `--cache o/cache --out o` deleted the cache. Every refusal comes before any work, in one line."""
+    root, corpus, models = project
+    mine = root / "mine"
+    mine.mkdir()
+    (mine / "notes.txt").write_text("my notes")
+    refused = _evaluate(root, str(models[0]), "--corpus", str(corpus), "--out", "mine", "--resamples", "100")
+    assert refused.exit_code == 2 and "holds notes.txt, which graspaug evaluate did not write" in refused.output
+    forced = _evaluate(root, str(models[0]), "--corpus", str(corpus), "--out", "mine", "--force", "--resamples", "100")
+    assert forced.exit_code == 0, forced.output
+    assert (mine / "notes.txt").read_text() == "my notes" and (mine / "report.md").is_file()
+    here = root / "here"
+    here.mkdir()
+    (here / "data.csv").write_text("mine")
+    dot = _evaluate(here, str(models[0]), "--corpus", str(corpus), "--out", ".", "--force", params="../params.yaml")
+    assert dot.exit_code == 2 and "output folder . is the working folder" in dot.output
+    assert os.listdir(here) == ["data.csv"]
+    cache = _evaluate(root, str(models[0]), "--corpus", str(corpus), "--cache", "o/cache", "--out", "o")
+    assert cache.exit_code == 2 and "holds the input o/cache" in cache.output and not (root / "o").exists()
+    shutil.copy(models[0], tmp_path / "m.pt")
+    model = _evaluate(root, str(tmp_path / "m.pt"), "--corpus", str(corpus), "--out", str(tmp_path), "--force")
+    assert model.exit_code == 2 and "holds the input" in model.output and "m.pt" in model.output
+    inside = _evaluate(root, str(models[0]), "--corpus", str(corpus), "--out", str(corpus / "report"))
+    assert inside.exit_code == 2 and "lies inside the input" in inside.output and not (corpus / "report").exists()
+
+
+def test_one_object_twice_from_inside_its_folder_the_same_objects_ap_and_no_interval(project, tmp_path):
+    """The issue's cases: run from inside the mesh folder, the default cache lies in the corpus and the second run
+    read its cached meshes as objects (2 → 4); one object printed a "95% interval" [x, x]; a non-UTF-8 file name
+    aborted the run; and the test set followed the params.yaml of the folder the command ran from."""
+    _, _, models = project
+    objects = tmp_path / "objects"
+    objects.mkdir()
+    trimesh.creation.box(extents=[0.05, 0.03, 0.08]).export(objects / "box.stl")
+    with open(os.path.join(os.fsencode(objects), b"caf\xe9.stl"), "w") as f:  # a name that is not UTF-8
+        f.write("not a mesh")
+    (objects / "params.yaml").write_text("seed: 0\ngrasps:\n  threshold: 0.5\n")  # not read: no --params
+    outputs = []
+    for run in range(2):
+        result = _evaluate(objects, str(models[0]), "--corpus", ".", "--out", str(tmp_path / f"r{run}"), params=None)
+        assert result.exit_code == 0, result.output
+        assert "test AP" in result.output and "(one object: no interval)" in result.output
+        outputs.append(json.loads((tmp_path / f"r{run}/evaluate.json").read_text()))
+    assert outputs[0]["counts"] == outputs[1]["counts"] and outputs[0]["counts"]["files"] == 2
+    assert outputs[0]["models"] == outputs[1]["models"] and outputs[0]["objects"] == 1
+    assert outputs[0]["models"][str(models[0])]["objects_low"] is None
+    assert outputs[0]["shaped_by"]["params"] == "built-in defaults" and outputs[0]["shaped_by"]["label_threshold"] > 0
+    assert (objects / ".graspaug-cache/evaluate/CACHEDIR.TAG").is_file()
+    rejects = (tmp_path / "r0/rejects.csv").read_text()
+    assert "folder:caf\\xe9.stl" in rejects
+    assert "one object: no interval" in (tmp_path / "r1/report.md").read_text()
+
+
+def test_the_test_set_key_holds_the_code_that_makes_it(tmp_path, monkeypatch):
+    """A change to the sampler, the renderer or prepare.FIT_SHARE reused old cached test sets: the key now holds a
+    digest of every source file of BUILDERS, which covers build_test_set's whole import closure."""
+    from graspaug.experiments.evaluate.testset import BUILDERS, code_fingerprint, fingerprint
+    from tests.test_dvc_deps import REPO, SRC, _is_inert, import_closure
+
+    closure = import_closure("graspaug.experiments.evaluate.testset", SRC)
+    covered = {m.replace(".", "/") for m in BUILDERS}
+    missing = [f for f in closure if not any(f.removeprefix("src/").startswith(c) for c in covered)]
+    code = [f for f in missing if not (f.endswith("__init__.py") and _is_inert(ast.parse((REPO / f).read_text())))]
+    assert code == [], code  # a package's __init__.py that holds only its docstring makes nothing
+    package = tmp_path / "somepkg"
+    package.mkdir()
+    (package / "__init__.py").write_text("")
+    (package / "sampler.py").write_text("N = 1\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    before = code_fingerprint(("somepkg",))
+    assert code_fingerprint(("somepkg",)) == before and code_fingerprint(("somepkg.sampler",)) != before
+    (package / "sampler.py").write_text("N = 2\n")
+    assert code_fingerprint(("somepkg",)) != before
+    assert code_fingerprint() == code_fingerprint() and len(code_fingerprint()) == 64
+    recipe_and_files = ([], _recipe())
+    assert fingerprint(*recipe_and_files, code="a") != fingerprint(*recipe_and_files, code="b")
+
+
+def _recipe():
+    from graspaug.experiments.evaluate.testset import CARD_KEYS, recipe_for
+    from graspaug.geometry.settings import SurfaceSettings
+    from graspaug.grasping.settings import GraspsSettings
+    from graspaug.planning.card import ModelCard
+    from graspaug.render.settings import RenderSettings
+
+    card = ModelCard.from_dict(
+        gqcnn_card(CropGeometry(), Intrinsics(), ViewpointRanges(), ParallelJawGripper(), 0.0005, 0), "depth"
+    )
+    values = {k: getattr(card, k) for k in CARD_KEYS}
+    return recipe_for(SurfaceSettings(), 10**6, 100.0, GraspsSettings(), RenderSettings(), 0, values)
+
+
+def test_the_report_says_how_many_objects_were_fitted_and_by_what_scale():
+    from graspaug.experiments.evaluate.words import shaped_by_text
+
+    made = {
+        "params": "params.yaml",
+        "params_sha256": "ab" * 32,
+        "recipe": "0123456789abcdef",
+        "label_threshold": 0.002,
+        "size": "fit",
+        "max_width": 0.08,
+        "unit_scale": 0.001,
+        "fitted": 3,
+        "fit_scale": [0.52, 0.91],
+    }
+    text = shaped_by_text(made, {"shapes": 12})
+    assert "params params.yaml (sha256 abababababab), recipe 0123456789abcdef; label: robust ε > 0.002" in text
+    assert "size rule `fit` (max width 0.08 m, unit scale 0.001 m per file unit); 3 of 12 objects fitted" in text
+    assert text.endswith("scaled by 0.52–0.91.")

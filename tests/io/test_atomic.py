@@ -38,3 +38,32 @@ def test_failed_block_keeps_the_old_file(tmp_path):
     except RuntimeError:
         pass
     assert target.read_text() == "old" and sorted(os.listdir(tmp_path)) == ["table.csv"]
+
+
+LOCK_HOLDER = textwrap.dedent("""
+    import sys, time
+    from pathlib import Path
+    from graspaug.io.atomic import exclusive_lock
+    with exclusive_lock(sys.argv[1]):
+        Path(sys.argv[2]).write_text("held")
+        time.sleep(1.0)
+        Path(sys.argv[2]).write_text("whole")
+""")
+
+
+def test_a_second_writer_waits_for_the_lock_and_then_sees_the_first_ones_work(tmp_path):
+    """Two evaluate runs on one fresh cache: the second failed on the first's vanished temporary folder; now the
+    second waits for the first's lock, then reads what it wrote."""
+    import time
+
+    from graspaug.io.atomic import exclusive_lock
+
+    lock, work = tmp_path / "cache/.key.lock", tmp_path / "work.txt"
+    first = subprocess.Popen([sys.executable, "-c", LOCK_HOLDER, str(lock), str(work)])
+    while not work.exists():
+        time.sleep(0.02)
+    start = time.perf_counter()
+    with exclusive_lock(lock):
+        waited = time.perf_counter() - start
+        assert work.read_text() == "whole"
+    assert first.wait() == 0 and waited > 0.5

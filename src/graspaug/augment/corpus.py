@@ -10,9 +10,10 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from graspaug.geometry.loading import MeshRejected, load_shape, sha256_of
+from graspaug.geometry.loading import MeshRejected, load_shape
 from graspaug.geometry.prepare import SurfaceSettings, prepare_shape
 from graspaug.geometry.voxelize import fit_grid, pack_bits, voxelize_solid
+from graspaug.io.digest import sha256_of
 from graspaug.io.meshes import mesh_path, write_mesh
 from graspaug.io.sources import Source
 

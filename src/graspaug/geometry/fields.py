@@ -57,7 +57,10 @@ def surface_from_field(field: np.ndarray, origin: np.ndarray, pitch: float, leve
     verts, faces, _, _ = marching_cubes(
         field, level=level, spacing=(pitch,) * 3, method="lewiner", allow_degenerate=False
     )
-    mesh = trimesh.Trimesh(verts + origin, faces, process=True)
+    # marching cubes shares its vertices already; trimesh's merge (process=True) would fuse the pairs closer than its
+    # tolerance (1e-8 m) that a sample on a face plane leaves, dropping triangles and opening a closed solid (a
+    # pyramid whose faces pass through samples came out in 6,700 pieces)
+    mesh = trimesh.Trimesh(verts + origin, faces, process=False)
     trimesh.repair.fix_normals(mesh)
     return mesh
 

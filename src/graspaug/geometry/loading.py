@@ -14,7 +14,6 @@ says which of these closed it (see :class:`LoadedShape`).
 
 from __future__ import annotations
 
-import hashlib
 import os
 from dataclasses import dataclass
 from pathlib import Path
@@ -50,15 +49,6 @@ class LoadedShape:
     mesh: trimesh.Trimesh
     parts: list[ConvexPart]
     closed_by: str = "as_is"
-
-
-def sha256_of(path: str | os.PathLike) -> str:
-    """Hex sha256 of a file's bytes."""
-    digest = hashlib.sha256()
-    with open(path, "rb") as f:
-        for block in iter(lambda: f.read(1 << 20), b""):
-            digest.update(block)
-    return digest.hexdigest()
 
 
 def by_geometry(mesh: trimesh.Trimesh) -> trimesh.Trimesh:

@@ -44,7 +44,7 @@ class SurfaceSettings:
             "arbitrary); `real`: each shape keeps its size in the file (times data.unit_scale), and shapes the "
             "gripper cannot take (min_extent, max_width) are rejected; `fit`: as `real`, but a shape too wide for the "
             "gripper is scaled down (its shape kept, its scale in the shape table) until its narrowest side is 0.9 "
-            "max_width."
+            "max_width; one it would scale by less than 0.5 is rejected (a unit mistake, or another object)."
         ),
     )
     min_extent: float = Field(

@@ -1,9 +1,11 @@
-"""Atomic writes: a file or folder appears under its final name complete, or not at all."""
+"""Atomic writes: a file or folder appears under its final name complete, or not at all; and the lock that keeps two
+writers of one shared folder (a cache entry) apart."""
 
 from __future__ import annotations
 
 import contextlib
 import glob
+import logging
 import os
 import shutil
 import tempfile
@@ -66,3 +68,24 @@ def atomic_paths(paths: Iterable[str | os.PathLike]) -> Iterator[list[Path]]:
     raises, no final name is touched and every temporary is removed."""
     with contextlib.ExitStack() as stack:  # exits in reverse order: the first path is moved in last
         yield [stack.enter_context(atomic_path(path)) for path in paths]
+
+
+@contextlib.contextmanager
+def exclusive_lock(path: str | os.PathLike) -> Iterator[None]:
+    """Hold an exclusive lock on the file ``path`` (made if missing; left in place) for the block: a second process
+    asking for it waits until the first leaves the block or dies (the system frees the lock of a dead process), so two
+    commands never write one cache entry at once."""
+    import fcntl
+
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with open(path, "a") as f:
+        try:
+            fcntl.flock(f, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            logging.getLogger(__name__).info("waiting for another process to release %s", path)
+            fcntl.flock(f, fcntl.LOCK_EX)
+        try:
+            yield
+        finally:
+            fcntl.flock(f, fcntl.LOCK_UN)

@@ -71,22 +71,48 @@ def _slug(text: str) -> str:
     return re.sub(r"[^A-Za-z0-9]+", "_", text).strip("_").lower() or "shape"
 
 
+#: The file that marks a cache folder (the Cache Directory Tagging convention, which backup tools honour too): a mesh
+#: folder walk never enters a folder holding it, so a tool's cache inside a corpus (``graspaug evaluate``'s test sets,
+#: meshes included) is never read as objects.
+CACHE_TAG = "CACHEDIR.TAG"
+CACHE_TAG_TEXT = "Signature: 8a477f597d28d172789f06886806bc55\n# graspaug's cache: its meshes are no corpus' objects\n"
+
+
+def tag_cache(folder: str | Path) -> None:
+    """Make ``folder`` (and its parents) and mark it a cache (:data:`CACHE_TAG`), so no corpus walk enters it."""
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    if not (folder / CACHE_TAG).is_file():
+        (folder / CACHE_TAG).write_text(CACHE_TAG_TEXT)
+
+
+def portable_name(relative: str) -> str:
+    """A file's path relative to its folder as text that any table can hold: bytes that are not UTF-8 (a name
+    os.walk decoded with surrogate escapes) shown as ``\\xNN``."""
+    return os.fsencode(relative).decode("utf-8", "backslashreplace")
+
+
 def folder_sources(folder: str | Path, unit_scale: float = 1.0, limit: int | None = None) -> list[Source]:
-    """Every mesh file under ``folder`` (recursively), sorted; ids from the relative path."""
+    """Every mesh file under ``folder`` (recursively, any file name, folders tagged as caches skipped), sorted; ids
+    from the relative path."""
     folder = Path(folder).resolve()
     if not folder.is_dir():
         raise FileNotFoundError(f"mesh folder not found: {folder}")
     # every entry with a mesh suffix, links and special files too (ingest reads or rejects each
-    # with a reason); linked folders are not entered
-    files = sorted(
-        Path(root, name)
-        for root, dirs, names in os.walk(folder)
-        for name in [*names, *dirs]
-        if Path(name).suffix.lower() in MESH_SUFFIXES and (name in names or os.path.islink(os.path.join(root, name)))
-    )
+    # with a reason); linked folders are not entered, nor caches
+    files = []
+    for root, dirs, names in os.walk(folder):
+        dirs[:] = [d for d in dirs if not os.path.isfile(os.path.join(root, d, CACHE_TAG))]
+        files += [
+            Path(root, name)
+            for name in [*names, *dirs]
+            if Path(name).suffix.lower() in MESH_SUFFIXES
+            and (name in names or os.path.islink(os.path.join(root, name)))
+        ]
+    files.sort()
     out, seen = [], set()
     for path in files:
-        rel = path.relative_to(folder).as_posix()
+        rel = portable_name(path.relative_to(folder).as_posix())
         shape_id = base = f"f_{_slug(rel.rsplit('.', 1)[0])}"
         n = 1
         while shape_id in seen:

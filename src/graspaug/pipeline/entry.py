@@ -30,13 +30,13 @@ import typer
 from graspaug.pipeline.command import Command, debug_mode
 
 
-def load_params(path: Path, model):
-    """The params ``model`` (a stage's ``Params``) reads from the file at ``path`` (a bad one: ParamsError, exit 2);
-    logging goes to stderr from here on."""
+def load_params(path: Path | None, model):
+    """The params ``model`` (a stage's ``Params``) reads from the file at ``path`` (a bad one: ParamsError, exit 2;
+    None: the built-in defaults); logging goes to stderr from here on."""
     from graspaug.pipeline.params.base import load
 
     logging.basicConfig(level=logging.INFO, format="%(asctime)s %(levelname)s %(name)s: %(message)s", stream=sys.stderr)
-    return load(path, model)
+    return model() if path is None else load(path, model)
 
 
 def run_stage(run: Callable[..., None], params, *args: Any) -> None:
@@ -87,6 +87,7 @@ def stage_main(module: str, **options: tuple[type, Any]) -> None:
     app(prog_name=f"python -m {module}")
 
 
-def load_stage_params(path: Path, stage):
-    """The params ``stage`` (a stage module) reads from the file at ``path`` (a bad one: ParamsError, exit 2)."""
+def load_stage_params(path: Path | None, stage):
+    """The params ``stage`` (a stage module) reads from the file at ``path`` (a bad one: ParamsError, exit 2; None: the
+    built-in defaults)."""
     return load_params(path, stage.Params)

@@ -121,12 +121,20 @@ def from_failures_command(
 @planner_app.command(
     cls=Command,
     name="evaluate",
-    help="Test trained GQ-CNNs on your own objects: every mesh under --corpus (.obj .stl .ply .off .glb, metres "
-    "unless --unit-scale) is ingested at real size, its grasps sampled and labelled, its datapoints rendered for the "
-    "models' camera (their card), as the pipeline makes its test set; prints each model's test AP with a 95% interval "
-    "over objects and the paired difference of each model against the first. The test set is cached by the files' "
-    "content and those settings (--cache), so another model costs seconds. Writes report.md, evaluate.json and "
-    "rejects.csv into --out.",
+    help="Test trained GQ-CNNs on your own objects: every mesh under --corpus (.obj .stl .ply .off .glb, any file "
+    "name; metres unless --unit-scale) is ingested at real size, its grasps sampled and labelled, its datapoints "
+    "rendered for the models' camera (their card), as the pipeline makes its test set; prints each model's test AP "
+    "with a 95% interval over objects (none with one object) and the paired difference of each model against the "
+    "first. The test set is made by the built-in default params, wherever the command runs from, unless --params "
+    "names a file (e.g. a project's params.yaml: its ingest, grasps and render sections; `ingest.surface.size: fit` "
+    "scales objects too wide for the gripper down, refusing one it would shrink by more than half). It is cached by "
+    "the files' content, those settings and the code that makes it (--cache; never read as objects, even inside "
+    "--corpus; a second run at once waits for the first), so another model costs seconds.\n\nWrites report.md, "
+    "evaluate.json (each AP and difference, the counts, and what shaped the test set: params, recipe fingerprint, "
+    "label threshold, size rule, objects fitted and by what scale) and rejects.csv into --out. An existing --out "
+    "holding a file evaluate did not write (or one changed since) is refused before any work (--force writes beside "
+    "it, keeping it); --out is refused when it is or holds the working folder, the --params file's folder, --corpus, "
+    "--cache or a model, or lies inside --corpus, or cannot be written.\n\n" + EXIT_CODES,
 )
 def evaluate_command(
     models: list[Path] = typer.Argument(..., help="Trained GQ-CNNs (model.pt); the first is the reference."),
@@ -137,12 +145,18 @@ def evaluate_command(
     limit: int | None = typer.Option(None, "--limit", min=1, help="Use only the first N files in sorted order."),
     resamples: int = typer.Option(1000, "--resamples", min=100, help="Bootstrap resamples of the objects."),
     force: bool = ForceOption,
-    params: Path = ParamsOption,
+    params: Path | None = typer.Option(
+        None,
+        "--params",
+        "-p",
+        help="The params file whose ingest, grasps and render sections make the test set "
+        "(default: the built-in defaults, not the params.yaml of the folder it runs from).",
+    ),
 ) -> None:
     import graspaug.pipeline.stages.evaluate as command
 
     settings = load_stage_params(params, command)
-    for line in command.run(settings, models, corpus, out, cache, unit_scale, limit, resamples, force):
+    for line in command.run(settings, models, corpus, out, cache, unit_scale, limit, resamples, force, params):
         typer.echo(line)
 
 

@@ -24,7 +24,8 @@ def test_ap(
     Returns
     -------
     ``{"models": name → contrast over objects (AP, 95% interval), "differences": "<name> − <first>" → contrast over
-    objects, "datapoints", "positives", "objects"}``; an AP is None when no datapoint is positive.
+    objects, "datapoints", "positives", "objects"}``; an AP is None when no datapoint is positive, an interval None
+    with one object (resampling one object gives its AP every time: no interval).
     """
     labels = np.asarray(labels, dtype=bool)
     boot = ObjectBootstrap(object_ids, n_resamples, seed)
@@ -34,13 +35,13 @@ def test_ap(
         ap = float(weighted_average_precision(labels[order].astype(np.float32), np.ones(len(labels), np.float32)))
         point[name] = None if np.isnan(ap) else ap
         resampled[name] = boot.average_precision(labels, p)
-        models[name] = contrast(point[name], "objects", objects=percentile_interval(resampled[name]))
+        models[name] = contrast(point[name], "objects", objects=_interval(resampled[name], boot.n_objects))
     first = next(iter(probabilities))
     differences = {}
     for name in list(probabilities)[1:]:
         mean = None if point[name] is None or point[first] is None else point[name] - point[first]
         diff = resampled[name] - resampled[first]  # paired: the same resamples
-        differences[f"{name} − {first}"] = contrast(mean, "objects", objects=percentile_interval(diff))
+        differences[f"{name} − {first}"] = contrast(mean, "objects", objects=_interval(diff, boot.n_objects))
     return {
         "models": models,
         "differences": differences,
@@ -48,3 +49,8 @@ def test_ap(
         "positives": int(labels.sum()),
         "objects": int(boot.n_objects),
     }
+
+
+def _interval(resampled: np.ndarray, n_objects: int) -> tuple[float, float] | None:
+    """The 95% percentile interval of (n_resamples,) ``resampled`` values; None over fewer than two objects."""
+    return percentile_interval(resampled) if n_objects > 1 else None

@@ -11,6 +11,7 @@ from __future__ import annotations
 import dataclasses
 import hashlib
 import json
+import logging
 from pathlib import Path
 
 import numpy as np
@@ -18,21 +19,42 @@ import pandas as pd
 
 from graspaug.augment.corpus import ingest_source
 from graspaug.errors import DataError
-from graspaug.geometry.loading import sha256_of
 from graspaug.geometry.settings import SurfaceSettings
 from graspaug.grasping.gripper import ParallelJawGripper
 from graspaug.grasping.labelled import grasps_of_shapes
 from graspaug.grasping.settings import GraspsSettings
+from graspaug.io.atomic import atomic_path, exclusive_lock
+from graspaug.io.digest import sha256_of
 from graspaug.io.gqcnn import write_grasp_images
 from graspaug.io.meshes import MESH_SUFFIX
-from graspaug.io.sources import Source
-from graspaug.io.tables import write_table
+from graspaug.io.sources import Source, tag_cache
+from graspaug.io.tables import write_json, write_table
 from graspaug.render.corpus_dataset import datapoints_table, render_corpus, with_pool_columns
 from graspaug.render.dataset import datapoints_index
 from graspaug.render.settings import CropGeometry, Intrinsics, RenderSettings
 
-#: Bump when the way a test set is made changes, so older cached sets are not reused.
+log = logging.getLogger(__name__)
+
+#: Bump when the layout of a test set folder changes, so older cached sets are not reused (a change to the code that
+#: makes one changes its key by itself: :func:`code_fingerprint`).
 TESTSET_FORMAT = "graspaug.evaluate-testset/1"
+
+#: The packages and modules whose code makes a test set (:func:`build_test_set`'s import closure, checked by a test):
+#: a change to any of their source files gives new cache keys, so a changed sampler, renderer or size rule is never
+#: read from an older cached set.
+BUILDERS = (
+    "graspaug.augment.corpus",
+    "graspaug.device",
+    "graspaug.errors",
+    "graspaug.experiments.evaluate.testset",
+    "graspaug.geometry",
+    "graspaug.grasping",
+    "graspaug.io",
+    "graspaug.parallel",
+    "graspaug.render",
+    "graspaug.rng",
+    "graspaug.settings",
+)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -92,10 +114,36 @@ def recipe_for(
     )
 
 
-def fingerprint(sources: list[Source], recipe: TestSetRecipe) -> str:
-    """A 64-hex key of the files' content (sha256 of each, with its id and unit scale) and the ``recipe``: equal keys,
-    the same test set. A file that cannot be read hashes as its error, so the key still changes when it does."""
-    digest = hashlib.sha256(json.dumps(recipe.as_dict(), sort_keys=True, default=str).encode())
+def code_fingerprint(modules: tuple[str, ...] = BUILDERS) -> str:
+    """A 64-hex digest of the package version and of every source file of ``modules`` (a package: each ``.py`` under
+    it; their paths relative to the top package and their bytes), found without importing them."""
+    from importlib.metadata import version
+    from importlib.util import find_spec
+
+    files = set()
+    for name in modules:
+        spec = find_spec(name)
+        if spec is None or spec.origin is None:
+            raise ValueError(f"{name}: no such module")
+        origin = Path(spec.origin)
+        files |= set(origin.parent.rglob("*.py")) if spec.submodule_search_locations else {origin}
+    top = Path(find_spec(modules[0].split(".")[0]).origin).parent
+    digest = hashlib.sha256(f"graspaug {version('graspaug')}\n".encode())
+    for path in sorted(files):
+        digest.update(f"{path.relative_to(top).as_posix()}\0{sha256_of(path)}\n".encode())
+    return digest.hexdigest()
+
+
+def recipe_fingerprint(recipe: TestSetRecipe) -> str:
+    """A 64-hex digest of the ``recipe`` alone: two runs with equal ones made their test sets the same way."""
+    return hashlib.sha256(json.dumps(recipe.as_dict(), sort_keys=True, default=str).encode()).hexdigest()
+
+
+def fingerprint(sources: list[Source], recipe: TestSetRecipe, code: str) -> str:
+    """A 64-hex key of the files' content (sha256 of each, with its id and unit scale), the ``recipe`` and ``code``
+    (:func:`code_fingerprint`): equal keys, the same test set. A file that cannot be read hashes as its error, so the
+    key still changes when it does."""
+    digest = hashlib.sha256(f"{recipe_fingerprint(recipe)}\0{code}\n".encode())
     for source in sources:
         try:
             content = sha256_of(source.path)
@@ -105,11 +153,46 @@ def fingerprint(sources: list[Source], recipe: TestSetRecipe) -> str:
     return digest.hexdigest()
 
 
+def cached_test_set(sources: list[Source], recipe: TestSetRecipe, cache: Path, workers, shard_rows: int) -> Path:
+    """The folder of the test set of ``sources`` made by ``recipe``: ``<cache>/<key>/`` (the first 16 hex of
+    :func:`fingerprint`), built there by :func:`build_test_set` (its counts in ``counts.json``) unless it is. One writer
+    per key at a time: a second process asking for the same key waits for the first, then reads its set. The cache
+    folder is tagged (:func:`~graspaug.io.sources.tag_cache`), so no corpus walk reads its meshes as objects."""
+    folder = cache / fingerprint(sources, recipe, code_fingerprint())[:16]
+    tag_cache(cache)
+    with exclusive_lock(cache / f".{folder.name}.lock"):
+        if (folder / "counts.json").is_file():
+            log.info("evaluate: the test set is cached in %s", folder)
+            return folder
+        with atomic_path(folder, directory=True) as tmp:
+            write_json(build_test_set(sources, recipe, tmp, workers, shard_rows), tmp / "counts.json")
+    return folder
+
+
+def shaped_by(recipe: TestSetRecipe, counts: dict, params_file: Path | None, unit_scale: float) -> dict:
+    """What made a test set, for its report: ``params`` (the file, or "built-in defaults") and its ``params_sha256``,
+    the ``recipe`` fingerprint (16 hex), ``label_threshold`` (robust ε), ``size`` rule, ``max_width`` (m),
+    ``unit_scale`` (m per file unit), and from ``counts`` the objects ``fitted`` and their ``fit_scale`` range."""
+    return {
+        "params": "built-in defaults" if params_file is None else str(params_file),
+        "params_sha256": None if params_file is None else sha256_of(params_file),
+        "recipe": recipe_fingerprint(recipe)[:16],
+        "label_threshold": recipe.grasps.threshold,
+        "size": recipe.surface.size,
+        "max_width": recipe.surface.max_width,
+        "unit_scale": unit_scale,
+        "fitted": counts.get("fitted", 0),
+        "fit_scale": counts.get("fit_scale"),
+    }
+
+
 def build_test_set(sources: list[Source], recipe: TestSetRecipe, folder: Path, workers, shard_rows: int) -> dict:
     """Make the test set of ``sources`` in ``folder`` (an empty folder the caller writes atomically).
 
-    Returns its counts: ``files``, ``shapes`` (ingested), ``rejected``, ``with_datapoints``, ``datapoints``, ``size``,
-    ``positives``. Raises :class:`DataError` when no file gives a datapoint (with the commonest reasons).
+    Returns its counts: ``files``, ``shapes`` (ingested), ``rejected``, ``with_datapoints``, ``datapoints``,
+    ``positives``, ``size`` (the size rule), ``fitted`` (shapes scaled down to fit the gripper) and ``fit_scale``
+    ([smallest, largest] factor they were scaled by; None when none was).
+    Raises :class:`DataError` when no file gives a datapoint (with the commonest reasons).
     """
     from graspaug.parallel import parallel_map
 
@@ -129,6 +212,9 @@ def build_test_set(sources: list[Source], recipe: TestSetRecipe, folder: Path, w
     if not kept:
         raise DataError(f"no usable mesh among {len(sources)} files; reasons: {_commonest(rejects['reason'])}")
     shapes = with_pool_columns(pd.DataFrame(kept).assign(origin="original", split="test"))
+    unit = {s.shape_id: s.unit_scale for s in sources}
+    factor = shapes["scale"].to_numpy(float) / shapes["shape_id"].map(unit).to_numpy(float)  # the size rule's own
+    fitted = factor[factor < 1 - 1e-9]
     write_table(shapes, folder / "shapes.parquet")
 
     ids = list(shapes["shape_id"])
@@ -161,6 +247,8 @@ def build_test_set(sources: list[Source], recipe: TestSetRecipe, folder: Path, w
         "datapoints": len(index),
         "positives": int(index["label"].sum()),
         "size": recipe.surface.size,  # real, or fit: too wide for the gripper scaled down until it fits
+        "fitted": len(fitted),
+        "fit_scale": [float(fitted.min()), float(fitted.max())] if len(fitted) else None,
     }
 
 

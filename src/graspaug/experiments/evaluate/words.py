@@ -1,4 +1,5 @@
-"""``graspaug evaluate``'s report: the models' test AP and their paired differences, in a table and in words."""
+"""``graspaug evaluate``'s report: the models' test AP and their paired differences, in a table and in words, and what
+shaped the test set."""
 
 from __future__ import annotations
 
@@ -10,9 +11,42 @@ SIZE_WORDS = {
 }
 
 
-def report_markdown(result: dict, corpus: str, counts: dict, camera: str) -> str:
+def ap_text(c: dict, objects: int, spec: str = "+.4f") -> str:
+    """A contrast of :func:`~graspaug.experiments.evaluate.numbers.test_ap` as ``mean [low, high]``, or with one
+    object ``mean (one object: no interval)``."""
+    if objects == 1 and c.get("mean") is not None:
+        return f"{format(c['mean'], spec)} (one object: no interval)"
+    return interval_text(c, spec)
+
+
+def shaped_by_text(shaped_by: dict, counts: dict) -> str:
+    """One paragraph: the params, recipe fingerprint, label threshold, size rule and the objects fitted (how many, by
+    what scale) behind a test set (``shaped_by``: the ``shaped_by`` of evaluate.json)."""
+    params = shaped_by["params"]
+    params = params if shaped_by["params_sha256"] is None else f"{params} (sha256 {shaped_by['params_sha256'][:12]})"
+    fitted = ""
+    if shaped_by["size"] == "fit":
+        scale = shaped_by["fit_scale"]
+        by = f", scaled by {scale[0]:.3g}–{scale[1]:.3g}" if scale else ""
+        fitted = f"; {shaped_by['fitted']} of {counts['shapes']} objects fitted to the gripper{by}"
+    return (
+        f"Test set shaped by: params {params}, recipe {shaped_by['recipe']}; label: robust ε > "
+        f"{shaped_by['label_threshold']:g}; size rule `{shaped_by['size']}` (max width {shaped_by['max_width']:g} m, "
+        f"unit scale {shaped_by['unit_scale']:g} m per file unit){fitted}."
+    )
+
+
+def report_markdown(result: dict, corpus: str, counts: dict, camera: str, shaped_by: dict) -> str:
     """report.md of :func:`graspaug.experiments.evaluate.numbers.test_ap`'s ``result`` on the test set of folder
-    ``corpus`` (``counts``: :func:`graspaug.experiments.evaluate.testset.build_test_set`'s), rendered for ``camera``."""
+    ``corpus`` (``counts``: :func:`graspaug.experiments.evaluate.testset.build_test_set`'s), rendered for ``camera``,
+    made as ``shaped_by`` says (:func:`shaped_by_text`)."""
+    objects = result["objects"]
+    over = (
+        "one object: no interval (resampling one object gives its AP every time)"
+        if objects == 1
+        else f"Intervals: 95% percentile bootstrap over the {objects} objects (every datapoint of a drawn object comes "
+        "along); the differences are paired, over the same datapoints and resamples"
+    )
     lines = [
         f"# Test AP on {corpus}",
         "",
@@ -20,16 +54,20 @@ def report_markdown(result: dict, corpus: str, counts: dict, camera: str) -> str
         f"({counts['rejected']} rejected, "
         f"see rejects.csv), {counts['with_datapoints']} with datapoints; {result['datapoints']} datapoints, "
         f"{result['positives']} positive ({result['positives'] / max(result['datapoints'], 1):.1%}), rendered for "
-        f"{camera}. Intervals: 95% percentile bootstrap over the {result['objects']} objects (every datapoint of a "
-        "drawn object comes along); the differences are paired, over the same datapoints and resamples.",
+        f"{camera}. {over}.",
+        "",
+        shaped_by_text(shaped_by, counts),
         "",
         "| model | test AP [95% interval over objects] |",
         "|---|---|",
-        *(f"| {name} | {interval_text(c, '.4f')} |" for name, c in result["models"].items()),
+        *(f"| {name} | {ap_text(c, objects, '.4f')} |" for name, c in result["models"].items()),
     ]
     if result["differences"]:
         lines += ["", "| difference | AP [95% interval over objects] | verdict |", "|---|---|---|"]
-        lines += [f"| {name} | {interval_text(c)} | {verdict(c)} |" for name, c in result["differences"].items()]
+        lines += [
+            f"| {name} | {ap_text(c, objects)} | {verdict(c) if objects > 1 else 'one object: no verdict'} |"
+            for name, c in result["differences"].items()
+        ]
     lines += [
         "",
         "The interval covers these objects' resampling only, not another draw of objects of the same kind nor "

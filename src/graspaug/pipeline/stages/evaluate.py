@@ -3,28 +3,26 @@ command whose adapter sits here as it knows the file names.
 
 The folder is ingested as the pipeline ingests (``ingest`` params, real size kept: ``ingest.surface.size: real``),
 grasps sampled and labelled by the ``grasps`` params with the models' gripper and label threshold, datapoints rendered
-by the ``render`` params with the models' camera (their model card). The test set is cached in ``<cache>/<key>/``
-(:func:`~graspaug.experiments.evaluate.testset.fingerprint`): another model costs its predictions. Writes into
-``out`` (refused if it holds files this command did not write): ``report.md``, ``evaluate.json`` (every AP and
-difference as a contrast, the counts, the cache key) and ``rejects.csv`` (the files not used, and why).
+by the ``render`` params with the models' camera (their model card); the params are the built-in defaults unless
+``--params FILE`` names a file, wherever the command runs. The test set is cached
+(:func:`~graspaug.experiments.evaluate.testset.cached_test_set`). Writes into ``out`` through its manifest
+(:mod:`graspaug.io.outputs`; every check before any work): ``report.md``, ``evaluate.json`` (every AP and difference as
+a contrast, the counts, the cache key, what shaped the test set) and ``rejects.csv`` (the files not used, and why).
 """
 
 from __future__ import annotations
 
 import json
-import logging
 from pathlib import Path
 
 from graspaug.device import resolve_device
 from graspaug.errors import DataError
 from graspaug.experiments.evaluate.numbers import test_ap
-from graspaug.experiments.evaluate.testset import CARD_KEYS, build_test_set, fingerprint, recipe_for
-from graspaug.experiments.evaluate.words import report_markdown
-from graspaug.experiments.stats import interval_text
-from graspaug.io.atomic import atomic_path
+from graspaug.experiments.evaluate.testset import CARD_KEYS, cached_test_set, recipe_for, shaped_by
+from graspaug.experiments.evaluate.words import ap_text, report_markdown
 from graspaug.io.checkpoints import read_gqcnn
 from graspaug.io.gqcnn import GraspImages
-from graspaug.io.outputs import check_output_folder, mark
+from graspaug.io.outputs import output_folder
 from graspaug.io.sources import folder_sources
 from graspaug.io.tables import read_table, write_csv, write_json
 from graspaug.pipeline.params.base import params_model
@@ -33,8 +31,6 @@ from graspaug.pipeline.params.ingest import IngestParams
 from graspaug.pipeline.params.render import RenderParams
 from graspaug.planning.card import ModelCard
 from graspaug.training.gqcnn import GraspArrays, predict
-
-log = logging.getLogger(__name__)
 
 Params = params_model(
     "The params `graspaug evaluate` reads.", ingest=IngestParams, grasps=GraspsParams, render=RenderParams
@@ -51,50 +47,45 @@ def run(
     limit: int | None,
     n_resamples: int,
     force: bool,
+    params_file: Path | None = None,
 ) -> list[str]:
-    """Evaluate ``models`` on the meshes of ``corpus``; the printed lines (one per model and difference)."""
+    """Evaluate ``models`` on the meshes of ``corpus``; the printed lines (one per model and difference).
+    ``params_file``: the file ``params`` came from (None: the built-in defaults), named in the report."""
     if not corpus.is_dir():
         raise DataError(f"--corpus {corpus}: no such folder")
-    sources = folder_sources(corpus, unit_scale, limit)
-    if not sources:
-        raise DataError(f"--corpus {corpus}: no mesh files (.obj .stl .ply .off .glb) in it")
     if len({str(m) for m in models}) < len(models):
         raise DataError("a model is named twice; name each once")
-    check_output_folder(out, "evaluate", inputs=[corpus], force=force)
-    nets, cards = {}, {}
-    for path in models:
-        nets[str(path)], card = read_gqcnn(path)
-        cards[str(path)] = ModelCard.from_dict(card, nets[str(path)].config.image_input)
-    first = next(iter(cards))
-    for name, card in cards.items():
-        differs = [k for k in CARD_KEYS if getattr(card, k) != getattr(cards[first], k)]
-        if differs:
-            raise DataError(f"model {name}: its card's {differs[0]} differs from {first}'s; evaluate them separately")
+    homes = [] if params_file is None else [("the project of --params", Path(params_file).absolute().parent)]
+    with output_folder(out, "evaluate", [corpus, cache, *models], force, homes) as staging:
+        sources = folder_sources(corpus, unit_scale, limit)
+        if not sources:
+            raise DataError(f"--corpus {corpus}: no mesh files (.obj .stl .ply .off .glb) in it")
+        nets, cards = {}, {}
+        for path in models:
+            nets[str(path)], card = read_gqcnn(path)
+            cards[str(path)] = ModelCard.from_dict(card, nets[str(path)].config.image_input)
+        first = next(iter(cards))
+        for name, card in cards.items():
+            differs = [k for k in CARD_KEYS if getattr(card, k) != getattr(cards[first], k)]
+            if differs:
+                raise DataError(f"model {name}: its card's {differs[0]} differs from {first}'s; evaluate them apart")
 
-    i, card = params.ingest, {k: getattr(cards[first], k) for k in CARD_KEYS}
-    recipe = recipe_for(i.surface, i.max_faces, i.max_file_mb, params.grasps, params.render, params.seed, card)
-    key = fingerprint(sources, recipe)[:16]
-    folder = cache / key
-    if (folder / "counts.json").is_file():
-        log.info("evaluate: the test set of %s is cached in %s", corpus, folder)
-    else:
-        with atomic_path(folder, directory=True) as tmp:
-            write_json(
-                build_test_set(sources, recipe, tmp, params.workers, params.render.shard_rows), tmp / "counts.json"
-            )
-    counts = json.loads((folder / "counts.json").read_text())
-    data = GraspImages.open(folder / "gqcnn")
-    arrays = GraspArrays(data.images(), data.read("z"), data.read("labels"))
-    device = resolve_device(params.device)
-    probabilities = {name: predict(net.to(device), arrays, device) for name, net in nets.items()}
-    result = test_ap(arrays.labels, data.index["shape_id"].to_numpy(), probabilities, n_resamples, params.seed)
+        i, card = params.ingest, {k: getattr(cards[first], k) for k in CARD_KEYS}
+        recipe = recipe_for(i.surface, i.max_faces, i.max_file_mb, params.grasps, params.render, params.seed, card)
+        folder = cached_test_set(sources, recipe, cache, params.workers, params.render.shard_rows)
+        counts = json.loads((folder / "counts.json").read_text())
+        data = GraspImages.open(folder / "gqcnn")
+        arrays = GraspArrays(data.images(), data.read("z"), data.read("labels"))
+        device = resolve_device(params.device)
+        probabilities = {name: predict(net.to(device), arrays, device) for name, net in nets.items()}
+        result = test_ap(arrays.labels, data.index["shape_id"].to_numpy(), probabilities, n_resamples, params.seed)
 
-    camera = f"the models' camera ({cards[first].camera_distance[0]:g}-{cards[first].camera_distance[1]:g} m)"
-    with atomic_path(out, directory=True) as tmp:
-        (tmp / "report.md").write_text(report_markdown(result, str(corpus), counts, camera))
-        write_json({**result, "counts": counts, "corpus": str(corpus), "test_set": key}, tmp / "evaluate.json")
-        write_csv(read_table(folder / "rejects.parquet")[["source", "reason"]], tmp / "rejects.csv")
-        mark(tmp, "evaluate")
-    lines = [f"{name}: test AP {interval_text(c, '.4f')}" for name, c in result["models"].items()]
-    lines += [f"{name}: {interval_text(c)}" for name, c in result["differences"].items()]
+        made = shaped_by(recipe, counts, params_file, unit_scale)
+        camera = f"the models' camera ({cards[first].camera_distance[0]:g}-{cards[first].camera_distance[1]:g} m)"
+        (staging / "report.md").write_text(report_markdown(result, str(corpus), counts, camera, made))
+        summary = {**result, "counts": counts, "corpus": str(corpus), "test_set": folder.name, "shaped_by": made}
+        write_json(summary, staging / "evaluate.json")
+        write_csv(read_table(folder / "rejects.parquet")[["source", "reason"]], staging / "rejects.csv")
+    lines = [f"{name}: test AP {ap_text(c, result['objects'], '.4f')}" for name, c in result["models"].items()]
+    lines += [f"{name}: {ap_text(c, result['objects'])}" for name, c in result["differences"].items()]
     return lines + [f"({result['objects']} objects, {result['datapoints']} datapoints; wrote {out / 'report.md'})"]
