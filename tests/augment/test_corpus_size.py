@@ -95,7 +95,7 @@ def test_fit_keeps_what_the_gripper_takes_and_shrinks_what_it_cannot(tmp_path):
 
 def test_fit_refuses_to_shrink_past_half_and_names_the_unit_mistake(tmp_path):
     """The issue's case: an 80 × 50 × 100 mm box written in millimetres was kept at scale 0.00144 (a metre-wide box
-    shrunk); `fit` refuses a scale below FIT_MIN_SCALE, and a shape 100× too wide or more names --unit-scale."""
+    shrunk); `fit` refuses a scale below fit_min_scale, and a shape 100× too wide or more names --unit-scale."""
     fit = SurfaceSettings(size="fit", resolution=32, finest_resolution=32)
     box_mm = trimesh.creation.box(extents=[80.0, 50.0, 100.0])
     read_as_metres = ingest_source(source_of(box_mm, tmp_path, "box_mm"), 10**6, 10.0, fit, tmp_path)
@@ -106,6 +106,8 @@ def test_fit_refuses_to_shrink_past_half_and_names_the_unit_mistake(tmp_path):
     big = trimesh.creation.box(extents=[0.4, 0.3, 0.2])  # a real 20 cm-deep object: fitting would take it to 0.36
     halved = ingest_source(source_of(big, tmp_path, "big"), 10**6, 10.0, fit, tmp_path)
     assert not halved["ok"] and "scale it by 0.36 < 0.5" in halved["reason"] and "unit" not in halved["reason"]
+    lowered = SurfaceSettings(size="fit", resolution=32, finest_resolution=32, fit_min_scale=0.2)  # real_objects'
+    assert ingest_source(source_of(big, tmp_path, "big_kept"), 10**6, 10.0, lowered, tmp_path)["ok"]
     real = ingest_source(source_of(box_mm, tmp_path, "box_real"), 10**6, 10.0, REAL, tmp_path)
     assert not real["ok"] and "smallest side 50.000 m > max_width=0.08 m" in real["reason"]
     assert "--unit-scale 0.001" in real["reason"]  # the same hint at real size

@@ -28,9 +28,6 @@ class PreparedShape:
 
 
 FIT_SHARE = 0.9  # size `fit`: a shape too wide for the gripper is scaled until its narrowest side is this share of it
-#: Size `fit` rejects a shape it would scale by less than this: shrinking a real object to under half its size makes
-#: another object, and a file in other units (millimetres read as metres) would otherwise pass unnoticed.
-FIT_MIN_SCALE = 0.5
 #: How many times too wide for the gripper a shape must be for its reject to name the likely unit mistake.
 UNIT_MISTAKE = 100.0
 UNIT_HINT = "millimetres read as metres? give the unit: --unit-scale 0.001 (evaluate), data.unit_scale: 0.001 (ingest)"
@@ -61,7 +58,7 @@ def prepare_shape(loaded: LoadedShape, settings: SurfaceSettings) -> PreparedSha
     """Rebuild one closed, one-piece outer surface, then center it and (``settings.size``: ``normalize``) scale it
     by the size rule, (``real``) keep its size, or (``fit``) keep its size unless the gripper cannot close across it,
     when it is scaled down until the smallest side of its oriented bounding box is :data:`FIT_SHARE` of
-    ``settings.max_width`` (rejected when that would scale it by less than :data:`FIT_MIN_SCALE`).
+    ``settings.max_width`` (rejected when that would scale it by less than ``settings.fit_min_scale``).
 
     Raises
     ------
@@ -101,9 +98,9 @@ def prepare_shape(loaded: LoadedShape, settings: SurfaceSettings) -> PreparedSha
     if settings.size == "fit":  # real size, but a shape too wide for the gripper shrinks until it fits
         smallest = float(np.min(surface.bounding_box_oriented.primitive.extents))
         scale = min(1.0, FIT_SHARE * settings.max_width / smallest)
-        if scale < FIT_MIN_SCALE:
+        if scale < settings.fit_min_scale:
             raise too_wide(
-                smallest, settings.max_width, f", and fitting would scale it by {scale:.3g} < {FIT_MIN_SCALE}"
+                smallest, settings.max_width, f", and fitting would scale it by {scale:.3g} < {settings.fit_min_scale}"
             )
         norm = Normalization(scale=scale, offset=scale * centering(surface).offset)
         _check_real_size(norm.apply(surface), settings)

@@ -44,7 +44,18 @@ class SurfaceSettings:
             "arbitrary); `real`: each shape keeps its size in the file (times data.unit_scale), and shapes the "
             "gripper cannot take (min_extent, max_width) are rejected; `fit`: as `real`, but a shape too wide for the "
             "gripper is scaled down (its shape kept, its scale in the shape table) until its narrowest side is 0.9 "
-            "max_width; one it would scale by less than 0.5 is rejected (a unit mistake, or another object)."
+            "max_width; one it would scale by less than fit_min_scale is rejected (a unit mistake, or another "
+            "object)."
+        ),
+    )
+    fit_min_scale: float = Field(
+        0.5,
+        gt=0,
+        le=1,
+        description=(
+            "With size `fit`: a shape it would scale by less than this is rejected, naming the likely unit mistake "
+            "(millimetres read as metres shrink by 0.001); a corpus of large real objects meant to be shrunk (the "
+            "real_objects profile) lowers it."
         ),
     )
     min_extent: float = Field(
