@@ -5,7 +5,7 @@ and test objects. Each draw k is a clone of the project's HEAD in ``workdir``/dr
 cache (so the stages no data seed reaches, ingest to ``render@original``, come from the run cache), with params.yaml
 written from the profile plus ``data_seed: k`` and any ``--set key=value``; it runs ``dvc repro report`` (the GQ-CNN
 experiment, not the robot cell). Then :func:`graspaug.experiments.ap.attribution.combine_draws` combines the draws'
-networks (a hierarchical bootstrap over draws, seeds within draws and test objects) and writes ``summary.json`` and
+networks (t over the draws' means, with the test objects' bootstrap) and writes ``summary.json`` and
 ``decomposition.md`` into ``workdir``, and the per-network, per-test-datapoint tables with the command and commit
 that made them into the project's ``results/<results>/`` (commit them: ``graspaug results`` recomputes every quoted
 figure from them). A finished draw is not run again (``dvc repro`` finds nothing to do).
