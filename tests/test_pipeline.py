@@ -1,6 +1,7 @@
 """Real ``dvc repro`` in a temporary copy of the repository, on the tiny profile (``profiles/tiny.yaml``)."""
 
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -501,11 +502,14 @@ def test_dvc_repro_gqcnn_matrix_and_report(tiny_repo):
     }
     assert len(pooled) == len(names), sorted(pooled)
     assert all(v is not None and np.isfinite(v) for v in pooled.values()), pooled
-    assert "no value (a test set with one class?)" not in report
+    no_ratio = {n for n, c in ap["contrasts"].items() if "mean over ratios none" in c["meaning"]}  # said, not dropped
+    assert all((c["mean"] is None) == (n in no_ratio) for n, c in ap["contrasts"].items()), ap["contrasts"]
+    recon_line = next(line for line in report.splitlines() if line.startswith("- `recon_vs_real@6`"))
+    assert re.search(r"\d of 6 recon shapes meshed \(\d dropped\) at 1:1\.$", recon_line), recon_line
     # one metrics file per declared contrast: its mean and t-interval ends
     assert {p.stem for p in (work / "metrics/ap").glob("*.json")} == set(ap["contrasts"])
-    matched = {n for n in ap["contrasts"] if n.endswith("_vs_real_datapoints@6")}  # where the real curve reaches
-    assert matched <= {f"{p}_vs_real_datapoints@6" for p in ("targeted", "random", "recon", "blend")}
+    matched = {n for n in ap["contrasts"] if n.endswith("_vs_real_datapoints@6")}  # every one declared, never dropped
+    assert matched == {f"{p}_vs_real_datapoints@6" for p in ("targeted", "random", "recon", "blend")}
     assert set(ap["contrasts"]) - {"targeted_vs_none_chosen@6"} - matched == {
         "real_data",
         "targeted_vs_none@6",

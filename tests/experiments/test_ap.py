@@ -1,6 +1,8 @@
 """The GQ-CNN experiment's declared contrasts and the report's sentences on scale."""
 
+import dataclasses
 import json
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -269,7 +271,11 @@ def test_datapoint_matched_contrasts_interpolate_the_real_shape_curve_in_datapoi
     ]
     runs = pd.DataFrame(rows, columns=["pool", "base_size", "ratio", "train_datapoints"]).assign(seed=0)
     out = {c.name: c for c in datapoint_matched_contrasts(runs, [50, 200], [0.0, 1.0], [50], POOLS)}
-    assert set(out) == {"targeted_vs_real_datapoints@50", "recon_vs_real_datapoints@50"}
+    assert set(out) == {f"{p}_vs_real_datapoints@50" for p in POOLS if p != "real"}  # declared: none disappears
+    assert out["random_vs_real_datapoints@50"].terms == () and out["warp_vs_real_datapoints@50"].terms == ()
+    assert "mean over ratios none; 1:1 left out: its training datapoints lie outside" in (
+        out["random_vs_real_datapoints@50"].meaning
+    )
     weights = lambda c: {k: w for w, k in c.terms if w}  # noqa: E731
     assert weights(out["targeted_vs_real_datapoints@50"]) == pytest.approx(
         {("targeted", 50, 1.0): 1.0, ("targeted", 50, 0.0): -0.5, ("real", 50, 1.0): -0.5}
@@ -278,6 +284,47 @@ def test_datapoint_matched_contrasts_interpolate_the_real_shape_curve_in_datapoi
         {("recon", 50, 1.0): 1.0, ("real", 50, 1.0): -0.5, ("targeted", 200, 0.0): -0.5}
     )
     assert datapoint_matched_contrasts(runs, [50, 200], [0.0, 1.0], [50], ("targeted", "recon")) == []  # no real pool
+
+
+def test_a_ratio_outside_the_real_pools_datapoints_is_left_out_of_its_contrast_and_said_on_the_real_objects_pools():
+    """Issue #67: on the real_objects profile of a94c689 targeted had 1:0.5, 1:1, 1:2 and real 1:1 (control_ratios);
+    targeted 1:2 gives more datapoints than any real-shape network, and targeted_vs_real_datapoints@B vanished."""
+    import pandas as pd
+
+    from graspaug.experiments.ap.numbers import datapoint_matched_contrasts, evaluate_contrasts
+    from graspaug.experiments.ap.words import verdict
+    from graspaug.training.variants import seed_variants
+
+    gen = {"base_sizes": [50, 100], "ratios": [0.0, 0.5, 1.0, 2.0]}  # the real_objects profile of a94c689
+    gq = {"augment_base_sizes": [50, 100], "pools": ["targeted", "random", "real", "recon", "procedural"]}
+    gq["control_ratios"] = [1.0]
+    variants = seed_variants(
+        gen["base_sizes"], gen["ratios"], gq["augment_base_sizes"], False, gq["pools"], gq["control_ratios"]
+    )
+    per_shape = {"targeted": 40, "random": 40, "recon": 45, "procedural": 30}  # a real shape gives 60 datapoints
+    runs = pd.DataFrame(
+        [
+            (v.pool, v.base_size, v.ratio, 60 * v.base_size + per_shape.get(v.pool, 60) * round(v.ratio * v.base_size))
+            for v in variants
+        ],
+        columns=["pool", "base_size", "ratio", "train_datapoints"],
+    ).assign(seed=0, test_ap=0.5)
+    found = datapoint_matched_contrasts(
+        runs, gen["base_sizes"], gen["ratios"], gq["augment_base_sizes"], gq["pools"], gq["control_ratios"]
+    )
+    out = {c.name: c for c in found}
+    for b in gq["augment_base_sizes"]:
+        assert {f"{p}_vs_real_datapoints@{b}" for p in gq["pools"] if p != "real"} <= set(out)
+        targeted = out[f"targeted_vs_real_datapoints@{b}"]
+        assert {k[2] for _, k in targeted.terms if k[0] == "targeted" and k[2] > 0} == {0.5, 1.0}  # on what it covers
+        assert "mean over ratios 1:0.5, 1:1; 1:2 left out" in targeted.meaning
+    # a pool with no ratio in range keeps its contrast: no value, and the report says why
+    none = dataclasses.replace(out["targeted_vs_real_datapoints@50"], terms=(), meaning="m; 1:2 left out: outside")
+    c = evaluate_contrasts([none], runs, {0: Path("unused")}, np.array([0, 1]), np.array(["a", "b"]), 10, 0)
+    assert c[none.name]["mean"] is None and c[none.name]["draws_low"] is None
+    assert verdict(none.name, c[none.name]).startswith(
+        "`targeted_vs_real_datapoints@50` (m; 1:2 left out: outside): no"
+    )
 
 
 def test_the_report_scopes_its_verdicts_to_its_one_draw_of_the_data():

@@ -98,7 +98,7 @@ def test_combine_draws_gives_every_contrast_one_interval_over_draws_seeds_and_ob
 
 
 def test_a_share_of_a_clear_real_gain_holds_its_estimate_and_its_gains_are_the_contrasts(tmp_path):
-    draws = make_draws(tmp_path, seeds=(0, 1, 2), real_noise=0.1)  # the real pool predicts the labels well
+    draws = make_draws(tmp_path, draws=(0, 1, 2), seeds=(0, 1, 2), real_noise=0.1)  # real predicts the labels well
     result = combine_draws(draws, LABELS, OBJECTS, GENERATE, GQCNN, n_resamples=300, seed=0)
     recon, blend = result["shares"]["recon"]["10"], result["shares"]["blend"]["10"]
     assert recon["real_gain"]["draws_low"] > 0

@@ -24,7 +24,7 @@ META = {"command": "graspaug study attribution --draws 0 1", "commit": "0" * 40,
 
 
 def _results(tmp_path, real_noise=0.1):
-    draws = make_draws(tmp_path / "networks", seeds=(0, 1, 2), real_noise=real_noise)
+    draws = make_draws(tmp_path / "networks", draws=(0, 1, 2), seeds=(0, 1, 2), real_noise=real_noise)
     result = combine_draws(draws, LABELS, OBJECTS, GENERATE, GQCNN, n_resamples=200, seed=3)
     folder = tmp_path / "repo" / "results" / "attribution"
     write_attribution(folder, draws, LABELS, OBJECTS, GENERATE, GQCNN, META | {"n_resamples": 200, "seed": 3})
@@ -60,6 +60,27 @@ def test_a_marked_figure_that_differs_or_that_no_study_recomputes_is_named(tmp_p
     ]
 
 
+def test_a_malformed_marker_an_unknown_key_or_a_figure_that_goes_on_is_a_problem():
+    """Issue #67: `results --check` skipped a marker written with a space and matched by prefix."""
+    figures = {"fidelity/gso300/meshed": "49 of 62"}
+    assert check_markdown("| <!-- results:fidelity/gso300/meshed -->49 of 62 |", figures, "README.md") == []
+    assert check_markdown("meshed <!-- results:fidelity/gso300/meshed -->49 of 62.", figures, "README.md") == []
+    assert check_markdown("<!-- results:fidelity/gso300/meshed -->49 of 620 |", figures, "README.md") == [
+        "README.md: fidelity/gso300/meshed: quoted '49 of 620', recomputed '49 of 62'"
+    ]
+    spaced = "<!-- results:fidelity/gso300/meshed -->49 of 62 and <!-- results: fidelity/gso300/meshed -->49 of 62"
+    assert check_markdown(spaced, figures, "README.md") == [
+        "README.md: malformed marker '<!-- results: fidelity/gso300/meshed -->' (write `<!-- results:KEY -->`, KEY "
+        "of letters, digits, @./+-_)"
+    ]
+    assert check_markdown("<!-- results:fidelity/gso100/meshed -->49 of 62", figures, "README.md") == [
+        "README.md: fidelity/gso100/meshed: no study in results/ recomputes it"
+    ]
+    assert check_markdown("no marker", figures, "docs/results.md") == [
+        "docs/results.md: no marked figure (a `<!-- results:KEY -->` before each quoted figure)"
+    ]
+
+
 def test_graspaug_results_recomputes_and_checks_the_documents(tmp_path):
     result, folder = _results(tmp_path)
     repo = folder.parents[1]
@@ -67,6 +88,9 @@ def test_graspaug_results_recomputes_and_checks_the_documents(tmp_path):
     (repo / "docs").mkdir()
     (repo / "docs/results.md").write_text("nothing marked\n")
     (repo / "README.md").write_text(f"<!-- results:attribution/targeted_vs_blend@10 -->{quoted}\n")
+    unmarked = CliRunner().invoke(app, ["results", "--root", str(repo), "--check"])  # a document without a marker
+    assert unmarked.exit_code == 2 and "docs/results.md: no marked figure" in unmarked.output
+    (repo / "docs/results.md").write_text(f"the same: <!-- results:attribution/targeted_vs_blend@10 -->{quoted}.\n")
     ok = CliRunner().invoke(app, ["results", "--root", str(repo), "--check"])
     assert ok.exit_code == 0, ok.output
     assert f"attribution/targeted_vs_blend@10: {quoted}" in ok.output
@@ -180,7 +204,7 @@ def test_draws_added_one_at_a_time_combine_as_the_whole_study_and_other_params_a
     from graspaug.experiments.results import add_attribution_draw
 
     result, _ = _results(tmp_path)
-    draws = make_draws(tmp_path / "again", seeds=(0, 1, 2), real_noise=0.1)  # the same networks (seeded)
+    draws = make_draws(tmp_path / "again", draws=(0, 1, 2), seeds=(0, 1, 2), real_noise=0.1)  # the same (seeded)
     folder = tmp_path / "stepwise" / "attribution"
     meta = META | {"n_resamples": 200, "seed": 3}
     for d in reversed(list(draws)):  # in any order

@@ -41,8 +41,7 @@ def test_the_bootstrap_resamples_objects_not_datapoints():
     assert not np.allclose(weights.sum(axis=1), len(objects))  # so the datapoint count varies
     labels = rng.integers(0, 2, len(objects))
     scores = rng.random(len(objects)) + 0.3 * labels
-    order = np.argsort(-scores)
-    plain = weighted_average_precision(labels[order].astype(float), np.ones(len(objects)))
+    plain = weighted_average_precision(labels, scores, np.ones(len(objects)))
     assert plain == pytest.approx(average_precision_score(labels, scores))  # unweighted, it is sklearn's AP
     resampled = boot.average_precision(labels, scores)
     assert resampled.shape == (200,) and resampled.std() > 0
@@ -78,28 +77,42 @@ def test_a_contrasts_headline_is_its_mean_and_interval_ends_rounded():
     assert headline({**c, "over": "objects"}) == {"mean": 0.01235, "lo": 0.5, "hi": 0.6}
 
 
-def test_the_nested_interval_covers_each_source_of_variance_on_hand_made_tables():
-    from graspaug.experiments.stats import nested_interval, percentile_interval
+def test_the_verdict_interval_adds_the_seeds_t_and_the_objects_normal_half_widths_on_hand_made_tables():
+    from graspaug.experiments.stats import nested_t_interval
 
-    rng = np.random.default_rng(0)
-    flat = nested_interval(np.full((3, 4), 0.02), np.full((3, 4, 500), 0.02), rng)
-    assert flat == pytest.approx({"mean": 0.02, "low": 0.02, "high": 0.02, "n_draws": 3, "n_seeds": 4})
-    # draws alone vary: the bootstrap of the mean of 60 draw effects, SE = SD / sqrt(60)
-    effects = rng.normal(0.1, 0.05, size=60)
-    full = np.repeat(effects[:, None], 4, axis=1)
-    out = nested_interval(full, np.repeat(full[:, :, None], 4000, axis=2), np.random.default_rng(1))
-    se = effects.std() / np.sqrt(60)
-    assert out["mean"] == pytest.approx(effects.mean())
-    assert out["low"] == pytest.approx(effects.mean() - 1.96 * se, abs=0.25 * se)
-    assert out["high"] == pytest.approx(effects.mean() + 1.96 * se, abs=0.25 * se)
-    # test objects alone vary (the same object resample in every cell): the object bootstrap's interval
-    objects = rng.normal(0.0, 0.01, size=3000)
-    alone = nested_interval(np.zeros((3, 4)), np.broadcast_to(objects, (3, 4, 3000)), np.random.default_rng(2))
-    assert (alone["low"], alone["high"]) == pytest.approx(percentile_interval(objects))
-    # seeds on top of objects: wider than objects alone
-    seeds = rng.normal(0.0, 0.02, size=(3, 4))
-    both = nested_interval(seeds, seeds[:, :, None] + objects, np.random.default_rng(3))
-    assert both["high"] - both["low"] > alone["high"] - alone["low"]
+    flat = nested_t_interval(np.full((3, 4), 0.02), np.full((3, 4, 500), 0.02))
+    assert (flat["mean"], flat["low"], flat["high"]) == pytest.approx((0.02, 0.02, 0.02))
+    assert (flat["n_draws"], flat["n_seeds"]) == (3, 4)
+    # one draw, seeds alone vary: the t-interval over the seeds, exactly
+    seeds = np.array([[0.0297, 0.0161, 0.0509, -0.0073]])  # issue #67's real gains per seed
+    out = nested_t_interval(seeds, np.repeat(seeds[:, :, None], 200, axis=2))
+    t = t_interval(seeds[0])
+    assert (out["low"], out["high"]) == pytest.approx((t["low"], t["high"]))
+    assert out["low"] == pytest.approx(-0.0165, abs=1e-4) and out["high"] == pytest.approx(0.0612, abs=1e-4)
+    assert draw_verdict(out["low"], out["high"]) == "no effect we can claim in this draw of the data"
+    # several draws: the draws' means over seeds are the replicates, on D − 1 degrees of freedom
+    draws = np.array([[0.01, 0.03, 0.02, 0.02], [0.04, 0.04, 0.05, 0.03], [0.0, 0.01, -0.01, 0.0]])
+    over = nested_t_interval(draws, np.repeat(draws[:, :, None], 200, axis=2))
+    means = t_interval(draws.mean(axis=1))
+    assert (over["low"], over["high"]) == pytest.approx((means["low"], means["high"]))
+    # test objects alone vary (the same object resample in every cell): the normal interval of their resamples
+    objects = np.random.default_rng(2).normal(0.0, 0.01, size=3000)
+    alone = nested_t_interval(np.zeros((3, 4)), np.broadcast_to(objects, (3, 4, 3000)))
+    assert alone["high"] == pytest.approx(1.959964 * objects.std(ddof=1)) and alone["low"] == -alone["high"]
+    # both: the two half-widths in quadrature
+    both = nested_t_interval(seeds, seeds[:, :, None] + objects)
+    half = np.hypot(t["high"] - t["mean"], alone["high"])
+    assert (both["low"], both["high"]) == pytest.approx((seeds.mean() - half, seeds.mean() + half))
+
+
+def test_one_seed_of_one_draw_has_no_interval_and_no_verdict():
+    from graspaug.experiments.stats import nested_contrast, nested_t_interval, verdict
+
+    one = nested_t_interval(np.array([[0.02]]), np.random.default_rng(0).normal(0.02, 0.01, (1, 1, 300)))
+    assert one["mean"] == pytest.approx(0.02) and one["low"] is None and one["high"] is None
+    assert verdict(nested_contrast(one)) == "no interval (one seed, or a missing value): no verdict"
+    missing = nested_t_interval(np.array([[0.02, np.nan]]), np.zeros((1, 2, 10)))
+    assert missing["mean"] is None and missing["low"] is None
 
 
 def test_the_fieller_interval_inverts_the_t_test_of_the_paired_difference():
@@ -141,7 +154,7 @@ def test_a_one_draw_interval_is_a_gain_or_loss_in_this_draw_only_and_says_where_
     assert draw_verdict(-0.055, -0.014) == "a loss in this draw of the data"  # not "a real loss"
     assert draw_verdict(0.01, 0.03) == "a gain in this draw of the data"
     assert draw_verdict(-0.03, 0.02) == "no effect we can claim in this draw of the data"
-    assert draw_verdict(None, None) == "no effect we can claim in this draw of the data"
+    assert draw_verdict(None, None) == "no interval (one seed, or a missing value): no verdict"
     assert draw_verdict(-0.05, -0.01, n_draws=3) == "a loss over 3 draws of the data"
     scope = draw_scope(2, [0, 1, 2, 3], "ap")
     assert "`data_seed` = 2" in scope and "training seeds [0, 1, 2, 3] (`gqcnn.seeds`)" in scope
@@ -170,51 +183,83 @@ def test_one_contrast_type_names_each_interval_by_what_it_covers():
         contrast(0.0, "t")
 
 
-def _nested_gain(mean: float, low: float, high: float, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
-    """A gain's (draws, seeds) values and (draws, seeds, resamples) object resamples whose nested bootstrap
-    (:func:`nested_means` over one set of indices) has the given 2.5% and 97.5% percentiles: returned as the
-    (R,) nested means, shifted and scaled onto ``low``, ``high``, with the mean of all cells ``mean``."""
-    from graspaug.experiments.stats import nested_indices, nested_means
-
-    cells = rng.normal(0.0, 1.0, size=(3, 4, 4000))
-    nested = nested_means(cells, nested_indices(3, 4, 4000, np.random.default_rng(7)))
-    q_low, q_high = np.quantile(nested, [0.025, 0.975])
-    return low + (nested - q_low) * (high - low) / (q_high - q_low), mean
-
-
 def test_a_share_of_a_real_gain_whose_interval_holds_zero_is_unbounded():
-    """Issue #58: a real-pool gain of +0.0001 [-0.0059, +0.0068] gave a share of +1321% with the "bounded"
-    percentile interval of the resampled ratios, [-677%, +848%], which excludes its own value."""
-    from graspaug.experiments.stats import percentile_interval, ratio_interval, share_text
+    """Issue #67: real gains per seed [+0.0297, +0.0161, +0.0509, −0.0073] gave, by the percentile bootstrap, the
+    verdict "a gain" and a bounded share [−59%, +687%]; their t-interval holds zero, and so the share is unbounded."""
+    from graspaug.experiments.stats import nested_t_interval, ratio_interval, share_text
 
-    rng = np.random.default_rng(58)
-    real, real_mean = _nested_gain(0.0001, -0.0059, 0.0068, rng)
-    pool = 0.001321 + 0.5 * (real - real_mean) + rng.normal(0.0, 0.002, size=real.shape)
-    assert percentile_interval(real) == pytest.approx((-0.0059, 0.0068))
-    out = ratio_interval(0.001321, real_mean, pool, real)
-    assert out["share"] == pytest.approx(13.21)
+    real = np.array([[0.0297, 0.0161, 0.0509, -0.0073]])
+    pool = np.array([[0.02, 0.01, 0.015, 0.005]])
+    flat = lambda a: np.repeat(a[..., None], 300, axis=2)  # noqa: E731
+    out = ratio_interval(pool, flat(pool), real, flat(real))
+    assert out["share"] == pytest.approx(pool.mean() / real.mean())
     assert not out["bounded"] and out["low"] is None and out["high"] is None
-    assert (out["denominator_low"], out["denominator_high"]) == pytest.approx((-0.0059, 0.0068))
-    assert share_text(out) == "+1321% [unbounded]"
-    old_low, old_high = percentile_interval(pool / real)  # the old method: bounded, and its value outside it
-    assert not old_low <= out["share"] <= old_high
+    den = nested_t_interval(real, flat(real))
+    assert (out["denominator_low"], out["denominator_high"]) == (den["low"], den["high"])
+    assert out["denominator_low"] < 0 < out["denominator_high"]
+    assert share_text(out).endswith("[unbounded]")
 
 
-def test_a_share_of_a_clearly_positive_gain_matches_fiellers_closed_form_on_paired_data():
-    from graspaug.experiments.stats import ObjectBootstrap, fieller_interval, ratio_interval
+def test_a_share_of_a_clearly_positive_gain_is_fiellers_on_the_seeds_and_wider_with_object_noise():
+    from graspaug.experiments.stats import fieller_interval, ratio_interval
 
     rng = np.random.default_rng(5)
-    real = rng.normal(0.05, 0.05, size=400)  # paired: one (pool gain, real gain) per object
-    pool = 0.6 * real + rng.normal(0.0, 0.03, size=400)
-    boot = ObjectBootstrap(np.arange(400), 4000, 1)
-    out = ratio_interval(pool.mean(), real.mean(), boot.means(pool), boot.means(real))
-    closed = fieller_interval(pool, real)
+    real = rng.normal(0.05, 0.01, (1, 5))
+    pool = 0.6 * real + rng.normal(0.0, 0.005, (1, 5))
+    flat = lambda a: np.repeat(a[..., None], 300, axis=2)  # noqa: E731
+    out, closed = ratio_interval(pool, flat(pool), real, flat(real)), fieller_interval(pool[0], real[0])
     assert out["bounded"] and out["low"] < out["share"] < out["high"]
-    assert out["share"] == pytest.approx(closed["ratio"])
-    width = closed["high"] - closed["low"]
-    assert out["low"] == pytest.approx(closed["low"], abs=0.05 * width)  # within bootstrap error
-    assert out["high"] == pytest.approx(closed["high"], abs=0.05 * width)
-    assert out["denominator_low"] > 0
+    assert (out["share"], out["low"], out["high"]) == pytest.approx((closed["ratio"], closed["low"], closed["high"]))
+    objects = rng.normal(0.0, 0.004, (300,))  # the same object resample moves both gains
+    noisy = ratio_interval(pool, pool[..., None] + 0.5 * objects, real, real[..., None] + objects)
+    assert noisy["share"] == out["share"] and noisy["high"] - noisy["low"] > out["high"] - out["low"]
+    # the set holds exactly the θ whose difference's own interval holds zero: at either end, zero is on its edge
+    from graspaug.experiments.stats import nested_t_interval
+
+    for theta in (noisy["low"], noisy["high"]):
+        edge = nested_t_interval(
+            pool - theta * real, (pool[..., None] + 0.5 * objects) - theta * (real[..., None] + objects)
+        )
+        assert min(abs(edge["low"]), abs(edge["high"])) == pytest.approx(0.0, abs=1e-12)
+
+
+def test_a_share_keeps_nothing_larger_than_its_resamples():
+    """Issue #67: the old test inversion kept an R × R array (1.6 GB at 10,000 resamples); 200,000 would be 320 GB."""
+    from graspaug.experiments.stats import ratio_interval
+
+    rng = np.random.default_rng(0)
+    real, pool = rng.normal(0.05, 0.01, (1, 4)), rng.normal(0.03, 0.01, (1, 4))
+    objects = rng.normal(0.0, 0.003, 200_000)
+    out = ratio_interval(pool, pool[..., None] + objects, real, real[..., None] + objects)
+    assert out["bounded"] and out["low"] < out["share"] < out["high"]
+
+
+def test_fieller_on_a_nan_input_is_not_bounded():
+    from graspaug.experiments.stats import fieller_interval
+
+    out = fieller_interval(np.array([0.01, np.nan, 0.02]), np.array([0.04, 0.05, 0.045]))
+    assert not out["bounded"] and out["low"] is None and out["high"] is None
+
+
+def test_average_precision_groups_tied_scores_as_sklearn_does():
+    """Issue #67: tied scores are one threshold, so AP does not depend on the order of the datapoints."""
+    labels = np.array([0, 1, 0, 1, 0, 0, 1, 0])
+    scores = np.array([0.9, 0.9, 0.9, 0.9, 0.2, 0.2, 0.2, 0.2])
+    assert average_precision_score(labels, scores) == pytest.approx(0.458333, abs=1e-6)
+    ap = weighted_average_precision(labels, scores, np.ones(8))
+    assert ap == pytest.approx(average_precision_score(labels, scores))
+    for order in (np.argsort(-labels, kind="stable"), np.random.default_rng(1).permutation(8)):  # positives first
+        assert weighted_average_precision(labels[order], scores[order], np.ones(8)) == pytest.approx(ap)
+    rng = np.random.default_rng(3)
+    y = rng.integers(0, 2, 400)
+    s = np.round(rng.random(400) + 0.3 * y, 1).astype(np.float32)  # few distinct scores, as bfloat16 outputs give
+    w = rng.integers(0, 4, (6, 400)).astype(np.float32)
+    want = [average_precision_score(y, s, sample_weight=x) for x in w]
+    assert weighted_average_precision(y, s, w) == pytest.approx(want, rel=1e-5)
+    boot = ObjectBootstrap(np.arange(400) // 8, 20, 0)  # the bootstrap's AP is the same function
+    counts = boot.object_counts[:, boot.object_index]
+    want = [average_precision_score(y, s, sample_weight=x) for x in counts]
+    assert boot.average_precision(y, s) == pytest.approx(want, rel=1e-5)
 
 
 def test_a_t_interval_that_leaves_the_quantitys_range_is_no_interval():

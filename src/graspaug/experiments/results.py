@@ -52,6 +52,8 @@ from graspaug.errors import DataError
 from graspaug.experiments.stats import interval_text, share_text
 
 MARKER = re.compile(r"<!-- results:([\w@./+-]+) -->")
+LOOSE = re.compile(r"<!--\s*results\b.*?-->", re.DOTALL)  # anything that looks like a marker, well formed or not
+CONTINUES = re.compile(r"[\w%\[]|[.,]\d")  # after a figure: it would go on (a digit, a letter, %, [, .5 or ,5)
 FILES = ("networks.parquet", "test.parquet", "meta.json")  # and predictions-d<draw>.parquet per draw
 DOCUMENTS = ("README.md", "docs/results.md")  # the markdown whose marked figures must equal the recomputed ones
 
@@ -232,15 +234,26 @@ def marked_figures(text: str) -> list[tuple[str, int]]:
 
 
 def check_markdown(text: str, figures: Mapping[str, str], name: str = "markdown") -> list[str]:
-    """One line per marked figure of ``text`` (:func:`marked_figures`) that no study recomputes or that differs from
-    the recomputed ``figures`` (key → text); empty when every marked figure is what the data say."""
-    problems = []
-    for key, at in marked_figures(text):
+    """One line per problem of a markdown ``text`` against the recomputed ``figures`` (key → text); empty when every
+    marked figure is what the data say. Problems: no marked figure at all (:func:`marked_figures`); a marker that is
+    not exactly ``<!-- results:KEY -->`` (a space after the colon, a missing one before ``-->``…); a key no study
+    recomputes; a quoted figure that differs in any character from the recomputed one, or goes on after it (a
+    digit, letter, ``%`` or ``[`` right after it: "49 of 620" quoted for "49 of 62")."""
+    marked = marked_figures(text)
+    problems = [] if marked else [f"{name}: no marked figure (a `<!-- results:KEY -->` before each quoted figure)"]
+    problems += [
+        f"{name}: malformed marker {m.group(0)!r} (write `<!-- results:KEY -->`, KEY of letters, digits, @./+-_)"
+        for m in LOOSE.finditer(text)
+        if not MARKER.fullmatch(m.group(0))
+    ]
+    for key, at in marked:
         if key not in figures:
             problems.append(f"{name}: {key}: no study in results/ recomputes it")
-        elif not text.startswith(figures[key], at):
-            quoted = text[at : at + len(figures[key])]
-            problems.append(f"{name}: {key}: quoted {quoted!r}, recomputed {figures[key]!r}")
+            continue
+        want, end = figures[key], at + len(figures[key])
+        if not text.startswith(want, at) or CONTINUES.match(text, end):
+            quoted = text[at:end] + (CONTINUES.match(text, end).group(0) if CONTINUES.match(text, end) else "")
+            problems.append(f"{name}: {key}: quoted {quoted!r}, recomputed {want!r}")
     return problems
 
 

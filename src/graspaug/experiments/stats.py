@@ -7,13 +7,13 @@
 * :func:`percentile_interval`, :func:`mean_interval`, :func:`paired_contrast`: the mean of values
   (of paired differences) with its percentile bootstrap interval;
 * :func:`weighted_average_precision`: Average Precision as sklearn's (step-wise, no
-  interpolation): the mean over positives of the precision at their rank, with datapoint
-  weights for the bootstrap; :func:`weighted_roc_auc`: ROC AUC as sklearn's (ties count
-  half), with datapoint weights;
-* :func:`nested_interval`: one interval over data draws, training seeds and test objects (a
-  hierarchical bootstrap); :func:`ratio_interval`: a ratio of two noisy gains (a share of a gain) by test
-  inversion over their bootstrap, unbounded when the denominator's interval holds zero; :func:`fieller_interval`:
-  its closed form for paired means over seeds (the reference it is tested against);
+  interpolation, tied scores one threshold), with datapoint weights for the bootstrap;
+  :func:`weighted_roc_auc`: ROC AUC as sklearn's (ties count half), with datapoint weights;
+* :func:`nested_t_interval`: the one interval every verdict reads, over data draws, training seeds and test
+  objects (the replicates' t half-width and the object bootstrap's normal one in quadrature, :func:`variance_parts`);
+  :func:`ratio_interval`: a ratio of two noisy gains (a share of a gain) by test inversion on that variance,
+  unbounded when the denominator's interval holds zero; :func:`fieller_interval`: its closed form for paired means
+  over seeds (the reference it is tested against);
 * :func:`wilson_interval` (a success rate). No McNemar test: the robot trials' picks cluster by
   object and training seed, so they are compared with the object bootstrap and the t-interval;
 * :func:`contrast`: the one result type of every experiment (a mean and its intervals, each keyed by what it
@@ -79,11 +79,9 @@ class ObjectBootstrap:
         self.n_objects = len(objects)
 
     def average_precision(self, labels: np.ndarray, scores: np.ndarray) -> np.ndarray:
-        """(n_resamples,) AP of ``scores`` (N,) for ``labels`` (N,) under every resample."""
-        order = np.argsort(-np.asarray(scores), kind="stable")
-        y = np.asarray(labels, dtype=np.float32)[order]
-        w = self.object_counts[:, self.object_index[order]]
-        return weighted_average_precision(y, w)
+        """(n_resamples,) AP of ``scores`` (N,) for ``labels`` (N,) under every resample
+        (:func:`weighted_average_precision`: tied scores grouped, as sklearn's)."""
+        return weighted_average_precision(labels, scores, self.object_counts[:, self.object_index])
 
     def roc_auc(self, labels: np.ndarray, scores: np.ndarray) -> np.ndarray:
         """(n_resamples,) ROC AUC of ``scores`` (N,) for ``labels`` (N,) under every resample
@@ -121,19 +119,21 @@ class PairBootstrap(ObjectBootstrap):
         return np.divide(sums, counts, out=np.full(len(drawn), np.nan), where=counts > 0)
 
 
-def weighted_average_precision(labels_sorted: np.ndarray, weights: np.ndarray) -> np.ndarray:
-    """AP of datapoints already sorted by descending score, with weights (..., N): the
-    weighted mean over positives of the precision at their rank."""
-    tp = np.cumsum(weights * labels_sorted, axis=-1)
-    seen = np.cumsum(weights, axis=-1)
+def weighted_average_precision(labels: np.ndarray, scores: np.ndarray, weights: np.ndarray) -> np.ndarray:
+    """Average Precision of ``scores`` (N,) for ``labels`` (N,) with datapoint ``weights`` (..., N), as sklearn's
+    ``average_precision_score(labels, scores, sample_weight=w)``: Σ over the distinct scores, highest first, of the
+    recall gained at that threshold times the precision there, tied scores taken together as one threshold (so the
+    result does not depend on the order of the datapoints). (...,); NaN where no positive has weight."""
+    order = np.argsort(-np.asarray(scores), kind="stable")
+    s, y = np.asarray(scores)[order], np.asarray(labels, dtype=bool)[order]
+    w = np.asarray(weights)  # float32 bootstrap counts stay float32: (R, N) of them is the memory that counts
+    w = (w if np.issubdtype(w.dtype, np.floating) else w.astype(float))[..., order]
+    starts = np.flatnonzero(np.r_[True, s[1:] != s[:-1]])  # groups of tied scores, highest first
+    positive = np.add.reduceat(w * y, starts, axis=-1)  # (..., G) positive weight per threshold
+    tp, seen = np.cumsum(positive, axis=-1), np.cumsum(np.add.reduceat(w, starts, axis=-1), axis=-1)
     precision = np.divide(tp, seen, out=np.zeros_like(tp), where=seen > 0)
-    positives = tp[..., -1]
-    return np.divide(
-        (precision * weights * labels_sorted).sum(axis=-1),
-        positives,
-        out=np.full_like(positives, np.nan),
-        where=positives > 0,
-    )
+    total = tp[..., -1]
+    return np.divide((positive * precision).sum(axis=-1), total, out=np.full_like(total, np.nan), where=total > 0)
 
 
 def weighted_roc_auc(labels: np.ndarray, scores: np.ndarray, weights: np.ndarray) -> np.ndarray:
@@ -185,7 +185,8 @@ def paired_contrast(
 INTERVALS = ("seeds", "objects", "draws")
 """What a contrast's intervals cover, the prefix of their keys: ``seeds`` the 95% t-interval over paired training
 seeds; ``objects`` the 95% cluster bootstrap over test objects (shapes; the critic study's interpolation pairs);
-``draws`` the 95% nested bootstrap over data draws × training seeds × test objects."""
+``draws`` the 95% interval over data draws × training seeds × test objects (:func:`nested_t_interval`; with one draw,
+over its seeds and the test objects)."""
 
 
 def contrast(mean: float | None, over: str, n_seeds: int | None = None, n_draws: int = 1, **intervals) -> dict:
@@ -205,7 +206,7 @@ def contrast(mean: float | None, over: str, n_seeds: int | None = None, n_draws:
 
 
 def nested_contrast(nested: dict, **extra) -> dict:
-    """A :func:`nested_interval` result as a :func:`contrast` over ``draws``; ``extra`` keys kept after its own."""
+    """A :func:`nested_t_interval` result as a :func:`contrast` over ``draws``; ``extra`` keys kept after its own."""
     draws = (nested["low"], nested["high"])
     return contrast(nested["mean"], "draws", nested["n_seeds"], nested["n_draws"], draws=draws, **extra)
 
@@ -268,7 +269,10 @@ def draw_scope(data_seed: int, seeds, experiment: str) -> str:
 def draw_verdict(low: float | None, high: float | None, n_draws: int = 1) -> str:
     """A 95% interval [``low``, ``high``] in words: a gain or a loss when it lies above or below zero, else
     no effect we can claim; an interval over one draw of the data is scoped to that draw
-    (:func:`draw_scope` says which), one over several draws says how many."""
+    (:func:`draw_scope` says which), one over several draws says how many. Without an interval (an end None: one
+    seed, or a network without a value) there is no verdict, and the words say so."""
+    if low is None or high is None:
+        return "no interval (one seed, or a missing value): no verdict"
     scope = "in this draw of the data" if n_draws == 1 else f"over {n_draws} draws of the data"
     if low is not None and low > 0:
         return f"a gain {scope}"
@@ -285,47 +289,77 @@ def wilson_interval(successes: int, attempts: int, confidence: float = 0.95) -> 
     return float(ci.low), float(ci.high)
 
 
-def nested_indices(n_draws: int, n_seeds: int, n_resamples: int, rng: np.random.Generator):
-    """The resamples of a hierarchical bootstrap over data draws and training seeds: (draws
-    (R, D), seeds (R, D, S)): resample r draws D draws with replacement and, within each drawn
-    draw, S of its seeds with replacement."""
-    draws = rng.integers(0, n_draws, size=(n_resamples, n_draws))
-    return draws, rng.integers(0, n_seeds, size=(n_resamples, n_draws, n_seeds))
-
-
-def nested_means(resampled: np.ndarray, indices) -> np.ndarray:
-    """(R,) the mean over each resample's drawn (draw, seed) cells of ``resampled`` (D, S, R): cell
-    (d, s) under the r-th resample of the test objects; ``indices``: :func:`nested_indices`."""
-    draws, seeds = indices
-    r = np.arange(len(draws))[:, None, None]
-    return np.asarray(resampled, dtype=float)[draws[:, :, None], seeds, r].mean(axis=(1, 2))
-
-
-def nested_interval(full: np.ndarray, resampled: np.ndarray, rng: np.random.Generator, level: float = 0.95) -> dict:
-    """A contrast's mean over data draws × training seeds with one interval that covers the draws,
-    the seeds and the test objects: a hierarchical percentile bootstrap.
-
-    Each resample r draws D data draws with replacement, within each drawn draw S of its seeds
-    with replacement, and takes the contrast of every drawn (draw, seed) under the r-th resample
-    of the test objects (the same object resample for every network, as :class:`ObjectBootstrap`
-    gives); the statistic is the mean of those. With few draws (3) the interval is on the narrow
-    side, as a bootstrap over few clusters is; it says so by ``n_draws``.
+def variance_parts(full: np.ndarray, resampled: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The two parts of the variance of a contrast's mean over data draws × training seeds × test objects.
 
     Parameters
     ----------
     full : (D, S) float — the contrast of draw d, training seed s on all test objects
-    resampled : (D, S, R) float — the same under each of R object resamples
-    rng : numpy.random.Generator — draws the draws and seeds
+    resampled : (D, S, R) float — the same under each of R resamples of the test objects, the r-th resample the same
+        for every cell (:class:`ObjectBootstrap`)
 
     Returns
     -------
-    dict — ``mean`` (of ``full``; None if a cell is not finite), ``low``, ``high``, ``n_draws``, ``n_seeds``
+    units : (U,) float — the replicates of the draws-and-seeds part: the per-draw means over seeds when there are
+        several draws (U = D), else the seeds of the one draw (U = S)
+    objects : (R,) float — the mean over all cells under each object resample (NaN where a cell is)
     """
     full, resampled = np.asarray(full, dtype=float), np.asarray(resampled, dtype=float)
-    n_draws, n_seeds, n_resamples = resampled.shape
-    low, high = percentile_interval(nested_means(resampled, nested_indices(n_draws, n_seeds, n_resamples, rng)), level)
-    mean = float(full.mean()) if np.isfinite(full).all() else None  # a network without a test AP: no mean
-    return {"mean": mean, "low": low, "high": high, "n_draws": n_draws, "n_seeds": n_seeds}
+    if full.ndim != 2 or resampled.shape[:2] != full.shape or resampled.ndim != 3:
+        raise ValueError(f"variance_parts: full {full.shape} and resampled {resampled.shape}, need (D, S), (D, S, R)")
+    units = full.mean(axis=1) if len(full) > 1 else full[0]
+    return units, resampled.mean(axis=(0, 1))
+
+
+def nested_t_interval(full: np.ndarray, resampled: np.ndarray, level: float = 0.95) -> dict:
+    """A contrast's mean over data draws × training seeds with the one interval every verdict reads: the half-widths
+    of its two parts of variance, each at its own quantile, added in quadrature.
+
+    * Draws and seeds (the replicates, :func:`variance_parts`): the D per-draw means over seeds when D > 1, else the
+      S seeds of the one draw; their variance of the mean s²/U at the t quantile on U − 1 degrees of freedom.
+    * Test objects: the variance of the mean of all cells over the object resamples (the same resample for every
+      network, so a contrast's networks are paired), at the normal quantile.
+
+    The interval is mean ± √(t² · s²/U + z² · v_objects). What it covers, at ``level``: the contrast's expected value
+    over training seeds and test objects, and over draws of the data (base sets, validation shapes, pools) when
+    D > 1; with one draw it covers that draw only. Exactly the t-interval when only seeds (or draws) vary; the
+    normal bootstrap interval when only test objects vary; wider than either part alone when both do (conservative:
+    a seed-by-object interaction is counted in both parts). Its coverage is checked by simulation
+    (``tests/experiments/test_coverage.py``, the table in docs/results.md): at least 93% at 4 seeds of 1 or 3 draws,
+    where the percentile bootstrap over draws, seeds and objects that it replaces covered 75–91% when seeds varied.
+
+    Parameters
+    ----------
+    full : (D, S) float — the contrast of draw d, training seed s on all test objects (AP, or any unit)
+    resampled : (D, S, R) float — the same under each of R object resamples; a resample with a NaN cell is left out
+    level : float — the interval's coverage
+
+    Returns
+    -------
+    dict — ``mean`` (of ``full``; None if a cell is not finite), ``low``, ``high`` (None without replicates: one
+    seed of one draw, or a non-finite cell), ``n_draws``, ``n_seeds``, ``replicates_sd`` (s), ``objects_sd``
+    (√v_objects)
+    """
+    units, objects = variance_parts(full, resampled)
+    n_draws, n_seeds = np.shape(full)
+    out = {"mean": None, "low": None, "high": None, "n_draws": n_draws, "n_seeds": n_seeds}
+    out |= {"replicates_sd": None, "objects_sd": None}
+    if not np.isfinite(full).all():  # a network without a test AP: no mean
+        return out
+    out["mean"] = float(np.mean(full))
+    objects = objects[np.isfinite(objects)]
+    if len(units) < 2 or len(objects) < 2:  # one seed of one draw: no replicate, no interval
+        return out
+    t2, z2 = _quantiles2(len(units), level)
+    half = float(np.sqrt(t2 * units.var(ddof=1) / len(units) + z2 * objects.var(ddof=1)))
+    sds = {"replicates_sd": float(units.std(ddof=1)), "objects_sd": float(objects.std(ddof=1))}
+    return out | {"low": out["mean"] - half, "high": out["mean"] + half} | sds
+
+
+def _quantiles2(n_units: int, level: float) -> tuple[float, float]:
+    """The squared two-sided ``level`` quantiles of :func:`nested_t_interval`: t on ``n_units`` − 1 degrees of freedom
+    (the replicates), normal (the test objects)."""
+    return float(stats.t.ppf(0.5 + level / 2, n_units - 1) ** 2), float(stats.norm.ppf(0.5 + level / 2) ** 2)
 
 
 def fieller_interval(x, y, level: float = 0.95) -> dict:
@@ -339,11 +373,11 @@ def fieller_interval(x, y, level: float = 0.95) -> dict:
 
     Returns
     -------
-    dict — ``ratio`` (x̄ / ȳ), ``low``, ``high``, ``bounded``
+    dict — ``ratio`` (x̄ / ȳ), ``low``, ``high``, ``bounded`` (False, every figure None, on a non-finite input)
     """
     x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
     n = len(x)
-    if n < 2 or not np.any(y):
+    if n < 2 or not np.any(y) or not (np.isfinite(x).all() and np.isfinite(y).all()):  # NaN in: nothing bounded out
         return {"ratio": None, "low": None, "high": None, "bounded": False}
     mx, my = x.mean(), y.mean()
     cov = np.cov(x, y, ddof=1)
@@ -360,67 +394,58 @@ def fieller_interval(x, y, level: float = 0.95) -> dict:
 
 
 def ratio_interval(
-    numerator: float,
-    denominator: float,
+    numerator: np.ndarray,
     resampled_numerator: np.ndarray,
+    denominator: np.ndarray,
     resampled_denominator: np.ndarray,
     level: float = 0.95,
 ) -> dict:
-    """A ratio of two noisy gains, numerator / denominator (e.g. a pool's AP gain over no augmentation divided by as
-    many real shapes' gain: a share), with a ``level`` interval by test inversion over one bootstrap (Fieller's
-    idea, the one method for every share in the package).
+    """A ratio of two noisy gains, mean(numerator) / mean(denominator) (e.g. a pool's AP gain over no augmentation
+    divided by as many real shapes' gain: a share), with a ``level`` interval by test inversion (Fieller's idea, the
+    one method for every share in the package) of :func:`nested_t_interval`.
 
-    θ is in the interval when the test of ``numerator − θ·denominator = 0`` does not reject: when 0 lies within the
-    percentile interval of its resamples, i.e. at least (1 − level)/2 of the resampled
-    ``resampled_numerator − θ·resampled_denominator`` lie at or below 0 and as many at or above it. The set of such
-    θ is an interval when the denominator is clearly nonzero (then it is the percentile interval of the resampled
-    ratios), and unbounded (an unbounded interval or the complement of one) when the denominator's own percentile
-    interval holds zero: the data then say nothing about the ratio's size, and both ends are None. The percentile
-    interval of the resampled ratios alone is not used: with a denominator near zero it is bounded and may exclude
-    its own estimate (issue #58). :func:`fieller_interval` is the closed form of the same idea for paired means.
+    θ is in the interval when :func:`nested_t_interval` of the paired difference ``numerator − θ·denominator`` (cell
+    by cell, resample by resample) holds zero: (x̄ − θȳ)² ≤ t² V_u(θ) + z² V_o(θ), with V_u and V_o the replicates' and
+    the test objects' variances of the difference, each a quadratic in θ (from the (2, 2) covariances of the two
+    gains' replicates and resamples). So the set is {θ : a θ² − 2 b θ + c ≤ 0}: an interval when a > 0, which is
+    exactly when the denominator's own :func:`nested_t_interval` excludes zero; otherwise it is unbounded (an
+    unbounded interval or the complement of one) and both ends are None: the data then say nothing about the
+    ratio's size. With one draw and no object spread it is :func:`fieller_interval` of the seeds' values. Nothing
+    larger than (R,) is kept.
 
     Parameters
     ----------
-    numerator, denominator : float — the two gains on all the data (AP, or any unit: the ratio has none)
-    resampled_numerator, resampled_denominator : (R,) float — the same under R resamples, the same resamples for
-        both (e.g. :func:`nested_means` with one set of :func:`nested_indices`); NaN resamples are left out
+    numerator, denominator : (D, S) float — the two gains of draw d, training seed s on all test objects (AP, or any
+        unit: the ratio has none)
+    resampled_numerator, resampled_denominator : (D, S, R) float — the same under R object resamples, the same
+        resamples for both; a resample with a NaN cell in either is left out
     level : float — the interval's coverage
 
     Returns
     -------
-    dict — ``share`` (numerator / denominator; None when the denominator is 0 or either is not finite), ``low``,
-    ``high`` (None when unbounded), ``bounded``, and the denominator's own percentile interval
-    ``denominator_low``, ``denominator_high``
+    dict — ``share`` (x̄ / ȳ; None when ȳ is 0 or a cell not finite), ``low``, ``high`` (None when unbounded),
+    ``bounded``, and the denominator's own :func:`nested_t_interval` ends ``denominator_low``, ``denominator_high``
     """
-    x, y = np.asarray(resampled_numerator, dtype=float), np.asarray(resampled_denominator, dtype=float)
-    if x.shape != y.shape or x.ndim != 1:
-        raise ValueError(f"ratio_interval: resamples of shapes {x.shape} and {y.shape}, need two equal (R,)")
-    keep = np.isfinite(x) & np.isfinite(y)
-    x, y = x[keep], y[keep]
-    finite = np.isfinite(numerator) and np.isfinite(denominator) and denominator != 0
-    ratio = float(numerator / denominator) if finite else None
-    den_low, den_high = percentile_interval(y, level)
-    unbounded = {"share": ratio, "low": None, "high": None, "bounded": False}
-    den = {"denominator_low": den_low, "denominator_high": den_high}
-    if len(y) == 0 or den_low is None or den_low <= 0 <= den_high:
-        return unbounded | den
-    tail = (1 - level) / 2
-
-    def accepted(theta: np.ndarray) -> np.ndarray:  # (T,) → (T,) bool: 0 within the differences' percentiles
-        diff = x[None, :] - theta[:, None] * y[None, :]  # (T, R)
-        return ((diff <= 0).mean(axis=1) >= tail) & ((diff >= 0).mean(axis=1) >= tail)
-
-    nonzero = y != 0
-    breaks = np.unique(x[nonzero] / y[nonzero])  # where a resample's difference changes sign
-    far = 10 * (np.abs(breaks).max() + 1)
-    between = (breaks[:-1] + breaks[1:]) / 2
-    if accepted(np.array([-far, far])).any():  # open at an end: unbounded
-        return unbounded | den
-    points = np.concatenate([breaks, between])
-    ok = points[accepted(points)]
-    if len(ok) == 0:
-        return unbounded | den
-    return {"share": ratio, "low": float(ok.min()), "high": float(ok.max()), "bounded": True} | den
+    ux, bx = variance_parts(numerator, resampled_numerator)
+    uy, by = variance_parts(denominator, resampled_denominator)
+    keep = np.isfinite(bx) & np.isfinite(by)
+    den = nested_t_interval(denominator, np.where(keep, resampled_denominator, np.nan), level)
+    out = {"share": None, "low": None, "high": None, "bounded": False}
+    out |= {"denominator_low": den["low"], "denominator_high": den["high"]}
+    if not (np.isfinite(numerator).all() and np.isfinite(denominator).all()) or np.mean(denominator) == 0:
+        return out
+    mx, my = float(np.mean(numerator)), float(np.mean(denominator))
+    out["share"] = mx / my
+    if den["low"] is None or den["low"] <= 0 <= den["high"] or keep.sum() < 2:
+        return out
+    t2, z2 = _quantiles2(len(ux), level)
+    v = t2 * np.cov(ux, uy, ddof=1) / len(ux) + z2 * np.cov(bx[keep], by[keep], ddof=1)  # (2, 2)
+    a, b, c = my**2 - v[1, 1], mx * my - v[0, 1], mx**2 - v[0, 0]  # a θ² − 2 b θ + c ≤ 0
+    disc = b * b - a * c
+    if a <= 0 or disc < 0:
+        return out
+    root = np.sqrt(disc)
+    return out | {"low": float((b - root) / a), "high": float((b + root) / a), "bounded": True}
 
 
 def share_headline(share: dict) -> dict[str, float | None]:

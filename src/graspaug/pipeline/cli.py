@@ -376,8 +376,8 @@ def profile_command(
     "`results/<study>/` (written by `graspaug study attribution`, `lifelong`, `heldout-fidelity` and `precision` with "
     "`--results`): writes `<out>/<study>/summary.json`, "
     "`decomposition.md` and `figures.json` (key → the quoted text) and prints each figure. `--check`: a figure the "
-    "markdown marks (`<!-- results:KEY -->` before it) that differs from the recomputed one, or that no study "
-    "recomputes, is an error naming it (exit 2).",
+    "markdown marks (`<!-- results:KEY -->` before it) that differs in any character from the recomputed one, or that "
+    "no study recomputes, a malformed marker, or a document without a marker, is an error naming it (exit 2).",
 )
 def results_command(
     root: Path = typer.Option(Path("."), "--root", help="The repository (its results/, README.md, docs/)."),
@@ -395,7 +395,7 @@ def results_command(
         if problems:
             from graspaug.errors import DataError
 
-            raise DataError(f"{len(problems)} quoted figure(s) differ from results/: {'; '.join(problems)}")
+            raise DataError(f"{len(problems)} problem(s) with the marked figures: {'; '.join(problems)}")
         typer.echo(f"every marked figure of {', '.join(DOCUMENTS)} equals the recomputed one")
 
 

@@ -72,8 +72,9 @@ def _logging() -> None:
     help="Why generated shapes add nothing, over several draws of the data (issue #33): for each data seed k, a clone "
     "of the project's HEAD in `<workdir>/draw<k>` (sharing its DVC cache) with the `--profile` params plus "
     "`data_seed: k` and every `--set`, runs `dvc repro report`; then one interval per contrast over draws, training "
-    "seeds and test objects (hierarchical bootstrap). Writes `<workdir>/summary.json`, `decomposition.md` and the "
-    "per-network tables with this command and the commit to `results/<results>/` (`graspaug results` recomputes every "
+    "seeds and test objects (t over the draws' means, with the object bootstrap). Writes `<workdir>/summary.json`, "
+    "`decomposition.md` and the per-network tables with this command and the commit to `results/<results>/` "
+    "(`graspaug results` recomputes every "
     "quoted figure from them). A finished draw is not run again.\n\nCost on 2 cores: the `attribution` profile, about "
     "40 min per draw (three draws: 121 min); with the distance decoder and seven pools, about 65 s per network (three "
     "draws, 204 networks: about 4 h). `--combine-only`: seconds to minutes.",

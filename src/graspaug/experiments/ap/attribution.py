@@ -1,6 +1,6 @@
 """Why generated shapes help or not: the GQ-CNN experiment's contrasts over several draws of the
 data (``data_seed``) crossed with the paired training seeds, each with one interval that covers
-draws, seeds and test objects (:func:`graspaug.experiments.stats.nested_interval`), and the
+draws, seeds and test objects (:func:`graspaug.experiments.stats.nested_t_interval`), and the
 decomposition of the gap between generated and real shapes into steps:
 
     real ─(recon_vs_real: what the decoder loses)→ recon ─(blend_vs_recon)→ blend
@@ -27,7 +27,6 @@ from graspaug.experiments.ap.numbers import (
     collect,
     datapoint_matched_contrasts,
     declared_contrasts,
-    nested_rng,
     test_predictions,
 )
 from graspaug.experiments.stats import (
@@ -35,9 +34,7 @@ from graspaug.experiments.stats import (
     draw_scope,
     interval_text,
     nested_contrast,
-    nested_indices,
-    nested_interval,
-    nested_means,
+    nested_t_interval,
     ratio_interval,
     share_text,
     verdict,
@@ -76,20 +73,20 @@ def combine_draws(
     labels, object_ids : (N,) — the test datapoints' labels and objects, in the order of every
         network's ``test_predictions.npy``
     generate, gqcnn : the params sections the draws were run with (only ``data_seed`` differs)
-    n_resamples : int — resamples of the test objects and of the nested bootstrap
-    seed : int — seeds both
+    n_resamples : int — resamples of the test objects
+    seed : int — seeds them
 
     Returns
     -------
     dict — ``contrasts``: name → a :func:`~graspaug.experiments.stats.contrast` over ``draws``
-    (:func:`nested_interval`) with ``per_draw`` (mean over seeds per draw) and ``meaning``; ``shares``: pool →
+    (:func:`nested_t_interval`) with ``per_draw`` (mean over seeds per draw) and ``meaning``; ``shares``: pool →
     augmented base size → the share of the real-shape gain that the pool gives (its mean gain over no augmentation,
     mean over ratios, divided by the real pool's): ``share``, ``low``, ``high``, ``bounded``
-    (:func:`~graspaug.experiments.stats.ratio_interval` over the same nested resamples; unbounded, ends None, when
+    (:func:`~graspaug.experiments.stats.ratio_interval` over the same object resamples; unbounded, ends None, when
     the real gain's interval holds zero), ``gain``, the pool's gain as a contrast over draws (the declared
     ``<pool>_vs_none@B`` where there is one), and ``real_gain``, the denominator as a contrast over draws;
-    ``share``: the targeted pool's; ``draws``, ``seeds``. Every nested interval uses the same resamples of draws,
-    seeds and objects, so a gain quoted twice (a contrast, a share's numerator) has one interval.
+    ``share``: the targeted pool's; ``draws``, ``seeds``. Every interval uses the same object resamples, so a gain
+    quoted twice (a contrast, a share's numerator) has one interval.
     """
     seeds = sorted({s for d in draws.values() for s in d})
     if any(sorted(d) != seeds for d in draws.values()):
@@ -136,26 +133,23 @@ def combine_runs(
         for i, (d, (runs, contrasts)) in enumerate(per_draw.items()):
             ap = runs.set_index(["pool", "base_size", "ratio", "seed"]).test_ap.astype(float)
             for j, s in enumerate(seeds):
-                f[i, j] = sum(w * ap.get((*k, s), np.nan) for w, k in terms_of(contrasts))
-                r[i, j] = sum(w * boot_ap(d, s, k) for w, k in terms_of(contrasts))
+                terms = terms_of(contrasts)  # none: a declared contrast no network gives (no value, NaN)
+                f[i, j] = sum(w * ap.get((*k, s), np.nan) for w, k in terms) if terms else np.nan
+                r[i, j] = sum(w * boot_ap(d, s, k) for w, k in terms) if terms else np.nan
         return f, r
 
     full, resampled = {}, {}
     for name in names:
         full[name], resampled[name] = arrays(lambda contrasts, name=name: contrasts[name].terms)
 
-    def rng() -> np.random.Generator:  # the same draws and seeds for every figure: one figure, one interval
-        return nested_rng(seed)
-
     out = {
         name: nested_contrast(
-            nested_interval(full[name], resampled[name], rng()),
+            nested_t_interval(full[name], resampled[name]),
             per_draw=[round(float(v), 5) if np.isfinite(v) else None for v in full[name].mean(axis=1)],
             meaning=per_draw[next(iter(per_draw))][1][name].meaning,
         )
         for name in names
     }
-    indices = nested_indices(len(draws), len(seeds), n_resamples, rng())  # those of every nested_interval above
     shares: dict[str, dict[str, dict]] = {}  # pool → base size → the share of the real-shape gain
     real_ratios = pool_ratios("real", generate.ratios, gqcnn.control_ratios)
 
@@ -170,12 +164,10 @@ def combine_runs(
             if not rs:
                 continue
             (f, r), (real_full, real_resampled) = gain(pool, b, rs), gain("real", b, rs)
-            real_gain = nested_contrast(nested_interval(real_full, real_resampled, rng()))  # the share's denominator
-            share = ratio_interval(
-                f.mean(), real_full.mean(), nested_means(r, indices), nested_means(real_resampled, indices)
-            )
+            real_gain = nested_contrast(nested_t_interval(real_full, real_resampled))  # the share's denominator
+            share = ratio_interval(f, r, real_full, real_resampled)
             declared = out.get(f"{pool}_vs_none@{b}") if list(rs) == list(own) else None  # the same terms: one interval
-            pool_gain = declared if declared is not None else nested_contrast(nested_interval(f, r, rng()))
+            pool_gain = declared if declared is not None else nested_contrast(nested_t_interval(f, r))
             shares.setdefault(pool, {})[str(b)] = {
                 "share": share["share"],
                 "low": share["low"],
@@ -225,12 +217,12 @@ def decomposition_markdown(result: dict, augment_base_sizes: Sequence[int], comm
     if len(result["draws"]) > 1:
         design = (
             f"Draws (data_seed) {result['draws']} × training seeds {result['seeds']}; every interval is a 95% "
-            "hierarchical bootstrap over draws, seeds within draws and test objects."
+            "t-interval over the draws' means (seeds within draws) combined with the bootstrap over test objects."
         )
     else:
         design = (
-            f"{draw_scope(result['draws'][0], result['seeds'], 'ap')} Every interval is a 95% bootstrap over the "
-            "seeds and the test objects."
+            f"{draw_scope(result['draws'][0], result['seeds'], 'ap')} Every interval is a 95% t-interval over the "
+            "seeds combined with the bootstrap over the test objects (none with one seed)."
         )
     lines = [
         "# Why generated shapes help or not: the gap to real shapes, step by step",

@@ -26,9 +26,9 @@ network is read:
 * ``<pool>_vs_real_datapoints@B``: the same pools against real shapes at as many training
   datapoints (:func:`datapoint_matched_contrasts`), since a generated shape yields fewer.
 
-Each contrast is judged by one interval, the nested bootstrap over seeds and test objects
-(:func:`evaluate_contrasts`); the share of the real-shape gain that targeted shapes give has an interval by test
-inversion over the same resamples (:func:`graspaug.experiments.ap.attribution.combine_draws`).
+Each contrast is judged by one interval, over seeds and test objects (:func:`evaluate_contrasts`:
+:func:`~graspaug.experiments.stats.nested_t_interval`); the share of the real-shape gain that targeted shapes give
+has an interval by test inversion over the same resamples (:func:`graspaug.experiments.ap.attribution.combine_draws`).
 """
 
 from __future__ import annotations
@@ -48,7 +48,7 @@ from graspaug.experiments.stats import (
     ObjectBootstrap,
     contrast,
     headline,
-    nested_interval,
+    nested_t_interval,
     percentile_interval,
     t_interval,
 )
@@ -156,10 +156,11 @@ def datapoint_matched_contrasts(
     AP minus the AP that real shapes give at as many training datapoints, mean over ratios R > 0.
     The real-shape curve is AP against training datapoints through the real-shape networks (1:0 at
     every base size, ``real`` at B and every R), linear between neighbouring points; the weights
-    come from the datapoint counts (the same in every seed: they are design, not outcome). A
-    network outside the curve's range, or without a count (``runs.train_datapoints``), gives no
-    contrast. So a pool is not penalised for yielding fewer datapoints per shape. With ``control_ratios``, each pool's
-    mean runs over its own ratios (:func:`graspaug.training.variants.pool_ratios`)."""
+    come from the datapoint counts (the same in every seed: they are design, not outcome). So a pool is not penalised
+    for yielding fewer datapoints per shape. With ``control_ratios``, each pool's mean runs over its own ratios
+    (:func:`graspaug.training.variants.pool_ratios`). A ratio whose network lies outside the curve's range, or has no
+    count (``runs.train_datapoints``), is left out of the mean and its ``meaning`` says so; a pool with no ratio left
+    keeps its contrast with no terms (no value; :func:`evaluate_contrasts`), so no declared contrast disappears."""
     counts = runs.groupby(["pool", "base_size", "ratio"]).train_datapoints.first()
     out = []
     for b in augment_base_sizes:
@@ -172,23 +173,29 @@ def datapoint_matched_contrasts(
         for pool in (p for p in pools if p != "real"):
             terms: list[tuple[float, Key]] = []
             own = pool_ratios(pool, ratios, control_ratios)
-            for r in own:
-                key = (pool, int(b), r)
-                x = counts.get(key)
-                if x is None or pd.isna(x) or not xs[0] <= x <= xs[-1]:
-                    terms = []
-                    break
+            covered = [
+                r for r in own if pd.notna(counts.get((pool, int(b), r))) and xs[0] <= counts[pool, b, r] <= xs[-1]
+            ]
+            for r in covered:
+                key, x = (pool, int(b), r), counts[pool, int(b), r]
                 hi = min(int(np.searchsorted(xs, x, side="left")), len(xs) - 1)
                 lo = max(hi - 1, 0)
                 share = 0.0 if xs[hi] == xs[lo] else (x - xs[lo]) / (xs[hi] - xs[lo])
-                n = len(own)
+                n = len(covered)
                 terms += [(1 / n, key), (-(1 - share) / n, points[lo][1]), (-share / n, points[hi][1])]
-            if terms:
-                words = (
-                    f"{pool} at B = {b} vs real shapes giving as many training datapoints (the real-shape networks' AP "
-                    "interpolated in datapoints), mean over ratios"
-                )
-                out.append(Contrast(f"{pool}_vs_real_datapoints@{b}", tuple(terms), words))
+            left = [r for r in own if r not in covered]
+            outside = (
+                f"; 1:{', 1:'.join(f'{r:g}' for r in left)} left out: {'its' if len(left) == 1 else 'their'} training "
+                f"datapoints lie outside the real-shape networks' range ({xs[0]:g}–{xs[-1]:g}) or are not recorded"
+                if left
+                else ""
+            )
+            words = (
+                f"{pool} at B = {b} vs real shapes giving as many training datapoints (the real-shape networks' AP "
+                f"interpolated in datapoints), mean over ratios {', '.join(f'1:{r:g}' for r in covered) or 'none'}"
+                + outside
+            )
+            out.append(Contrast(f"{pool}_vs_real_datapoints@{b}", tuple(terms), words))
     return out
 
 
@@ -326,13 +333,14 @@ def evaluate_contrasts(
     seed: int,
 ) -> dict:
     """Per contrast, a :func:`~graspaug.experiments.stats.contrast` judged by ONE interval, the one that covers both
-    sources of variance: the 95% nested bootstrap over the training seeds and the test objects (``draws_low``,
-    ``draws_high``, ``over`` ``draws`` with ``n_draws`` 1: :func:`~graspaug.experiments.stats.nested_interval` on
-    this one draw, with the resamples :func:`graspaug.experiments.ap.attribution.combine_draws` uses, so the
-    decomposition quotes the same interval). Secondary, never judged: the 95% t-interval over seeds (``seeds_*``;
-    None where it leaves [−1, 1]: too few seeds), the bootstrap over test objects alone (``objects_*``), the SD of
-    the per-seed values. ``seed_dirs``: training seed → the folder of its networks; ``labels``, ``object_ids``
-    (N,): the test datapoints' labels and objects."""
+    sources of variance: the 95% interval over the training seeds and the test objects (``draws_low``,
+    ``draws_high``, ``over`` ``draws`` with ``n_draws`` 1: :func:`~graspaug.experiments.stats.nested_t_interval` on
+    this one draw, with the object resamples :func:`graspaug.experiments.ap.attribution.combine_draws` uses, so the
+    decomposition quotes the same interval; none with one seed). A contrast without terms (declared, but no network
+    can give it: :func:`datapoint_matched_contrasts`) has no value and says why in its ``meaning``. Secondary, never
+    judged: the 95% t-interval over seeds (``seeds_*``; None where it leaves [−1, 1]: too few seeds), the bootstrap
+    over test objects alone (``objects_*``), the SD of the per-seed values. ``seed_dirs``: training seed → the folder
+    of its networks; ``labels``, ``object_ids`` (N,): the test datapoints' labels and objects."""
     seeds = list(seed_dirs)
     boot = ObjectBootstrap(object_ids, n_resamples, seed)
     ap = runs.set_index(["pool", "base_size", "ratio", "seed"]).test_ap.astype(float)  # None (one class) → NaN
@@ -346,11 +354,12 @@ def evaluate_contrasts(
     out = {}
     r5 = lambda v: None if v is None else round(float(v), 5)  # noqa: E731
     for c in contrasts:
-        per_seed = [sum(w * ap.get((*k, s), np.nan) for w, k in c.terms) for s in seeds]
+        per_seed = [sum(w * ap.get((*k, s), np.nan) for w, k in c.terms) if c.terms else np.nan for s in seeds]
         summary = t_interval(per_seed, bounds=DIFFERENCE_RANGE)
-        resampled = np.array([sum(w * boot_ap(k, s) for w, k in c.terms) for s in seeds])  # (S, R)
+        no_value = np.full(n_resamples, np.nan)
+        resampled = np.array([sum(w * boot_ap(k, s) for w, k in c.terms) if c.terms else no_value for s in seeds])
         low, high = percentile_interval(resampled.mean(axis=0))
-        nested = nested_interval(np.array([per_seed]), resampled[None], nested_rng(seed))
+        nested = nested_t_interval(np.array([per_seed]), resampled[None])
         finite = [v for v in per_seed if np.isfinite(v)]
         out[c.name] = contrast(
             r5(summary["mean"]),
@@ -362,14 +371,23 @@ def evaluate_contrasts(
             sd=round(float(np.std(finite, ddof=1)), 5) if len(finite) > 1 else None,
             per_seed=[round(float(v), 5) if np.isfinite(v) else None for v in per_seed],
             meaning=c.meaning,
+            **({"recon_shapes": recon_shapes(runs, c)} if c.name.startswith("recon_vs_real@") else {}),
         )
     return out
 
 
-def nested_rng(seed: int) -> np.random.Generator:
-    """The generator of the draws and seeds of every nested interval of the AP experiment (a fresh one per
-    interval: the same resamples for every contrast, so a figure quoted in two reports has one interval)."""
-    return np.random.default_rng([seed, 0xA77])
+def recon_shapes(runs: pd.DataFrame, c: Contrast) -> list[dict]:
+    """Per recon network of contrast ``c`` (its terms of pool ``recon``), how many of the real shapes it decodes
+    meshed: ``ratio``, ``meshed`` (``generated_shapes``), ``asked`` (``generated_shapes_asked``), from the first seed
+    that records them in ``runs`` (:func:`collect`; every seed of a draw trains on the same pool); empty when no
+    summary records them."""
+    out = []
+    for _, (pool, base, ratio) in c.terms:
+        rows = runs[(runs.pool == pool) & (runs.base_size == base) & (runs.ratio == ratio)] if pool == "recon" else []
+        if "generated_shapes" in runs and len(rows) and rows.generated_shapes.notna().any():
+            row = rows[rows.generated_shapes.notna()].iloc[0]
+            out.append({"ratio": ratio, "meshed": int(row.generated_shapes), "asked": int(row.generated_shapes_asked)})
+    return out
 
 
 def per_object_aps(
@@ -461,6 +479,6 @@ def ap_metrics(contrasts: dict, table: pd.DataFrame, chosen: dict[int, float], p
 
 def ap_headline(report: dict) -> dict[str, dict]:
     """The experiment's metrics from its :func:`ap_metrics` report: per declared contrast its mean and the one
-    interval it is judged by, the 95% bootstrap over seeds × test objects
+    interval it is judged by, the 95% interval over seeds × test objects
     (:func:`~graspaug.experiments.stats.headline`), one metrics file each."""
     return {name: headline(c) for name, c in report["contrasts"].items()}

@@ -51,11 +51,24 @@ def verdict(name: str, c: dict) -> str:
     """One sentence: the contrast with its one interval (its ``over``: seeds × test objects) and its one verdict,
     scoped to the run's one draw of the data (:func:`~graspaug.experiments.stats.draw_verdict`)."""
     if c["mean"] is None:
-        return f"`{name}` ({c['meaning']}): no value (a test set with one class?)."
+        return f"`{name}` ({c['meaning']}): no value (a network without a test AP, or no ratio it can use), no verdict."
+    shapes = recon_words(c.get("recon_shapes") or [])
     if None in interval(c):  # no usable interval: say so rather than print one
         seeds = "one seed" if c.get("n_seeds") == 1 else "too few seeds"
-        return f"`{name}` ({c['meaning']}): {c['mean']:+.4f} AP, {seeds}, no interval: nothing we can claim."
-    return f"`{name}` ({c['meaning']}): {interval_text(c)} AP, {contrast_verdict(c)}."
+        return f"`{name}` ({c['meaning']}): {c['mean']:+.4f} AP, {seeds}, no interval: no verdict.{shapes}"
+    return f"`{name}` ({c['meaning']}): {interval_text(c)} AP, {contrast_verdict(c)}.{shapes}"
+
+
+def recon_words(counts: list[dict]) -> str:
+    """`` N of M recon shapes meshed (K dropped)`` per recon network of a contrast (its ``recon_shapes``:
+    :func:`~graspaug.experiments.ap.numbers.recon_shapes`), "at 1:R" after each when there are several; empty
+    without counts."""
+    parts = [
+        f"{n['meshed']} of {n['asked']} recon shapes meshed ({n['asked'] - n['meshed']} dropped)"
+        + (f" at 1:{n['ratio']:g}" if len(counts) > 1 else "")
+        for n in counts
+    ]
+    return f" {'; '.join(parts)}." if parts else ""
 
 
 def _fmt(v, digits: int = 4) -> str:
@@ -116,8 +129,9 @@ def report_markdown(
         "",
         "## Contrasts (declared before any network was read)",
         "",
-        "Each contrast is judged by one interval, the 95% bootstrap over training seeds and test objects together "
-        "(the one every report quotes). Secondary columns, never judged on their own: the 95% t-interval over seeds "
+        "Each contrast is judged by one interval over training seeds and test objects together (the one every report "
+        "quotes: the seeds' t half-width and the object bootstrap's normal one in quadrature; none with one seed). "
+        "Secondary columns, never judged on their own: the 95% t-interval over seeds "
         '("too few seeds" where it would leave [−1, 1]), the SD over seeds, the bootstrap over test objects alone.',
         "",
         "| contrast | mean [95% interval: seeds × objects] | verdict | t over seeds | SD over seeds | objects alone |",
@@ -125,7 +139,7 @@ def report_markdown(
     ]
     for name, c in contrasts.items():
         t_cell = "too few seeds" if c["seeds_low"] is None else f"[{_fmt(c['seeds_low'])}, {_fmt(c['seeds_high'])}]"
-        word = "-" if c["mean"] is None else contrast_verdict(c)
+        word = "-" if c["mean"] is None else contrast_verdict(c)  # no interval: "no interval … no verdict"
         lines.append(
             f"| `{name}` | {interval_text(c)} | {word} | {t_cell} | {_fmt(c['sd'])} | "
             f"[{_fmt(c['objects_low'])}, {_fmt(c['objects_high'])}] |"

@@ -31,8 +31,7 @@ def test_ap(
     boot = ObjectBootstrap(object_ids, n_resamples, seed)
     point, resampled, models = {}, {}, {}
     for name, p in probabilities.items():
-        order = np.argsort(-np.asarray(p), kind="stable")  # the AP itself: every datapoint once
-        ap = float(weighted_average_precision(labels[order].astype(np.float32), np.ones(len(labels), np.float32)))
+        ap = float(weighted_average_precision(labels, p, np.ones(len(labels))))  # the AP itself: every datapoint once
         point[name] = None if np.isnan(ap) else ap
         resampled[name] = boot.average_precision(labels, p)
         models[name] = contrast(point[name], "objects", objects=_interval(resampled[name], boot.n_objects))

@@ -21,9 +21,7 @@ from graspaug.errors import DataError
 from graspaug.experiments.stats import (
     ObjectBootstrap,
     nested_contrast,
-    nested_indices,
-    nested_interval,
-    nested_means,
+    nested_t_interval,
     ratio_interval,
 )
 from graspaug.training.variants import Variant
@@ -173,7 +171,7 @@ def arm_contrasts(
     seed: int,
 ) -> dict:
     """Every arm's test AP and the :data:`ARM_CONTRASTS` of one round, over data draws × training seeds × test
-    objects (:func:`graspaug.experiments.stats.nested_interval`; one draw: seeds × objects).
+    objects (:func:`graspaug.experiments.stats.nested_t_interval`; one draw: seeds × objects).
 
     Parameters
     ----------
@@ -181,15 +179,15 @@ def arm_contrasts(
         folder (``test_predictions.npy``) or its (N,) predictions themselves (:func:`network_predictions`; what
         ``results/lifelong/`` keeps); every draw has the same seeds and arms
     labels, object_ids : (N,) — the test datapoints' labels and objects, in the predictions' order
-    n_resamples, seed : resamples of the objects and of the nested bootstrap, and their seed
+    n_resamples, seed : resamples of the objects, and their seed
 
     Returns
     -------
     dict — ``ap``: arm → a :func:`~graspaug.experiments.stats.contrast` over ``draws``; ``contrasts``: name → the
     same; ``share``: the share of the real shapes' gain that failure-targeted shapes give
-    (:func:`~graspaug.experiments.stats.ratio_interval` over the same nested resamples: ``share``, ``low``, ``high``,
+    (:func:`~graspaug.experiments.stats.ratio_interval` over the same object resamples: ``share``, ``low``, ``high``,
     ``bounded``; unbounded when ``real_data``'s interval holds zero), ``draws``, ``seeds``. Every interval uses the
-    same resamples of draws, seeds and objects.
+    same object resamples.
     """
     draws = list(networks)
     seeds = sorted(networks[draws[0]])
@@ -206,16 +204,13 @@ def arm_contrasts(
                 full[a, i, j] = average_precision_score(labels, p)
                 resampled[a, i, j] = boot.average_precision(labels, p)
 
-    def rng() -> np.random.Generator:  # the same draws and seeds for every figure: one figure, one interval
-        return np.random.default_rng([seed, 0x11FE])
-
     at = {arm: a for a, arm in enumerate(arms)}
     rounded = lambda d: {k: (round(v, 5) if isinstance(v, float) else v) for k, v in d.items()}  # noqa: E731
     out = {
-        "ap": {arm: rounded(nested_contrast(nested_interval(full[a], resampled[a], rng()))) for arm, a in at.items()},
+        "ap": {arm: rounded(nested_contrast(nested_t_interval(full[a], resampled[a]))) for arm, a in at.items()},
         "contrasts": {
             name: rounded(
-                nested_contrast(nested_interval(full[at[a]] - full[at[b]], resampled[at[a]] - resampled[at[b]], rng()))
+                nested_contrast(nested_t_interval(full[at[a]] - full[at[b]], resampled[at[a]] - resampled[at[b]]))
             )
             for name, (a, b) in ARM_CONTRASTS.items()
             if a in at and b in at
@@ -224,14 +219,11 @@ def arm_contrasts(
         "seeds": seeds,
     }
     if {"none", "failure", "real"} <= set(at):
-        x = resampled[at["failure"]] - resampled[at["none"]]
-        y = resampled[at["real"]] - resampled[at["none"]]
-        indices = nested_indices(len(draws), len(seeds), n_resamples, rng())  # those of every interval above
         share = ratio_interval(
-            float((full[at["failure"]] - full[at["none"]]).mean()),
-            float((full[at["real"]] - full[at["none"]]).mean()),
-            nested_means(x, indices),
-            nested_means(y, indices),
+            full[at["failure"]] - full[at["none"]],
+            resampled[at["failure"]] - resampled[at["none"]],
+            full[at["real"]] - full[at["none"]],
+            resampled[at["real"]] - resampled[at["none"]],
         )
         out["share"] = rounded(share)  # beside it in every report: its denominator, contrasts["real_data"]
     return out

@@ -133,7 +133,7 @@ def write_round(
     design = (
         f"Base set B = {cfg.base_size}; each arm adds {cfg.shapes_per_round} shapes per round (round {round_}: "
         f"{round_ * cfg.shapes_per_round}); failures: the {cfg.worst} worst validation objects, {cfg.per_failure} "
-        "anchors each. Intervals: 95% bootstrap over the seeds and the test objects. "
+        "anchors each. Intervals: 95%, over the seeds (t) and the test objects (bootstrap), in quadrature. "
         f"{draw_scope(params.data_seed, params.gqcnn.seeds, 'lifelong')}"
     )
     words = {"design": design, "command": f"dvc repro lifelong@r{round_}" if round_ else "dvc repro lifelong_start"}

@@ -1,7 +1,7 @@
 """Stage ``report``: the paper's GQ-CNN experiment in one table, declared contrasts with intervals, figures, words.
 
 Reads every network of every seed (``models/gqcnn/s<seed>/``). Writes ``metrics/ap/<contrast>.json`` (``mean``,
-``lo``, ``hi``: the 95% bootstrap over seeds × test objects, the one interval every report quotes) and, in
+``lo``, ``hi``: the 95% interval over seeds × test objects, the one interval every report quotes) and, in
 ``reports/gqcnn/``: ``ap.json`` (per declared contrast a :func:`~graspaug.experiments.stats.contrast`, judged by
 ``draws_low``/``draws_high``; AP per network and object; ``chosen_ratio`` per base size, picked on validation AP),
 ``ap_table.csv``, ``report.md``, ``decomposition.{md,json}`` (the gap to real shapes step by step, real → recon →

@@ -7,10 +7,11 @@ written from the profile plus ``data_seed: k`` and any ``--set key=value``; it r
 experiment, not the robot cell), and adds that draw's per-network, per-test-datapoint tables with the command and
 commit that made them to the project's ``results/<results>/`` at once (commit them as they come: ``graspaug results``
 recomputes every quoted figure from them). Then :func:`graspaug.experiments.results.combine_attribution` combines
-the draws from those tables alone (one interval per contrast over draws, training seeds and test objects) and writes
-``summary.json`` and ``decomposition.md`` into ``workdir``; ``--combine-only`` does only that, with no clone. A
-finished draw is not run again (``dvc repro`` finds nothing to do), and a second draw's clone takes every stage no
-data seed reaches (ingest to ``render@original``) from the shared run cache.
+the draws from those tables alone (one interval per contrast: t over the draws' means, or over the seeds with one
+draw, with the test objects' bootstrap) and writes ``summary.json`` and ``decomposition.md`` into ``workdir``;
+``--combine-only`` does only that, with no clone. A finished draw is not run again (``dvc repro`` finds nothing to
+do), and a second draw's clone takes every stage no data seed reaches (ingest to ``render@original``) from the
+shared run cache.
 """
 
 from __future__ import annotations

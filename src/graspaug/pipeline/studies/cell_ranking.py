@@ -25,11 +25,10 @@ import pandas as pd
 from graspaug.experiments.ap.numbers import choose_ratios, collect
 from graspaug.experiments.cell.numbers import CONTRASTS, arm_scores, auc_samples, ranking_bootstrap, ranking_summary
 from graspaug.experiments.cell.trials import after_ratio
-from graspaug.experiments.stats import nested_interval
+from graspaug.experiments.stats import nested_t_interval
 from graspaug.io.tables import read_table
 from graspaug.pipeline.params.model import load_params
 from graspaug.pipeline.paths import AP_REPORT
-from graspaug.rng import shape_rng
 from graspaug.training.variants import Variant
 
 
@@ -89,12 +88,11 @@ def run(
         draws[str(project)]["top_pick"] = top_pick(grasps, scores)
         full.append(f)
         resampled.append(r)
-    rng = shape_rng(params.seed, "sim", "ranking-draws")
     pooled = {}
     for name, (arm, reference) in CONTRASTS.items():
         if arm in full[0] and reference in full[0]:
             f = np.stack([d[arm] - d[reference] for d in full])  # (D, S)
             r = np.stack([d[arm] - d[reference] for d in resampled])  # (D, S, R)
-            pooled[name] = nested_interval(f, r, rng) if len(full) > 1 else None
+            pooled[name] = nested_t_interval(f, r) if len(full) > 1 else None
     summary = {"grasps": len(grasps), "shapes": int(grasps.shape_id.nunique()), "reference": ranking["reference"]}
     return {**summary, "draws": draws, "pooled": pooled}
