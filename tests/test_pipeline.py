@@ -843,8 +843,12 @@ def test_attribution_study_records_a_finished_draw_then_combines_from_results_al
     run(["dvc", "repro", "report"], work, env)
     (tmp_path / "draw0").symlink_to(work)
     cmd = [*GRASPAUG, "study", "attribution", "--draws", "0", "--workdir", str(tmp_path), "--profile", "tiny"]
-    printed = run([*cmd, "--resamples", "50", "--results", "tiny-study"], work, env).stdout
+    printed = run([*cmd, "--resamples", "50", "--results", "tiny-study", "--keep-networks", "0/0"], work, env).stdout
     assert (tmp_path / "decomposition.md").read_text() in printed
+    kept = sorted(p.parent.name for p in (work / "results/tiny-study/networks/d0-s0").glob("*/model.pt"))
+    assert kept and all(k.split("-")[0] in ("targeted", "real") for k in kept) and any(k.endswith("-0") for k in kept)
+    card = json.loads(next((work / "results/tiny-study/networks/d0-s0").glob("*/card.json")).read_text())
+    assert card["label_threshold"] > 0
     meta = json.loads((work / "results/tiny-study/meta.json").read_text())
     assert meta["command"].startswith("graspaug study attribution --draws 0") and meta["n_resamples"] == 50
     assert meta["draws"]["0"]["seconds"] >= 0 and len(meta["draws"]["0"]["commit"]) == 40

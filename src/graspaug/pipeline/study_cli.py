@@ -89,13 +89,26 @@ def attribution_command(
     resamples: int = typer.Option(2000, "--resamples", min=1, help="Bootstrap resamples."),
     combine_only: bool = typer.Option(False, "--combine-only", help="Combine finished draws, run nothing."),
     results: str = typer.Option("attribution", "--results", help="`results/<this>/`: the per-network tables."),
+    keep: str = typer.Option(
+        None,
+        "--keep-networks",
+        help="DRAW/SEED, e.g. `0/0`: copy that draw's seed's networks (none, targeted and real at every augmented B: "
+        "model.pt and card.json) to `results/<results>/networks/d<DRAW>-s<SEED>/`, for `graspaug evaluate`.",
+    ),
     project: Path = ProjectOption,
 ) -> None:
     from graspaug.pipeline.studies import attribution
 
     _logging()
     workdir = workdir or project.resolve().parent / "attribution"
-    text = attribution.run(project, draws, workdir, profile, changes, resamples, combine_only, results, _command_line())
+    kept = None
+    if keep:
+        draw, _, seed = keep.partition("/")
+        if not (draw.isdigit() and seed.isdigit()):
+            raise typer.BadParameter(f"{keep!r}: DRAW/SEED, two numbers, e.g. 0/0", param_hint="--keep-networks")
+        kept = (int(draw), int(seed))
+    command = _command_line()
+    text = attribution.run(project, draws, workdir, profile, changes, resamples, combine_only, results, command, kept)
     typer.echo(text)
 
 

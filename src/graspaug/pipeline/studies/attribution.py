@@ -23,13 +23,27 @@ from pathlib import Path
 
 from graspaug.experiments.ap.attribution import decomposition_markdown
 from graspaug.experiments.ap.numbers import test_labels
-from graspaug.experiments.results import add_attribution_draw, combine_attribution
+from graspaug.experiments.results import add_attribution_draw, combine_attribution, keep_networks
 from graspaug.io.atomic import atomic_paths
 from graspaug.io.tables import read_table
 from graspaug.pipeline.paths import gqcnn_dir
 from graspaug.pipeline.studies.draws import checked, draw_params, prepare_draw, provenance
 
 log = logging.getLogger(__name__)
+KEPT_POOLS = ("targeted", "real")  # with no augmentation (targeted at 1:0), what a user keeps to evaluate
+
+
+def kept_networks(generate, gqcnn) -> list[tuple[str, int, float]]:
+    """The networks a study keeps for its users: at every augmented base size B, none (1:0) and the targeted and
+    real pools at each of their nonzero ratios."""
+    from graspaug.training.variants import pool_ratios
+
+    out = []
+    for b in gqcnn.augment_base_sizes:
+        out.append(("targeted", b, 0.0))
+        for pool in KEPT_POOLS:
+            out += [(pool, b, float(r)) for r in pool_ratios(pool, generate.ratios, gqcnn.control_ratios) if r > 0]
+    return out
 
 
 def run(
@@ -42,11 +56,14 @@ def run(
     combine_only: bool,
     results: str,
     command: str,
+    keep: tuple[int, int] | None = None,
 ) -> str:
     """Run (unless ``combine_only``) the draws ``draws`` (data seeds) of ``profile`` in ``workdir``, adding each
     draw's tables to ``project``/results/``results`` as soon as it finishes (``command``: the line recorded with
     them), then combine the draws from those tables alone; the decomposition's markdown (also written to
-    ``workdir``/decomposition.md, with summary.json). ``combine_only`` needs no clone: only the results folder."""
+    ``workdir``/decomposition.md, with summary.json). ``combine_only`` needs no clone: only the results folder.
+    ``keep`` (draw, training seed): that seed's networks without augmentation and with the targeted and real pools
+    at every augmented B (:data:`KEPT_POOLS`) go to the results folder's ``networks/d<draw>-s<seed>/``."""
     start = time.perf_counter()
     project, workdir = project.resolve(), workdir.resolve()
     folder = project / "results" / results
@@ -65,6 +82,9 @@ def run(
         seconds = round(time.perf_counter() - began)
         meta = provenance(clone, command) | {"profile": profile, "n_resamples": resamples, "seed": p.seed}  # its code
         add_attribution_draw(folder, k, networks, labels, objects, p.generate, p.gqcnn, meta | {"seconds": seconds})
+        if keep and keep[0] == k:
+            keys = kept_networks(p.generate, p.gqcnn)
+            keep_networks(networks[keep[1]], folder / "networks" / f"d{k}-s{keep[1]}", keys)
         log.info("draw %d: done in %d s; its tables are in %s (commit them)", k, seconds, folder)
     result = combine_attribution(folder, draws)
     text = decomposition_markdown(result, p.gqcnn.augment_base_sizes, command)
