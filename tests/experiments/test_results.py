@@ -16,6 +16,7 @@ from graspaug.experiments.results import (
     recompute,
     write_attribution,
 )
+from graspaug.experiments.stats import interval_text
 from graspaug.pipeline.cli import app
 from tests.experiments.test_attribution import GENERATE, GQCNN, LABELS, OBJECTS, make_draws
 
@@ -39,6 +40,10 @@ def test_the_results_tables_recompute_the_studys_result_figure_for_figure(tmp_pa
     figures = attribution_figures(result)
     assert figures["attribution/share/recon@10"] == "+100% [+100%, +100%]"  # the real gain is clear here
     assert figures["attribution/worth/recon@10"] == "+10 [+10, +10]"  # its 10 shapes at 1:1 are worth 10 real ones
+    curve = result["real_curve"]  # 10 real shapes (the floor), 20: the base set of 20 and 10 + 10 of the real pool
+    assert list(curve) == ["10", "20"] and curve["10"]["gain"] is None
+    assert curve["20"]["networks"] == ["real/10-1", "targeted/20-0"] and curve["20"]["replicates_sd"] > 0
+    assert figures["attribution/real_curve/20"] == interval_text(curve["20"]["gain"])
     real = result["shares"]["recon"]["10"]["real_gain"]
     assert (
         figures["attribution/real_gain@10"]

@@ -229,6 +229,9 @@ def attribution_figures(result: dict, study: str = "attribution") -> dict[str, s
     from graspaug.experiments.ap.attribution import exchange_rate, exchange_text
 
     out = {f"{study}/{name}": interval_text(c) for name, c in result["contrasts"].items()}
+    for n, c in result.get("real_curve", {}).items():
+        if c["gain"] is not None:
+            out[f"{study}/real_curve/{n}"] = interval_text(c["gain"])
     for pool, by_size in result["shares"].items():
         for b, s in by_size.items():
             out[f"{study}/share/{pool}@{b}"] = share_text(s)

@@ -39,7 +39,7 @@ from graspaug.experiments.stats import (
     share_text,
     verdict,
 )
-from graspaug.training.variants import pool_ratios, seed_variants
+from graspaug.training.variants import network_variant, pool_ratios, seed_variants
 
 STEPS = ("recon_vs_real", "blend_vs_recon", "targeted_vs_blend", "targeted_vs_random")
 
@@ -179,11 +179,65 @@ def combine_runs(
             }
     return {
         "contrasts": out,
+        "real_curve": real_curve(runs, lambda terms: nested_t_interval(*arrays(lambda _: terms))),
         "share": shares.get("targeted", {}),
         "shares": shares,
         "draws": list(draws),
         "seeds": seeds,
     }
+
+
+def real_curve(runs: Mapping[int, pd.DataFrame], gain_of: Callable[[list], dict]) -> dict[str, dict]:
+    """The real-shape curve: for every count n of real shapes some network trained on (the base sets without
+    augmentation, n = B, and the real pool's networks, n = B + R·B), its AP gain over the smallest base set's network
+    as a contrast (``gain_of(terms)``: the :func:`nested_t_interval` of those terms, over the same draws, seeds and
+    object resamples as every contrast; networks of equal n averaged) with its two SDs (``replicates_sd``: seeds of
+    one draw, or draws; ``objects_sd``), the networks it averages (``networks``) and the mean positive
+    datapoints a network of n trained on (``positives``, None where the tables do not say). The positive control
+    ``real_data`` is the curve's last base set; the exchange rate reads the curve."""
+    table = pd.concat(list(runs.values()), ignore_index=True)
+    real = table[(table.ratio == 0) | (table.pool == "real")]
+    n_real = real.base_size + [
+        ratio_count(r, b) if p == "real" else 0 for p, b, r in zip(real.pool, real.base_size, real.ratio)
+    ]
+    real = real.assign(n=n_real.astype(int))
+    smallest = int(real.base_size[real.ratio == 0].min())
+    floor = ("targeted", smallest, 0.0)
+    out = {}
+    for n, rows in real.groupby("n", sort=True):
+        keys = sorted({(p, int(b), float(r)) for p, b, r in zip(rows.pool, rows.base_size, rows.ratio)})
+        keys = [("targeted", b, 0.0) if r == 0 else (p, b, r) for p, b, r in keys]
+        keys = list(dict.fromkeys(keys))
+        positives = None
+        if "train_positive_share" in rows and rows.train_positive_share.notna().all():
+            positives = round(float((rows.train_datapoints * rows.train_positive_share).mean()), 1)
+        raw = None if n == smallest else gain_of([(1 / len(keys), k) for k in keys] + [(-1.0, floor)])
+        names = [network_variant(*k).name for k in keys]
+        out[str(n)] = {
+            "n": int(n),
+            "networks": names,
+            "gain": None if raw is None else nested_contrast(raw),
+            "replicates_sd": None if raw is None else raw["replicates_sd"],  # the seeds' (one draw) or draws' SD
+            "objects_sd": None if raw is None else raw["objects_sd"],
+            "positives": positives,
+        }
+    return out
+
+
+def curve_lines(curve: Mapping[str, dict]) -> list[str]:
+    """The real-shape curve (:func:`real_curve`) as a markdown table: n real shapes, its networks, the AP gain over
+    the smallest base set with its 95% interval and verdict, the seeds' SD of that gain, positives per network."""
+    lines = [
+        "| real shapes | networks | AP gain over the fewest [95%] | seed (or draw) SD | positives per network |",
+        "|---|---|---|---|---|",
+    ]
+    for c in curve.values():
+        g = c["gain"]
+        gain = "(the floor)" if g is None else f"{interval_text(g)}, {verdict(g)}"
+        sd = "-" if c["replicates_sd"] is None else f"{c['replicates_sd']:.4f}"
+        positives = "-" if c["positives"] is None else f"{c['positives']:.0f}"
+        lines.append(f"| {c['n']} | {', '.join(f'`{n}`' for n in c['networks'])} | {gain} | {sd} | {positives} |")
+    return lines
 
 
 def losing_step(contrasts: Mapping[str, dict], base_size: int) -> str:
@@ -240,6 +294,8 @@ def decomposition_markdown(result: dict, augment_base_sizes: Sequence[int], comm
     lines += ["", "## What it says", ""]
     lines += [f"- {share_sentence('targeted', b, s)}" for b, s in result["share"].items()]
     lines += [f"- {losing_step(result['contrasts'], b)}" for b in augment_base_sizes]
+    if result.get("real_curve"):
+        lines += ["", "## The real-shape curve: AP gain with more real shapes", "", *curve_lines(result["real_curve"])]
     if result.get("shares"):
         lines += ["", "## What to add: each pool's share of the real-shape gain", "", *recommendation(result)]
         lines += [
