@@ -854,7 +854,7 @@ def test_attribution_study_records_a_finished_draw_then_combines_from_results_al
     assert meta["draws"]["0"]["seconds"] >= 0 and len(meta["draws"]["0"]["commit"]) == 40
     networks = pd.read_parquet(work / "results/tiny-study/networks.parquet")
     assert set(networks.seed) == {0, 1} and set(networks.draw) == {0} and networks.test_ap.between(0, 1).all()
-    assert (work / "results/tiny-study/predictions-d0.parquet").is_file()
+    assert (work / "results/tiny-study/predictions-d0-s1.parquet").is_file()
     summary = json.loads((tmp_path / "summary.json").read_text())
     (tmp_path / "draw0").unlink()
     (tmp_path / "summary.json").unlink()

@@ -6,8 +6,8 @@ README and docs/results.md quote, recomputed from them (issue #58).
 * ``networks.parquet`` — one row per draw, training seed and network: ``draw`` (``data_seed``), ``pool``,
   ``base_size``, ``ratio``, ``seed``, ``val_ap``, ``test_ap``, ``test_roc_auc``, ``train_datapoints``
   (:func:`~graspaug.experiments.ap.numbers.collect`'s columns);
-* ``predictions-d<draw>.parquet`` — one per draw, one row per test datapoint, one float32 column per network of
-  that draw, ``<draw>/<seed>/<pool>/<B>-<R>``: its P(success);
+* ``predictions-d<draw>-s<seed>.parquet`` — one per draw and training seed (each under 2 MB), one row per test
+  datapoint, one float32 column per network of that draw and seed, ``<draw>/<seed>/<pool>/<B>-<R>``: its P(success);
 * ``test.parquet`` — one row per test datapoint, in the same order: ``label`` (1: a successful grasp), ``object``
   (its test shape);
 * ``meta.json`` — the exact ``command`` and code ``commit`` that made them, the date (and per draw, ``draws``), and
@@ -54,7 +54,7 @@ from graspaug.experiments.stats import interval_text, share_text
 MARKER = re.compile(r"<!-- results:([\w@./+-]+) -->")
 LOOSE = re.compile(r"<!--\s*results\b.*?-->", re.DOTALL)  # anything that looks like a marker, well formed or not
 CONTINUES = re.compile(r"[\w%\[]|[.,]\d")  # after a figure: it would go on (a digit, a letter, %, [, .5 or ,5)
-FILES = ("networks.parquet", "test.parquet", "meta.json")  # and predictions-d<draw>.parquet per draw
+FILES = ("networks.parquet", "test.parquet", "meta.json")  # and predictions-d<draw>-s<seed>.parquet
 DOCUMENTS = ("README.md", "docs/results.md")  # the markdown whose marked figures must equal the recomputed ones
 
 
@@ -96,9 +96,10 @@ def add_attribution_draw(
     folder: Path, draw: int, seed_dirs: Mapping[int, Path], labels, object_ids, generate, gqcnn, meta: dict
 ) -> None:
     """Add (or replace) one finished draw's tables in ``folder`` at once, so a study that stops keeps every draw it
-    finished: ``predictions-d<draw>.parquet`` (one float32 column per network, ``<draw>/<seed>/<pool>/<B>-<R>``), its
-    rows of ``networks.parquet``, ``test.parquet`` (written by the first draw, checked by the others) and
-    ``meta.json`` (written last; ``draws``: draw → its ``command``, ``commit``, ``date`` and ``seconds``).
+    finished: ``predictions-d<draw>-s<seed>.parquet`` (one float32 column per network,
+    ``<draw>/<seed>/<pool>/<B>-<R>``), its rows of ``networks.parquet``, ``test.parquet`` (written by the first
+    draw, checked by the others) and ``meta.json`` (written last; ``draws``: draw → its ``command``, ``commit``,
+    ``date`` and ``seconds``).
 
     Parameters
     ----------
@@ -126,12 +127,14 @@ def add_attribution_draw(
         generate.base_sizes, generate.ratios, gqcnn.augment_base_sizes, False, gqcnn.pools, gqcnn.control_ratios
     )
     runs = collect(seed_dirs, variants)
-    columns = {
-        _column(draw, s, (v.pool, v.base_size, float(v.ratio))): test_predictions(
-            folder_s, (v.pool, v.base_size, float(v.ratio))
-        ).astype(np.float32)
+    by_seed = {
+        s: {
+            _column(draw, s, (v.pool, v.base_size, float(v.ratio))): test_predictions(
+                folder_s, (v.pool, v.base_size, float(v.ratio))
+            ).astype(np.float32)
+            for v in variants
+        }
         for s, folder_s in seed_dirs.items()
-        for v in variants
     }
     networks = runs.assign(draw=draw)[["draw", *runs.columns]]
     if networks_file.is_file():
@@ -139,12 +142,19 @@ def add_attribution_draw(
         networks = pd.concat([others[others.draw != draw], networks], ignore_index=True)
         networks = networks.sort_values("draw", kind="stable")
     meta_file.unlink(missing_ok=True)  # a folder without meta.json is an unfinished one
-    frames = {
-        f"predictions-d{draw}.parquet": pd.DataFrame(columns),
-        "networks.parquet": networks.reset_index(drop=True),
-        "test.parquet": test,
-    }
-    for name, frame in frames.items():
+    for old_file in folder.glob(f"predictions-d{draw}-s*.parquet"):
+        old_file.unlink()
+    for s, columns in by_seed.items():  # float32 bytes split by position and zstd: 40% smaller than the default
+        with atomic_path(folder / f"predictions-d{draw}-s{s}.parquet") as tmp:
+            pd.DataFrame(columns).to_parquet(
+                tmp,
+                index=False,
+                compression="zstd",
+                compression_level=19,
+                use_byte_stream_split=True,
+                use_dictionary=False,
+            )
+    for name, frame in {"networks.parquet": networks.reset_index(drop=True), "test.parquet": test}.items():
         with atomic_path(folder / name) as tmp:
             frame.to_parquet(tmp, index=False)
     by_draw = old.get("draws", {}) | {
@@ -199,7 +209,7 @@ def combine_attribution(folder: Path, draws: Sequence[int] | None = None) -> dic
         if absent:
             raise DataError(f"{folder}: no draw {', '.join(map(str, absent))} (it holds {sorted(runs)})")
         runs = {d: runs[d] for d in sorted(draws)}
-    files = {d: folder / f"predictions-d{d}.parquet" for d in runs}
+    files = {(d, s): folder / f"predictions-d{d}-s{s}.parquet" for d, r in runs.items() for s in sorted(set(r.seed))}
     missing = [str(f.name) for f in files.values() if not f.is_file()]
     if missing:
         raise DataError(f"{folder}: no {', '.join(missing)} (an unfinished or foreign results folder)")
@@ -208,7 +218,7 @@ def combine_attribution(folder: Path, draws: Sequence[int] | None = None) -> dic
     def network(d: int, s: int, key: tuple) -> np.ndarray:
         name = _column(d, s, key)
         if name not in predictions:
-            raise DataError(f"{folder / f'predictions-d{d}.parquet'}: no column {name!r}")
+            raise DataError(f"{folder / f'predictions-d{d}-s{s}.parquet'}: no column {name!r}")
         return predictions[name].to_numpy()
 
     generate = SimpleNamespace(base_sizes=meta["base_sizes"], ratios=meta["ratios"])
