@@ -270,3 +270,19 @@ def test_a_t_interval_that_leaves_the_quantitys_range_is_no_interval():
     assert two["mean"] == pytest.approx(-0.025) and two["low"] is None and not two["usable"]
     four = t_interval([0.02, 0.03, 0.025, 0.035], bounds=DIFFERENCE_RANGE)
     assert four["usable"] and -1 <= four["low"] < four["high"] <= 1
+
+
+def test_the_object_bootstraps_ap_is_the_weighted_ap_of_its_object_counts():
+    """ObjectBootstrap.average_precision works from the objects' counts at the thresholds that hold a positive (fast);
+    it must give weighted_average_precision's figures, tied scores grouped, NaN where a resample has no positive."""
+    from graspaug.experiments.stats import ObjectBootstrap, weighted_average_precision
+
+    rng = np.random.default_rng(0)
+    for trial in range(20):
+        n, n_objects = int(rng.integers(5, 3000)), int(rng.integers(1, 40))
+        objects = rng.integers(0, n_objects, n)
+        labels = rng.random(n) < rng.choice([0.0, 0.02, 0.3])
+        scores = np.round(rng.random(n), int(rng.integers(1, 4)))  # many ties
+        boot = ObjectBootstrap(objects, 200, trial)
+        slow = weighted_average_precision(labels, scores, boot.object_counts[:, boot.object_index])
+        np.testing.assert_allclose(boot.average_precision(labels, scores), slow, rtol=1e-5)  # slow sums float32

@@ -79,9 +79,36 @@ class ObjectBootstrap:
         self.n_objects = len(objects)
 
     def average_precision(self, labels: np.ndarray, scores: np.ndarray) -> np.ndarray:
-        """(n_resamples,) AP of ``scores`` (N,) for ``labels`` (N,) under every resample
-        (:func:`weighted_average_precision`: tied scores grouped, as sklearn's)."""
-        return weighted_average_precision(labels, scores, self.object_counts[:, self.object_index])
+        """(n_resamples,) AP of ``scores`` (N,) for ``labels`` (N,) under every resample: the same figures as
+        :func:`weighted_average_precision` with each datapoint weighted by its object's count (tied scores grouped,
+        as sklearn's), computed from the objects' counts up to each threshold that holds a positive, so one network
+        costs (R × objects × positive thresholds) rather than (R × N): 35,000 datapoints of 73 objects, 2,000
+        resamples, in about 0.05 s instead of 2 s."""
+        order = np.argsort(-np.asarray(scores), kind="stable")
+        s, y = np.asarray(scores)[order], np.asarray(labels, dtype=bool)[order]
+        obj = self.object_index[order]
+        new_group = np.r_[True, s[1:] != s[:-1]]
+        group = np.cumsum(new_group) - 1  # each datapoint's group of tied scores, highest first
+        starts = np.flatnonzero(new_group)
+        ends = np.r_[starts[1:], len(s)]
+        held = np.unique(group[y])  # the thresholds that hold a positive: only they add to AP
+        if len(held) == 0:
+            return np.full(len(self.object_counts), np.nan)
+        lo, hi = starts[held], ends[held]
+        seen = np.zeros((self.n_objects, len(held)))  # datapoints of each object up to each such threshold
+        hits = np.zeros((self.n_objects, len(held)))  # positives of each object up to each threshold
+        gained = np.zeros((self.n_objects, len(held)))  # positives of each object at each threshold
+        for o in np.unique(obj):
+            where = np.flatnonzero(obj == o)
+            where_pos = where[y[where]]
+            seen[o] = np.searchsorted(where, hi)
+            hits[o] = np.searchsorted(where_pos, hi)
+            gained[o] = hits[o] - np.searchsorted(where_pos, lo)
+        counts = self.object_counts.astype(float)
+        tp, total_seen, positive = counts @ hits, counts @ seen, counts @ gained  # (R, thresholds)
+        precision = np.divide(tp, total_seen, out=np.zeros_like(tp), where=total_seen > 0)
+        total = tp[:, -1]
+        return np.divide((positive * precision).sum(axis=1), total, out=np.full_like(total, np.nan), where=total > 0)
 
     def roc_auc(self, labels: np.ndarray, scores: np.ndarray) -> np.ndarray:
         """(n_resamples,) ROC AUC of ``scores`` (N,) for ``labels`` (N,) under every resample
