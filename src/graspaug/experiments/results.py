@@ -233,15 +233,21 @@ def combine_attribution(folder: Path, draws: Sequence[int] | None = None) -> dic
 
 def attribution_figures(result: dict, study: str = "attribution") -> dict[str, str]:
     """Every figure of an attribution result (:func:`combine_attribution`) as the text a document quotes, by key:
-    ``<study>/<contrast>`` (``mean [low, high]``, AP, 4 decimals), ``<study>/share/<pool>@<B>`` (the share with its
+    ``<study>/<contrast>`` (``mean [low, high]``, AP, 4 decimals), ``<study>/<contrast>/per_draw`` (each draw's mean
+    over seeds, in draw order), ``<study>/share/<pool>@<B>`` (the share with its
     interval by test inversion, or ``[unbounded]``), ``<study>/real_gain@<B>`` (the shares' denominator) and
     ``<study>/worth/<pool>@<B>`` (what the pool's shapes are worth in real shapes: ``exchange_rate``)."""
     from graspaug.experiments.ap.attribution import exchange_rate, exchange_text
 
     out = {f"{study}/{name}": interval_text(c) for name, c in result["contrasts"].items()}
+    for name, c in result["contrasts"].items():  # the mean over seeds of each draw, in draw order
+        per_draw = c.get("per_draw") or []
+        out[f"{study}/{name}/per_draw"] = ", ".join("-" if v is None else f"{v:+.4f}" for v in per_draw)
     for n, c in result.get("real_curve", {}).items():
         if c["gain"] is not None:
             out[f"{study}/real_curve/{n}"] = interval_text(c["gain"])
+            per_draw = c["gain"].get("per_draw") or []
+            out[f"{study}/real_curve/{n}/per_draw"] = ", ".join("-" if v is None else f"{v:+.4f}" for v in per_draw)
     for pool, by_size in result["shares"].items():
         for b, s in by_size.items():
             out[f"{study}/share/{pool}@{b}"] = share_text(s)

@@ -138,6 +138,12 @@ def combine_runs(
                 r[i, j] = sum(w * boot_ap(d, s, k) for w, k in terms) if terms else np.nan
         return f, r
 
+    def curve_gain(terms) -> dict:  # a real-curve point: its interval and each draw's mean over seeds
+        f, r = arrays(lambda _: terms)
+        return nested_t_interval(f, r) | {
+            "per_draw": [round(float(v), 5) if np.isfinite(v) else None for v in f.mean(1)]
+        }
+
     full, resampled = {}, {}
     for name in names:
         full[name], resampled[name] = arrays(lambda contrasts, name=name: contrasts[name].terms)
@@ -179,7 +185,7 @@ def combine_runs(
             }
     return {
         "contrasts": out,
-        "real_curve": real_curve(runs, lambda terms: nested_t_interval(*arrays(lambda _: terms))),
+        "real_curve": real_curve(runs, curve_gain),
         "share": shares.get("targeted", {}),
         "shares": shares,
         "draws": list(draws),
@@ -216,7 +222,7 @@ def real_curve(runs: Mapping[int, pd.DataFrame], gain_of: Callable[[list], dict]
         out[str(n)] = {
             "n": int(n),
             "networks": names,
-            "gain": None if raw is None else nested_contrast(raw),
+            "gain": None if raw is None else nested_contrast(raw, per_draw=raw.get("per_draw")),
             "replicates_sd": None if raw is None else raw["replicates_sd"],  # the seeds' (one draw) or draws' SD
             "objects_sd": None if raw is None else raw["objects_sd"],
             "positives": positives,
