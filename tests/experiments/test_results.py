@@ -229,3 +229,9 @@ def test_draws_added_one_at_a_time_combine_as_the_whole_study_and_other_params_a
     other = SimpleNamespace(**vars(GQCNN) | {"pools": ("targeted",)})
     with pytest.raises(DataError, match="pools"):
         add_attribution_draw(folder, first, draws[first], LABELS, OBJECTS, GENERATE, other, meta)
+    steps = {"gqcnn": {"train": {"max_steps": 1000}}, "render": {"images_per_pose": 5}}
+    again = tmp_path / "steps" / "attribution"
+    add_attribution_draw(again, 0, draws[0], LABELS, OBJECTS, GENERATE, GQCNN, meta | {"params": steps})
+    longer = {"gqcnn": {"train": {"max_steps": 4000}}, "render": {"images_per_pose": 5}}
+    with pytest.raises(DataError, match="gqcnn.train.max_steps = 1000, draw 1 with 4000"):
+        add_attribution_draw(again, 1, draws[1], LABELS, OBJECTS, GENERATE, GQCNN, meta | {"params": longer})

@@ -92,6 +92,17 @@ def _kept_params(generate, gqcnn) -> dict:
     }
 
 
+def _flat(tree: Mapping, prefix: str = "") -> dict:
+    """A nested params mapping as ``{"a.b.c": value}``."""
+    out = {}
+    for key, value in tree.items():
+        if isinstance(value, Mapping):
+            out |= _flat(value, f"{prefix}{key}.")
+        else:
+            out[f"{prefix}{key}"] = value
+    return out
+
+
 def add_attribution_draw(
     folder: Path, draw: int, seed_dirs: Mapping[int, Path], labels, object_ids, generate, gqcnn, meta: dict
 ) -> None:
@@ -107,7 +118,9 @@ def add_attribution_draw(
     seed_dirs : training seed → the folder of that seed's networks (``summary.json``, ``test_predictions.npy``)
     labels, object_ids : (N,) — the test datapoints' labels and objects, in the predictions' order
     generate, gqcnn : the params sections the draw ran with; a folder of other params is refused, naming the key
-    meta : ``command``, ``commit``, ``date``, ``n_resamples``, ``seed`` (and the draw's wall time, ``seconds``)
+    meta : ``command``, ``commit``, ``date``, ``n_resamples``, ``seed`` (and the draw's wall time, ``seconds``), and
+        ``params``: the draw's params but ``data_seed`` (a draw whose params differ from the folder's in any key is
+        refused, naming it)
     """
     from graspaug.experiments.ap.numbers import collect, test_predictions
     from graspaug.io.atomic import atomic_path
@@ -121,6 +134,10 @@ def add_attribution_draw(
     for key, value in keep.items():
         if key in old and old[key] != value:
             raise DataError(f"{folder}: its draws ran with {key} = {old[key]}, draw {draw} with {value}")
+    ran, runs_with = _flat(old.get("params") or {}), _flat(meta.get("params") or {})
+    for key in sorted(set(ran) & set(runs_with)):  # every other setting (steps, views, corpus) must agree too
+        if ran[key] != runs_with[key]:
+            raise DataError(f"{folder}: its draws ran with {key} = {ran[key]}, draw {draw} with {runs_with[key]}")
     if test_file.is_file() and not pd.read_parquet(test_file).equals(test):
         raise DataError(f"{folder}: draw {draw} was tested on other datapoints than the draws already there")
     variants = seed_variants(

@@ -26,6 +26,7 @@ from graspaug.experiments.ap.numbers import test_labels
 from graspaug.experiments.results import add_attribution_draw, combine_attribution, keep_networks
 from graspaug.io.atomic import atomic_paths
 from graspaug.io.tables import read_table
+from graspaug.pipeline.params.model import params_dict
 from graspaug.pipeline.paths import gqcnn_dir
 from graspaug.pipeline.studies.draws import checked, draw_params, prepare_draw, provenance
 
@@ -81,6 +82,7 @@ def run(
         )
         seconds = round(time.perf_counter() - began)
         meta = provenance(clone, command) | {"profile": profile, "n_resamples": resamples, "seed": p.seed}  # its code
+        meta["params"] = {k: v for k, v in params_dict(params[k]).items() if k != "data_seed"}
         add_attribution_draw(folder, k, networks, labels, objects, p.generate, p.gqcnn, meta | {"seconds": seconds})
         if keep and keep[0] == k:
             keys = kept_networks(p.generate, p.gqcnn)
