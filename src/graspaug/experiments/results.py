@@ -248,6 +248,11 @@ def combine_attribution(folder: Path, draws: Sequence[int] | None = None) -> dic
     return result | {"augment_base_sizes": meta["augment_base_sizes"]}
 
 
+def per_draw_text(c: Mapping) -> str:
+    """A contrast's ``per_draw`` means (AP, in draw order) as a document quotes them: ``+0.0100, -0.0200``."""
+    return ", ".join("-" if v is None else f"{v:+.4f}" for v in c.get("per_draw") or [])
+
+
 def attribution_figures(result: dict, study: str = "attribution") -> dict[str, str]:
     """Every figure of an attribution result (:func:`combine_attribution`) as the text a document quotes, by key:
     ``<study>/<contrast>`` (``mean [low, high]``, AP, 4 decimals), ``<study>/<contrast>/per_draw`` (each draw's mean
@@ -258,13 +263,11 @@ def attribution_figures(result: dict, study: str = "attribution") -> dict[str, s
 
     out = {f"{study}/{name}": interval_text(c) for name, c in result["contrasts"].items()}
     for name, c in result["contrasts"].items():  # the mean over seeds of each draw, in draw order
-        per_draw = c.get("per_draw") or []
-        out[f"{study}/{name}/per_draw"] = ", ".join("-" if v is None else f"{v:+.4f}" for v in per_draw)
+        out[f"{study}/{name}/per_draw"] = per_draw_text(c)
     for n, c in result.get("real_curve", {}).items():
         if c["gain"] is not None:
             out[f"{study}/real_curve/{n}"] = interval_text(c["gain"])
-            per_draw = c["gain"].get("per_draw") or []
-            out[f"{study}/real_curve/{n}/per_draw"] = ", ".join("-" if v is None else f"{v:+.4f}" for v in per_draw)
+            out[f"{study}/real_curve/{n}/per_draw"] = per_draw_text(c["gain"])
     for pool, by_size in result["shares"].items():
         for b, s in by_size.items():
             out[f"{study}/share/{pool}@{b}"] = share_text(s)
