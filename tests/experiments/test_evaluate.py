@@ -18,6 +18,7 @@ from sklearn.metrics import average_precision_score
 from typer.testing import CliRunner
 
 from graspaug.experiments.evaluate.numbers import test_ap as ap_of_models
+from graspaug.experiments.stats import ObjectBootstrap, nested_t_interval
 from graspaug.grasping.gripper import ParallelJawGripper
 from graspaug.io.checkpoints import finish_gqcnn_card, gqcnn_card, save_gqcnn
 from graspaug.nets.gqcnn import GQCNN, GQCNNConfig
@@ -48,6 +49,31 @@ def test_ap_and_paired_differences_over_objects():
     assert same["mean"] == 0 and same["objects_low"] == 0 and same["objects_high"] == 0
     better = out["differences"]["perfect − noisy"]
     assert better["objects_low"] > 0 and better["over"] == "objects"
+
+
+def test_models_as_seeds_of_networks_give_each_networks_mean_with_the_verdict_interval():
+    rng = np.random.default_rng(1)
+    objects = np.repeat([f"o{i}" for i in range(15)], 30)
+    labels = rng.random(len(objects)) < 0.3
+    weak = {f"weak{s}": labels + rng.normal(0, 1.2, len(labels)) for s in range(3)}
+    strong = {f"strong{s}": labels + rng.normal(0, 0.6, len(labels)) for s in range(3)}
+    out = ap_of_models(labels, objects, weak | strong, 300, 0, seeds=3)
+    boot = ObjectBootstrap(objects, 300, 0)  # the resamples test_ap draws
+    full = np.array([[average_precision_score(labels, p) for p in group.values()] for group in (weak, strong)])
+    resampled = np.stack([[boot.average_precision(labels, p) for p in group.values()] for group in (weak, strong)])
+    first, second = out["networks"]["weak0 (3 seeds)"], out["networks"]["strong0 (3 seeds)"]
+    expected = nested_t_interval(full[:1], resampled[:1])
+    assert first["mean"] == pytest.approx(full[0].mean()) and first["over"] == "draws" and first["n_seeds"] == 3
+    assert (first["draws_low"], first["draws_high"]) == pytest.approx((expected["low"], expected["high"]))
+    assert second["draws_low"] < second["mean"] < second["draws_high"]
+    gain = out["network_differences"]["strong0 (3 seeds) − weak0 (3 seeds)"]  # seed k paired with seed k
+    paired = nested_t_interval(full[1:] - full[:1], resampled[1:] - resampled[:1])
+    assert gain["mean"] == pytest.approx(full[1].mean() - full[0].mean())
+    assert (gain["draws_low"], gain["draws_high"]) == pytest.approx((paired["low"], paired["high"]))
+    assert gain["draws_low"] > 0  # less noise ranks better on every seed
+    assert "networks" not in ap_of_models(labels, objects, weak, 300, 0)
+    with pytest.raises(ValueError, match="not networks of 2 seeds"):
+        ap_of_models(labels, objects, weak, 300, 0, seeds=2)
 
 
 def _model(path: Path, seed: int) -> Path:
@@ -127,6 +153,16 @@ def test_evaluate_prints_each_models_ap_and_the_paired_difference(project):
     second = json.loads((root / "reports/evaluate/evaluate.json").read_text())["models"][str(models[1])]
     assert second == report["models"][str(models[1])]  # the same test set, the same resamples
 
+    seeds = _evaluate(
+        root, str(models[0]), str(models[1]), "--corpus", str(corpus), "--resamples", "200", "--seeds", "2"
+    )
+    assert seeds.exit_code == 0, seeds.output
+    assert f"{models[0]} (2 seeds): mean test AP" in seeds.output
+    as_networks = json.loads((root / "reports/evaluate/evaluate.json").read_text())
+    assert as_networks["networks"][f"{models[0]} (2 seeds)"]["n_seeds"] == 2
+    assert as_networks["network_differences"] == {}
+    assert "networks of 2 training seeds each (`--seeds 2`)" in (root / "reports/evaluate/report.md").read_text()
+
 
 def test_bad_folders_and_models_are_refused_in_one_line(project, tmp_path):
     root, corpus, models = project
@@ -138,6 +174,8 @@ def test_bad_folders_and_models_are_refused_in_one_line(project, tmp_path):
     (tmp_path / "broken.pt").write_text("not a checkpoint")
     broken = _evaluate(root, str(models[0]), str(tmp_path / "broken.pt"), "--corpus", str(corpus))
     assert broken.exit_code == 2 and "broken.pt" in broken.output and len(broken.output.splitlines()) == 1
+    uneven = _evaluate(root, *map(str, models), str(root / "m2.pt"), "--corpus", str(corpus), "--seeds", "2")
+    assert uneven.exit_code == 2 and "--seeds 2: 3 models are not networks of 2 seeds" in uneven.output
 
 
 @pytest.mark.skipif(not GSO300.is_dir(), reason="the gso300 corpus is not on this machine")

@@ -152,11 +152,20 @@ def evaluate_command(
         help="The params file whose ingest, grasps and render sections make the test set "
         "(default: the built-in defaults, not the params.yaml of the folder it runs from).",
     ),
+    seeds: int | None = typer.Option(
+        None,
+        "--seeds",
+        min=2,
+        help="The models are training seeds of networks, this many each, one network's after another (e.g. 8 "
+        "models with --seeds 4: two networks): also prints each network's mean AP and each network's paired "
+        "difference to the first (seed k with seed k), 95% over the seeds (t) and the objects (bootstrap).",
+    ),
 ) -> None:
     import graspaug.pipeline.stages.evaluate as command
 
     settings = load_stage_params(params, command)
-    for line in command.run(settings, models, corpus, out, cache, unit_scale, limit, resamples, force, params):
+    args = (settings, models, corpus, out, cache, unit_scale, limit, resamples, force, params, seeds)
+    for line in command.run(*args):
         typer.echo(line)
 
 

@@ -1,16 +1,30 @@
 """Each model's test AP on one test set with its 95% interval over objects, and the paired difference of every model
 against the first: the same datapoints, the same bootstrap resamples of the objects (:mod:`graspaug.experiments.stats`).
+Given the models as training seeds of networks, each network's mean AP and each network's paired difference to the
+first with the verdict interval over seeds and objects (:func:`~graspaug.experiments.stats.nested_t_interval`).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from graspaug.experiments.stats import ObjectBootstrap, contrast, percentile_interval, weighted_average_precision
+from graspaug.experiments.stats import (
+    ObjectBootstrap,
+    contrast,
+    nested_contrast,
+    nested_t_interval,
+    percentile_interval,
+    weighted_average_precision,
+)
 
 
 def test_ap(
-    labels: np.ndarray, object_ids: np.ndarray, probabilities: dict[str, np.ndarray], n_resamples: int, seed: int
+    labels: np.ndarray,
+    object_ids: np.ndarray,
+    probabilities: dict[str, np.ndarray],
+    n_resamples: int,
+    seed: int,
+    seeds: int | None = None,
 ) -> dict:
     """AP of every model and the paired difference of each against the first.
 
@@ -20,12 +34,18 @@ def test_ap(
     object_ids : (N,) str — each datapoint's object, the bootstrap's clusters
     probabilities : model name → (N,) float — its P(success) of every datapoint, the first the reference
     n_resamples, seed : the object bootstrap's resamples and seed (the same resamples for every model)
+    seeds : None, or S ≥ 2: the models, in order, are S training seeds of each network (the first S one network, the
+        next S the next…; seed k of every network paired with seed k of the others). The count of models must be a
+        multiple of S.
 
     Returns
     -------
     ``{"models": name → contrast over objects (AP, 95% interval), "differences": "<name> − <first>" → contrast over
     objects, "datapoints", "positives", "objects"}``; an AP is None when no datapoint is positive, an interval None
-    with one object (resampling one object gives its AP every time: no interval).
+    with one object (resampling one object gives its AP every time: no interval). With ``seeds``, also
+    ``"networks"``: "<first model> (S seeds)" → its mean AP over the seeds as a contrast over ``draws`` (95%: t over
+    the S seeds with the objects' bootstrap), and ``"network_differences"``: "<network> − <first network>" → the same
+    for the paired difference.
     """
     labels = np.asarray(labels, dtype=bool)
     boot = ObjectBootstrap(object_ids, n_resamples, seed)
@@ -41,13 +61,32 @@ def test_ap(
         mean = None if point[name] is None or point[first] is None else point[name] - point[first]
         diff = resampled[name] - resampled[first]  # paired: the same resamples
         differences[f"{name} − {first}"] = contrast(mean, "objects", objects=_interval(diff, boot.n_objects))
-    return {
+    out = {
         "models": models,
         "differences": differences,
         "datapoints": int(len(labels)),
         "positives": int(labels.sum()),
         "objects": int(boot.n_objects),
     }
+    return out if seeds is None else out | _networks(point, resampled, seeds)
+
+
+def _networks(point: dict[str, float | None], resampled: dict[str, np.ndarray], seeds: int) -> dict:
+    """``networks`` and ``network_differences`` of :func:`test_ap`: the models in consecutive groups of ``seeds``."""
+    names = list(point)
+    if seeds < 2 or len(names) % seeds:
+        raise ValueError(f"{len(names)} models are not networks of {seeds} seeds each (seeds ≥ 2, a whole multiple)")
+    groups = [names[i : i + seeds] for i in range(0, len(names), seeds)]
+    full = {g[0]: np.array([[np.nan if point[n] is None else point[n] for n in g]]) for g in groups}  # (1, S)
+    boot = {g[0]: np.stack([resampled[n] for n in g])[None] for g in groups}  # (1, S, R)
+    label = {g[0]: f"{g[0]} ({seeds} seeds)" for g in groups}
+    first = groups[0][0]
+    networks = {label[k]: nested_contrast(nested_t_interval(full[k], boot[k])) for k in full}
+    differences = {
+        f"{label[k]} − {label[first]}": nested_contrast(nested_t_interval(full[k] - full[first], boot[k] - boot[first]))
+        for k in list(full)[1:]
+    }
+    return {"networks": networks, "network_differences": differences}
 
 
 def _interval(resampled: np.ndarray, n_objects: int) -> tuple[float, float] | None:

@@ -73,4 +73,21 @@ def report_markdown(result: dict, corpus: str, counts: dict, camera: str, shaped
         "The interval covers these objects' resampling only, not another draw of objects of the same kind nor "
         "other training seeds of the models.",
     ]
+    if result.get("networks"):
+        n = next(iter(result["networks"].values()))["n_seeds"]
+        lines += [
+            "",
+            f"The models as networks of {n} training seeds each (`--seeds {n}`): each network's mean test AP, and "
+            "each network's paired difference to the first (seed k with seed k), 95% over the seeds (t on "
+            f"{n - 1} degrees of freedom) and the objects (their bootstrap's variance), added in quadrature.",
+            "",
+            "| network | mean test AP [95% over seeds and objects] |",
+            "|---|---|",
+            *(f"| {name} | {interval_text(c, '.4f')} |" for name, c in result["networks"].items()),
+        ]
+        if result["network_differences"]:
+            lines += ["", "| difference | AP [95% over seeds and objects] | verdict |", "|---|---|---|"]
+            lines += [
+                f"| {name} | {interval_text(c)} | {verdict(c)} |" for name, c in result["network_differences"].items()
+            ]
     return "\n".join(lines) + "\n"

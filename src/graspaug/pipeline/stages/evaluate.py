@@ -20,6 +20,7 @@ from graspaug.errors import DataError
 from graspaug.experiments.evaluate.numbers import test_ap
 from graspaug.experiments.evaluate.testset import CARD_KEYS, cached_test_set, recipe_for, shaped_by
 from graspaug.experiments.evaluate.words import ap_text, report_markdown
+from graspaug.experiments.stats import interval_text
 from graspaug.io.checkpoints import read_gqcnn
 from graspaug.io.gqcnn import GraspImages
 from graspaug.io.outputs import output_folder
@@ -48,13 +49,20 @@ def run(
     n_resamples: int,
     force: bool,
     params_file: Path | None = None,
+    seeds: int | None = None,
 ) -> list[str]:
     """Evaluate ``models`` on the meshes of ``corpus``; the printed lines (one per model and difference).
-    ``params_file``: the file ``params`` came from (None: the built-in defaults), named in the report."""
+    ``params_file``: the file ``params`` came from (None: the built-in defaults), named in the report. ``seeds``: the
+    models are training seeds of networks, ``seeds`` each in a row (:func:`test_ap`): also each network's mean."""
     if not corpus.is_dir():
         raise DataError(f"--corpus {corpus}: no such folder")
     if len({str(m) for m in models}) < len(models):
         raise DataError("a model is named twice; name each once")
+    if seeds is not None and (seeds < 2 or len(models) % seeds):
+        raise DataError(
+            f"--seeds {seeds}: {len(models)} models are not networks of {seeds} seeds each; name each network's "
+            "seeds one after another (at least 2 a network)"
+        )
     homes = [] if params_file is None else [("the project of --params", Path(params_file).absolute().parent)]
     with output_folder(out, "evaluate", [corpus, cache, *models], force, homes) as staging:
         sources = folder_sources(corpus, unit_scale, limit)
@@ -78,7 +86,8 @@ def run(
         arrays = GraspArrays(data.images(), data.read("z"), data.read("labels"))
         device = resolve_device(params.device)
         probabilities = {name: predict(net.to(device), arrays, device) for name, net in nets.items()}
-        result = test_ap(arrays.labels, data.index["shape_id"].to_numpy(), probabilities, n_resamples, params.seed)
+        ids = data.index["shape_id"].to_numpy()
+        result = test_ap(arrays.labels, ids, probabilities, n_resamples, params.seed, seeds)
 
         made = shaped_by(recipe, counts, params_file, unit_scale)
         camera = f"the models' camera ({cards[first].camera_distance[0]:g}-{cards[first].camera_distance[1]:g} m)"
@@ -88,4 +97,6 @@ def run(
         write_csv(read_table(folder / "rejects.parquet")[["source", "reason"]], staging / "rejects.csv")
     lines = [f"{name}: test AP {ap_text(c, result['objects'], '.4f')}" for name, c in result["models"].items()]
     lines += [f"{name}: {ap_text(c, result['objects'])}" for name, c in result["differences"].items()]
+    lines += [f"{name}: mean test AP {interval_text(c, '.4f')}" for name, c in result.get("networks", {}).items()]
+    lines += [f"{name}: {interval_text(c)}" for name, c in result.get("network_differences", {}).items()]
     return lines + [f"({result['objects']} objects, {result['datapoints']} datapoints; wrote {out / 'report.md'})"]
