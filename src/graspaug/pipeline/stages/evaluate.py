@@ -59,10 +59,8 @@ def run(
     if len({str(m) for m in models}) < len(models):
         raise DataError("a model is named twice; name each once")
     if seeds is not None and (seeds < 2 or len(models) % seeds):
-        raise DataError(
-            f"--seeds {seeds}: {len(models)} models are not networks of {seeds} seeds each; name each network's "
-            "seeds one after another (at least 2 a network)"
-        )
+        where = f"--seeds {seeds}: {len(models)} models are not networks of {seeds} seeds each"
+        raise DataError(f"{where}; name each network's seeds one after another (at least 2 a network)")
     homes = [] if params_file is None else [("the project of --params", Path(params_file).absolute().parent)]
     with output_folder(out, "evaluate", [corpus, cache, *models], force, homes) as staging:
         sources = folder_sources(corpus, unit_scale, limit)
