@@ -36,6 +36,15 @@ def shaped_by_text(shaped_by: dict, counts: dict) -> str:
     )
 
 
+def table(head: list[str], rows: dict, cells) -> list[str]:
+    """A markdown table's lines: the header ``head``, then one row per ``rows`` item, its name and ``cells(value)``."""
+    return [
+        "| " + " | ".join(head) + " |",
+        "|" + "---|" * len(head),
+        *("| " + " | ".join([name, *cells(c)]) + " |" for name, c in rows.items()),
+    ]
+
+
 def report_markdown(result: dict, corpus: str, counts: dict, camera: str, shaped_by: dict) -> str:
     """report.md of :func:`graspaug.experiments.evaluate.numbers.test_ap`'s ``result`` on the test set of folder
     ``corpus`` (``counts``: :func:`graspaug.experiments.evaluate.testset.build_test_set`'s), rendered for ``camera``,
@@ -58,15 +67,19 @@ def report_markdown(result: dict, corpus: str, counts: dict, camera: str, shaped
         "",
         shaped_by_text(shaped_by, counts),
         "",
-        "| model | test AP [95% interval over objects] |",
-        "|---|---|",
-        *(f"| {name} | {ap_text(c, objects, '.4f')} |" for name, c in result["models"].items()),
+        *table(
+            ["model", "test AP [95% interval over objects]"], result["models"], lambda c: [ap_text(c, objects, ".4f")]
+        ),
     ]
     if result["differences"]:
-        lines += ["", "| difference | AP [95% interval over objects] | verdict |", "|---|---|---|"]
+        no_verdict = "one object: no verdict"
         lines += [
-            f"| {name} | {ap_text(c, objects)} | {verdict(c) if objects > 1 else 'one object: no verdict'} |"
-            for name, c in result["differences"].items()
+            "",
+            *table(
+                ["difference", "AP [95% interval over objects]", "verdict"],
+                result["differences"],
+                lambda c: [ap_text(c, objects), verdict(c) if objects > 1 else no_verdict],
+            ),
         ]
     lines += [
         "",
@@ -81,13 +94,19 @@ def report_markdown(result: dict, corpus: str, counts: dict, camera: str, shaped
             "each network's paired difference to the first (seed k with seed k), 95% over the seeds (t on "
             f"{n - 1} degrees of freedom) and the objects (their bootstrap's variance), added in quadrature.",
             "",
-            "| network | mean test AP [95% over seeds and objects] |",
-            "|---|---|",
-            *(f"| {name} | {interval_text(c, '.4f')} |" for name, c in result["networks"].items()),
+            *table(
+                ["network", "mean test AP [95% over seeds and objects]"],
+                result["networks"],
+                lambda c: [interval_text(c, ".4f")],
+            ),
         ]
         if result["network_differences"]:
-            lines += ["", "| difference | AP [95% over seeds and objects] | verdict |", "|---|---|---|"]
             lines += [
-                f"| {name} | {interval_text(c)} | {verdict(c)} |" for name, c in result["network_differences"].items()
+                "",
+                *table(
+                    ["difference", "AP [95% over seeds and objects]", "verdict"],
+                    result["network_differences"],
+                    lambda c: [interval_text(c), verdict(c)],
+                ),
             ]
     return "\n".join(lines) + "\n"
