@@ -111,17 +111,17 @@ def test_graspaug_results_recomputes_and_checks_the_documents(tmp_path):
 def test_the_readme_and_results_quote_only_what_the_committed_results_recompute():
     """Every marked figure of the README and docs/results.md equals what `graspaug results` recomputes from the
     committed results/; and the README's Results section quotes no share of the real-shape gain and no interval
-    that is not a marked figure (the 2026-11-27 study's per-network results were not kept: it is no longer quoted)."""
+    outside a marked figure (the 2026-11-27 study's per-network results were not kept: it is no longer quoted)."""
     figures, _ = recompute(ROOT / "results")
     for doc in DOCUMENTS:
         assert check_markdown((ROOT / doc).read_text(), figures, doc) == []
     readme = (ROOT / "README.md").read_text()
     results = readme.split("## Results", 1)[1].split("\n## ", 1)[0]
-    shares = re.findall(r"[+−-]?\d+% \[[+−-]?\d+%, [+−-]?\d+%\]", results)  # e.g. "+78% [+1%, +200%]"
-    assert shares == [], f"the README quotes shares no committed result recomputes: {shares}"
     unmarked = results
     for key, at in marked_figures(results):  # take out every marked figure: what is left quotes no interval
         unmarked = unmarked.replace(results[at - len(f"<!-- results:{key} -->") : at] + figures[key], "", 1)
+    shares = re.findall(r"[+−-]?\d+% \[[+−-]?\d+%, [+−-]?\d+%\]", unmarked)  # e.g. "+78% [+1%, +200%]"
+    assert shares == [], f"the README quotes shares no committed result recomputes: {shares}"
     loose = re.findall(r"\[[+−-]?\d+\.\d+%?, [+−-]?\d+\.\d+%?\]", unmarked)  # e.g. "[+0.015, +0.043]"
     assert loose == [], f"the README's Results quote intervals no committed result recomputes: {loose}"
 
