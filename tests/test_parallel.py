@@ -35,10 +35,11 @@ def worker_address(_: int) -> str:
 
 def run_ingest_and_voxelize(folder, params, monkeypatch) -> tuple[pd.DataFrame, dict, dict]:
     from graspaug.io.voxels import read_voxels
-    from graspaug.pipeline.stages import ingest, voxelize
+    from graspaug.pipeline.stages import ingest, split, voxelize
 
     monkeypatch.chdir(folder)
     ingest.run(params)
+    split.run(params)
     voxelize.run(params)
     shapes = pd.read_parquet(folder / "data/shapes.parquet")
     meshes = {p.name: p.read_bytes() for p in sorted((folder / "data/shapes").iterdir())}
@@ -96,7 +97,7 @@ def test_workers_hand_freed_memory_back_so_loky_restarts_none(tmp_path):
 def rendered_tiny(repo_root, tmp_path_factory):
     """A project folder holding the tiny profile's ingested, graded and rendered original shapes (20 default
     objects, about 30 s) and params that train its three 1:0 and ceiling networks (no generated shapes)."""
-    from graspaug.pipeline.stages import grasps, ingest, render
+    from graspaug.pipeline.stages import grasps, ingest, render, split
 
     tiny = profile_params("tiny", repo_root / "profiles")
     params = tiny.model_copy(update={"gqcnn": dataclasses.replace(tiny.gqcnn, augment_base_sizes=())})
@@ -104,6 +105,7 @@ def rendered_tiny(repo_root, tmp_path_factory):
     with pytest.MonkeyPatch.context() as patch:
         patch.chdir(folder)
         ingest.run(params)
+        split.run(params)
         grasps.run(params)
         render.run(params)
     return folder, params

@@ -338,9 +338,18 @@ def test_a_second_clone_takes_every_stage_no_data_seed_reaches_from_the_run_cach
     run(["dvc", "cache", "dir", "--local", str(work / ".dvc" / "cache")], clone, env)
     again = run(["dvc", "repro", "render@original", "score"], clone, env).stdout
     assert "Running stage" not in again, again
-    for stage in ("ingest", "voxelize", "train_ae", "embed", "grasps@original", "score", "render@original"):
+    for stage in ("ingest", "split", "voxelize", "train_ae", "embed", "grasps@original", "score", "render@original"):
         assert f"Stage '{stage}' is cached - skipping run" in again, stage
     assert (clone / "reports/train_ae/summary.json").is_file() and (clone / "metrics/score.json").is_file()
+    # an independent draw (its own split) shares every per-object stage and redraws the split alone before them
+    params = yaml.safe_load((clone / "params.yaml").read_text()) | {"data_seed": 1, "independent_draws": True}
+    (clone / "params.yaml").write_text(yaml.safe_dump(params, sort_keys=False))
+    redrawn = run(["dvc", "repro", "render@original", "split"], clone, env).stdout
+    assert "Running stage 'split'" in redrawn, redrawn
+    for stage in ("ingest", "voxelize", "grasps@original", "render@original"):
+        assert f"Running stage '{stage}'" not in redrawn, stage
+    before = pd.read_parquet(work / "data/shapes.parquet")
+    assert (pd.read_parquet(clone / "data/shapes.parquet").split != before.split).any()
 
 
 def test_dvc_repro_fidelity(tiny_repo):

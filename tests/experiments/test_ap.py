@@ -165,6 +165,8 @@ def _seed_folders(tmp_path, variants, seeds=(0, 1)):
     for seed_dir in seed_dirs.values():
         seed_dir.mkdir()
         np.save(seed_dir / "test_rows.npy", np.arange(n))
+        roles = {"validation": ["t1"], "real_pool": [], "base": {"10": ["t0"]}}  # the train shapes t0, t1
+        (seed_dir / "split.json").write_text(json.dumps(roles))
         for v in variants:
             folder = seed_dir / v.name
             folder.mkdir(parents=True)

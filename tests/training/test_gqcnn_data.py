@@ -62,10 +62,11 @@ def test_a_new_data_seed_redraws_base_sets_validation_and_real_pool_but_not_the_
         assert getattr(draws[0], role) != getattr(draws[1], role), role
     assert draws[0].base[20] != draws[1].base[20] and all(set(d.base[10]) < set(d.base[20]) for d in draws)
     assert all(not {"tst_0", "tst_1"} & (set(d.ceiling) | set(d.real_pool)) for d in draws)
-    # the test split is ingest's, drawn from `seed`: only the stages that draw the experiment's data read data_seed
+    # the test split is the split stage's, drawn from `seed` (and data_seed with independent_draws): only it and the
+    # stages that draw the experiment's data read data_seed
     # (fidelity takes the real pool as they do; the report names the draw its decomposition comes from; the lifelong
     # loop's rounds draw their random parents from it and name the draw in their reports; sim names the draw its
     # contrasts cover)
     stages = yaml.safe_load((repo_root / "dvc.yaml").read_text())["stages"]
     readers = {name for name, stage in stages.items() if "data_seed" in (stage.get("do") or stage).get("params", [])}
-    assert readers == {"generate", "fidelity", "train_gqcnn", "report", "lifelong_start", "lifelong", "sim"}
+    assert readers == {"split", "generate", "fidelity", "train_gqcnn", "report", "lifelong_start", "lifelong", "sim"}

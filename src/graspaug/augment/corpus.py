@@ -173,8 +173,14 @@ def flag_duplicates(shapes: pd.DataFrame, occupancy: list[bytes]) -> pd.DataFram
     return out
 
 
+def split_seed(seed: int, data_seed: int, independent_draws: bool) -> int | list[int]:
+    """The seed of the train/test split: ``seed``, or with ``independent_draws`` the pair (``seed``, ``data_seed``)
+    (a NumPy seed sequence), a split of its own for every draw of the data."""
+    return [seed, data_seed] if independent_draws else seed
+
+
 def assign_split(
-    shape_ids: list[str], test_fraction: float, seed: int, duplicate_of: dict[str, str] | None = None
+    shape_ids: list[str], test_fraction: float, seed: int | list[int], duplicate_of: dict[str, str] | None = None
 ) -> dict[str, str]:
     """Seeded shuffle of the sorted ids; the first ``round(test_fraction * n)`` are ``test``.
     A shape in ``duplicate_of`` (id → the id it duplicates) takes its original's split, so a

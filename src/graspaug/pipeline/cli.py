@@ -75,10 +75,18 @@ stage_command(
 stage_command(
     "ingest",
     "Load the shape corpus, reject broken meshes with a reason, rebuild one closed outer surface per shape, center and "
-    "scale it, and split train/test.\n\nWrites `data/shapes/<shape_id>.ply`, `data/shapes.parquet`, "
-    "`data/rejects.parquet`.\n\n{params}\n\nAlso `seed` (split) and `n_jobs`.",
+    "scale it; `graspaug split` then splits train/test.\n\nWrites `data/shapes/<shape_id>.ply`, "
+    "`data/objects.parquet` (no split), `data/rejects.parquet`.\n\n{params}\n\nAlso `n_jobs`.",
     "data",
     "ingest",
+)
+stage_command(
+    "split",
+    "Split the ingested objects into train and test (`ingest.test_fraction` of them test; a duplicate goes where its "
+    "original goes), seeded by `seed`, or with `independent_draws: true` by `seed` and `data_seed` (a split of its "
+    "own for every draw). Ingest, voxels and the originals' grasps and renders read no split, so a new split reruns "
+    "none of them.\n\nWrites `data/shapes.parquet` (the objects table with a `split` column).\n\nReads `seed`, "
+    "`data_seed`, `independent_draws` and `ingest.test_fraction`.",
 )
 stage_command(
     "voxelize",

@@ -6,10 +6,12 @@ say what each file holds.
 
 from pathlib import Path
 
-# ingest
+# ingest: every object, with no train/test split (per-object work reads this, so a new split reruns none of it)
 SHAPES_DIR = Path("data/shapes")
-SHAPES_TABLE = Path("data/shapes.parquet")
+OBJECTS_TABLE = Path("data/objects.parquet")
 REJECTS_TABLE = Path("data/rejects.parquet")
+# split: the objects table with each shape's split (every stage that tells train from test reads this)
+SHAPES_TABLE = Path("data/shapes.parquet")
 # voxelize
 VOXELS = Path("data/voxels.npz")
 # train_ae
@@ -73,10 +75,10 @@ def fidelity_reports(base_size: int) -> Path:
 
 # grasps (one table per corpus: `dvc.yaml` runs the stage for each)
 def corpus_files(corpus: str) -> tuple[Path, Path, str] | None:
-    """(shape table, mesh folder, mesh suffix) of a corpus: ``original`` (ingested shapes) or
-    ``gen_<B>`` (the shapes generated for base size B); None for an unknown name."""
+    """(shape table, mesh folder, mesh suffix) of a corpus: ``original`` (ingested shapes: the objects table, with
+    no split) or ``gen_<B>`` (the shapes generated for base size B); None for an unknown name."""
     if corpus == "original":
-        return SHAPES_TABLE, SHAPES_DIR, ".ply"
+        return OBJECTS_TABLE, SHAPES_DIR, ".ply"
     if corpus.startswith("gen_") and corpus[4:].isdigit():
         size = int(corpus[4:])
         return generated_index(size), generated_meshes(size), GENERATED_SUFFIX

@@ -212,6 +212,8 @@ def render_shape(
     )
 
 
+#: Copied from the corpus table onto each datapoint; ``split`` is empty for the original objects (the ``split``
+#: stage's shape table holds it, so a new split renders nothing again) and ``train`` for generated shapes.
 SHAPE_COLUMNS = ("shape_id", "origin", "split", "base_size", "pool", "order")
 
 
@@ -227,7 +229,7 @@ def datapoints_index(shapes, by_shape: dict, results: list, threshold: float) ->
             log.warning("render: %s has no datapoints: %s", shape.shape_id, reason)
             continue
         rows = by_shape[shape.shape_id].iloc[data.columns["grasp_index"]]
-        part = pd.DataFrame({name: [getattr(shape, name)] * len(data) for name in SHAPE_COLUMNS})
+        part = pd.DataFrame({name: [getattr(shape, name, None)] * len(data) for name in SHAPE_COLUMNS})
         part["grasp_id"] = rows["grasp_id"].to_numpy()
         for name, values in data.columns.items():
             if name != "grasp_index":

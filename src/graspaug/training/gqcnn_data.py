@@ -82,13 +82,20 @@ def split_ids(split: ExperimentSplit) -> dict:
     }
 
 
+def with_split(index: pd.DataFrame, shapes: pd.DataFrame) -> pd.DataFrame:
+    """The rendered original corpus's ``index`` with each datapoint's ``split`` from the shape table ``shapes``
+    (``shape_id``, ``split``: the ``split`` stage's; the rendered index holds none, so one rendering serves every
+    split)."""
+    return index.assign(split=index.shape_id.map(shapes.set_index("shape_id")["split"]).to_numpy())
+
+
 def load_split(
     original: Path, shapes: pd.DataFrame, base_sizes: list[int], n_validation: int, seed: int
 ) -> ExperimentSplit:
-    """The split of the rendered original corpus (dataset folder ``original``) and the base sets
-    drawn from the shape table ``shapes`` (as ``generate`` draws them, so base sizes that are not
+    """The split of the rendered original corpus (dataset folder ``original``) by the shape table ``shapes``
+    and the base sets drawn from it (as ``generate`` draws them, so base sizes that are not
     augmented need no ``generate`` run)."""
-    index = read_table(Path(original) / "index.parquet")
+    index = with_split(read_table(Path(original) / "index.parquet"), shapes)
     train_ids = sorted(index.shape_id[index.split == "train"].unique())
     rendered = set(train_ids)
     drawn = draw_base_sets(shapes, base_sizes, seed)
@@ -155,9 +162,11 @@ def training_set(variant: Variant, split: ExperimentSplit, corpora: Corpora) -> 
     return data, info
 
 
-def test_set(original: Path) -> tuple[GraspArrays, np.ndarray]:
-    """Every test-split datapoint of the original corpus (dataset folder ``original``) and its row
-    in the index."""
+def test_set(original: Path, shapes: pd.DataFrame | None = None) -> tuple[GraspArrays, np.ndarray]:
+    """Every test-split datapoint of the original corpus (dataset folder ``original``) and its row in the index;
+    the split by the shape table ``shapes`` (the pipeline's: its rendered index holds none), or with None the
+    index's own ``split`` column (a dataset that carries it, as `graspaug evaluate`'s test sets do)."""
     data = GraspImages.open(original)
-    rows = np.flatnonzero((data.index.split == "test").to_numpy())
+    index = data.index if shapes is None else with_split(data.index, shapes)
+    rows = np.flatnonzero((index.split == "test").to_numpy())
     return _arrays(data, rows), rows

@@ -53,6 +53,15 @@ from graspaug.training.variants import Variant
 log = logging.getLogger(__name__)
 
 
+def network_seed(seed: int, data_seed: int, independent_draws: bool) -> int:
+    """The global seed of the networks' initial weights and noise streams (:func:`stream_seeds`): ``seed``, or with
+    ``independent_draws`` one drawn from (``seed``, ``data_seed``), so that training seed s starts from other
+    weights in every draw (seeds nested in draws)."""
+    if not independent_draws:
+        return seed
+    return int(np.random.SeedSequence([seed, data_seed]).generate_state(1)[0])
+
+
 def stream_seeds(global_seed: int, seed: int, member: int = 0) -> tuple[int, int]:
     """(initial-weights seed, noise-and-batch-order seed) of member ``member`` (< 3959) of
     training seed ``seed``; member 0's are the seed's own."""
@@ -370,15 +379,17 @@ def train_paired(
     card: dict,
     label: str,
     workers: Workers | int = 1,
+    shapes=None,
 ) -> dict[int, list[dict]]:
     """Train ``variants`` for every training seed of the ``gqcnn`` params as :mod:`train_gqcnn
     <graspaug.pipeline.stages.train_gqcnn>` does (the seed's initial weights and noise streams, validated on
     ``split.validation``, tested on the test split of ``corpora.original``), each seed into
     ``out_dir``/s<seed>/ with its ``test_rows.npy``, ``val_rows.npy`` and ``split.json``; every seed's networks
-    on ``workers`` at once (:func:`train_jobs`). Returns training seed → the networks' summaries
+    on ``workers`` at once (:func:`train_jobs`); ``shapes``: the shape table that holds the split
+    (:func:`~graspaug.training.gqcnn_data.test_set`). Returns training seed → the networks' summaries
     (:func:`train_network`)."""
     val, val_rows = shapes_datapoints(corpora.original, split.validation)
-    test, test_rows = test_set(corpora.original)
+    test, test_rows = test_set(corpora.original, shapes)
     jobs = []
     for seed in gqcnn.seeds:
         inits, noise_seeds = seed_members(gqcnn.net, global_seed, seed, gqcnn.members)

@@ -67,6 +67,8 @@ def test_ingest_keeps_good_shapes_and_records_every_reject(tmp_path, corpus_para
     with caplog.at_level(logging.INFO):
         result = run_stage(tmp_path, "ingest", params)
     assert result.exit_code == 0, result.output
+    assert "split" not in pd.read_parquet(tmp_path / "data/objects.parquet")  # no per-object stage reads a split
+    assert run_stage(tmp_path, "split", params).exit_code == 0
     shapes = pd.read_parquet(tmp_path / "data/shapes.parquet")
     rejects = pd.read_parquet(tmp_path / "data/rejects.parquet")
     assert sorted(shapes.shape_id) == [
@@ -134,10 +136,21 @@ def test_ingest_keeps_good_shapes_and_records_every_reject(tmp_path, corpus_para
 def test_split_is_seeded_and_deterministic(tmp_path, corpus_params):
     params, _ = corpus_params
     assert run_stage(tmp_path, "ingest", params).exit_code == 0
+    assert run_stage(tmp_path, "split", params).exit_code == 0
     first = pd.read_parquet(tmp_path / "data/shapes.parquet")
     assert run_stage(tmp_path, "ingest", params).exit_code == 0
+    assert run_stage(tmp_path, "split", params).exit_code == 0
     again = pd.read_parquet(tmp_path / "data/shapes.parquet")
     pd.testing.assert_frame_equal(first, again)
+    objects = (tmp_path / "data/objects.parquet").read_bytes()
+    # data_seed moves the split only with independent_draws; the objects table never depends on it
+    assert run_stage(tmp_path, "split", params | {"data_seed": 1}).exit_code == 0
+    pd.testing.assert_frame_equal(first, pd.read_parquet(tmp_path / "data/shapes.parquet"))
+    splits = set()
+    for data_seed in (0, 1, 2):
+        assert run_stage(tmp_path, "split", params | {"data_seed": data_seed, "independent_draws": True}).exit_code == 0
+        splits.add(tuple(pd.read_parquet(tmp_path / "data/shapes.parquet").split))
+    assert len(splits) > 1 and (tmp_path / "data/objects.parquet").read_bytes() == objects
     # byte-identical outputs, so DVC sees no change on a rerun
     first_bytes = {p.name: p.read_bytes() for p in (tmp_path / "data").rglob("*") if p.is_file()}
     assert run_stage(tmp_path, "ingest", params).exit_code == 0
@@ -190,6 +203,7 @@ def test_links_special_files_and_duplicates(tmp_path, capfd):
     }
     result = run_stage(tmp_path, "ingest", params)
     assert result.exit_code == 0, result.output
+    assert run_stage(tmp_path, "split", params).exit_code == 0
     shapes = pd.read_parquet(tmp_path / "data/shapes.parquet").set_index("shape_id")
     rejects = pd.read_parquet(tmp_path / "data/rejects.parquet").set_index("shape_id")
     assert dict(rejects.reason) == {

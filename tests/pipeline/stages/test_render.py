@@ -10,6 +10,7 @@ from typer.testing import CliRunner
 from graspaug.io.dexnet import read_tensor_field
 from graspaug.io.gqcnn import GraspImages
 from graspaug.pipeline.cli import app
+from graspaug.training.gqcnn_data import with_split
 
 from .test_ingest import run_stage
 
@@ -28,7 +29,7 @@ def make_project(tmp_path):
     trimesh.creation.cylinder(radius=0.03, height=0.09).export(corpus / "can.stl")
     trimesh.creation.capsule(height=0.06, radius=0.02).export(corpus / "pill.stl")
     params = {**PARAMS, "data": {"source": "folder", "path": str(corpus)}}
-    for stage in ("ingest", "grasps"):
+    for stage in ("ingest", "split", "grasps"):
         result = run_stage(tmp_path, stage, params)
         assert result.exit_code == 0, result.output
     return params
@@ -42,7 +43,9 @@ def test_render_writes_shards_index_metrics_and_a_dexnet_export(tmp_path, monkey
     data = GraspImages.open(folder)
     index, grasps = data.index, pd.read_parquet(tmp_path / "data/grasps/original.parquet")
     shapes = pd.read_parquet(tmp_path / "data/shapes.parquet")
-    assert len(data) > 7 and set(index.split) == {"train", "test"}
+    assert len(data) > 7 and index.split.isna().all()  # the original objects' renders hold no split ...
+    index = with_split(index, shapes)  # ... the split stage's table does
+    assert set(index.split) == {"train", "test"}
     assert sorted(p.name for p in folder.glob("images_*.npy"))[0] == "images_00000.npy"
     assert len(list(folder.glob("images_*.npy"))) == int(np.ceil(len(data) / 7))  # shards of 7 rows
     images = data.images()

@@ -252,10 +252,11 @@ def test_labels(index: pd.DataFrame, seed_dir: Path) -> tuple[np.ndarray, np.nda
     return index.label.to_numpy()[rows], index.shape_id.to_numpy()[rows]
 
 
-def ceiling_shapes(index: pd.DataFrame, val_shapes: int) -> int:
-    """How many train shapes the ceiling trains on: the train shapes of the original corpus's
-    ``index`` but the ``val_shapes`` validation shapes."""
-    return len(index[index.split == "train"].shape_id.unique()) - val_shapes
+def ceiling_shapes(seed_dir: Path) -> int:
+    """How many train shapes the ceiling trains on: every rendered train shape outside validation, the base sets
+    and the real pool of the seed's ``split.json`` (in ``seed_dir``)."""
+    roles = json.loads((Path(seed_dir) / "split.json").read_text())
+    return len(set(roles["real_pool"]).union(*map(set, roles["base"].values())))
 
 
 def choose_ratios(runs: pd.DataFrame, base_sizes) -> dict[int, float]:  # base sizes with augmented networks
@@ -311,7 +312,9 @@ def evaluate_networks(
     results = evaluate_contrasts(contrasts, runs, seed_dirs, labels, object_ids, n_resamples=n_resamples, seed=seed)
     per_object, by_network = per_object_aps(seed_dirs, variants, labels, object_ids)
     table = network_table(runs, per_object)
-    return Evaluation(chosen, results, table, by_network, labels, object_ids, ceiling_shapes(index, gqcnn.val_shapes))
+    return Evaluation(
+        chosen, results, table, by_network, labels, object_ids, ceiling_shapes(seed_dirs[next(iter(seed_dirs))])
+    )
 
 
 def per_object_ap(labels: np.ndarray, probability: np.ndarray, shape_ids: np.ndarray) -> pd.Series:

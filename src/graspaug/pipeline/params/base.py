@@ -101,8 +101,16 @@ class BaseParams(BaseModel):
         ge=0,
         description="Seeds the draws of the GQ-CNN experiment's data, apart from the training seeds: the base sets, "
         "the validation shapes and the real pool's order, and the random pool's pairs (so every generated pool). The "
-        "test split, the AutoEncoder and the grasp labels stay on `seed`. Cross it with gqcnn.seeds to cover data "
-        "draws: `dvc exp run -S data_seed=1`.",
+        "test split, the AutoEncoder and the grasp labels stay on `seed` unless independent_draws is on. Cross it "
+        "with gqcnn.seeds to cover data draws: `dvc exp run -S data_seed=1`.",
+    )
+    independent_draws: bool = Field(
+        False,
+        description="On: data_seed also redraws the train/test split (so the AutoEncoder, trained on the train "
+        "split, and everything after it) and seeds the GQ-CNNs' initial weights with the training seed, so training "
+        "seeds are nested in draws and draws are independent (the confirmatory study's design). Off: the split and "
+        "the initial weights stay on `seed`, the same in every draw (seeds crossed with draws). Per-object work "
+        "(ingest, voxels, the original shapes' grasps and renders) never depends on it.",
     )
     device: Literal["auto", "cpu", "cuda"] = Field(
         "auto", description="Torch device: `auto` (CUDA when present), `cpu` or `cuda`."

@@ -61,7 +61,7 @@ def run(params: Params, base_size: int) -> None:
     if b not in cfg.augment_base_sizes:
         raise StageError(f"base size {b} is not in gqcnn.augment_base_sizes {list(cfg.augment_base_sizes)}")
     start, count = time.perf_counter(), ratio_count(1.0, b)
-    original = read_table(gqcnn_dir("original") / "index.parquet")
+    original, shapes = read_table(gqcnn_dir("original") / "index.parquet"), read_table(SHAPES_TABLE)
     rendered = pd.concat([original, read_table(gqcnn_dir(f"gen_{b}") / "index.parquet")])
     generated = read_table(generated_index(b)).sort_values("order")
     graspness = read_table(SCORES).set_index("shape_id").graspness.to_dict()
@@ -69,9 +69,7 @@ def run(params: Params, base_size: int) -> None:
     pools, parent_counts = {}, original.groupby("shape_id").size().to_dict()  # a real shape's datapoints
     for pool in cfg.pools:
         if pool == "real":  # the real pool as the GQ-CNN experiment draws it
-            split = load_split(
-                gqcnn_dir("original"), read_table(SHAPES_TABLE), list(gen.base_sizes), cfg.val_shapes, params.data_seed
-            )
+            split = load_split(gqcnn_dir("original"), shapes, list(gen.base_sizes), cfg.val_shapes, params.data_seed)
             ids, folder, suffix, parents = split.real_pool[:count], SHAPES_DIR, MESH_SUFFIX, None
         else:
             rows = generated[generated.pool == pool].head(count)
@@ -80,7 +78,7 @@ def run(params: Params, base_size: int) -> None:
         meshes = {s: read_mesh(mesh_path(folder, s, suffix)) for s in ids}
         rows = rendered[rendered.shape_id.isin(ids)]
         pools[pool] = pool_shapes(meshes, graspness, rows, FIDELITY_POINTS, params.seed, parents, parent_counts)
-    test_ids = sorted(original.shape_id[original.split == "test"].unique())
+    test_ids = sorted(set(original.shape_id) & set(shapes.shape_id[shapes.split == "test"]))
     rng = shape_rng(params.seed, "fidelity", f"reference-{b}")
     reference_ids = [test_ids[i] for i in sorted(rng.choice(len(test_ids), size=min(b, len(test_ids)), replace=False))]
     reference_meshes = {s: read_mesh(mesh_path(SHAPES_DIR, s)) for s in reference_ids}

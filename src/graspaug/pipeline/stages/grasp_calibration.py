@@ -29,8 +29,16 @@ from graspaug.io.atomic import atomic_path
 from graspaug.io.tables import read_table, write_csv, write_json, write_json_files
 from graspaug.pipeline.params.base import params_model
 from graspaug.pipeline.params.sim import SimParams
-from graspaug.pipeline.paths import CALIBRATION_METRICS, CALIBRATION_REPORT_DIR, SHAPES_DIR, gqcnn_dir, grasps_table
+from graspaug.pipeline.paths import (
+    CALIBRATION_METRICS,
+    CALIBRATION_REPORT_DIR,
+    SHAPES_DIR,
+    SHAPES_TABLE,
+    gqcnn_dir,
+    grasps_table,
+)
 from graspaug.pipeline.stages import StageError
+from graspaug.training.gqcnn_data import with_split
 
 log = logging.getLogger(__name__)
 
@@ -41,7 +49,11 @@ def run(params: Params) -> None:
     start = time.perf_counter()
     cfg = params.sim
     try:
-        chosen = choose_grasps(read_table(gqcnn_dir("original") / "index.parquet"), cfg.calibration_grasps, params.seed)
+        chosen = choose_grasps(
+            with_split(read_table(gqcnn_dir("original") / "index.parquet"), read_table(SHAPES_TABLE)),
+            cfg.calibration_grasps,
+            params.seed,
+        )
     except ValueError as exc:
         raise StageError(f"grasp_calibration: {exc}") from None
     jobs = shape_jobs(chosen, read_table(grasps_table("original")), SHAPES_DIR, cfg, params.seed, params.workers)

@@ -1,6 +1,7 @@
-"""Stage ``ingest``: source meshes → normalized closed outer surfaces, a shape table, a reject table.
+"""Stage ``ingest``: source meshes → normalized closed outer surfaces, an objects table, a reject table.
 
-Outputs: ``data/shapes/<shape_id>.ply``, ``data/shapes.parquet``, ``data/rejects.parquet``.
+Outputs: ``data/shapes/<shape_id>.ply``, ``data/objects.parquet`` (no train/test split: the ``split`` stage adds it),
+``data/rejects.parquet``.
 """
 
 from __future__ import annotations
@@ -11,7 +12,7 @@ from collections import Counter
 
 import pandas as pd
 
-from graspaug.augment.corpus import assign_split, closing_summary, flag_duplicates, ingest_source, reject_lines
+from graspaug.augment.corpus import closing_summary, flag_duplicates, ingest_source, reject_lines
 from graspaug.io.atomic import atomic_path
 from graspaug.io.settings import CorpusSettings
 from graspaug.io.sources import folder_sources, pybullet_sources
@@ -19,7 +20,7 @@ from graspaug.io.tables import write_table
 from graspaug.pipeline.params.base import params_model
 from graspaug.pipeline.params.ingest import IngestParams
 from graspaug.pipeline.params.voxelize import VoxelizeParams
-from graspaug.pipeline.paths import REJECTS_TABLE, SHAPES_DIR, SHAPES_TABLE
+from graspaug.pipeline.paths import OBJECTS_TABLE, REJECTS_TABLE, SHAPES_DIR
 from graspaug.pipeline.stages import StageError
 
 log = logging.getLogger(__name__)
@@ -64,12 +65,8 @@ def run(params: Params) -> None:
                 f"only {len(shapes)} of {len(sources)} shapes are usable, "
                 f"ingest.min_shapes={cfg.min_shapes} ({reasons})"
             )
-        split = assign_split(
-            list(shapes["shape_id"]), cfg.test_fraction, params.seed, dict(zip(shapes.shape_id, shapes.duplicate_of))
-        )
-        shapes["split"] = shapes["shape_id"].map(split)
         shapes["origin"] = "original"
-        write_table(shapes, SHAPES_TABLE)
+        write_table(shapes, OBJECTS_TABLE)
         write_table(rejects, REJECTS_TABLE)
 
     for line in reject_lines(rejects, REJECTS_TABLE):
@@ -77,18 +74,15 @@ def run(params: Params) -> None:
     log.info("ingest: %s", closing_summary(shapes))
     kinds = shapes["duplicate_kind"].value_counts()
     log.info(
-        "ingest: %d duplicates kept and flagged (%d exact, %d same geometry), each in its original's split",
+        "ingest: %d duplicates kept and flagged (%d exact, %d same geometry), each to go to its original's split",
         int((shapes["duplicate_of"] != "").sum()),
         kinds.get("exact", 0),
         kinds.get("geometry", 0),
     )
-    counts = shapes["split"].value_counts()
     log.info(
-        "ingest: %d shapes (%d train, %d test), %d rejected, %d/%d watertight, median %d faces, %d over the face "
+        "ingest: %d shapes, %d rejected, %d/%d watertight, median %d faces, %d over the face "
         "budget of %d (not decimated: the decimator failed or would open the surface), in %.1f s",
         len(shapes),
-        counts.get("train", 0),
-        counts.get("test", 0),
         len(rejects),
         int(shapes["watertight"].sum()),
         len(shapes),

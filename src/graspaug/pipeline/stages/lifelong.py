@@ -28,7 +28,7 @@ from graspaug.pipeline.params.base import params_model
 from graspaug.pipeline.provenance import report_header
 from graspaug.pipeline.stages import StageError
 from graspaug.training.gqcnn_data import Corpora, load_split, training_shapes
-from graspaug.training.networks import network_workers, seed_card, train_paired
+from graspaug.training.networks import network_seed, network_workers, seed_card, train_paired
 
 log = logging.getLogger(__name__)
 
@@ -45,7 +45,7 @@ Params = params_model(
 
 
 def run(params: Params, round_: int) -> None:
-    cfg, gq, b = params.lifelong, params.gqcnn, params.lifelong.base_size
+    cfg, gq, b, draws_apart = params.lifelong, params.gqcnn, params.lifelong.base_size, params.independent_draws
     if round_ not in cfg.round_numbers():
         raise StageError(f"round {round_} is not in lifelong.rounds {sorted(cfg.rounds)}")
     before, label = paths.lifelong_data(round_ - 1), f"lifelong r{round_}"
@@ -83,8 +83,8 @@ def run(params: Params, round_: int) -> None:
         real = training_shapes(variants[ARMS.index("real")], split)[0][b:]
         pd.DataFrame({"shape_id": real}).to_csv(folder / "real.csv", index=False)
         corpora, card = Corpora(original, {b: folder / "dataset"}), seed_card(params.render, params.grasps, params.seed)
-        workers = network_workers(params.workers)
-        train_paired(variants, split, gq, params.seed, device, nets, corpora, card, label, workers)
+        workers, seeds = network_workers(params.workers), network_seed(params.seed, params.data_seed, draws_apart)
+        train_paired(variants, split, gq, seeds, device, nets, corpora, card, label, workers, shapes)
         seed_dirs, corpus = {s: nets / f"s{s}" for s in gq.seeds}, read_table(original / "index.parquet")
         history, curve = pd.read_csv(before / "history.csv"), pd.read_csv(before / "curve.csv")
         errors, history, followed = score_round(seed_dirs, variants, ARMS, corpus, failures, history, round_, cfg.worst)

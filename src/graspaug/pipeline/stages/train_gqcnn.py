@@ -37,6 +37,7 @@ from graspaug.plots import validation_curves
 from graspaug.training.gqcnn_data import Corpora, load_split, shapes_datapoints, test_set
 from graspaug.training.networks import (
     NetworkJob,
+    network_seed,
     network_workers,
     read_history,
     result_lines,
@@ -73,9 +74,10 @@ def run(params: Params, seed: int) -> None:
     sizes = (gen.base_sizes, gen.ratios, cfg.augment_base_sizes)
     variants = seed_variants(*sizes, cfg.ceiling, cfg.pools, cfg.control_ratios)
     device = resolve_device(params.device)
-    inits, noise_seeds = seed_members(cfg.net, params.seed, seed, cfg.members)
+    global_seed = network_seed(params.seed, params.data_seed, params.independent_draws)
+    inits, noise_seeds = seed_members(cfg.net, global_seed, seed, cfg.members)
     val, val_rows = shapes_datapoints(corpora.original, split.validation)
-    test, test_rows = test_set(corpora.original)
+    test, test_rows = test_set(corpora.original, shapes)
     plan = seed_plan(variants, cfg.members, len(split.validation), val_rows, test_rows, device)
     log.info("train_gqcnn seed %d: %s", seed, plan)
     log_precision(f"train_gqcnn seed {seed}", "gqcnn.train.precision", cfg.train.precision, device, GQCNN_GPU_BFLOAT16)

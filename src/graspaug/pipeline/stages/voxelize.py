@@ -17,7 +17,7 @@ from graspaug.io.voxels import VoxelSet, write_voxels
 from graspaug.pipeline.params.ae import AEParams
 from graspaug.pipeline.params.base import params_model
 from graspaug.pipeline.params.voxelize import VoxelizeParams
-from graspaug.pipeline.paths import SHAPES_DIR, SHAPES_TABLE, VOXELS
+from graspaug.pipeline.paths import OBJECTS_TABLE, SHAPES_DIR, VOXELS
 
 log = logging.getLogger(__name__)
 
@@ -48,7 +48,7 @@ def run(params: Params) -> None:
 
     start = time.perf_counter()
     cfg = params.voxelize
-    shape_ids = list(read_table(SHAPES_TABLE)["shape_id"])
+    shape_ids = list(read_table(OBJECTS_TABLE)["shape_id"])
     paths = [mesh_path(SHAPES_DIR.resolve(), s) for s in shape_ids]  # workers may have another cwd
     truncation = params.ae.net.truncation if params.ae.net.output == "sdf" else None
     out = parallel_map(

@@ -24,7 +24,8 @@ from graspaug.experiments.cell.calibration import choose_grasps, run_calibration
 from graspaug.io.tables import read_table
 from graspaug.pipeline.params.base import ParamsError
 from graspaug.pipeline.params.model import load_params
-from graspaug.pipeline.paths import SHAPES_DIR, gqcnn_dir, grasps_table
+from graspaug.pipeline.paths import SHAPES_DIR, SHAPES_TABLE, gqcnn_dir, grasps_table
+from graspaug.training.gqcnn_data import with_split
 
 
 def with_changes(sim, changes: list[str]):
@@ -54,7 +55,14 @@ def run(project: Path, n: int, workers: int, changes: list[str], split: str) -> 
     sim = with_changes(params.sim, changes)
     start = time.perf_counter()
     try:
-        chosen = choose_grasps(read_table(project / gqcnn_dir("original") / "index.parquet"), n, params.seed, split)
+        chosen = choose_grasps(
+            with_split(
+                read_table(project / gqcnn_dir("original") / "index.parquet"), read_table(project / SHAPES_TABLE)
+            ),
+            n,
+            params.seed,
+            split,
+        )
     except ValueError as exc:
         raise DataError(f"grasp-calibration: {exc}") from None
     table = read_table(project / grasps_table("original"))

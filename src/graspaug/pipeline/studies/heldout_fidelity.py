@@ -39,7 +39,7 @@ from graspaug.io.meshes import mesh_path, write_obj
 from graspaug.io.tables import read_table, write_csv, write_json
 from graspaug.io.voxels import read_voxels
 from graspaug.pipeline.params.model import load_params
-from graspaug.pipeline.paths import AE_CRITIC_MODEL, GENERATED_SUFFIX, LATENTS, VOXELS, corpus_files
+from graspaug.pipeline.paths import AE_CRITIC_MODEL, GENERATED_SUFFIX, LATENTS, SHAPES_TABLE, VOXELS, corpus_files
 from graspaug.render.corpus_dataset import render_corpus, with_pool_columns
 from graspaug.render.dataset import datapoints_index
 
@@ -102,8 +102,8 @@ def run(project: Path, n_shapes: int, seed: int, workers: int, out: Path) -> str
     ``per_shape.csv`` and ``summary.json`` into the folder ``out``; the text to print."""
     project = project.resolve()
     params = load_params(project / "params.yaml")
-    table, mesh_dir, suffix = corpus_files("original")
-    shapes = read_table(project / table)
+    _, mesh_dir, suffix = corpus_files("original")
+    shapes = read_table(project / SHAPES_TABLE)  # with the split
     test = shapes.shape_id[shapes.split == "test"].to_numpy()
     rng = np.random.default_rng(seed)
     ids = sorted(rng.choice(test, size=min(n_shapes, len(test)), replace=False).tolist())

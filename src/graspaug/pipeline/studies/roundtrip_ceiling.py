@@ -43,7 +43,7 @@ from graspaug.io.meshes import mesh_path, read_mesh, write_obj
 from graspaug.io.tables import read_table, write_csv, write_json
 from graspaug.parallel import parallel_map
 from graspaug.pipeline.params.model import load_params
-from graspaug.pipeline.paths import GENERATED_SUFFIX, corpus_files
+from graspaug.pipeline.paths import GENERATED_SUFFIX, SHAPES_TABLE, corpus_files
 
 log = logging.getLogger(__name__)
 
@@ -113,8 +113,8 @@ def run(project: Path, n_shapes: int, seed: int, workers: int | None, truncation
     processes (None: the project's ``n_jobs``); writes its tables into the folder ``out``; the markdown table."""
     project = project.resolve()
     params = load_params(project / "params.yaml")
-    table_path, mesh_dir, suffix = corpus_files("original")
-    shapes = read_table(project / table_path)
+    _, mesh_dir, suffix = corpus_files("original")
+    shapes = read_table(project / SHAPES_TABLE)  # with the split
     train = shapes.shape_id[shapes.split == "train"].to_numpy()
     chosen = sorted(np.random.default_rng(seed).choice(train, size=min(n_shapes, len(train)), replace=False))
     jobs = [(mesh_path(project / mesh_dir, shape_id, suffix), shape_id) for shape_id in chosen]

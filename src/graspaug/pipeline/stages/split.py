@@ -1,0 +1,47 @@
+"""Stage ``split``: the objects table → the shape table, each shape in the ``train`` or ``test`` split.
+
+A seeded shuffle of the objects (:func:`graspaug.augment.corpus.assign_split`; a duplicate goes where its original
+goes). The seed is ``seed``, or with ``independent_draws`` on the pair (``seed``, ``data_seed``), so that every draw
+of the data has its own test objects while ingest, the voxels and the originals' grasps and renders, which read the
+objects table, are shared by every draw.
+
+Outputs: ``data/shapes.parquet`` (the objects table with a ``split`` column).
+"""
+
+from __future__ import annotations
+
+import logging
+
+from graspaug.augment.corpus import assign_split, split_seed
+from graspaug.io.tables import read_table, write_table
+from graspaug.pipeline.params.base import params_model
+from graspaug.pipeline.params.ingest import IngestParams
+from graspaug.pipeline.paths import OBJECTS_TABLE, SHAPES_TABLE
+
+log = logging.getLogger(__name__)
+
+Params = params_model("The params the `split` stage reads.", ingest=IngestParams)
+
+
+def run(params: Params) -> None:
+    shapes = read_table(OBJECTS_TABLE)
+    seed = split_seed(params.seed, params.data_seed, params.independent_draws)
+    duplicates = dict(zip(shapes.shape_id, shapes.duplicate_of))
+    shapes["split"] = shapes["shape_id"].map(
+        assign_split(list(shapes["shape_id"]), params.ingest.test_fraction, seed, duplicates)
+    )
+    write_table(shapes, SHAPES_TABLE)
+    counts = shapes["split"].value_counts()
+    log.info(
+        "split: %d shapes, %d train, %d test (seed %s)",
+        len(shapes),
+        counts.get("train", 0),
+        counts.get("test", 0),
+        seed,
+    )
+
+
+if __name__ == "__main__":
+    from graspaug.pipeline.entry import stage_main
+
+    stage_main(__spec__.name)
