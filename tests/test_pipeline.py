@@ -881,6 +881,34 @@ def test_attribution_study_records_a_finished_draw_then_combines_from_results_al
     assert missing.returncode != 0 and "no draw 1" in missing.stderr + missing.stdout
 
 
+def test_attribution_study_runs_draws_on_a_dask_cluster_and_names_a_failed_one(tiny_repo, tmp_path):
+    """`graspaug study attribution --scheduler`: each draw one task on a LocalCluster of two workers (draw 0 the
+    finished tiny run, draw 1 a new clone whose data stages come from the run cache); draw 2, whose clone cannot be
+    made, is named with its reason while the others finish and keep their tables."""
+    distributed = pytest.importorskip("distributed")
+    work, env = tiny_repo
+    run(["dvc", "repro", "report"], work, env)
+    (tmp_path / "draw0").symlink_to(work)
+    (tmp_path / "draw2").write_text("not a folder")  # git cannot clone into it
+    cmd = [*GRASPAUG, "study", "attribution", "--draws", "0", "1", "2", "--workdir", str(tmp_path), "--profile", "tiny"]
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
+        done = subprocess.run(
+            [*cmd, "--resamples", "20", "--results", "tiny-dask", "--scheduler", cluster.scheduler_address],
+            cwd=work,
+            env=env,
+            capture_output=True,
+            text=True,
+        )
+    assert done.returncode == 2, done.stderr
+    assert "1 draw(s) failed, the others finished (draw 2: StageError: draw 2: `git clone" in done.stderr, done.stderr
+    networks = pd.read_parquet(work / "results/tiny-dask/networks.parquet")
+    assert set(networks.draw) == {0, 1}  # both finished draws kept their tables
+    both = run(
+        [*cmd[:6], "0", "1", *cmd[9:], "--combine-only", "--resamples", "20", "--results", "tiny-dask"], work, env
+    )
+    assert "targeted_vs_none" in both.stdout
+
+
 def test_lifelong_study_combines_a_finished_draw(tiny_repo, tmp_path):
     """`graspaug study lifelong --combine-only` over one draw (the tiny run's rounds, linked as draw0): every
     round's arms, the curves, the predictions recorded with the command."""

@@ -76,12 +76,14 @@ def test_models_as_seeds_of_networks_give_each_networks_mean_with_the_verdict_in
         ap_of_models(labels, objects, weak, 300, 0, seeds=2)
 
 
-def _model(path: Path, seed: int) -> Path:
-    """A seeded, untrained GQ-CNN with the model card train_gqcnn writes (label threshold 0.0005, the tiny one)."""
+def _model(path: Path, seed: int, pool: str = "targeted", rules: dict | None = None) -> Path:
+    """A seeded, untrained GQ-CNN with the model card train_gqcnn writes (label threshold 0.0005, the tiny one; with
+    ``rules``, the test-set rules its data were made by)."""
     torch.manual_seed(seed)
     card = gqcnn_card(CropGeometry(), Intrinsics(), ViewpointRanges(), ParallelJawGripper(), 0.0005, 0)
+    card |= {} if rules is None else {"test_set_rules": rules}
     summary = {
-        "pool": "targeted",
+        "pool": pool,
         "base_size": 4,
         "ratio": 0.0,
         "seed": seed,
@@ -161,7 +163,43 @@ def test_evaluate_prints_each_models_ap_and_the_paired_difference(project):
     as_networks = json.loads((root / "reports/evaluate/evaluate.json").read_text())
     assert as_networks["networks"][f"{models[0]} (2 seeds)"]["n_seeds"] == 2
     assert as_networks["network_differences"] == {}
-    assert "networks of 2 training seeds each (`--seeds 2`)" in (root / "reports/evaluate/report.md").read_text()
+    report_md = (root / "reports/evaluate/report.md").read_text()
+    assert "arms of 2 replicates each (`--seeds 2`; their cards say they are training seeds of one draw" in report_md
+
+
+def test_a_single_network_difference_is_no_method_verdict_and_seeds_must_be_replicates(project):
+    root, corpus, models = project
+    single = _evaluate(root, str(models[0]), str(models[1]), "--corpus", str(corpus), "--resamples", "100")
+    assert single.exit_code == 0, single.output
+    assert "training seeds not covered: not evidence about the method" in single.output
+    report_md = (root / "reports/evaluate/report.md").read_text()
+    assert "not evidence about the method" in report_md and "a gain in this draw" not in report_md
+    other = _model(root / "random.pt", 2, pool="random")
+    mixed = _evaluate(root, str(models[0]), str(other), "--corpus", str(corpus), "--seeds", "2")
+    assert mixed.exit_code == 2 and len(mixed.output.strip().splitlines()) == 1
+    assert "is not a replicate of" in mixed.output and "card's pool is 'random', not 'targeted'" in mixed.output
+
+
+def test_the_models_cards_make_their_test_set_unless_params_says_otherwise(project, repo_root):
+    import dataclasses
+
+    from graspaug.pipeline.params.profiles import profile_params
+    from graspaug.training.networks import test_set_rules
+
+    root, corpus, _ = project
+    tiny = profile_params("tiny", repo_root / "profiles")
+    ingest = dataclasses.replace(tiny.ingest, surface=dataclasses.replace(tiny.ingest.surface, size="fit"))
+    rules = test_set_rules(ingest, tiny.grasps, tiny.render)
+    fitted = [_model(root / f"fit{s}.pt", s, rules=rules) for s in (0, 1)]
+    made = _evaluate(root, *map(str, fitted), "--corpus", str(corpus), "--resamples", "100", params=None)
+    assert made.exit_code == 0, made.output
+    shaped = json.loads((root / "reports/evaluate/evaluate.json").read_text())["shaped_by"]
+    assert shaped["size"] == "fit" and shaped["rules"].startswith("the models' cards")
+    assert "Test set shaped by: params the models' cards" in (root / "reports/evaluate/report.md").read_text()
+    overridden = _evaluate(root, *map(str, fitted), "--corpus", str(corpus), "--resamples", "100")
+    assert overridden.exit_code == 0, overridden.output
+    shaped = json.loads((root / "reports/evaluate/evaluate.json").read_text())["shaped_by"]
+    assert shaped["size"] == "real" and shaped["rules"] == "--params params.yaml"
 
 
 def test_bad_folders_and_models_are_refused_in_one_line(project, tmp_path):
@@ -175,7 +213,7 @@ def test_bad_folders_and_models_are_refused_in_one_line(project, tmp_path):
     broken = _evaluate(root, str(models[0]), str(tmp_path / "broken.pt"), "--corpus", str(corpus))
     assert broken.exit_code == 2 and "broken.pt" in broken.output and len(broken.output.splitlines()) == 1
     uneven = _evaluate(root, *map(str, models), str(root / "m2.pt"), "--corpus", str(corpus), "--seeds", "2")
-    assert uneven.exit_code == 2 and "--seeds 2: 3 models are not networks of 2 seeds" in uneven.output
+    assert uneven.exit_code == 2 and "--seeds 2: 3 models are not arms of 2 replicates" in uneven.output
 
 
 @pytest.mark.skipif(not GSO300.is_dir(), reason="the gso300 corpus is not on this machine")

@@ -283,13 +283,30 @@ def recompute(results_dir: Path) -> tuple[dict[str, str], dict[str, dict]]:
     functions and its keys start with its folder name."""
     figures, results = {}, {}
     for folder in sorted(p for p in Path(results_dir).iterdir() if p.is_dir()) if Path(results_dir).is_dir() else ():
-        kind = folder.name.split("-")[0]
+        kind = study_kind(folder)
         if kind not in STUDIES:
             raise DataError(f"{folder}: not a study folder (known: {', '.join(STUDIES)})")
         combine, figures_of = STUDIES[kind]
         results[folder.name] = combine(folder)
         figures |= figures_of(results[folder.name], folder.name)
     return figures, results
+
+
+def study_kind(folder: Path) -> str:
+    """The study a results folder holds: ``confirm`` where it has a plan (``plan.yaml``), else its name's first
+    word (``attribution-real-objects``: ``attribution``)."""
+    from graspaug.experiments.confirm_results import PLAN
+
+    return "confirm" if (Path(folder) / PLAN).is_file() else Path(folder).name.split("-")[0]
+
+
+def history_problems(results_dir: Path) -> list[str]:
+    """What git says is wrong with the results folders whose history matters: a confirmatory study's plan committed
+    after its data, edited, or a draw dropped (:func:`~graspaug.experiments.confirm_results.check_plan_history`)."""
+    from graspaug.experiments.confirm_results import check_plan_history
+
+    folders = sorted(p for p in Path(results_dir).iterdir() if p.is_dir()) if Path(results_dir).is_dir() else []
+    return [p for folder in folders if study_kind(folder) == "confirm" for p in check_plan_history(folder)]
 
 
 def marked_figures(text: str) -> list[tuple[str, int]]:
@@ -498,7 +515,14 @@ def precision_figures(result: dict, study: str = "precision") -> dict[str, str]:
     return out
 
 
+def _confirm():
+    from graspaug.experiments.confirm_results import combine_confirm, confirm_figures
+
+    return combine_confirm, confirm_figures
+
+
 STUDIES = {
+    "confirm": (lambda folder: _confirm()[0](folder), lambda result, study: _confirm()[1](result, study)),
     "attribution": (combine_attribution, attribution_figures),
     "lifelong": (combine_lifelong, lifelong_figures),
     "fidelity": (combine_fidelity, fidelity_figures),

@@ -385,14 +385,16 @@ def profile_command(
     "`--results`): writes `<out>/<study>/summary.json`, "
     "`decomposition.md` and `figures.json` (key → the quoted text) and prints each figure. `--check`: a figure the "
     "markdown marks (`<!-- results:KEY -->` before it) that differs in any character from the recomputed one, or that "
-    "no study recomputes, a malformed marker, or a document without a marker, is an error naming it (exit 2).",
+    "no study recomputes, a malformed marker, or a document without a marker, is an error naming it (exit 2); so is a "
+    "confirmatory study's plan (`results/<name>/plan.yaml`) that git shows committed after any other file of its "
+    "folder or edited since, or a draw once committed and now gone.",
 )
 def results_command(
     root: Path = typer.Option(Path("."), "--root", help="The repository (its results/, README.md, docs/)."),
     out: Path = typer.Option(Path("reports/results"), "--out", "-o", help="Folder for the recomputed tables."),
     check: bool = typer.Option(False, "--check", help="Compare the marked figures of README.md, docs/results.md."),
 ) -> None:
-    from graspaug.experiments.results import DOCUMENTS, check_markdown, recompute, write_recomputed
+    from graspaug.experiments.results import DOCUMENTS, check_markdown, history_problems, recompute, write_recomputed
 
     figures, results = recompute(root / "results")
     write_recomputed(results, figures, root / out)
@@ -400,6 +402,7 @@ def results_command(
         typer.echo(f"{key}: {text}")
     if check:
         problems = [p for doc in DOCUMENTS for p in check_markdown((root / doc).read_text(), figures, doc)]
+        problems += history_problems(root / "results")  # a confirmatory plan: committed first, never edited
         if problems:
             from graspaug.errors import DataError
 

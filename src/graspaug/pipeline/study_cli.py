@@ -62,6 +62,27 @@ def _check_results_name(results: str | None, kind: str) -> None:
         raise typer.BadParameter(f"must be {kind} or {kind}-<label>; got {results}", param_hint="--results")
 
 
+def _draw_seed(value: str | None) -> tuple[int, int] | None:
+    """``--keep-networks DRAW/SEED`` as (draw, seed); anything else is a usage error naming the option (exit 2)."""
+    if value is None:
+        return None
+    draw, _, seed = value.partition("/")
+    if not (draw.isdigit() and seed.isdigit()):
+        raise typer.BadParameter(f"{value!r}: DRAW/SEED, two numbers, e.g. 0/0")
+    return int(draw), int(seed)
+
+
+SchedulerOption = typer.Option(
+    None,
+    "--scheduler",
+    help="The address of a running Dask scheduler (tcp://host:8786) whose workers see this project and its DVC cache "
+    "at the same paths; each draw is one task there (default: a LocalCluster on this machine).",
+)
+WorkersOption = typer.Option(
+    1, "--workers", min=1, help="Draws at once on the LocalCluster (each draw's stages use n_jobs cores)."
+)
+
+
 def _logging() -> None:
     logging.basicConfig(level=logging.INFO, format="%(asctime)s %(levelname)s %(name)s: %(message)s", stream=sys.stderr)
 
@@ -69,9 +90,12 @@ def _logging() -> None:
 @study_app.command(
     cls=StudyCommand,
     name="attribution",
-    help="Why generated shapes add nothing, over several draws of the data (issue #33): for each data seed k, a clone "
+    help="What each pool of shapes adds to a GQ-CNN's test AP, over several draws of the data (an exploratory "
+    "study: for a confirmatory answer, `graspaug study confirm`): for each data seed k, a clone "
     "of the project's HEAD in `<workdir>/draw<k>` (sharing its DVC cache) with the `--profile` params plus "
-    "`data_seed: k` and every `--set`, runs `dvc repro report`; then one interval per contrast over draws, training "
+    "`data_seed: k` and every `--set`, runs `dvc repro report`, each draw one task on a Dask cluster (a LocalCluster "
+    "of `--workers` processes, or the one at `--scheduler`; a failed draw is named and the others go on); then one "
+    "interval per contrast over draws, training "
     "seeds and test objects (t over the draws' means, with the object bootstrap). Writes `<workdir>/summary.json`, "
     "`decomposition.md` and the per-network tables with this command and the commit to `results/<results>/` "
     "(`graspaug results` recomputes every "
@@ -92,23 +116,53 @@ def attribution_command(
     keep: str = typer.Option(
         None,
         "--keep-networks",
+        callback=_draw_seed,
         help="DRAW/SEED, e.g. `0/0`: copy that draw's seed's networks (none, targeted and real at every augmented B: "
         "model.pt and card.json) to `results/<results>/networks/d<DRAW>-s<SEED>/`, for `graspaug evaluate`.",
     ),
+    scheduler: str = SchedulerOption,
+    workers: int = WorkersOption,
     project: Path = ProjectOption,
 ) -> None:
     from graspaug.pipeline.studies import attribution
 
     _logging()
     workdir = workdir or project.resolve().parent / "attribution"
-    kept = None
-    if keep:
-        draw, _, seed = keep.partition("/")
-        if not (draw.isdigit() and seed.isdigit()):
-            raise typer.BadParameter(f"{keep!r}: DRAW/SEED, two numbers, e.g. 0/0", param_hint="--keep-networks")
-        kept = (int(draw), int(seed))
+    if keep and keep[0] not in draws:
+        raise typer.BadParameter(f"draw {keep[0]} is not among --draws {draws}", param_hint="--keep-networks")
     command = _command_line()
-    text = attribution.run(project, draws, workdir, profile, changes, resamples, combine_only, results, command, kept)
+    args = (project, draws, workdir, profile, changes, resamples, combine_only, results, command, keep)
+    typer.echo(attribution.run(*args, scheduler=scheduler, workers=workers))
+
+
+@study_app.command(
+    cls=StudyCommand,
+    name="confirm",
+    help="The draws of a committed confirmatory plan (issue #74): `--plan results/<name>/plan.yaml` names the "
+    "profile, the draws (data seeds), the training seeds of each draw, the hypotheses and the words of each outcome. "
+    "Refuses a plan git does not hold unchanged, or whose profile now gives other params. Each draw is one task on a "
+    "Dask cluster (a LocalCluster of `--workers` processes, or the one at `--scheduler`): a clone of HEAD in "
+    "`<workdir>/draw<k>` sharing the DVC cache runs `dvc repro train_gqcnn@<seed>` for each seed; its tables go into "
+    "the plan's folder as it finishes (commit them as they come); a failed draw is named and the others go on; a draw "
+    "already there is not run again. Prints the progress, or once every planned draw is in, the control, the primary "
+    "and secondary tests and the verdict in the plan's words (`graspaug results` recomputes them).\n\nCost on 2 "
+    "cores: the pilot draw's wall time is in the plan (`power.pilot_minutes`).",
+)
+def confirm_command(
+    plan: Path = typer.Option(..., "--plan", help="The plan: results/<name>/plan.yaml, committed."),
+    draws: list[int] = typer.Option(None, "--draws", help="Only these of the plan's draws (default: all of them)."),
+    workdir: Path = typer.Option(None, "--workdir", help="Where the draws' clones go (default: ../confirm)."),
+    combine_only: bool = typer.Option(False, "--combine-only", help="Combine the finished draws, run nothing."),
+    scheduler: str = SchedulerOption,
+    workers: int = WorkersOption,
+    project: Path = ProjectOption,
+) -> None:
+    from graspaug.pipeline.studies import confirm
+
+    _logging()
+    workdir = workdir or project.resolve().parent / "confirm"
+    chosen = list(draws) if draws else None
+    text = confirm.run(project, plan, workdir, chosen, scheduler, workers, combine_only, _command_line())
     typer.echo(text)
 
 

@@ -20,6 +20,7 @@ float sums round differently (docs/cluster.md).
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import hashlib
 import json
@@ -198,12 +199,32 @@ def train_network(job: NetworkJob, val: GraspArrays | None = None, test: GraspAr
     }
 
 
-def seed_card(render, grasps, global_seed: int) -> dict:
+def seed_card(render, grasps, global_seed: int, ingest=None, data_seed: int | None = None, train=None) -> dict:
     """The model card's data part of every network (:func:`graspaug.io.checkpoints.gqcnn_card`) from the
     ``render`` params (crop, intrinsics, viewpoints: the camera distance range the planner warns outside of),
-    the ``grasps`` params (gripper, label threshold) and the global seed. :func:`train_network` adds each
+    the ``grasps`` params (gripper, label threshold) and the global seed; with the ``ingest`` params also
+    ``test_set_rules``: the ingest, grasps and render settings its data were made by, so that a test set made for it
+    is made alike (`graspaug evaluate` uses them); with ``data_seed`` the draw of the data it was trained in, with the
+    ``gqcnn.train`` settings ``train`` its ``training_rule`` (steps, schedule, checkpoint choice): what tells replicates
+    of one arm apart from other arms (`graspaug evaluate --seeds`). :func:`train_network` adds each
     network's training set, AP, validation operating point and training data range."""
-    return gqcnn_card(render.crop, render.intrinsics, render.viewpoints, grasps.gripper, grasps.threshold, global_seed)
+    card = gqcnn_card(render.crop, render.intrinsics, render.viewpoints, grasps.gripper, grasps.threshold, global_seed)
+    if ingest is not None:
+        card["test_set_rules"] = test_set_rules(ingest, grasps, render)
+    if data_seed is not None:
+        card["data_seed"] = int(data_seed)
+    if train is not None:
+        card["training_rule"] = json.loads(json.dumps(dataclasses.asdict(train)))
+    return card
+
+
+def test_set_rules(ingest, grasps, render) -> dict:
+    """The ``ingest`` (checks and surface: the size rule and its limits), ``grasps`` and ``render`` settings (views
+    per pose, poses, camera) a network's data were made by, as plain data (a model card's ``test_set_rules``)."""
+    surface = {"max_faces": ingest.max_faces, "max_file_mb": ingest.max_file_mb, "min_voxels": ingest.min_voxels}
+    ingest_rules = surface | {"surface": dataclasses.asdict(ingest.surface)}
+    rules = {"ingest": ingest_rules, "grasps": dataclasses.asdict(grasps), "render": dataclasses.asdict(render)}
+    return json.loads(json.dumps(rules))  # tuples as lists: what the card's JSON holds
 
 
 TASK_THREADS = 1  # torch threads of a network trained beside others: a small network's layers scale poorly over

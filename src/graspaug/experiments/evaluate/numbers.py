@@ -25,6 +25,7 @@ def test_ap(
     n_resamples: int,
     seed: int,
     seeds: int | None = None,
+    replicates: str = "seeds",
 ) -> dict:
     """AP of every model and the paired difference of each against the first.
 
@@ -37,6 +38,8 @@ def test_ap(
     seeds : None, or S ≥ 2: the models, in order, are S training seeds of each network (the first S one network, the
         next S the next…; seed k of every network paired with seed k of the others). The count of models must be a
         multiple of S.
+    replicates : what the S models of a network are replicates over: ``seeds`` (training seeds of one draw) or
+        ``draws`` (one network of each of S draws of the data); the report says which its intervals cover.
 
     Returns
     -------
@@ -68,10 +71,10 @@ def test_ap(
         "positives": int(labels.sum()),
         "objects": int(boot.n_objects),
     }
-    return out if seeds is None else out | _networks(point, resampled, seeds)
+    return out if seeds is None else out | _networks(point, resampled, seeds, replicates) | {"replicates": replicates}
 
 
-def _networks(point: dict[str, float | None], resampled: dict[str, np.ndarray], seeds: int) -> dict:
+def _networks(point: dict[str, float | None], resampled: dict[str, np.ndarray], seeds: int, over: str) -> dict:
     """``networks`` and ``network_differences`` of :func:`test_ap`: the models in consecutive groups of ``seeds``."""
     names = list(point)
     if seeds < 2 or len(names) % seeds:
@@ -79,7 +82,7 @@ def _networks(point: dict[str, float | None], resampled: dict[str, np.ndarray], 
     groups = [names[i : i + seeds] for i in range(0, len(names), seeds)]
     full = {g[0]: np.array([[np.nan if point[n] is None else point[n] for n in g]]) for g in groups}  # (1, S)
     boot = {g[0]: np.stack([resampled[n] for n in g])[None] for g in groups}  # (1, S, R)
-    label = {g[0]: f"{g[0]} ({seeds} seeds)" for g in groups}
+    label = {g[0]: f"{g[0]} ({seeds} {over})" for g in groups}
     first = groups[0][0]
     networks = {label[k]: nested_contrast(nested_t_interval(full[k], boot[k])) for k in full}
     differences = {

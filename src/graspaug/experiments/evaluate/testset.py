@@ -255,3 +255,39 @@ def build_test_set(sources: list[Source], recipe: TestSetRecipe, folder: Path, w
 def _commonest(reasons: pd.Series, n: int = 3) -> str:
     """The ``n`` commonest reasons with their counts, one line."""
     return "; ".join(f"{count}× {reason}" for reason, count in reasons.value_counts().head(n).items()) or "none given"
+
+
+#: What must agree between replicates of one arm (``evaluate --seeds``): the card's training set's pool, base size
+#: and ratio, its training rule and the rules its data were made by.
+ARM_FIELDS = ("pool", "base_size", "ratio", "training_rule", "test_set_rules")
+
+
+def _arm_field(card: dict, field: str):
+    return card.get("training_set", {}).get(field) if field in ("pool", "base_size", "ratio") else card.get(field)
+
+
+def replicate_kind(cards: dict[str, dict], k: int) -> str:
+    """What the ``k`` consecutive models of each arm are replicates over, from their cards (model name → card, in
+    order): ``seeds`` (training seeds of one draw of the data) or ``draws`` (networks of distinct draws). A model
+    whose pool, base size, ratio, training rule or test-set rules (:data:`ARM_FIELDS`) differ from its arm's first,
+    or two models that are the same replicate, are a :class:`DataError` naming the first field that differs."""
+    names = list(cards)
+    kinds = set()
+    for start in range(0, len(names), k):
+        arm = names[start : start + k]
+        head = cards[arm[0]]
+        for name in arm[1:]:
+            for field in ARM_FIELDS:
+                if _arm_field(cards[name], field) != _arm_field(head, field):
+                    raise DataError(
+                        f"--seeds {k}: model {name} is not a replicate of {arm[0]}: its card's {field} is "
+                        f"{_arm_field(cards[name], field)!r}, not {_arm_field(head, field)!r}"
+                    )
+        draws = [cards[n].get("data_seed") for n in arm]
+        seeds = [(cards[n].get("data_seed"), cards[n].get("training_set", {}).get("seed")) for n in arm]
+        if len(set(seeds)) < len(seeds):
+            raise DataError(f"--seeds {k}: models of arm {arm[0]} share a draw and training seed (the same replicate)")
+        kinds.add("draws" if None not in draws and len(set(draws)) == len(draws) else "seeds")
+    if len(kinds) > 1:
+        raise DataError(f"--seeds {k}: some arms are replicates over seeds, others over draws; evaluate them apart")
+    return kinds.pop()

@@ -11,12 +11,29 @@ SIZE_WORDS = {
 }
 
 
+#: What a paired difference of two single networks is, in the report and the printed lines: never a method's gain.
+SINGLE = "these two networks on these objects; training seeds not covered: not evidence about the method"
+#: Replicates an arm needs for a verdict about a method (``--seeds K``).
+MIN_REPLICATES = 3
+NO_POSITIVE = "n/a (no positive datapoint: AP is undefined)"
+
+
 def ap_text(c: dict, objects: int, spec: str = "+.4f") -> str:
-    """A contrast of :func:`~graspaug.experiments.evaluate.numbers.test_ap` as ``mean [low, high]``, or with one
-    object ``mean (one object: no interval)``."""
-    if objects == 1 and c.get("mean") is not None:
+    """A contrast of :func:`~graspaug.experiments.evaluate.numbers.test_ap` as ``mean [low, high]``, with one
+    object ``mean (one object: no interval)``, and with no mean (no positive datapoint) :data:`NO_POSITIVE`."""
+    if c.get("mean") is None:
+        return NO_POSITIVE
+    if objects == 1:
         return f"{format(c['mean'], spec)} (one object: no interval)"
     return interval_text(c, spec)
+
+
+def method_verdict(c: dict, n: int) -> str:
+    """A replicated difference's verdict (:func:`~graspaug.experiments.stats.verdict`), given only with at least
+    :data:`MIN_REPLICATES` replicates an arm."""
+    if n < MIN_REPLICATES:
+        return f"no verdict: {n} replicates an arm (a method verdict needs --seeds {MIN_REPLICATES} or more)"
+    return verdict(c)
 
 
 def shaped_by_text(shaped_by: dict, counts: dict) -> str:
@@ -24,6 +41,8 @@ def shaped_by_text(shaped_by: dict, counts: dict) -> str:
     what scale) behind a test set (``shaped_by``: the ``shaped_by`` of evaluate.json)."""
     params = shaped_by["params"]
     params = params if shaped_by["params_sha256"] is None else f"{params} (sha256 {shaped_by['params_sha256'][:12]})"
+    if shaped_by["params_sha256"] is None and shaped_by.get("rules"):  # no --params: the cards' rules, or the defaults
+        params = shaped_by["rules"]
     fitted = ""
     if shaped_by["size"] == "fit":
         scale = shaped_by["fit_scale"]
@@ -72,13 +91,12 @@ def report_markdown(result: dict, corpus: str, counts: dict, camera: str, shaped
         ),
     ]
     if result["differences"]:
-        no_verdict = "one object: no verdict"
         lines += [
             "",
             *table(
-                ["difference", "AP [95% interval over objects]", "verdict"],
+                ["difference", "AP [95% interval over objects]", "what it is"],
                 result["differences"],
-                lambda c: [ap_text(c, objects), verdict(c) if objects > 1 else no_verdict],
+                lambda c: [ap_text(c, objects), SINGLE],
             ),
         ]
     lines += [
@@ -87,15 +105,22 @@ def report_markdown(result: dict, corpus: str, counts: dict, camera: str, shaped
         "other training seeds of the models.",
     ]
     if result.get("networks"):
-        n = next(iter(result["networks"].values()))["n_seeds"]
+        n, over = next(iter(result["networks"].values()))["n_seeds"], result.get("replicates", "seeds")
+        what = "training seeds of one draw of the data" if over == "seeds" else "networks of distinct draws of the data"
         lines += [
             "",
-            f"The models as networks of {n} training seeds each (`--seeds {n}`): each network's mean test AP, and "
-            "each network's paired difference to the first (seed k with seed k), 95% over the seeds (t on "
-            f"{n - 1} degrees of freedom) and the objects (their bootstrap's variance), added in quadrature.",
+            f"The models as arms of {n} replicates each (`--seeds {n}`; their cards say they are {what}): each arm's "
+            f"mean test AP, and each arm's paired difference to the first (replicate k with replicate k), 95% over "
+            f"the {over} (t on {n - 1} degrees of freedom) and the objects (their bootstrap's variance), added in "
+            "quadrature. "
+            + (
+                "Over seeds of one draw, a verdict covers that draw of the training data only."
+                if over == "seeds"
+                else "Over draws, a verdict covers draws of the training data too."
+            ),
             "",
             *table(
-                ["network", "mean test AP [95% over seeds and objects]"],
+                ["arm", f"mean test AP [95% over {over} and objects]"],
                 result["networks"],
                 lambda c: [interval_text(c, ".4f")],
             ),
@@ -104,9 +129,9 @@ def report_markdown(result: dict, corpus: str, counts: dict, camera: str, shaped
             lines += [
                 "",
                 *table(
-                    ["difference", "AP [95% over seeds and objects]", "verdict"],
+                    ["difference", f"AP [95% over {over} and objects]", "verdict about the method"],
                     result["network_differences"],
-                    lambda c: [interval_text(c), verdict(c)],
+                    lambda c: [interval_text(c), method_verdict(c, n)],
                 ),
             ]
     return "\n".join(lines) + "\n"

@@ -22,6 +22,7 @@ from graspaug.pipeline.params.base import params_model
 from graspaug.pipeline.params.generate import GenerateParams
 from graspaug.pipeline.params.gqcnn import GQCNNParams
 from graspaug.pipeline.params.grasps import GraspsParams
+from graspaug.pipeline.params.ingest import IngestParams
 from graspaug.pipeline.params.render import RenderParams
 from graspaug.pipeline.paths import (
     SHAPES_TABLE,
@@ -56,6 +57,7 @@ log = logging.getLogger(__name__)
 
 Params = params_model(
     "The params the `train_gqcnn` stage reads.",
+    ingest=IngestParams,
     grasps=GraspsParams,
     generate=GenerateParams,
     render=RenderParams,
@@ -82,7 +84,7 @@ def run(params: Params, seed: int) -> None:
     log.info("train_gqcnn seed %d: %s", seed, plan)
     log_precision(f"train_gqcnn seed {seed}", "gqcnn.train.precision", cfg.train.precision, device, GQCNN_GPU_BFLOAT16)
     with atomic_path(gqcnn_seed_dir(seed), directory=True) as folder:
-        card = seed_card(params.render, params.grasps, params.seed)
+        card = seed_card(params.render, params.grasps, global_seed, params.ingest, params.data_seed, cfg.train)
         shared = (split, cfg.net, cfg.train, inits, noise_seeds, seed, str(device), folder, corpora, card)
         jobs = [NetworkJob(v, *shared) for v in variants]
         results = train_jobs(jobs, val, test, f"train GQ-CNNs (seed {seed})", network_workers(params.workers))

@@ -28,7 +28,14 @@ from graspaug.io.atomic import atomic_paths
 from graspaug.io.tables import read_table
 from graspaug.pipeline.params.model import params_dict
 from graspaug.pipeline.paths import gqcnn_dir
-from graspaug.pipeline.studies.draws import checked, draw_params, prepare_draw, provenance
+from graspaug.pipeline.studies.draws import (
+    checked,
+    draw_params,
+    failed_draws_error,
+    prepare_draw,
+    provenance,
+    run_on_cluster,
+)
 
 log = logging.getLogger(__name__)
 KEPT_POOLS = ("targeted", "real")  # with no augmentation (targeted at 1:0), what a user keeps to evaluate
@@ -47,6 +54,16 @@ def kept_networks(generate, gqcnn) -> list[tuple[str, int, float]]:
     return out
 
 
+def run_draw(project: Path, k: int, clone: Path, params, profile: str) -> int:
+    """One draw, on whichever worker runs it: clone ``project`` into ``clone`` (once), write the draw's params, run
+    ``dvc repro report``; its wall time (s)."""
+    began = time.perf_counter()
+    header = f"graspaug params, profile `{profile}` with data_seed {k}: written by `graspaug study attribution`"
+    prepare_draw(project, clone, params, header)
+    checked(["dvc", "repro", "report"], clone, f"draw {k}")
+    return round(time.perf_counter() - began)
+
+
 def run(
     project: Path,
     draws: list[int],
@@ -58,29 +75,29 @@ def run(
     results: str,
     command: str,
     keep: tuple[int, int] | None = None,
+    scheduler: str | None = None,
+    workers: int = 1,
 ) -> str:
     """Run (unless ``combine_only``) the draws ``draws`` (data seeds) of ``profile`` in ``workdir``, adding each
     draw's tables to ``project``/results/``results`` as soon as it finishes (``command``: the line recorded with
     them), then combine the draws from those tables alone; the decomposition's markdown (also written to
     ``workdir``/decomposition.md, with summary.json). ``combine_only`` needs no clone: only the results folder.
     ``keep`` (draw, training seed): that seed's networks without augmentation and with the targeted and real pools
-    at every augmented B (:data:`KEPT_POOLS`) go to the results folder's ``networks/d<draw>-s<seed>/``."""
+    at every augmented B (:data:`KEPT_POOLS`) go to the results folder's ``networks/d<draw>-s<seed>/``. Each draw is
+    one task on the Dask cluster at ``scheduler``, or on a LocalCluster of ``workers`` processes; a failed draw is
+    named at the end, the others go on (:func:`~graspaug.pipeline.studies.draws.run_on_cluster`)."""
     start = time.perf_counter()
     project, workdir = project.resolve(), workdir.resolve()
     folder = project / "results" / results
     params = {k: draw_params(project, profile, k, changes) for k in draws}
     p = params[draws[0]]
-    for k in [] if combine_only else draws:
-        began = time.perf_counter()
+
+    def finished(k: int, seconds: int) -> None:
         clone = workdir / f"draw{k}"
-        header = f"graspaug params, profile `{profile}` with data_seed {k}: written by `graspaug study attribution`"
-        prepare_draw(project, clone, params[k], header)
-        checked(["dvc", "repro", "report"], clone, f"draw {k}")
         networks = {s: clone / f"models/gqcnn/s{s}" for s in p.gqcnn.seeds}
         labels, objects = test_labels(
             read_table(clone / gqcnn_dir("original") / "index.parquet"), networks[p.gqcnn.seeds[0]]
         )
-        seconds = round(time.perf_counter() - began)
         meta = provenance(clone, command) | {"profile": profile, "n_resamples": resamples, "seed": p.seed}  # its code
         meta["params"] = {k: v for k, v in params_dict(params[k]).items() if k != "data_seed"}
         add_attribution_draw(folder, k, networks, labels, objects, p.generate, p.gqcnn, meta | {"seconds": seconds})
@@ -88,6 +105,11 @@ def run(
             keys = kept_networks(p.generate, p.gqcnn)
             keep_networks(networks[keep[1]], folder / "networks" / f"d{k}-s{keep[1]}", keys)
         log.info("draw %d: done in %d s; its tables are in %s (commit them)", k, seconds, folder)
+
+    jobs = {k: (run_draw, (project, k, workdir / f"draw{k}", params[k], profile)) for k in draws}
+    failed = run_on_cluster({} if combine_only else jobs, scheduler, workers, finished)
+    if failed:
+        raise failed_draws_error(failed, "study attribution")
     result = combine_attribution(folder, draws)
     text = decomposition_markdown(result, p.gqcnn.augment_base_sizes, command)
     workdir.mkdir(parents=True, exist_ok=True)

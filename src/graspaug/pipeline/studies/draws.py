@@ -3,6 +3,7 @@ of the tables they write to ``results/``."""
 
 from __future__ import annotations
 
+import logging
 import os
 import subprocess
 import sys
@@ -64,3 +65,54 @@ def provenance(project: Path, command: str) -> dict:
     """The ``command`` line, ``project``'s commit and today's date: what ``results/<study>/`` records."""
     commit = subprocess.run(["git", "rev-parse", "HEAD"], cwd=project, capture_output=True, text=True).stdout.strip()
     return {"command": command, "commit": commit, "date": time.strftime("%Y-%m-%d")}
+
+
+def run_on_cluster(jobs: dict, scheduler: str | None, workers: int, finished) -> dict[int, str]:
+    """Run ``jobs`` (draw → (function, args)), each as one task on a Dask cluster: the scheduler at ``scheduler``
+    (workers that see the project and the DVC cache at the same paths), or a ``distributed.LocalCluster`` of
+    ``workers`` processes of one thread each. ``finished(draw, result)`` runs here, in this process, as each draw
+    ends (so one process writes ``results/``); a draw that fails is logged with its reason and the others go on.
+    Returns draw → the reason of each failed draw (empty: all finished). Without ``distributed`` installed the draws
+    run here, one after another."""
+    log = logging.getLogger(__name__)
+    failed: dict[int, str] = {}
+
+    def done(draw, call):
+        try:
+            result = call()
+        except Exception as exc:  # one failed draw must not stop the others: it is named at the end
+            failed[draw] = f"{type(exc).__name__}: {exc}"
+            log.error("draw %d failed: %s", draw, failed[draw])
+            return
+        finished(draw, result)
+
+    if not jobs:
+        return failed
+    try:
+        from distributed import Client, LocalCluster, as_completed
+    except ImportError:  # pragma: no cover - the dev extras install it
+        log.warning("distributed is not installed: the draws run here, one after another")
+        for draw, (function, args) in jobs.items():
+            done(draw, lambda: function(*args))
+        return failed
+    cluster = None
+    if scheduler is None:
+        cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None)
+    try:
+        with Client(scheduler or cluster) as client:
+            log.info("draws %s on the Dask cluster at %s", sorted(jobs), client.scheduler.address)
+            futures = {
+                client.submit(f, *a, key=f"draw-{d}-{time.time_ns()}", pure=False): d for d, (f, a) in jobs.items()
+            }
+            for future in as_completed(futures):
+                done(futures[future], future.result)
+    finally:
+        if cluster is not None:
+            cluster.close()
+    return failed
+
+
+def failed_draws_error(failed: dict[int, str], what: str) -> StageError:
+    """The error a study ends with when draws failed: each named with its reason."""
+    reasons = "; ".join(f"draw {d}: {why}" for d, why in sorted(failed.items()))
+    return StageError(f"{what}: {len(failed)} draw(s) failed, the others finished ({reasons})")

@@ -1,0 +1,396 @@
+"""The confirmatory study's folder, ``results/<name>/`` with a ``plan.yaml`` (issue #74): its plan, its draws'
+tables, and the checks that the plan came first.
+
+* ``plan.yaml`` — committed before any other file of the folder and never edited (a new plan is a new folder):
+  hypotheses, arms, statistic and test, alpha, draws (data seeds) and seeds per draw, the training rule, the power
+  computation and the words each outcome is reported in (:func:`read_plan` names what it needs);
+* ``networks.parquet`` — one row per draw, training seed and network (:func:`~graspaug.experiments.ap.numbers.collect`'s
+  columns, ``train_steps`` among them);
+* ``predictions-d<draw>-s<seed>.parquet`` — each network's P(success) on that draw's test datapoints, one float32
+  column per network, ``<draw>/<seed>/<pool>/<B>-<R>``;
+* ``test-d<draw>.parquet`` — that draw's test datapoints (``label``, ``object``): every draw has its own test objects;
+* ``networks/d<draw>-s0/`` — the kept seed-0 networks of the control and primary arms (``model.pt``, ``card.json``)
+  with ``objects.json`` (the objects each trained on, the draw's validation and test objects);
+* ``meta.json`` — per draw its command, commit, date, wall time and machine; the params the draws ran with.
+
+:func:`combine_confirm` reads the plan's tests (:mod:`graspaug.experiments.confirm`) once every planned draw is in;
+before that it reports progress and nothing else (no interim look). :func:`check_plan_history` checks from git that
+the plan was committed first and never changed, and that no draw once committed was dropped.
+"""
+
+from __future__ import annotations
+
+import io
+import json
+import platform
+import subprocess
+from collections.abc import Mapping
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import yaml
+
+from graspaug.errors import DataError
+from graspaug.experiments import confirm
+from graspaug.experiments.stats import weighted_average_precision
+
+PLAN = "plan.yaml"
+PLAN_FORMAT = "graspaug.confirm-plan/1"
+#: What a plan must say (its hypotheses and design); the study refuses a plan without one of them.
+PLAN_KEYS = (
+    "format",
+    "question",
+    "profile",
+    "draws",
+    "seeds",
+    "arms",
+    "training_rule",
+    "statistic",
+    "alpha",
+    "control",
+    "primary",
+    "secondary",
+    "power",
+    "words",
+)
+
+
+def read_plan(path: Path) -> dict:
+    """The plan at ``path`` (a ``plan.yaml``), checked: every key of :data:`PLAN_KEYS`, distinct draws, the arms the
+    hypotheses name. A missing or incomplete plan is a :class:`DataError` naming what is missing."""
+    path = Path(path)
+    if not path.is_file():
+        raise DataError(f"{path}: no plan; a confirmatory study runs only from a committed plan.yaml")
+    plan = yaml.safe_load(path.read_text()) or {}
+    missing = [k for k in PLAN_KEYS if k not in plan]
+    if missing:
+        raise DataError(f"{path}: the plan lacks {', '.join(missing)}")
+    if plan["format"] != PLAN_FORMAT:
+        raise DataError(f"{path}: format {plan['format']!r}, expected {PLAN_FORMAT!r}")
+    if len(set(plan["draws"])) != len(plan["draws"]) or len(plan["draws"]) < 2:
+        raise DataError(f"{path}: draws must be at least 2 distinct data seeds; got {plan['draws']}")
+    named = {plan["control"]["a"], plan["control"]["b"], plan["primary"]["a"], plan["primary"]["b"]}
+    named |= {s[k] for s in plan["secondary"] for k in ("a", "b") if k in s}
+    unknown = sorted(named - set(plan["arms"]))
+    if unknown:
+        raise DataError(f"{path}: hypotheses name arms the plan does not define: {', '.join(unknown)}")
+    return plan
+
+
+def arm_key(plan: Mapping, arm: str) -> tuple[str, int, float]:
+    """(pool, B, R) of a plan's arm name (``none@50`` is the targeted pool at 1:0, as the pipeline names it)."""
+    pool, b, r = plan["arms"][arm]
+    return str(pool), int(b), float(r)
+
+
+def column(draw: int, seed: int, key: tuple) -> str:
+    """A network's predictions column: ``<draw>/<seed>/<pool>/<B>-<R>``."""
+    pool, b, r = key
+    return f"{draw}/{seed}/{pool}/{b}-{r:g}"
+
+
+def add_confirm_draw(
+    folder: Path, plan: Mapping, draw: int, seed_dirs: Mapping[int, Path], labels, objects, meta: dict, roles: dict
+) -> None:
+    """Add one finished draw to ``folder``: its predictions per seed, ``test-d<draw>.parquet``, its rows of
+    ``networks.parquet``, the kept seed-0 networks (the plan's ``keep`` arms) with ``objects.json`` (``roles``: the
+    draw's split by role, shape ids), and ``meta.json`` last. A draw the plan does not list is refused."""
+    from graspaug.experiments.ap.numbers import collect, test_predictions
+    from graspaug.experiments.results import keep_networks
+    from graspaug.io.atomic import atomic_path
+    from graspaug.training.variants import Variant
+
+    if draw not in plan["draws"]:
+        raise DataError(f"draw {draw} is not in the plan's draws {plan['draws']}: an extra draw is exploratory")
+    keys = {arm: arm_key(plan, arm) for arm in plan["arms"]}
+    variants = [Variant(*k) for k in keys.values()]
+    runs = collect(seed_dirs, variants).assign(draw=draw)
+    networks_file, meta_file = folder / "networks.parquet", folder / "meta.json"
+    old = json.loads(meta_file.read_text()) if meta_file.is_file() else {}
+    if "params" in old and old["params"] != meta["params"]:
+        ran, runs = old["params"], meta["params"]
+        changed = sorted(k for k in set(ran) | set(runs) if ran.get(k) != runs.get(k))
+        raise DataError(f"{folder}: draw {draw} ran with other params than the draws there ({', '.join(changed)})")
+    meta_file.unlink(missing_ok=True)  # a folder without meta.json is an unfinished one
+    for s, seed_dir in seed_dirs.items():
+        columns = {column(draw, s, k): test_predictions(seed_dir, k).astype(np.float32) for k in keys.values()}
+        with atomic_path(folder / f"predictions-d{draw}-s{s}.parquet") as tmp:
+            pd.DataFrame(columns).to_parquet(
+                tmp, index=False, compression="zstd", compression_level=19, use_byte_stream_split=True
+            )
+    test = pd.DataFrame({"label": np.asarray(labels, dtype=np.int8), "object": np.asarray(objects)})
+    with atomic_path(folder / f"test-d{draw}.parquet") as tmp:
+        test.to_parquet(tmp, index=False)
+    networks = runs[["draw", *[c for c in runs.columns if c != "draw"]]]
+    if networks_file.is_file():
+        others = pd.read_parquet(networks_file)
+        networks = pd.concat([others[others.draw != draw], networks], ignore_index=True).sort_values(
+            ["draw", "seed"], kind="stable"
+        )
+    with atomic_path(networks_file) as tmp:
+        networks.reset_index(drop=True).to_parquet(tmp, index=False)
+    kept = folder / "networks" / f"d{draw}-s0"
+    if 0 in seed_dirs:
+        keep_networks(seed_dirs[0], kept, [keys[a] for a in plan.get("keep", [])])
+        with atomic_path(kept / "objects.json") as tmp:
+            tmp.write_text(json.dumps(roles | {"arms": {a: list(keys[a]) for a in plan.get("keep", [])}}, indent=1))
+    by_draw = old.get("draws", {}) | {
+        str(draw): {k: meta[k] for k in ("command", "commit", "date", "seconds") if k in meta} | {"machine": machine()}
+    }
+    with atomic_path(meta_file) as tmp:
+        top = {k: v for k, v in meta.items() if k not in ("seconds",)}
+        by_draw = dict(sorted(by_draw.items(), key=lambda kv: int(kv[0])))
+        tmp.write_text(json.dumps(old | top | {"draws": by_draw}, indent=1) + "\n")
+
+
+def machine() -> str:
+    """This machine in a few words (CPU model and cores), recorded with each draw's wall time."""
+    import os
+
+    model = platform.processor() or platform.machine()
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                model = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    return f"{model}, {os.cpu_count()} cores"
+
+
+def draw_values(folder: Path, plan: Mapping, draw: int, seeds: list[int]) -> dict[str, float]:
+    """One draw's mean test AP over its seeds of every plan arm, by arm name."""
+    test = pd.read_parquet(folder / f"test-d{draw}.parquet")
+    labels = test.label.to_numpy()
+    out: dict[str, list[float]] = {arm: [] for arm in plan["arms"]}
+    ones = np.ones(len(labels), dtype=np.float32)
+    for s in seeds:
+        predictions = pd.read_parquet(folder / f"predictions-d{draw}-s{s}.parquet")
+        for arm in plan["arms"]:
+            name = column(draw, s, arm_key(plan, arm))
+            if name not in predictions:
+                raise DataError(f"{folder}/predictions-d{draw}-s{s}.parquet: no column {name!r}")
+            p = predictions[name].to_numpy()
+            out[arm].append(float(weighted_average_precision(labels, p, ones)))
+    return {arm: float(np.mean(v)) for arm, v in out.items()}
+
+
+def combine_confirm(folder: Path) -> dict:
+    """The plan's result from the folder's tables: progress until every planned draw is in, then the control, the
+    primary and the secondary hypotheses with their verdicts in the plan's words (:func:`read_plan_result`). A draw
+    the plan does not list, or a planned seed missing from a draw, is a :class:`DataError`."""
+    plan = read_plan(folder / PLAN)
+    planned, done = [int(d) for d in plan["draws"]], []
+    networks = None
+    if (folder / "networks.parquet").is_file():
+        networks = pd.read_parquet(folder / "networks.parquet")
+        extra = sorted(set(int(d) for d in networks.draw) - set(planned))
+        if extra:
+            raise DataError(f"{folder}: draws {extra} are not in the plan's draws {planned} (report them apart)")
+        done = sorted(set(int(d) for d in networks.draw))
+        for d in done:
+            seeds = sorted(set(int(s) for s in networks.seed[networks.draw == d]))
+            if seeds != sorted(plan["seeds"]):
+                raise DataError(f"{folder}: draw {d} holds seeds {seeds}, the plan {sorted(plan['seeds'])}")
+    meta = json.loads((folder / "meta.json").read_text()) if (folder / "meta.json").is_file() else {}
+    out = {"draws_planned": planned, "draws_done": done, "complete": done == sorted(planned)}
+    out["wall_seconds"] = {d: v.get("seconds") for d, v in meta.get("draws", {}).items()}
+    if networks is not None:
+        steps = networks.groupby(["pool", "base_size", "ratio"]).train_steps.agg(["min", "max"]).reset_index()
+        out["train_steps"] = steps.to_dict(orient="records")
+    if not out["complete"]:
+        out["status"] = f"in progress: {len(done)} of {len(planned)} planned draws"
+        return out
+    values = {d: draw_values(folder, plan, d, sorted(plan["seeds"])) for d in planned}
+    return out | {"status": "complete"} | read_plan_result(plan, values)
+
+
+def read_plan_result(plan: Mapping, values: Mapping[int, Mapping[str, float]]) -> dict:
+    """The plan's tests on per-draw arm values (draw → arm → mean test AP over its seeds), in the fixed sequence:
+    the control, then the primary, then the secondary family under Holm; with the plan's words."""
+    alpha = float(plan["alpha"])
+    draws = sorted(values)
+
+    def diff(spec):
+        return [values[d][spec["a"]] - values[d][spec["b"]] for d in draws]
+
+    control = confirm.draw_test(diff(plan["control"]), 1 - alpha)
+    shows = control["p"] is not None and control["p"] < alpha and control["mean"] > 0
+    primary = confirm.draw_test(diff(plan["primary"]), 1 - alpha)
+    secondary = {s["name"]: confirm.draw_test(diff(s), 1 - alpha) for s in plan["secondary"] if "a" in s}
+    adjusted = confirm.holm({k: v["p"] for k, v in secondary.items()})
+    for name, c in secondary.items():
+        c["p_holm"] = adjusted[name]
+        spec = next(s for s in plan["secondary"] if s.get("name") == name)
+        if "margin" in spec:
+            c["equivalence"] = confirm.tost(diff(spec), float(spec["margin"]), alpha)
+            c["verdict"] = confirm.equivalence_verdict(c, c["equivalence"], alpha, adjusted[name])
+    words = plan["words"]
+    if not shows:
+        verdict, sentence = confirm.UNINFORMATIVE, words["uninformative"]
+    elif primary["p"] < alpha:
+        verdict = "raises" if primary["mean"] > 0 else "lowers"
+        sentence = words[verdict]
+    else:
+        verdict, sentence = "not shown", words["not_shown"]
+    result = {"control": control | {"shows": shows}, "primary": primary | {"verdict": verdict}, "secondary": secondary}
+    result["sentence"] = sentence.format(**_fields(primary), control=_fields(control))
+    curve = plan.get("exchange")
+    if curve and shows:
+        sizes = curve["sizes"]
+        grid = np.array([[values[d][f"none@{b}"] for b in sizes] for d in draws])
+        arm = np.array([values[d][curve["arm"]] for d in draws])
+        result["exchange"] = confirm.exchange_rate_on_curve(sizes, grid, arm, 1 - alpha) | {"arm": curve["arm"]}
+    result["per_draw_ap"] = {str(d): values[d] for d in draws}
+    return result
+
+
+def _fields(c: Mapping) -> dict:
+    return {
+        "mean": f"{c['mean']:+.4f}",
+        "low": f"{c['low']:+.4f}",
+        "high": f"{c['high']:+.4f}",
+        "p": f"{c['p']:.3f}" if c["p"] >= 0.001 else f"{c['p']:.1e}",
+        "draws": c["n_draws"],
+    }
+
+
+def confirm_figures(result: dict, study: str) -> dict[str, str]:
+    """The figures a document quotes, by key: ``<study>/status``, and once complete ``<study>/control``,
+    ``<study>/primary`` (``mean [low, high], p = P``), ``<study>/primary/verdict``, ``<study>/sentence``,
+    ``<study>/<secondary>`` and its ``/verdict``, ``<study>/worth`` (the exchange rate)."""
+    out = {f"{study}/status": result["status"]}
+    if not result["complete"]:
+        return out
+    for key in ("control", "primary"):
+        out[f"{study}/{key}"] = test_text(result[key])
+    out[f"{study}/primary/verdict"] = result["primary"]["verdict"]
+    out[f"{study}/control/verdict"] = "shows" if result["control"]["shows"] else "does not show"
+    out[f"{study}/sentence"] = result["sentence"]
+    for name, c in result["secondary"].items():
+        holm = f" (Holm p = {c['p_holm']:.3f})" if c.get("p_holm") is not None else ""
+        out[f"{study}/{name}"] = test_text(c) + holm
+        if "verdict" in c:
+            out[f"{study}/{name}/verdict"] = c["verdict"]
+    if "exchange" in result:
+        e = result["exchange"]
+        low = "≤ {}".format(e["sizes"][0]) if e["low"] is None else f"{e['low']:.0f}"
+        high = "≥ {}".format(e["sizes"][-1]) if e["high"] is None else f"{e['high']:.0f}"
+        worth = f"outside the curve ({e['outside']})" if e["worth"] is None else f"{e['worth']:.0f}"
+        out[f"{study}/worth"] = f"{worth} real objects [{low}, {high}]"
+    return out
+
+
+def test_text(c: Mapping) -> str:
+    """``+0.0300 [+0.0100, +0.0500], p = 0.012`` of a :func:`~graspaug.experiments.confirm.draw_test`."""
+    f = _fields(c)
+    return f"{f['mean']} [{f['low']}, {f['high']}], p = {f['p']}"
+
+
+def _git(root: Path, *args: str) -> str:
+    done = subprocess.run(["git", *args], cwd=root, capture_output=True, text=True)
+    if done.returncode != 0:
+        why = done.stderr.strip() or "failed"
+        raise DataError(f"git {' '.join(args)} in {root}: {why} (the plan's history is read from git)")
+    return done.stdout
+
+
+def check_plan_history(folder: Path) -> list[str]:
+    """The problems of a confirmatory folder's git history (none: an empty list): the plan was not committed, was
+    changed after its first commit or differs from it now; another file of the folder was committed in or before the
+    plan's commit; a draw that a commit of ``networks.parquet`` held is gone."""
+    folder = Path(folder).resolve()
+    root = Path(_git(folder, "rev-parse", "--show-toplevel").strip())
+    rel = folder.relative_to(root)
+    plan = (rel / PLAN).as_posix()
+    commits = _git(root, "log", "--format=%H", "--follow", "--", plan).split()
+    if not commits:
+        return [f"{plan}: not committed (commit the plan before its first draw)"]
+    problems = []
+    if len(commits) > 1:
+        later = len(commits) - 1
+        problems.append(f"{plan}: changed after its first commit ({later} later commit(s)); a new plan is a new folder")
+    if _git(root, "status", "--porcelain", "--", plan).strip():
+        problems.append(f"{plan}: differs from its committed text")
+    first, added = commits[-1], {}
+    for line in _git(root, "log", "--format=@%H", "--name-only", "--diff-filter=A", "--", rel.as_posix()).splitlines():
+        if line.startswith("@"):
+            commit = line[1:]
+        elif line.strip() and line.strip() != plan:
+            added.setdefault(commit, []).append(line.strip())
+    for commit, files in added.items():
+        if commit == first or _is_ancestor(root, commit, first):
+            problems.append(f"{files[0]}: committed in or before the plan's commit {first[:10]}")
+    networks = (rel / "networks.parquet").as_posix()
+    now = set()
+    if (root / networks).is_file():
+        now = set(int(d) for d in pd.read_parquet(root / networks).draw)
+    for commit in _git(root, "log", "--format=%H", "--", networks).split():
+        blob = subprocess.run(["git", "show", f"{commit}:{networks}"], cwd=root, capture_output=True)
+        if blob.returncode != 0:
+            continue  # the file was deleted in that commit
+        gone = set(int(d) for d in pd.read_parquet(io.BytesIO(blob.stdout)).draw) - now
+        if gone:
+            problems.append(f"{networks}: draw(s) {sorted(gone)} committed in {commit[:10]} are gone")
+            break
+    return problems
+
+
+def _is_ancestor(root: Path, a: str, b: str) -> bool:
+    return subprocess.run(["git", "merge-base", "--is-ancestor", a, b], cwd=root).returncode == 0
+
+
+def exploratory_contrast(folder: Path, a: tuple, b: tuple, n_resamples: int, seed: int) -> tuple[np.ndarray, ...]:
+    """A contrast (network ``a`` − ``b``, each (pool, B, R)) of an attribution study's folder (one test set for every
+    draw): (D, S) on all test objects and (D, S, ``n_resamples``) under the same object resamples in every cell."""
+    from graspaug.experiments.results import _column
+    from graspaug.experiments.stats import ObjectBootstrap
+
+    networks, test = pd.read_parquet(folder / "networks.parquet"), pd.read_parquet(folder / "test.parquet")
+    labels = test.label.to_numpy()
+    boot = ObjectBootstrap(test.object.to_numpy(), n_resamples, seed)
+    ones = np.ones(len(labels), dtype=np.float32)
+    draws, seeds = sorted(set(networks.draw)), sorted(set(networks.seed))
+    full, resampled = np.zeros((len(draws), len(seeds))), np.zeros((len(draws), len(seeds), n_resamples))
+    for i, d in enumerate(draws):
+        for j, s in enumerate(seeds):
+            p = pd.read_parquet(folder / f"predictions-d{d}-s{s}.parquet")
+            pa, pb = (p[_column(d, s, (k[0], int(k[1]), float(k[2])))].to_numpy() for k in (a, b))
+            full[i, j] = weighted_average_precision(labels, pa, ones) - weighted_average_precision(labels, pb, ones)
+            resampled[i, j] = boot.average_precision(labels, pa) - boot.average_precision(labels, pb)
+    return full, resampled
+
+
+def design(
+    exploratory: Path,
+    a: tuple,
+    b: tuple,
+    effect: float,
+    alpha: float,
+    draw_minutes: float,
+    seed_minutes: float,
+    draws: int,
+    seeds: int,
+    n_sims: int = 2000,
+    seed: int = 0,
+) -> dict:
+    """The plan's power and coverage from an exploratory study: the contrast's variance parts, the draws needed for
+    80% power at ``effect`` for 1 … 8 seeds a draw with their compute, the power of ``draws`` × ``seeds``, and the
+    coverage of the draw-level t-interval at that design, simulated on the exploratory networks."""
+    full, resampled = exploratory_contrast(exploratory, a, b, max(n_sims * draws, 2000), seed)
+    parts = confirm.variance_components(full, resampled)
+    sd = confirm.draw_mean_sd(parts, seeds)
+    coverage = confirm.simulate_coverage(full, resampled, draws, seeds, n_sims, np.random.default_rng(seed), 1 - alpha)
+    return {
+        "exploratory": str(exploratory),
+        "contrast": {"a": list(a), "b": list(b)},
+        "components": parts,
+        "effect": effect,
+        "alpha": alpha,
+        "draw_minutes": draw_minutes,
+        "seed_minutes": seed_minutes,
+        "by_seeds": confirm.seeds_for_cost(parts, effect, draw_minutes, seed_minutes, alpha),
+        "planned": {"draws": draws, "seeds": seeds, "draw_sd": sd, "power": confirm.power(draws, sd, effect, alpha)},
+        "coverage": coverage,
+    }

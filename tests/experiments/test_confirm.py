@@ -1,0 +1,181 @@
+"""The confirmatory study's statistics and its plan's history (issue #74): the tests it reads, the order it reads
+them in, and the git checks that the plan came first."""
+
+import json
+import subprocess
+
+import numpy as np
+import pandas as pd
+import pytest
+import yaml
+from scipy import stats
+
+from graspaug.errors import DataError
+from graspaug.experiments import confirm
+from graspaug.experiments.confirm_results import check_plan_history, combine_confirm, read_plan, read_plan_result
+
+PLAN = {
+    "format": "graspaug.confirm-plan/1",
+    "question": "Does the paper's augmentation raise test AP on real objects?",
+    "profile": "confirm",
+    "draws": [0, 1, 2],
+    "seeds": [0],
+    "arms": {
+        "none@50": ["targeted", 50, 0.0],
+        "none@150": ["targeted", 150, 0.0],
+        "targeted@50": ["targeted", 50, 1.0],
+        "random@50": ["random", 50, 1.0],
+    },
+    "training_rule": "4,000 steps",
+    "statistic": "t over draws",
+    "alpha": 0.05,
+    "control": {"name": "real_data", "a": "none@150", "b": "none@50"},
+    "primary": {"name": "targeted_vs_none@50", "a": "targeted@50", "b": "none@50"},
+    "secondary": [{"name": "targeted_vs_random@50", "a": "targeted@50", "b": "random@50", "margin": 0.03}],
+    "power": {},
+    "words": {
+        "uninformative": "uninformative: the control did not show",
+        "raises": "raises AP by {mean} [{low}, {high}], p = {p}",
+        "lowers": "lowers AP by {mean}",
+        "not_shown": "not shown: {mean} [{low}, {high}], p = {p}",
+    },
+}
+
+
+def test_the_draw_test_is_a_one_sample_t_and_tost_holm_and_power_behave():
+    x = [0.05, 0.01, 0.08, 0.03, -0.01, 0.06]
+    t = confirm.draw_test(x)
+    ref = stats.ttest_1samp(x, 0.0)
+    assert t["p"] == pytest.approx(ref.pvalue) and t["mean"] == pytest.approx(np.mean(x))
+    ci = ref.confidence_interval(0.95)
+    assert (t["low"], t["high"]) == pytest.approx((ci.low, ci.high))
+    assert confirm.draw_test([0.1])["low"] is None  # one draw: no interval
+    # equivalence: a tight spread around 0 is equivalent within ±0.03, a wide one is not
+    assert confirm.tost([0.001, -0.002, 0.003, 0.0, -0.001], 0.03)["p"] < 0.05
+    assert confirm.tost([0.05, -0.06, 0.02, 0.0], 0.03)["p"] > 0.05
+    assert confirm.holm({"a": 0.01, "b": 0.04, "c": None}) == {"a": 0.02, "b": 0.04, "c": None}
+    assert confirm.holm({"a": 0.03, "b": 0.02}) == {"a": pytest.approx(0.04), "b": pytest.approx(0.04)}
+    assert confirm.power(8, 0.05, 0.0) == pytest.approx(0.05, abs=1e-6)  # no effect: the false-positive rate
+    assert confirm.power(8, 0.05, 0.03) < confirm.power(16, 0.05, 0.03) < confirm.power(16, 0.03, 0.03)
+    n = confirm.draws_for_power(0.05, 0.03)
+    assert confirm.power(n, 0.05, 0.03) >= 0.8 > confirm.power(n - 1, 0.05, 0.03)
+
+
+def test_variance_components_and_the_seeds_that_cost_least():
+    rng = np.random.default_rng(0)
+    draws, seeds = 400, 4
+    full = 0.02 * rng.standard_normal((draws, 1)) + 0.07 * rng.standard_normal((draws, seeds))
+    resampled = full[..., None] + 0.01 * rng.standard_normal((draws, seeds, 50))
+    parts = confirm.variance_components(full, resampled)
+    assert parts["seed_sd"] == pytest.approx(0.07, rel=0.05) and parts["draw_sd"] == pytest.approx(0.02, rel=0.3)
+    assert parts["object_sd"] == pytest.approx(0.01 / 2, rel=0.2)  # the mean of 4 seeds' independent noise
+    rows = confirm.seeds_for_cost(parts, 0.03, draw_minutes=20, seed_minutes=9)
+    assert rows[0]["hours"] == min(r["hours"] for r in rows) and 2 <= rows[0]["seeds"] <= 5
+
+
+def test_coverage_of_the_draw_t_interval_is_simulated_from_networks():
+    rng = np.random.default_rng(1)
+    full = 0.05 + 0.06 * rng.standard_normal((5, 4))
+    resampled = full[..., None] + 0.02 * rng.standard_normal((5, 4, 4000))
+    c = confirm.simulate_coverage(full, resampled, n_draws=8, n_seeds=2, n_sims=500, rng=rng)
+    assert 0.91 <= c["coverage"] <= 0.99 and c["n_sims"] == 500
+    with pytest.raises(ValueError, match="need 8000"):
+        confirm.simulate_coverage(full, resampled, n_draws=8, n_seeds=2, n_sims=1000, rng=rng)
+
+
+def test_exchange_rate_is_read_only_inside_the_curve():
+    sizes = [25, 50, 100, 150, 200]
+    curve = np.array([[0.2, 0.3, 0.4, 0.45, 0.5]] * 4) + np.array([[0.0], [0.01], [-0.01], [0.005]])
+    inside = confirm.exchange_rate_on_curve(sizes, curve, np.array([0.41, 0.40, 0.39, 0.405]))
+    assert inside["worth"] == pytest.approx(100, abs=3) and inside["outside"] is None
+    assert inside["low"] is not None and inside["low"] < 100 < inside["high"]
+    above = confirm.exchange_rate_on_curve(sizes, curve, np.array([0.6, 0.61, 0.59, 0.6]))
+    assert above["worth"] is None and above["outside"] == "above"
+
+
+def test_the_plan_is_read_in_its_fixed_sequence():
+    values = {
+        d: {"none@50": 0.3, "none@150": 0.3 + c, "targeted@50": 0.3 + g, "random@50": 0.3 + g}
+        for d, (c, g) in enumerate([(0.1, 0.05), (0.12, 0.06), (0.09, 0.04), (0.11, 0.05)])
+    }
+    shown = read_plan_result(PLAN, values)
+    assert shown["control"]["shows"] and shown["primary"]["verdict"] == "raises"
+    assert shown["sentence"].startswith("raises AP by +0.0500 [")
+    assert shown["secondary"]["targeted_vs_random@50"]["verdict"] == "equivalent within ±0.03"
+    # the same gain with a control that does not show: uninformative, never negative or positive
+    flat = {d: v | {"none@150": v["none@50"] + (0.01 if d % 2 else -0.01)} for d, v in values.items()}
+    assert read_plan_result(PLAN, flat)["primary"]["verdict"] == "uninformative"
+    noisy = {d: v | {"targeted@50": v["none@50"] + (0.05 if d % 2 else -0.04)} for d, v in values.items()}
+    assert read_plan_result(PLAN, noisy)["primary"]["verdict"] == "not shown"
+
+
+def _git(folder, *args):
+    subprocess.run(["git", *args], cwd=folder, check=True, capture_output=True)
+
+
+def _draw_tables(folder, draws):
+    rows = [
+        {"draw": d, "pool": "targeted", "base_size": 50, "ratio": 0.0, "seed": 0, "train_steps": 4000} for d in draws
+    ]
+    pd.DataFrame(rows).to_parquet(folder / "networks.parquet", index=False)
+
+
+@pytest.fixture
+def plan_repo(tmp_path):
+    repo = tmp_path / "repo"
+    folder = repo / "results" / "confirm-x"
+    folder.mkdir(parents=True)
+    _git(repo, "init", "-q")
+    _git(repo, "config", "user.email", "t@example.com")
+    _git(repo, "config", "user.name", "t")
+    (folder / "plan.yaml").write_text(yaml.safe_dump(PLAN))
+    _git(repo, "add", ".")
+    _git(repo, "commit", "-qm", "plan")
+    return repo, folder
+
+
+def test_the_plan_history_is_checked_from_git(plan_repo):
+    repo, folder = plan_repo
+    assert check_plan_history(folder) == []
+    assert read_plan(folder / "plan.yaml")["draws"] == [0, 1, 2]
+    _draw_tables(folder, [0])
+    _git(repo, "add", ".")
+    _git(repo, "commit", "-qm", "draw 0")
+    _draw_tables(folder, [0, 1])
+    _git(repo, "commit", "-qam", "draw 1")
+    assert check_plan_history(folder) == []
+    progress = combine_confirm(folder)
+    assert progress["draws_done"] == [0, 1] and progress["status"] == "in progress: 2 of 3 planned draws"
+    # a draw dropped after it was committed
+    _draw_tables(folder, [1])
+    _git(repo, "commit", "-qam", "drop draw 0")
+    assert any("draw(s) [0]" in p and "are gone" in p for p in check_plan_history(folder))
+    _git(repo, "revert", "--no-edit", "HEAD")
+    # a draw the plan does not list
+    _draw_tables(folder, [0, 1, 7])
+    with pytest.raises(DataError, match=r"draws \[7\] are not in the plan's draws"):
+        combine_confirm(folder)
+    _git(repo, "checkout", "--", ".")
+    # the plan edited in the working tree, then committed
+    (folder / "plan.yaml").write_text(yaml.safe_dump(PLAN | {"draws": [0, 1, 2, 3]}))
+    assert any("differs from its committed text" in p for p in check_plan_history(folder))
+    _git(repo, "commit", "-qam", "edit the plan")
+    assert any("changed after its first commit" in p for p in check_plan_history(folder))
+
+
+def test_a_plan_committed_with_or_after_its_data_is_refused(tmp_path):
+    repo = tmp_path / "repo"
+    folder = repo / "results" / "confirm-y"
+    folder.mkdir(parents=True)
+    _git(repo, "init", "-q")
+    _git(repo, "config", "user.email", "t@example.com")
+    _git(repo, "config", "user.name", "t")
+    _draw_tables(folder, [0])
+    (folder / "plan.yaml").write_text(yaml.safe_dump(PLAN))
+    _git(repo, "add", ".")
+    _git(repo, "commit", "-qm", "plan and data at once")
+    assert any("committed in or before the plan's commit" in p for p in check_plan_history(folder))
+    (tmp_path / "loose").mkdir()
+    (tmp_path / "loose" / "plan.yaml").write_text(json.dumps({"format": "x"}))
+    with pytest.raises(DataError, match="the plan lacks question"):
+        read_plan(tmp_path / "loose" / "plan.yaml")
