@@ -363,3 +363,20 @@ def test_the_report_says_how_many_objects_were_fitted_and_by_what_scale():
     assert "params params.yaml (sha256 abababababab), recipe 0123456789abcdef; label: robust ε > 0.002" in text
     assert "size rule `fit` (max width 0.08 m, unit scale 0.001 m per file unit); 3 of 12 objects fitted" in text
     assert text.endswith("scaled by 0.52–0.91.")
+
+
+def test_two_evaluates_into_one_out_take_turns_and_both_finish(project):
+    """Two `graspaug evaluate` at once into one --out: the second waits for the first (each staging folder is its
+    own until it is moved in), and both end with their report written, not a half-removed folder."""
+    import subprocess
+    import sys
+
+    root, corpus, models = project
+    cmd = [sys.executable, "-m", "graspaug.pipeline.cli", "evaluate", "--corpus", str(corpus), "--out", "both"]
+    runs = [
+        subprocess.Popen([*cmd, str(m), "--params", "params.yaml"], cwd=root, stderr=subprocess.PIPE, text=True)
+        for m in models
+    ]
+    outcomes = [(r.wait(timeout=600), r.stderr.read()) for r in runs]
+    assert [code for code, _ in outcomes] == [0, 0], outcomes
+    assert (root / "both/report.md").is_file() and not list(root.glob(".both.tmp-*"))

@@ -100,6 +100,10 @@ def test_readme_example_plans_an_antipodal_grasp(scene, model_path, tmp_path):
     assert np.allclose(grasp.rotation.T @ grasp.rotation, np.eye(3)) and np.isclose(np.linalg.det(grasp.rotation), 1)
     assert_antipodal(scene, grasp.position, grasp.rotation, grasp.width)
     assert planner.card.crop_size == 96 and planner.card.camera_distance == (0.65, 0.75) and not planner.card.assumed
+    from graspaug.planning.limits import quality_floor
+
+    floor = quality_floor(planner.card)  # the README shows it: a best grasp may lie below it
+    assert 0 <= floor.value <= 1 and floor.accepts(grasp.quality) == (grasp.quality >= floor.value)
 
 
 def test_top_k_is_ranked_and_the_best_two_are_antipodal(scene, model_path):

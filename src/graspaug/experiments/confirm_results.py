@@ -97,7 +97,7 @@ def add_confirm_draw(
     ``networks.parquet``, the kept seed-0 networks (the plan's ``keep`` arms) with ``objects.json`` (``roles``: the
     draw's split by role, shape ids), and ``meta.json`` last. A draw the plan does not list is refused."""
     from graspaug.experiments.ap.numbers import collect, test_predictions
-    from graspaug.experiments.results import keep_networks
+    from graspaug.experiments.kept import keep_networks
     from graspaug.io.atomic import atomic_path
     from graspaug.training.variants import Variant
 
@@ -117,7 +117,12 @@ def add_confirm_draw(
         columns = {column(draw, s, k): test_predictions(seed_dir, k).astype(np.float32) for k in keys.values()}
         with atomic_path(folder / f"predictions-d{draw}-s{s}.parquet") as tmp:
             pd.DataFrame(columns).to_parquet(
-                tmp, index=False, compression="zstd", compression_level=19, use_byte_stream_split=True
+                tmp,
+                index=False,
+                compression="zstd",
+                compression_level=19,
+                use_byte_stream_split=True,
+                use_dictionary=False,
             )
     test = pd.DataFrame({"label": np.asarray(labels, dtype=np.int8), "object": np.asarray(objects)})
     with atomic_path(folder / f"test-d{draw}.parquet") as tmp:
@@ -344,7 +349,6 @@ def _is_ancestor(root: Path, a: str, b: str) -> bool:
 def exploratory_contrast(folder: Path, a: tuple, b: tuple, n_resamples: int, seed: int) -> tuple[np.ndarray, ...]:
     """A contrast (network ``a`` − ``b``, each (pool, B, R)) of an attribution study's folder (one test set for every
     draw): (D, S) on all test objects and (D, S, ``n_resamples``) under the same object resamples in every cell."""
-    from graspaug.experiments.results import _column
     from graspaug.experiments.stats import ObjectBootstrap
 
     networks, test = pd.read_parquet(folder / "networks.parquet"), pd.read_parquet(folder / "test.parquet")
@@ -356,7 +360,7 @@ def exploratory_contrast(folder: Path, a: tuple, b: tuple, n_resamples: int, see
     for i, d in enumerate(draws):
         for j, s in enumerate(seeds):
             p = pd.read_parquet(folder / f"predictions-d{d}-s{s}.parquet")
-            pa, pb = (p[_column(d, s, (k[0], int(k[1]), float(k[2])))].to_numpy() for k in (a, b))
+            pa, pb = (p[column(d, s, (k[0], int(k[1]), float(k[2])))].to_numpy() for k in (a, b))
             full[i, j] = weighted_average_precision(labels, pa, ones) - weighted_average_precision(labels, pb, ones)
             resampled[i, j] = boot.average_precision(labels, pa) - boot.average_precision(labels, pb)
     return full, resampled

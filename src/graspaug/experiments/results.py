@@ -183,31 +183,6 @@ def add_attribution_draw(
         tmp.write_text(json.dumps(old | top | keep | {"draws": by_draw}, indent=1) + "\n")
 
 
-def keep_networks(seed_dir: Path, out: Path, keys) -> list[Path]:
-    """Copy the networks ``keys`` ((pool, B, R) each) of one draw's training seed (its folder ``seed_dir``) into
-    ``out``/<pool>-<B>-<R>/: ``model.pt`` (weights, training summary and model card) and ``card.json`` (the card as
-    text: the camera, crop, gripper, label threshold and training set a user checks before ``graspaug evaluate``).
-    Returns the model files written."""
-    import shutil
-
-    from graspaug.experiments.ap.numbers import network_folder
-    from graspaug.io.atomic import atomic_path
-    from graspaug.io.checkpoints import read_gqcnn
-
-    written = []
-    for pool, b, r in keys:
-        model = network_folder(seed_dir, (pool, b, float(r))) / "model.pt"
-        folder = Path(out) / f"{pool}-{b}-{float(r):g}"
-        folder.mkdir(parents=True, exist_ok=True)
-        with atomic_path(folder / "model.pt") as tmp:
-            shutil.copyfile(model, tmp)
-        card = read_gqcnn(model)[1]
-        with atomic_path(folder / "card.json") as tmp:
-            tmp.write_text(json.dumps(card, indent=1, default=str) + "\n")
-        written.append(folder / "model.pt")
-    return written
-
-
 def combine_attribution(folder: Path, draws: Sequence[int] | None = None) -> dict:
     """:func:`~graspaug.experiments.ap.attribution.combine_runs` of the tables in ``folder`` (module docstring), with
     the resamples and seed its ``meta.json`` names: the study's ``summary.json``, figure for figure. ``draws``: the
@@ -293,11 +268,16 @@ def recompute(results_dir: Path) -> tuple[dict[str, str], dict[str, dict]]:
 
 
 def study_kind(folder: Path) -> str:
-    """The study a results folder holds: ``confirm`` where it has a plan (``plan.yaml``), else its name's first
-    word (``attribution-real-objects``: ``attribution``)."""
+    """The study a results folder holds: ``confirm`` where it has a plan (``plan.yaml``), ``picks`` where it has a
+    table of pick attempts (``attempts.parquet``), else its name's first word (``attribution-real-objects``:
+    ``attribution``)."""
     from graspaug.experiments.confirm_results import PLAN
 
-    return "confirm" if (Path(folder) / PLAN).is_file() else Path(folder).name.split("-")[0]
+    if (Path(folder) / PLAN).is_file():
+        return "confirm"
+    if (Path(folder) / "attempts.parquet").is_file():
+        return "picks"
+    return Path(folder).name.split("-")[0]
 
 
 def history_problems(results_dir: Path) -> list[str]:
@@ -521,7 +501,32 @@ def _confirm():
     return combine_confirm, confirm_figures
 
 
+def combine_picks(folder: Path) -> dict:
+    """The robot picks' summary (:func:`~graspaug.experiments.cell.picks.pick_summary`) of ``attempts.parquet``,
+    with the bootstrap settings its ``meta.json`` names."""
+    from graspaug.experiments.cell.picks import pick_summary
+
+    attempts = pd.read_parquet(folder / "attempts.parquet")
+    meta = json.loads((folder / "meta.json").read_text())
+    arms = list(dict.fromkeys(attempts.arm))
+    return pick_summary(attempts, arms, meta.get("n_bootstrap", 2000), meta.get("seed", 0))
+
+
+def picks_figures(result: dict, study: str) -> dict[str, str]:
+    """``<study>/<arm>`` (success rate, ``mean [low, high]``), ``<study>/<contrast>`` and its ``/verdict``."""
+
+    def text(c):
+        return "n/a" if c["low"] is None else f"{c['mean']:.3f} [{c['low']:.3f}, {c['high']:.3f}]"
+
+    out = {f"{study}/{arm}": text(c) for arm, c in result["arms"].items()}
+    for name, c in result["contrasts"].items():
+        out[f"{study}/{name}"] = text(c).replace(f"{c['mean']:.3f}", f"{c['mean']:+.3f}", 1)
+        out[f"{study}/{name}/verdict"] = c["verdict"]
+    return out
+
+
 STUDIES = {
+    "picks": (combine_picks, picks_figures),
     "confirm": (lambda folder: _confirm()[0](folder), lambda result, study: _confirm()[1](result, study)),
     "attribution": (combine_attribution, attribution_figures),
     "lifelong": (combine_lifelong, lifelong_figures),

@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import contextlib
 import errno
+import hashlib
 import json
 import logging
 import os
@@ -271,21 +272,27 @@ def output_folder(
     into, and when the block ends without error move them into ``out`` and list them in its manifest; the command's
     files of the last run that it does not write now are removed, no other file is touched. On an error (or an
     interrupt) ``out`` is left as it was and the staging folder removed (a killed process leaves it as a ``.tmp-*``
-    sibling of ``out`` that the next run removes)."""
+    sibling of ``out`` that the next run removes). Two commands writing into one ``out`` take turns: the second
+    waits (logging that it does) until the first has finished, then writes over the first's files as its own."""
+    from graspaug.io.atomic import exclusive_lock
+
     inputs, homes = list(inputs), list(homes)
     out = Path(out)
     check_output_folder(out, command, inputs, force, homes)
     where = out.absolute()
     where.parent.mkdir(parents=True, exist_ok=True)
-    remove_stale_temporaries(where)
-    staging = Path(tempfile.mkdtemp(prefix=f".{where.name}.tmp-", dir=where.parent))
-    try:
-        yield staging
-        check_output_folder(out, command, inputs, True, homes)  # still not a link, a file or an input
-        _commit(staging, where, command, force)
-    finally:
-        if staging.exists():
-            shutil.rmtree(staging, ignore_errors=True)
+    key = hashlib.sha256(str(where).encode()).hexdigest()[:16]  # the lock lives outside the user's folders
+    with exclusive_lock(Path(tempfile.gettempdir()) / "graspaug-locks" / f"out-{key}.lock"):  # a second one waits
+        check_output_folder(out, command, inputs, force, homes)  # as the first one left it
+        remove_stale_temporaries(where)
+        staging = Path(tempfile.mkdtemp(prefix=f".{where.name}.tmp-", dir=where.parent))
+        try:
+            yield staging
+            check_output_folder(out, command, inputs, True, homes)  # still not a link, a file or an input
+            _commit(staging, where, command, force)
+        finally:
+            if staging.exists():
+                shutil.rmtree(staging, ignore_errors=True)
 
 
 def check_output_files(

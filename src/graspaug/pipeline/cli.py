@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import importlib
 import os
+import sys
 from pathlib import Path
 
 import typer
@@ -26,7 +27,9 @@ from graspaug.pipeline.entry import load_stage_params, round_number, run_stage
 
 app = typer.Typer(
     help="graspaug: augment a grasp planner's training objects with generated shapes.\n\n"
-    "Each command runs one stage of the DVC pipeline with the settings in params.yaml; `dvc repro` runs them in order."
+    "The stage commands (ingest … report) each run one stage of the DVC pipeline with the settings in params.yaml; "
+    "`dvc repro` runs them in order. The others are tools around it: `evaluate` (trained networks on your meshes), "
+    "`plan` (a grasp on your depth image), `study` (experiments over several draws), `results`, `profile`, ..."
     "\n\n" + EXIT_CODES,
     rich_markup_mode="markdown",
     no_args_is_help=True,
@@ -456,7 +459,24 @@ def _root(
 
 
 def main() -> None:
-    app()
+    """The ``graspaug`` command: a usage error (an unknown option, a bad value, a missing argument) is one line
+    naming it and exit 2, as every other bad input (:data:`~graspaug.pipeline.command.EXIT_CODES`)."""
+    try:
+        code = app(standalone_mode=False)
+    except Exception as exc:  # typer's own copy of click's errors: told apart by their class names
+        kinds = {c.__name__ for c in type(exc).__mro__}
+        if "NoArgsIsHelpError" in kinds:  # `graspaug` or a group alone: its help
+            exc.show()
+            sys.exit(exc.exit_code)
+        if "UsageError" in kinds:
+            where = exc.ctx.command_path if exc.ctx is not None else "graspaug"
+            typer.echo(f"error: {where}: {' '.join(exc.format_message().split())} (see `{where} --help`)", err=True)
+            sys.exit(2)
+        if "Abort" in kinds:
+            typer.echo("aborted", err=True)
+            sys.exit(1)
+        raise
+    sys.exit(code if isinstance(code, int) else 0)
 
 
 if __name__ == "__main__":

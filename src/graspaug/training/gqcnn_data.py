@@ -19,6 +19,7 @@ pool is the base set alone (the ``targeted`` network).
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -53,6 +54,7 @@ class ExperimentSplit:
     validation: tuple[str, ...]
     real_pool: tuple[str, ...]  # in a seeded order; ratio R of base size B takes the first round(R·B)
     ceiling: tuple[str, ...]
+    test: tuple[str, ...] = ()  # the test split's rendered shapes (what a worker reads the test set by)
 
 
 def experiment_split(train_ids: list[str], base: dict[int, list[str]], n_validation: int, seed: int) -> ExperimentSplit:
@@ -100,7 +102,8 @@ def load_split(
     rendered = set(train_ids)
     drawn = draw_base_sets(shapes, base_sizes, seed)
     base = {b: [s for s in ids if s in rendered] for b, ids in drawn.items()}
-    return experiment_split(train_ids, base, n_validation, seed)
+    test = tuple(sorted(index.shape_id[index.split == "test"].unique()))
+    return dataclasses.replace(experiment_split(train_ids, base, n_validation, seed), test=test)
 
 
 def _arrays(data: GraspImages, rows: np.ndarray) -> GraspArrays:

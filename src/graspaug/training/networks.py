@@ -134,7 +134,9 @@ def train_network(job: NetworkJob, val: GraspArrays | None = None, test: GraspAr
     device = torch.device(job.device)
     train, info = training_set(job.variant, job.split, job.corpora)
     val = val if val is not None else shapes_datapoints(job.corpora.original, job.split.validation)[0]
-    test = test if test is not None else test_set(job.corpora.original)[0]
+    if test is None:  # on a worker: the test split's shapes, as the stage read them
+        test = shapes_datapoints(job.corpora.original, job.split.test)[0] if job.split.test else None
+        test = test if test is not None else test_set(job.corpora.original)[0]
     members = [GQCNN(job.net) for _ in job.inits]
     for net, init in zip(members, job.inits, strict=True):
         net.load_state_dict(init)

@@ -18,6 +18,15 @@ MIN_REPLICATES = 3
 NO_POSITIVE = "n/a (no positive datapoint: AP is undefined)"
 
 
+def rules_source(params_file, rules: dict | None) -> str:
+    """Where the rules that made a test set came from, in words (evaluate.json's ``shaped_by.rules``)."""
+    if params_file is not None:
+        return f"--params {params_file}"
+    if rules:
+        return "the models' cards (the rules their training data were made by)"
+    return "the built-in defaults (the models' cards hold no test-set rules)"
+
+
 def ap_text(c: dict, objects: int, spec: str = "+.4f") -> str:
     """A contrast of :func:`~graspaug.experiments.evaluate.numbers.test_ap` as ``mean [low, high]``, with one
     object ``mean (one object: no interval)``, and with no mean (no positive datapoint) :data:`NO_POSITIVE`."""
@@ -135,3 +144,16 @@ def report_markdown(result: dict, corpus: str, counts: dict, camera: str, shaped
                 ),
             ]
     return "\n".join(lines) + "\n"
+
+
+def printed_lines(result: dict, report) -> list[str]:
+    """What ``graspaug evaluate`` prints: each model's test AP, each single-network difference as what it is
+    (:data:`SINGLE`), each arm's mean and difference with ``--seeds``, and where the ``report`` is."""
+    objects = result["objects"]
+    lines = [f"{name}: test AP {ap_text(c, objects, '.4f')}" for name, c in result["models"].items()]
+    lines += [f"{name}: {ap_text(c, objects)} ({SINGLE})" for name, c in result["differences"].items()]
+    lines += [f"{name}: mean test AP {interval_text(c, '.4f')}" for name, c in result.get("networks", {}).items()]
+    n = next(iter(result.get("networks", {}).values()), {}).get("n_seeds", 0)
+    differences = result.get("network_differences", {})
+    lines += [f"{name}: {interval_text(c)} ({method_verdict(c, n)})" for name, c in differences.items()]
+    return lines + [f"({objects} objects, {result['datapoints']} datapoints; wrote {report})"]

@@ -141,3 +141,14 @@ def hand_edits(text: str, folder: Path = PROFILES_DIR) -> list[str]:
     theirs = _flat(params_dict(profile_params(name, folder)))
     changed = [f"{k}: {_scalar(v)}" for k, v in mine.items() if k not in theirs or theirs[k] != v]
     return changed + [f"{k} (removed)" for k in theirs if k not in mine] or ["its comments or layout"]
+
+
+def with_sections(params, sections: dict):
+    """``params`` (any stage's params model) with the keys of ``sections`` (section → a mapping of its keys, e.g. a
+    model card's ``test_set_rules``: ingest, grasps, render) put over its own, validated again."""
+    from graspaug.pipeline.params.base import parse
+
+    raw = params.model_dump(mode="json", by_alias=True)
+    for name, values in sections.items():
+        raw[name] = (raw.get(name) or {}) | values
+    return parse(raw, type(params))

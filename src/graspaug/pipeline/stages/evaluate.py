@@ -18,46 +18,25 @@ from pathlib import Path
 from graspaug.device import resolve_device
 from graspaug.errors import DataError
 from graspaug.experiments.evaluate.numbers import test_ap
-from graspaug.experiments.evaluate.testset import (
-    CARD_KEYS,
-    cached_test_set,
-    recipe_for,
-    replicate_kind,
-    shaped_by,
-)
-from graspaug.experiments.evaluate.words import SINGLE, ap_text, report_markdown
-from graspaug.experiments.stats import interval_text
+from graspaug.experiments.evaluate.testset import CARD_KEYS, cached_test_set, recipe_for, replicate_kind, shaped_by
+from graspaug.experiments.evaluate.words import printed_lines, report_markdown, rules_source
 from graspaug.io.checkpoints import read_gqcnn
 from graspaug.io.gqcnn import GraspImages
 from graspaug.io.outputs import output_folder
 from graspaug.io.sources import folder_sources
 from graspaug.io.tables import read_table, write_csv, write_json
-from graspaug.pipeline.params.base import params_model, parse
+from graspaug.pipeline.params.base import params_model
 from graspaug.pipeline.params.grasps import GraspsParams
 from graspaug.pipeline.params.ingest import IngestParams
+from graspaug.pipeline.params.profiles import with_sections
 from graspaug.pipeline.params.render import RenderParams
 from graspaug.planning.card import ModelCard
 from graspaug.training.gqcnn import GraspArrays, predict
 
+ARMS_HINT = "name each arm's replicates (seeds or draws) one after another (at least 2 an arm)"
 Params = params_model(
     "The params `graspaug evaluate` reads.", ingest=IngestParams, grasps=GraspsParams, render=RenderParams
 )
-
-
-def with_card_rules(params, card: dict, params_file: Path | None):
-    """The params that make a model's test set, and in words where they came from: ``params`` itself when
-    ``params_file`` names a file (it overrides); else the card's ``test_set_rules`` (ingest, grasps and render as the
-    network's data were made) over ``params``; else ``params`` (the built-in defaults: a card from before the rules
-    were recorded)."""
-    if params_file is not None:
-        return params, f"--params {params_file}"
-    rules = card.get("test_set_rules")
-    if not rules:
-        return params, "the built-in defaults (the models' cards hold no test-set rules)"
-    raw = params.model_dump(mode="json", by_alias=True)
-    raw["ingest"] = raw["ingest"] | rules["ingest"]
-    raw["grasps"], raw["render"] = rules["grasps"], rules["render"]
-    return parse(raw, type(params)), "the models' cards (the rules their training data were made by)"
 
 
 def run(
@@ -73,19 +52,14 @@ def run(
     params_file: Path | None = None,
     seeds: int | None = None,
 ) -> list[str]:
-    """Evaluate ``models`` on the meshes of ``corpus``; the printed lines (one per model and difference).
-    ``params_file``: the file ``params`` came from (None: the built-in defaults), named in the report. ``seeds``: the
-    models are replicates (training seeds of one draw, or one network of each of several draws, as their cards say)
-    of arms, ``seeds`` each in a row (:func:`test_ap`): also each arm's mean and paired difference. The test set is
-    made by the models' cards' ``test_set_rules`` unless ``params_file`` is given (then by its sections; the built-in
-    defaults for cards without rules)."""
+    """Evaluate ``models`` on the meshes of ``corpus``; the printed lines. ``params_file``: the file ``params`` came
+    from (None: the cards' ``test_set_rules``, else the defaults). ``seeds``: arms of that many replicates each."""
     if not corpus.is_dir():
         raise DataError(f"--corpus {corpus}: no such folder")
     if len({str(m) for m in models}) < len(models):
         raise DataError("a model is named twice; name each once")
     if seeds is not None and (seeds < 2 or len(models) % seeds):
-        where = f"--seeds {seeds}: {len(models)} models are not arms of {seeds} replicates each"
-        raise DataError(f"{where}; name each arm's replicates (seeds or draws) one after another (at least 2 an arm)")
+        raise DataError(f"--seeds {seeds}: {len(models)} models are not arms of {seeds} replicates each; {ARMS_HINT}")
     homes = [] if params_file is None else [("the project of --params", Path(params_file).absolute().parent)]
     with output_folder(out, "evaluate", [corpus, cache, *models], force, homes) as staging:
         sources = folder_sources(corpus, unit_scale, limit)
@@ -102,7 +76,8 @@ def run(
             if differs:
                 raise DataError(f"model {name}: its card's {differs[0]} differs from {first}'s; evaluate them apart")
         replicates = None if seeds is None else replicate_kind(raw, seeds)
-        params, rules = with_card_rules(params, raw[first], params_file)
+        rules = None if params_file is not None else raw[first].get("test_set_rules")  # --params overrides the card
+        params = with_sections(params, rules) if rules else params
 
         i, card = params.ingest, {k: getattr(cards[first], k) for k in CARD_KEYS}
         recipe = recipe_for(i.surface, i.max_faces, i.max_file_mb, params.grasps, params.render, params.seed, card)
@@ -115,14 +90,10 @@ def run(
         ids = data.index["shape_id"].to_numpy()
         result = test_ap(arrays.labels, ids, probabilities, n_resamples, params.seed, seeds, replicates)
 
-        made = shaped_by(recipe, counts, params_file, unit_scale) | {"rules": rules}
+        made = shaped_by(recipe, counts, params_file, unit_scale) | {"rules": rules_source(params_file, rules)}
         camera = f"the models' camera ({cards[first].camera_distance[0]:g}-{cards[first].camera_distance[1]:g} m)"
         (staging / "report.md").write_text(report_markdown(result, str(corpus), counts, camera, made))
         summary = {**result, "counts": counts, "corpus": str(corpus), "test_set": folder.name, "shaped_by": made}
         write_json(summary, staging / "evaluate.json")
         write_csv(read_table(folder / "rejects.parquet")[["source", "reason"]], staging / "rejects.csv")
-    lines = [f"{name}: test AP {ap_text(c, result['objects'], '.4f')}" for name, c in result["models"].items()]
-    lines += [f"{name}: {ap_text(c, result['objects'])} ({SINGLE})" for name, c in result["differences"].items()]
-    lines += [f"{name}: mean test AP {interval_text(c, '.4f')}" for name, c in result.get("networks", {}).items()]
-    lines += [f"{name}: {interval_text(c)}" for name, c in result.get("network_differences", {}).items()]
-    return lines + [f"({result['objects']} objects, {result['datapoints']} datapoints; wrote {out / 'report.md'})"]
+    return printed_lines(result, out / "report.md")

@@ -66,10 +66,9 @@ Params = params_model(
 
 
 def run(params: Params, seed: int) -> None:
-    cfg, gen = params.gqcnn, params.generate
+    cfg, gen, start = params.gqcnn, params.generate, time.perf_counter()
     if seed not in cfg.seeds:
         raise StageError(f"seed {seed} is not in gqcnn.seeds {list(cfg.seeds)}")
-    start = time.perf_counter()
     corpora = Corpora(gqcnn_dir("original"), {b: gqcnn_dir(f"gen_{b}") for b in cfg.augment_base_sizes})
     shapes = read_table(SHAPES_TABLE)  # too few for the validation set: a DataError, printed in one line
     split = load_split(corpora.original, shapes, list(gen.base_sizes), cfg.val_shapes, params.data_seed)

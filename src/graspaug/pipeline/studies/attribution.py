@@ -23,7 +23,8 @@ from pathlib import Path
 
 from graspaug.experiments.ap.attribution import decomposition_markdown
 from graspaug.experiments.ap.numbers import test_labels
-from graspaug.experiments.results import add_attribution_draw, combine_attribution, keep_networks
+from graspaug.experiments.kept import keep_networks
+from graspaug.experiments.results import add_attribution_draw, combine_attribution
 from graspaug.io.atomic import atomic_paths
 from graspaug.io.tables import read_table
 from graspaug.pipeline.params.model import params_dict
@@ -43,13 +44,13 @@ KEPT_POOLS = ("targeted", "real")  # with no augmentation (targeted at 1:0), wha
 
 def kept_networks(generate, gqcnn) -> list[tuple[str, int, float]]:
     """The networks a study keeps for its users: at every augmented base size B, none (1:0) and the targeted and
-    real pools at each of their nonzero ratios."""
+    real pools at each of their nonzero ratios, of the pools the run trains (``gqcnn.pools``)."""
     from graspaug.training.variants import pool_ratios
 
     out = []
     for b in gqcnn.augment_base_sizes:
         out.append(("targeted", b, 0.0))
-        for pool in KEPT_POOLS:
+        for pool in (p for p in KEPT_POOLS if p in gqcnn.pools):
             out += [(pool, b, float(r)) for r in pool_ratios(pool, generate.ratios, gqcnn.control_ratios) if r > 0]
     return out
 

@@ -32,7 +32,7 @@ from graspaug.experiments.confirm_results import (
 )
 from graspaug.io.tables import read_table
 from graspaug.pipeline.params.model import params_dict
-from graspaug.pipeline.paths import gqcnn_dir
+from graspaug.pipeline.paths import SHAPES_TABLE, gqcnn_dir
 from graspaug.pipeline.studies.draws import (
     checked,
     draw_params,
@@ -65,9 +65,13 @@ def run_draw(project: Path, draw: int, clone: Path, params, seeds: list[int]) ->
 
 def draw_roles(clone: Path, seed: int, objects) -> dict:
     """The draw's objects by role, as the kept networks' ``objects.json`` records them: its base sets, validation
-    and test objects (shape ids)."""
+    and test objects (shape ids), and each test object's source file (relative to the corpus folder, e.g.
+    ``gso100/Name.obj``) with the scale ingest gave it, so a test object can be loaded again from the corpora."""
     roles = json.loads((clone / "models" / "gqcnn" / f"s{seed}" / "split.json").read_text())
-    return {"base": roles["base"], "validation": list(roles["validation"]), "test": sorted(set(objects))}
+    test = sorted(set(objects))
+    shapes = read_table(clone / SHAPES_TABLE).set_index("shape_id")
+    sources = {s: {"source": str(shapes.source[s]).split(":", 1)[-1], "scale": float(shapes.scale[s])} for s in test}
+    return {"base": roles["base"], "validation": list(roles["validation"]), "test": test, "test_sources": sources}
 
 
 def run(

@@ -1,0 +1,121 @@
+"""The paper's robot experiment on real objects (issue #76): success rates of picks by arm, their paired contrasts
+and the objects behind them, from a table of attempts.
+
+The attempts table (``results/real-picks/attempts.parquet``) holds one row per attempt: ``draw``, ``seed``, ``arm``,
+``object``, ``attempt``, ``drop_seed``, ``success`` (bool), ``outcome``, ``quality`` (the network's P(success), NaN
+for the antipodal arm) and the executed grasp (``grasp_x``, ``grasp_y``, ``grasp_z`` m, ``jaw_angle`` rad).
+Attempts of one object are not independent (one shape, one network): the unit is the object. Within a draw, an
+arm's rate is the mean over its test objects of each object's share of successful attempts; a paired contrast is
+the mean over objects of the difference of two arms' shares (the same drops in every arm). Over several draws (each
+with its own test objects) the interval is a t over the draws' values, which carries the objects' variance; with one
+draw it is the objects' bootstrap (attempts resampled with their object).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+import pandas as pd
+
+from graspaug.experiments.confirm import draw_test
+from graspaug.experiments.stats import ObjectBootstrap, percentile_interval
+
+ANTIPODAL = "antipodal"
+#: The paper's robot result (Section IV-D): 8 everyday objects, 10 attempts each, no interval.
+PAPER = {"objects": 8, "attempts": 10, "before": 0.68, "after": 0.86}
+
+
+def object_rates(attempts: pd.DataFrame) -> pd.DataFrame:
+    """Each (draw, arm, object)'s share of successful attempts: a table indexed by (draw, object), a column per arm."""
+    rates = attempts.groupby(["draw", "arm", "object"]).success.mean().unstack("arm")
+    return rates.sort_index()
+
+
+def _interval(values_by_draw: dict[int, np.ndarray], n_resamples: int, seed: int) -> dict:
+    """Mean and 95% interval of a per-object quantity: t over the draws' means with two draws or more, else the
+    objects' bootstrap of the one draw."""
+    means = [float(np.mean(v)) for v in values_by_draw.values()]
+    if len(values_by_draw) >= 2:
+        t = draw_test(means)
+        return {"mean": t["mean"], "low": t["low"], "high": t["high"], "p": t["p"], "over": "draws", "n": len(means)}
+    (values,) = values_by_draw.values()
+    boot = ObjectBootstrap(np.arange(len(values)), n_resamples, seed)
+    low, high = percentile_interval(boot.means(np.asarray(values, dtype=float)))
+    return {"mean": means[0], "low": low, "high": high, "p": None, "over": "objects", "n": int(len(values))}
+
+
+def pick_summary(attempts: pd.DataFrame, arms: Sequence[str], n_resamples: int = 2000, seed: int = 0) -> dict:
+    """Rates by arm, the contrasts (``control``: none@B − none@50, B the largest none arm, 150 in the confirmatory
+    study; ``targeted_vs_none``: targeted@50 − none@50;
+    ``<arm>_vs_antipodal``) and their verdicts, the control read first: where it does not show, every other verdict
+    is "the cell cannot tell"."""
+    rates = object_rates(attempts)
+    missing = [a for a in arms if a not in rates]
+    if missing:
+        raise ValueError(f"no attempts of arm(s) {missing}")
+    by_draw = {int(d): g.droplevel("draw") for d, g in rates.groupby(level="draw")}
+    out = {"arms": {}, "contrasts": {}, "draws": sorted(by_draw), "objects": int(len(rates))}
+    out["attempts_per_arm"] = {a: int((attempts.arm == a).sum()) for a in arms}
+    for arm in arms:
+        out["arms"][arm] = _interval({d: g[arm].to_numpy() for d, g in by_draw.items()}, n_resamples, seed)
+    control = max((a for a in arms if a.startswith("none@") and a != "none@50"), default="none@150", key=_size)
+    pairs = {"control": (control, "none@50"), "targeted_vs_none": ("targeted@50", "none@50")}
+    pairs |= {f"{a}_vs_antipodal": (a, ANTIPODAL) for a in arms if a != ANTIPODAL}
+    for name, (a, b) in pairs.items():
+        if a in arms and b in arms:
+            diffs = {d: (g[a] - g[b]).to_numpy() for d, g in by_draw.items()}
+            out["contrasts"][name] = _interval(diffs, n_resamples, seed) | {"a": a, "b": b}
+    control = out["contrasts"].get("control")
+    shows = control is not None and control["low"] is not None and control["low"] > 0
+    out["control_shows"] = shows
+    for name, c in out["contrasts"].items():
+        if name == "control" or shows:
+            c["verdict"] = _verdict(c)
+        else:
+            c["verdict"] = "the cell cannot tell (the positive control does not show)"
+    return out
+
+
+def _size(arm: str) -> int:
+    return int(arm.split("@")[1])
+
+
+def _verdict(c: dict) -> str:
+    if c["low"] is None:
+        return "no interval"
+    if c["low"] > 0:
+        return "higher"
+    if c["high"] < 0:
+        return "lower"
+    return "not shown (the interval holds zero)"
+
+
+def hardest_objects(attempts: pd.DataFrame, k: int = 10) -> pd.DataFrame:
+    """The ``k`` objects with the lowest success over every arm and attempt: their success share by arm."""
+    rates = attempts.groupby(["object", "arm"]).success.mean().unstack("arm")
+    return rates.loc[rates.mean(axis=1).sort_values(kind="stable").index[:k]]
+
+
+def never_held(attempts: pd.DataFrame) -> list[str]:
+    """Objects that no arm ever held (reported, not dropped)."""
+    held = attempts.groupby("object").success.any()
+    return sorted(held.index[~held])
+
+
+def paper_table(summary: dict, before: str = "none@50", after: str = "targeted@50") -> pd.DataFrame:
+    """The paper's robot result beside ours: objects, attempts, before, after (rates with their intervals)."""
+
+    def text(c: dict) -> str:
+        if c["low"] is None:
+            return f"{c['mean']:.0%}"
+        return f"{c['mean']:.0%} [{c['low']:.0%}, {c['high']:.0%}]"
+
+    ours = {
+        "objects": summary["objects"],
+        "attempts": summary["attempts_per_arm"][before] // max(summary["objects"], 1),
+        "before": text(summary["arms"][before]),
+        "after": text(summary["arms"][after]),
+    }
+    paper = {k: (f"{v:.0%}" if isinstance(v, float) else v) for k, v in PAPER.items()}
+    return pd.DataFrame([paper | {"who": "paper (8 everyday objects, no interval)"}, ours | {"who": "graspaug"}])

@@ -1,0 +1,258 @@
+"""``graspaug study real-picks``: the paper's robot experiment on real objects (issue #76).
+
+For each draw's kept seed-0 networks (``<networks>/d<k>-s0/``: none@50, targeted@50, none@150, and the random
+antipodal grasp), every test object of that draw (``objects.json``'s ``test``, or the study's ``test.parquet``
+objects for a folder of the exploratory study) is loaded from the corpora and sized as ingest sized it (the
+networks' cards' ``test_set_rules``, else the ``--profile``'s ingest surface), then picked ``--attempts`` times in
+the simulated Panda cell (the ``sim`` params: depth noise, drawn mass and friction, a shake after the lift), each
+attempt a seeded drop that every arm shares. ``--objects DIR`` picks the meshes of any folder instead (the same
+objects for every draw). Writes one row per attempt to ``results/<results>/attempts.parquet`` (with the command and
+commit in ``meta.json``), and the summary, the table beside the paper's and a success and a failure picture of each
+network arm to ``--out``.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import time
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from graspaug.errors import DataError
+from graspaug.experiments.cell.picks import ANTIPODAL, hardest_objects, never_held, paper_table, pick_summary
+from graspaug.experiments.cell.trials import ObjectJob, run_trials
+from graspaug.rng import shape_rng
+
+log = logging.getLogger(__name__)
+
+#: The arms a draw's kept networks give, by the folder each network is kept in (``<pool>-<B>-<R>``); the control
+#: arm is none@150 where kept, else the largest none@B above 50 (the exploratory study kept 50 and 100).
+ARM_FOLDERS = {"none@50": "targeted-50-0", "targeted@50": "targeted-50-1"}
+
+
+def draw_arms(folder: Path) -> dict[str, str]:
+    """Arm → its network's folder name in a draw's kept folder: none@50, targeted@50 and the control's none@B."""
+    sizes = sorted(int(p.name.split("-")[1]) for p in folder.glob("targeted-*-0") if (p / "model.pt").is_file())
+    above = [b for b in sizes if b > 50]
+    if not above:
+        raise DataError(f"{folder}: no 1:0 network above B = 50 (targeted-<B>-0) for the positive control")
+    b = 150 if 150 in above else above[-1]
+    return ARM_FOLDERS | {f"none@{b}": f"targeted-{b}-0"}
+
+
+def draw_folders(networks: Path, draws: list[int] | None) -> dict[int, Path]:
+    """Draw → its kept seed-0 networks' folder (``networks``/d<k>-s0); every arm's ``model.pt`` must be there."""
+    networks = Path(networks)
+    if not networks.is_dir():
+        raise DataError(f"--networks {networks}: no such folder")
+    found = {int(p.name[1:].split("-")[0]): p for p in networks.glob("d*-s0") if p.is_dir()}
+    chosen = sorted(found) if draws is None else draws
+    if not chosen:
+        raise DataError(f"--networks {networks}: no d<draw>-s0 folder of kept networks")
+    out = {}
+    for d in chosen:
+        if d not in found:
+            raise DataError(f"draw {d}: no networks in {networks / f'd{d}-s0'} (it holds {sorted(found)})")
+        absent = [f for f in draw_arms(found[d]).values() if not (found[d] / f / "model.pt").is_file()]
+        if absent:
+            raise DataError(f"draw {d}: {found[d]} lacks {', '.join(f + '/model.pt' for f in absent)}")
+        out[d] = found[d]
+    return out
+
+
+def test_objects(folder: Path) -> list[str]:
+    """The draw's test objects (shape ids): its ``objects.json``, else the study's ``test.parquet`` (the exploratory
+    study, whose draws share one test split)."""
+    roles = folder / "objects.json"
+    if roles.is_file():
+        return list(json.loads(roles.read_text())["test"])
+    table = folder.parent.parent / "test.parquet"
+    if table.is_file():
+        return sorted(set(pd.read_parquet(table).object))
+    raise DataError(f"{folder}: no objects.json and no {table}: which objects did this draw test on?")
+
+
+def card_surface(folder: Path, fallback):
+    """The ingest surface settings the draw's networks' data were made by (their cards' ``test_set_rules``), else
+    ``fallback``; a camera other than the cell's is refused."""
+    from graspaug.geometry.settings import SurfaceSettings
+
+    card = json.loads((folder / ARM_FOLDERS["none@50"] / "card.json").read_text())
+    rules = card.get("test_set_rules")
+    return (SurfaceSettings(**rules["ingest"]["surface"]) if rules else fallback), card
+
+
+def check_camera(card: dict, cell, where: Path) -> None:
+    """The cell's camera must be one the networks were trained for: its height inside the card's camera distances
+    (with the planner's tolerance) and its intrinsics the card's."""
+    from graspaug.planning.camera import DISTANCE_TOLERANCE
+
+    low, high = card["camera_distance"]
+    if not (low - DISTANCE_TOLERANCE <= cell.camera_height <= high + DISTANCE_TOLERANCE):
+        raise DataError(
+            f"{where}: trained for a camera {low:g}-{high:g} m above the table; the cell's is {cell.camera_height:g} m "
+            "(sim.cell.camera_height)"
+        )
+    ours = {k: getattr(cell.intrinsics, k) for k in card["intrinsics"]}
+    if any(abs(float(ours[k]) - float(v)) > 1e-6 for k, v in card["intrinsics"].items()):
+        raise DataError(f"{where}: trained for intrinsics {card['intrinsics']}, the cell's are {ours}")
+
+
+def corpus_meshes(corpora: Path, ids: list[str], surface, limit: int | None) -> tuple[list, dict[str, str]]:
+    """The meshes of the objects ``ids`` (shape ids as ingest names them) found in the folder ``corpora``, each
+    loaded, closed and sized as ingest does (``surface``); those not found or broken, with the reason."""
+    from graspaug.geometry.loading import MeshRejected, load_shape
+    from graspaug.geometry.prepare import prepare_shape
+    from graspaug.io.sources import folder_sources
+
+    by_id = {s.shape_id: s for s in folder_sources(corpora, 1.0, None)}
+    meshes, skipped = [], {}
+    for shape_id in ids[:limit] if limit else ids:
+        source = by_id.get(shape_id)
+        if source is None:
+            skipped[shape_id] = f"not found in {corpora}"
+            continue
+        try:
+            meshes.append((shape_id, prepare_shape(load_shape(source.path, 1.0), surface).mesh))
+        except (MeshRejected, OSError, ValueError) as exc:
+            skipped[shape_id] = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+    return meshes, skipped
+
+
+RECORDED = 12  # objects whose first attempt is recorded in every arm (the pictures are drawn from them)
+
+
+def jobs_for_draw(draw: int, folder: Path, objects, attempts: int, seed: int, pictures: bool) -> list[ObjectJob]:
+    """An :class:`ObjectJob` per object and arm; an object's drops and planner seeds are drawn from ``seed`` and
+    its name, the same in every arm (and every draw: the same object is dropped alike)."""
+    jobs = []
+    for index, obj in enumerate(objects):
+        record = pictures and index < RECORDED  # frames of the first attempt: a success and a failure to draw
+        drops = tuple(int(shape_rng(seed, obj.name, f"sim-drop-{a}").integers(2**31 - 1)) for a in range(attempts))
+        plans = tuple(int(shape_rng(seed, obj.name, f"sim-plan-{a}").integers(2**31 - 1)) for a in range(attempts))
+        for arm, name in (draw_arms(folder) | {ANTIPODAL: None}).items():
+            model = None if name is None else str(folder / name / "model.pt")
+            jobs.append(ObjectJob(arm, 0, model, obj.name, obj.kind, obj.body, drops, plans, record))
+    return jobs
+
+
+ATTEMPT_COLUMNS = (
+    "draw", "seed", "arm", "object", "attempt", "drop_seed", "success", "outcome", "quality",
+    "grasp_x", "grasp_y", "grasp_z", "jaw_angle",
+)  # fmt: skip
+
+
+def run(
+    networks: Path,
+    draws: list[int] | None,
+    corpora: Path | None,
+    objects_dir: Path | None,
+    attempts: int,
+    limit: int | None,
+    params,
+    fallback_surface,
+    out: Path,
+    pictures: bool,
+) -> tuple[pd.DataFrame, dict, str]:
+    """Pick every object of every draw in every arm; (the attempts table, the summary, the report's markdown).
+    ``out``: the folder the pictures go to (a staging folder)."""
+    from graspaug.sim.objects import folder_meshes, prepare_objects
+
+    folders = draw_folders(networks, draws)
+    sim, rows, skipped, seconds = params.sim, [], {}, {}
+    for d, folder in folders.items():
+        began = time.perf_counter()
+        surface, card = card_surface(folder, fallback_surface)
+        check_camera(card, sim.cell, folder)
+        if objects_dir is not None:
+            try:
+                meshes, missed = folder_meshes(objects_dir, surface, label="real-picks")
+            except ValueError as exc:  # a folder with no (usable) mesh: one line
+                raise DataError(str(exc).replace("sim.objects_path", "--objects")) from None
+            meshes = meshes[:limit] if limit else meshes
+        else:
+            meshes, missed = corpus_meshes(corpora, test_objects(folder), surface, limit)
+        if not meshes:
+            why = "; ".join(f"{k}: {v}" for k, v in missed.items())
+            raise DataError(f"draw {d}: no object could be loaded ({why})")
+        skipped |= {f"d{d}/{k}": v for k, v in missed.items()}
+        physics = (sim.physics, params.seed, sim.vhacd_resolution)
+        objects = prepare_objects((), (), Path("."), *physics, meshes, None, params.workers)
+        jobs, arms = jobs_for_draw(d, folder, objects, attempts, params.seed, pictures), [*draw_arms(folder)]
+        log.info("real-picks draw %d: %d objects × %d attempts, arms %s", d, len(objects), attempts, arms)
+        done = run_trials(jobs, sim, params.render.crop, params.workers)
+        for row in done:
+            row["draw"] = d
+        rows += done
+        seconds[d] = round(time.perf_counter() - began)
+        log.info("real-picks draw %d: %d attempts in %d s", d, len(done), seconds[d])
+    table = pd.DataFrame([{k: row.get(k) for k in ATTEMPT_COLUMNS} for row in rows])
+    table["success"] = table.success.astype(bool)
+    summary = pick_summary(table, list(dict.fromkeys(table.arm)), sim.n_bootstrap, params.seed)
+    summary |= {"never_held": never_held(table), "skipped": skipped, "seconds": seconds, "attempts": attempts}
+    if pictures:
+        draw_pictures(rows, out)
+    return table, summary, report_markdown(table, summary)
+
+
+def draw_pictures(rows: list[dict], out: Path) -> None:
+    """One success and one failure of each network arm (the first recorded of each), drawn as the cell's pictures."""
+    from graspaug.experiments.cell.figures import pick_story, trial_picture
+
+    for arm in dict.fromkeys(r["arm"] for r in rows if r["arm"] != ANTIPODAL):
+        for success in (True, False):
+            row = next((r for r in rows if r["arm"] == arm and r["success"] == success and r.get("_frames")), None)
+            if row is not None:
+                pic = trial_picture(row, None)
+                name = f"{arm.replace('@', '-')}-{'success' if success else 'failure'}.png"
+                pick_story(pic["depth"], pic["jaw"], pic["window"], pic["frames"], out / name, f"{arm}: {pic['title']}")
+
+
+def report_markdown(table: pd.DataFrame, summary: dict) -> str:
+    """The report: the table beside the paper's, rates and contrasts with their intervals and verdicts, the
+    hardest objects and those no arm held."""
+
+    def text(c: dict) -> str:
+        ends = "no interval" if c["low"] is None else f"[{c['low']:+.3f}, {c['high']:+.3f}]"
+        return f"{c['mean']:+.3f} {ends} (95% over {c['over']}, n = {c['n']})"
+
+    paper = paper_table(summary)
+    lines = [
+        "# Picks of real objects by arm",
+        "",
+        f"{summary['objects']} objects (object × draw), {summary['attempts']} attempts each and arm, draws "
+        f"{summary['draws']}; an object's attempts are one unit (its share of successes).",
+        "",
+        "| who | objects | attempts | before (none@50) | after (targeted@50) |",
+        "|---|---|---|---|---|",
+        *(f"| {r.who} | {r.objects} | {r.attempts} | {r.before} | {r.after} |" for r in paper.itertuples()),
+        "",
+        "| arm | success rate [95%] |",
+        "|---|---|",
+        *(f"| {a} | {text(c)} |" for a, c in summary["arms"].items()),
+        "",
+        "| contrast | difference [95%] | verdict |",
+        "|---|---|---|",
+        *(f"| {n} ({c['a']} − {c['b']}) | {text(c)} | {c['verdict']} |" for n, c in summary["contrasts"].items()),
+        "",
+        f"Objects no arm ever held ({len(summary['never_held'])}): {', '.join(summary['never_held']) or 'none'}.",
+        "",
+        "The hardest objects (success share by arm):",
+        "",
+        hardest_objects(table).round(2).to_markdown(),
+    ]
+    return "\n".join(lines) + "\n"
+
+
+def write_results(folder: Path, table: pd.DataFrame, meta: dict) -> None:
+    """``attempts.parquet`` (one row per attempt) and ``meta.json`` into the results folder ``folder``."""
+    from graspaug.io.atomic import atomic_path
+
+    folder.mkdir(parents=True, exist_ok=True)
+    with atomic_path(folder / "attempts.parquet") as tmp:
+        table.to_parquet(tmp, index=False)
+    with atomic_path(folder / "meta.json") as tmp:
+        tmp.write_text(json.dumps(meta, indent=1, default=lambda v: v.item() if isinstance(v, np.generic) else str(v)))

@@ -1,0 +1,83 @@
+"""`graspaug study real-picks` (issue #76): the kept networks pick real household objects in the simulated cell, one
+row per attempt; bad input is one line and exit 2."""
+
+import json
+import shutil
+
+import numpy as np
+import pandas as pd
+import pytest
+from typer.testing import CliRunner
+
+from graspaug.experiments.cell.picks import ANTIPODAL, hardest_objects, never_held, pick_summary
+from graspaug.pipeline.cli import app
+
+KEPT = "results/attribution-real-objects-4000/networks"
+SMALL = ("AllergenFree_JarroDophilus.obj", "3D_Dollhouse_TablePurple.obj")  # two of gso100's objects
+
+
+def _picks(repo_root, monkeypatch, *args):
+    monkeypatch.chdir(repo_root)
+    return CliRunner().invoke(app, ["study", "real-picks", *args])
+
+
+def test_pick_summary_reads_the_control_first_and_clusters_attempts_by_object():
+    rng = np.random.default_rng(0)
+    rows = []
+    for draw in (0, 1, 2):
+        for obj in range(20):
+            easy = rng.random()
+            for arm, gain in (("none@50", 0.0), ("targeted@50", 0.02), ("none@150", 0.3), (ANTIPODAL, -0.2)):
+                for attempt in range(10):
+                    success = rng.random() < np.clip(easy + gain, 0, 1)
+                    rows.append({"draw": draw, "arm": arm, "object": f"d{draw}o{obj}", "attempt": attempt,
+                                 "success": success})  # fmt: skip
+    attempts = pd.DataFrame(rows)
+    summary = pick_summary(attempts, ["none@50", "targeted@50", "none@150", ANTIPODAL])
+    assert summary["control_shows"] and summary["contrasts"]["control"]["over"] == "draws"
+    assert summary["contrasts"]["control"]["verdict"] == "higher"
+    assert summary["contrasts"]["none@50_vs_antipodal"]["verdict"] == "higher"
+    one = pick_summary(attempts[attempts.draw == 0], ["none@50", "targeted@50", "none@150"])
+    assert one["contrasts"]["control"]["over"] == "objects" and one["contrasts"]["control"]["n"] == 20
+    flat = attempts.assign(success=np.where(attempts.arm == "none@150", attempts.success.shift(40), attempts.success))
+    flat = flat.fillna(False).assign(success=lambda t: t.success.astype(bool))
+    unclear = pick_summary(flat[flat.arm != ANTIPODAL], ["none@50", "targeted@50", "none@150"])
+    if not unclear["control_shows"]:
+        assert unclear["contrasts"]["targeted_vs_none"]["verdict"].startswith("the cell cannot tell")
+    assert len(hardest_objects(attempts, 5)) == 5 and isinstance(never_held(attempts), list)
+
+
+def test_the_kept_networks_pick_a_few_real_objects(repo_root, tmp_path, monkeypatch):
+    corpus = repo_root.parent / "shared" / "corpora" / "gso100"
+    if not corpus.is_dir():
+        pytest.skip(f"{corpus} absent beside this clone")
+    objects = tmp_path / "objects"
+    objects.mkdir()
+    for name in SMALL:
+        shutil.copy(corpus / name, objects / name)
+    out = tmp_path / "out"
+    done = _picks(repo_root, monkeypatch, "--networks", KEPT, "--draws", "0", "--objects", str(objects),
+                  "--attempts", "2", "--workers", "2", "--out", str(out))  # fmt: skip
+    assert done.exit_code == 0, done.output
+    summary = json.loads((out / "summary.json").read_text())
+    assert set(summary["arms"]) == {"none@50", "targeted@50", "none@100", ANTIPODAL}
+    assert summary["attempts_per_arm"] == {arm: 4 for arm in summary["arms"]} and summary["objects"] == 2
+    assert summary["contrasts"]["control"]["a"] == "none@100"  # the exploratory study kept B = 50 and 100
+    report = (out / "report.md").read_text()
+    assert "| paper (8 everyday objects, no interval) | 8 | 10 | 68% | 86% |" in report and "none@100" in report
+
+
+def test_bad_input_is_one_line(repo_root, tmp_path, monkeypatch):
+    (tmp_path / "empty").mkdir()
+    empty = _picks(repo_root, monkeypatch, "--networks", KEPT, "--objects", str(tmp_path / "empty"),
+                   "--out", str(tmp_path / "o1"))  # fmt: skip
+    assert empty.exit_code == 2 and "holds no mesh file" in empty.output, empty.output
+    missing = _picks(repo_root, monkeypatch, "--networks", KEPT, "--draws", "7", "--objects", str(tmp_path / "empty"),
+                     "--out", str(tmp_path / "o2"))  # fmt: skip
+    assert missing.exit_code == 2 and "draw 7: no networks in" in missing.output, missing.output
+    params = tmp_path / "params.yaml"
+    params.write_text("sim:\n  cell:\n    camera_height: 1.5\n")
+    camera = _picks(repo_root, monkeypatch, "--networks", KEPT, "--draws", "0", "--objects", str(tmp_path / "empty"),
+                    "--params", str(params), "--out", str(tmp_path / "o3"))  # fmt: skip
+    assert camera.exit_code == 2 and "trained for a camera 0.65-0.75 m" in camera.output, camera.output
+    assert not (tmp_path / "o1").exists() and not (tmp_path / "o3").exists()  # nothing half-written
