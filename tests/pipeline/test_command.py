@@ -59,3 +59,32 @@ def test_which_os_errors_are_the_systems():
     assert not is_system_error(IsADirectoryError(errno.EISDIR, "Is a directory", "in.npy"))
     assert not is_system_error(FileNotFoundError("data/gqcnn/gen_6: no rendered dataset"))  # a message, no errno
     assert not is_system_error(ValueError("not an OSError"))
+
+
+def test_usage_errors_are_one_line_and_exit_2():
+    """Every usage error of `graspaug` (a bad option value, an unknown option) is one line naming it, exit 2: the
+    `--keep-networks` parse error included (it exited 3 as an unexpected error before)."""
+    import subprocess
+    import sys
+
+    cli = [sys.executable, "-m", "graspaug.pipeline.cli"]
+    for args, words in (
+        (["study", "attribution", "--keep-networks", "x/y"], "Invalid value for '--keep-networks': 'x/y'"),
+        (["evaluate", "--nope"], "No such option: --nope"),
+    ):
+        done = subprocess.run([*cli, *args], capture_output=True, text=True)
+        assert done.returncode == 2 and words in done.stderr, done.stderr
+        assert len(done.stderr.strip().splitlines()) == 1, done.stderr
+
+
+def test_a_study_keeps_only_the_networks_its_run_trains():
+    """`--keep-networks` with `gqcnn.pools=[targeted]` keeps none and targeted (no real pool to copy after the run)."""
+    from types import SimpleNamespace
+
+    from graspaug.pipeline.studies.attribution import kept_networks
+
+    generate = SimpleNamespace(ratios=(0.0, 1.0))
+    only = SimpleNamespace(augment_base_sizes=(50,), pools=("targeted",), control_ratios=None)
+    assert kept_networks(generate, only) == [("targeted", 50, 0.0), ("targeted", 50, 1.0)]
+    both = SimpleNamespace(augment_base_sizes=(50,), pools=("targeted", "real"), control_ratios=None)
+    assert ("real", 50, 1.0) in kept_networks(generate, both)

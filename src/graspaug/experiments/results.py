@@ -232,7 +232,8 @@ def attribution_figures(result: dict, study: str = "attribution") -> dict[str, s
     """Every figure of an attribution result (:func:`combine_attribution`) as the text a document quotes, by key:
     ``<study>/<contrast>`` (``mean [low, high]``, AP, 4 decimals), ``<study>/<contrast>/per_draw`` (each draw's mean
     over seeds, in draw order), ``<study>/share/<pool>@<B>`` (the share with its
-    interval by test inversion, or ``[unbounded]``), ``<study>/real_gain@<B>`` (the shares' denominator) and
+    interval by test inversion, or ``[unbounded]``), ``<study>/real_gain@<B>`` (the shares' denominator),
+    ``<study>/gain/<pool>@<B>`` (their numerator: the pool's gain over no augmentation) and
     ``<study>/worth/<pool>@<B>`` (what the pool's shapes are worth in real shapes: ``exchange_rate``)."""
     from graspaug.experiments.ap.attribution import exchange_rate, exchange_text
 
@@ -247,6 +248,8 @@ def attribution_figures(result: dict, study: str = "attribution") -> dict[str, s
         for b, s in by_size.items():
             out[f"{study}/share/{pool}@{b}"] = share_text(s)
             out[f"{study}/real_gain@{b}"] = interval_text(s["real_gain"])
+            if s.get("gain") is not None:  # the share's numerator: the pool's own gain over no augmentation
+                out[f"{study}/gain/{pool}@{b}"] = interval_text(s["gain"])
             if "shapes" in s:
                 out[f"{study}/worth/{pool}@{b}"] = exchange_text(exchange_rate(s))
     return out

@@ -1,4 +1,4 @@
-"""``graspaug study attribution``: why generated shapes add nothing, over several draws of the data (issue #33).
+"""``graspaug study attribution``: what each pool of generated shapes adds, over several draws of the data (issue #33).
 
 Runs the ``attribution`` profile once per data seed and gives every contrast one interval over draws, training seeds
 and test objects. Each draw k is a clone of the project's HEAD in ``workdir``/draw<k> that shares the project's DVC
