@@ -120,14 +120,20 @@ def _draw_tables(folder, draws):
     pd.DataFrame(rows).to_parquet(folder / "networks.parquet", index=False)
 
 
-@pytest.fixture
-def plan_repo(tmp_path):
+def _repo(tmp_path, name):
+    """A new git repository with the folder results/<name>/: (repo, folder)."""
     repo = tmp_path / "repo"
-    folder = repo / "results" / "confirm-x"
+    folder = repo / "results" / name
     folder.mkdir(parents=True)
     _git(repo, "init", "-q")
     _git(repo, "config", "user.email", "t@example.com")
     _git(repo, "config", "user.name", "t")
+    return repo, folder
+
+
+@pytest.fixture
+def plan_repo(tmp_path):
+    repo, folder = _repo(tmp_path, "confirm-x")
     (folder / "plan.yaml").write_text(yaml.safe_dump(PLAN))
     _git(repo, "add", ".")
     _git(repo, "commit", "-qm", "plan")
@@ -164,12 +170,7 @@ def test_the_plan_history_is_checked_from_git(plan_repo):
 
 
 def test_a_plan_committed_with_or_after_its_data_is_refused(tmp_path):
-    repo = tmp_path / "repo"
-    folder = repo / "results" / "confirm-y"
-    folder.mkdir(parents=True)
-    _git(repo, "init", "-q")
-    _git(repo, "config", "user.email", "t@example.com")
-    _git(repo, "config", "user.name", "t")
+    repo, folder = _repo(tmp_path, "confirm-y")
     _draw_tables(folder, [0])
     (folder / "plan.yaml").write_text(yaml.safe_dump(PLAN))
     _git(repo, "add", ".")

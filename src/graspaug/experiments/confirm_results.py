@@ -97,7 +97,7 @@ def add_confirm_draw(
     ``networks.parquet``, the kept seed-0 networks (the plan's ``keep`` arms) with ``objects.json`` (``roles``: the
     draw's split by role, shape ids), and ``meta.json`` last. A draw the plan does not list is refused."""
     from graspaug.experiments.ap.numbers import collect, test_predictions
-    from graspaug.experiments.kept import keep_networks
+    from graspaug.experiments.kept import keep_networks, write_predictions
     from graspaug.io.atomic import atomic_path
     from graspaug.training.variants import Variant
 
@@ -115,15 +115,7 @@ def add_confirm_draw(
     meta_file.unlink(missing_ok=True)  # a folder without meta.json is an unfinished one
     for s, seed_dir in seed_dirs.items():
         columns = {column(draw, s, k): test_predictions(seed_dir, k).astype(np.float32) for k in keys.values()}
-        with atomic_path(folder / f"predictions-d{draw}-s{s}.parquet") as tmp:
-            pd.DataFrame(columns).to_parquet(
-                tmp,
-                index=False,
-                compression="zstd",
-                compression_level=19,
-                use_byte_stream_split=True,
-                use_dictionary=False,
-            )
+        write_predictions(columns, folder / f"predictions-d{draw}-s{s}.parquet")
     test = pd.DataFrame({"label": np.asarray(labels, dtype=np.int8), "object": np.asarray(objects)})
     with atomic_path(folder / f"test-d{draw}.parquet") as tmp:
         test.to_parquet(tmp, index=False)

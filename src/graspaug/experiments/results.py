@@ -123,6 +123,7 @@ def add_attribution_draw(
         refused, naming it)
     """
     from graspaug.experiments.ap.numbers import collect, test_predictions
+    from graspaug.experiments.kept import write_predictions
     from graspaug.io.atomic import atomic_path
     from graspaug.training.variants import seed_variants
 
@@ -161,16 +162,8 @@ def add_attribution_draw(
     meta_file.unlink(missing_ok=True)  # a folder without meta.json is an unfinished one
     for old_file in folder.glob(f"predictions-d{draw}-s*.parquet"):
         old_file.unlink()
-    for s, columns in by_seed.items():  # float32 bytes split by position and zstd: 40% smaller than the default
-        with atomic_path(folder / f"predictions-d{draw}-s{s}.parquet") as tmp:
-            pd.DataFrame(columns).to_parquet(
-                tmp,
-                index=False,
-                compression="zstd",
-                compression_level=19,
-                use_byte_stream_split=True,
-                use_dictionary=False,
-            )
+    for s, columns in by_seed.items():
+        write_predictions(columns, folder / f"predictions-d{draw}-s{s}.parquet")
     for name, frame in {"networks.parquet": networks.reset_index(drop=True), "test.parquet": test}.items():
         with atomic_path(folder / name) as tmp:
             frame.to_parquet(tmp, index=False)
