@@ -180,3 +180,16 @@ def test_a_plan_committed_with_or_after_its_data_is_refused(tmp_path):
     (tmp_path / "loose" / "plan.yaml").write_text(json.dumps({"format": "x"}))
     with pytest.raises(DataError, match="the plan lacks question"):
         read_plan(tmp_path / "loose" / "plan.yaml")
+
+
+def test_the_study_runs_only_from_a_committed_plan_and_only_its_draws(plan_repo, tmp_path):
+    """`graspaug study confirm` checks the plan's history and the draws asked for before any work."""
+    from graspaug.pipeline.studies import confirm as study
+
+    repo, folder = plan_repo
+    with pytest.raises(DataError, match=r"--draws \[99\]: not in the plan's draws \[0, 1, 2\]"):
+        study.run(repo, folder / "plan.yaml", tmp_path / "work", [99], None, 1, False, "test")
+    (folder / "plan.yaml").write_text(yaml.safe_dump(PLAN | {"seeds": [0, 1]}))
+    with pytest.raises(DataError, match="differs from its committed text"):
+        study.run(repo, folder / "plan.yaml", tmp_path / "work", None, None, 1, False, "test")
+    assert not (tmp_path / "work").exists()  # nothing cloned, nothing run
