@@ -193,3 +193,22 @@ def test_the_study_runs_only_from_a_committed_plan_and_only_its_draws(plan_repo,
     with pytest.raises(DataError, match="differs from its committed text"):
         study.run(repo, folder / "plan.yaml", tmp_path / "work", None, None, 1, False, "test")
     assert not (tmp_path / "work").exists()  # nothing cloned, nothing run
+
+
+def test_graspaug_results_check_reads_the_plans_history(plan_repo):
+    """`graspaug results --check` recomputes the confirmatory folder's figures and fails once its plan is edited."""
+    from typer.testing import CliRunner
+
+    from graspaug.pipeline.cli import app
+
+    repo, _ = plan_repo
+    (repo / "docs").mkdir()
+    text = "<!-- results:confirm-x/status -->in progress: 0 of 3 planned draws\n"
+    (repo / "README.md").write_text(text)
+    (repo / "docs/results.md").write_text(text)
+    ok = CliRunner().invoke(app, ["results", "--root", str(repo), "--check", "--out", str(repo / "out")])
+    assert ok.exit_code == 0, ok.output
+    (repo / "results/confirm-x/plan.yaml").write_text(yaml.safe_dump(PLAN | {"alpha": 0.1}))
+    _git(repo, "commit", "-qam", "a looser alpha")
+    edited = CliRunner().invoke(app, ["results", "--root", str(repo), "--check", "--out", str(repo / "out")])
+    assert edited.exit_code == 2 and "changed after its first commit" in edited.output

@@ -299,6 +299,8 @@ def check_plan_history(folder: Path) -> list[str]:
     plan's commit; a draw that a commit of ``networks.parquet`` held is gone."""
     folder = Path(folder).resolve()
     root = Path(_git(folder, "rev-parse", "--show-toplevel").strip())
+    if _git(root, "rev-parse", "--is-shallow-repository").strip() == "true":
+        return [f"{folder.name}: a shallow clone holds no history to check the plan against (git fetch --unshallow)"]
     rel = folder.relative_to(root)
     plan = (rel / PLAN).as_posix()
     commits = _git(root, "log", "--format=%H", "--follow", "--", plan).split()
