@@ -136,7 +136,8 @@ def power(n_draws: int, sd: float, effect: float, alpha: float = 0.05) -> float:
         return 0.0
     df, nc = n_draws - 1, effect / (sd / np.sqrt(n_draws))
     crit = stats.t.ppf(1 - alpha / 2, df)
-    return float(stats.nct.sf(crit, df, nc) + stats.nct.cdf(-crit, df, nc))
+    value = stats.nct.sf(crit, df, nc) + stats.nct.cdf(-crit, df, nc)
+    return float(value) if np.isfinite(value) else float(stats.norm.sf(crit - nc) + stats.norm.cdf(-crit - nc))
 
 
 def draws_for_power(sd: float, effect: float, alpha: float = 0.05, target: float = 0.8, most: int = 1000) -> int:

@@ -511,12 +511,12 @@ def combine_picks(folder: Path) -> dict:
 def picks_figures(result: dict, study: str) -> dict[str, str]:
     """``<study>/<arm>`` (success rate, ``mean [low, high]``), ``<study>/<contrast>`` and its ``/verdict``."""
 
-    def text(c):
-        return "n/a" if c["low"] is None else f"{c['mean']:.3f} [{c['low']:.3f}, {c['high']:.3f}]"
+    def text(c, sign=""):
+        return "n/a" if c["low"] is None else f"{c['mean']:{sign}.3f} [{c['low']:{sign}.3f}, {c['high']:{sign}.3f}]"
 
     out = {f"{study}/{arm}": text(c) for arm, c in result["arms"].items()}
     for name, c in result["contrasts"].items():
-        out[f"{study}/{name}"] = text(c).replace(f"{c['mean']:.3f}", f"{c['mean']:+.3f}", 1)
+        out[f"{study}/{name}"] = text(c, "+")
         out[f"{study}/{name}/verdict"] = c["verdict"]
     return out
 

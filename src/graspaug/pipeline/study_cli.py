@@ -246,6 +246,7 @@ def real_picks_command(
     _logging()
     if objects is None and not corpora.is_dir():
         raise typer.BadParameter(f"{corpora}: no such folder", param_hint="--corpora")
+    meta = provenance(Path("."), _command_line())  # the code that runs, before any commit made while it runs
     settings = load_stage_params(params, sim_stage).model_copy(update={"n_jobs": workers})
     surface = profile_params(profile).ingest.surface
     chosen = list(draws) if draws else None
@@ -255,7 +256,7 @@ def real_picks_command(
         (tmp / "report.md").write_text(text)
         (tmp / "summary.json").write_text(json.dumps(summary, indent=1, default=str))
     if results is not None:
-        meta = provenance(Path("."), _command_line()) | {"attempts": attempts, "seconds": summary["seconds"]}
+        meta |= {"attempts": attempts, "seconds": summary["seconds"]}
         real_picks.write_results(Path("results") / results, table, meta)
     typer.echo(text)
 

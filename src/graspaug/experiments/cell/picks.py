@@ -119,3 +119,24 @@ def paper_table(summary: dict, before: str = "none@50", after: str = "targeted@5
     }
     paper = {k: (f"{v:.0%}" if isinstance(v, float) else v) for k, v in PAPER.items()}
     return pd.DataFrame([paper | {"who": "paper (8 everyday objects, no interval)"}, ours | {"who": "graspaug"}])
+
+
+def pick_power(attempts: pd.DataFrame, a: str, b: str, n_objects: int, draws: Sequence[int], effect: float) -> dict:
+    """The power of the paired contrast ``a`` − ``b`` (two arms) over draws of ``n_objects`` test objects each, from a
+    pilot's attempts: the SD of the per-object difference of success shares, so one draw's value has SD
+    ``sd / √n_objects`` (the draws' own spread beyond their objects is not in a one-draw pilot: the power is an upper
+    bound), against a true difference ``effect``; the power of the t over ``draws`` draws for each count."""
+    from graspaug.experiments.confirm import power
+
+    rates = object_rates(attempts)
+    diffs = (rates[a] - rates[b]).to_numpy()
+    sd = float(np.std(diffs, ddof=1))
+    per_draw = sd / np.sqrt(n_objects)
+    return {
+        "pilot_objects": int(len(diffs)),
+        "pilot_mean": float(np.mean(diffs)),
+        "object_sd": sd,
+        "draw_sd": per_draw,
+        "effect": effect,
+        "power": {int(d): power(int(d), per_draw, effect) for d in draws},
+    }
