@@ -9,7 +9,7 @@ import pandas as pd
 import pytest
 from typer.testing import CliRunner
 
-from graspaug.experiments.cell.picks import ANTIPODAL, hardest_objects, never_held, pick_summary
+from graspaug.experiments.cell.picks import ANTIPODAL, hardest_objects, never_held, pick_power, pick_summary
 from graspaug.pipeline.cli import app
 
 KEPT = "results/attribution-real-objects-4000/networks"
@@ -45,6 +45,8 @@ def test_pick_summary_reads_the_control_first_and_clusters_attempts_by_object():
     if not unclear["control_shows"]:
         assert unclear["contrasts"]["targeted_vs_none"]["verdict"].startswith("the cell cannot tell")
     assert len(hardest_objects(attempts, 5)) == 5 and isinstance(never_held(attempts), list)
+    power = pick_power(attempts[attempts.draw == 0], "none@150", "none@50", 70, [2, 4, 8], 0.1)
+    assert power["pilot_objects"] == 20 and 0 < power["power"][2] < power["power"][4] <= power["power"][8] <= 1
 
 
 def test_the_kept_networks_pick_a_few_real_objects(repo_root, tmp_path, monkeypatch):
