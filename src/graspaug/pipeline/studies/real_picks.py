@@ -45,7 +45,7 @@ def draw_arms(folder: Path) -> dict[str, str]:
 
 def draw_folders(networks: Path, draws: list[int] | None) -> dict[int, Path]:
     """Draw → its kept seed-0 networks' folder (``networks``/d<k>-s0); every arm's ``model.pt`` must be there."""
-    networks = Path(networks)
+    networks = Path(networks).resolve()  # absolute: worker processes may run in another folder
     if not networks.is_dir():
         raise DataError(f"--networks {networks}: no such folder")
     found = {int(p.name[1:].split("-")[0]): p for p in networks.glob("d*-s0") if p.is_dir()}
