@@ -380,3 +380,25 @@ def test_two_evaluates_into_one_out_take_turns_and_both_finish(project):
     outcomes = [(r.wait(timeout=600), r.stderr.read()) for r in runs]
     assert [code for code, _ in outcomes] == [0, 0], outcomes
     assert (root / "both/report.md").is_file() and not list(root.glob(".both.tmp-*"))
+
+
+def test_the_confirmatory_networks_make_their_test_set_by_their_cards(repo_root, tmp_path):
+    """The kept networks of the confirmatory study, with no --params: the test set is made as their training data
+    were (size `fit`, 5 views per pose, from their cards), and evaluate.json says so."""
+    import shutil
+
+    corpus = repo_root.parent / "shared" / "corpora" / "gso100"
+    kept = repo_root / "results/real-objects-confirm/networks/d10-s0"
+    if not corpus.is_dir() or not kept.is_dir():
+        pytest.skip("gso100 beside this clone and the confirmatory study's draw 10 are needed")
+    objects = tmp_path / "objects"
+    objects.mkdir()
+    shutil.copy(corpus / "AllergenFree_JarroDophilus.obj", objects)
+    models = [str(kept / name / "model.pt") for name in ("targeted-50-0", "targeted-50-1")]
+    out = tmp_path / "out"
+    done = _evaluate(tmp_path, *models, "--corpus", str(objects), "--out", str(out), "--cache", str(tmp_path / "c"),
+                     params=None)  # fmt: skip
+    assert done.exit_code == 0, done.output
+    shaped = json.loads((out / "evaluate.json").read_text())["shaped_by"]
+    assert shaped["size"] == "fit" and shaped["rules"].startswith("the models' cards")
+    assert "not evidence about the method" in done.output  # two single networks: no method verdict
