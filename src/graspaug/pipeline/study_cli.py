@@ -216,7 +216,8 @@ def confirm_design_command(
     "the objects' bootstrap with one draw; an object's attempts are one unit), beside the paper's 68% → 86%. Writes "
     "report.md, summary.json and a success and a failure picture of each network arm to `--out`; with `--results` "
     "one row per attempt to `results/<NAME>/attempts.parquet` (`graspaug results` recomputes every figure).\n\n"
-    "Cost on 2 cores: see docs/results.md (timed on one draw before the rest).",
+    "Cost on 2 cores: about 1.1 s an attempt on one core (the pilot: 800 attempts in 881 s), so a draw of 71 objects × "
+    "10 attempts × 4 arms about 40 min with `--workers 2`.",
 )
 def real_picks_command(
     networks: Path = typer.Option(
