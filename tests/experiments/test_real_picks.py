@@ -57,10 +57,19 @@ def test_the_kept_networks_pick_a_few_real_objects(repo_root, tmp_path, monkeypa
     objects.mkdir()
     for name in SMALL:
         shutil.copy(corpus / name, objects / name)
-    out = tmp_path / "out"
-    done = _picks(repo_root, monkeypatch, "--networks", KEPT, "--draws", "0", "--objects", str(objects),
-                  "--attempts", "2", "--workers", "2", "--out", str(out))  # fmt: skip
+    out, kept = tmp_path / "out", str(repo_root / KEPT)
+    shutil.copytree(repo_root / "profiles", tmp_path / "profiles")  # these d0-s0 cards predate test-set rules
+    monkeypatch.chdir(tmp_path)  # --results writes results/<NAME>/ here, not into the repository
+    pick = ["study", "real-picks", "--networks", kept, "--draws", "0", "--objects", str(objects), "--attempts", "2"]
+    done = CliRunner().invoke(app, [*pick, "--workers", "2", "--out", str(out), "--results", "picks"])
     assert done.exit_code == 0, done.output
+    table = pd.read_parquet(tmp_path / "results" / "picks" / "attempts.parquet")
+    assert len(table) == 2 * 2 * 4 and set(table.draw) == {0}
+    again = CliRunner().invoke(app, [*pick, "--out", str(tmp_path / "again"), "--results", "picks"])
+    assert again.exit_code == 0 and "in the results table already" in again.output, again.output
+    assert pd.read_parquet(tmp_path / "results" / "picks" / "attempts.parquet").equals(table)  # not picked again
+    other = CliRunner().invoke(app, [*pick[:-1], "3", "--out", str(tmp_path / "other"), "--results", "picks"])
+    assert other.exit_code == 2 and "its draws have 2 attempts" in other.output, other.output
     summary = json.loads((out / "summary.json").read_text())
     assert set(summary["arms"]) == {"none@50", "targeted@50", "none@100", ANTIPODAL}
     assert summary["attempts_per_arm"] == {arm: 4 for arm in summary["arms"]} and summary["objects"] == 2

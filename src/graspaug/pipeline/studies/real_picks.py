@@ -77,12 +77,12 @@ def test_objects(folder: Path) -> list[str]:
 
 def card_surface(folder: Path, fallback):
     """The ingest surface settings the draw's networks' data were made by (their cards' ``test_set_rules``), else
-    ``fallback``; a camera other than the cell's is refused."""
+    ``fallback()`` (read only then: a profile of the project the command runs in)."""
     from graspaug.geometry.settings import SurfaceSettings
 
     card = json.loads((folder / ARM_FOLDERS["none@50"] / "card.json").read_text())
     rules = card.get("test_set_rules")
-    return (SurfaceSettings(**rules["ingest"]["surface"]) if rules else fallback), card
+    return (SurfaceSettings(**rules["ingest"]["surface"]) if rules else fallback()), card
 
 
 def check_camera(card: dict, cell, where: Path) -> None:
@@ -156,14 +156,22 @@ def run(
     fallback_surface,
     out: Path,
     pictures: bool,
+    done: pd.DataFrame | None = None,
+    on_draw=None,
 ) -> tuple[pd.DataFrame, dict, str]:
     """Pick every object of every draw in every arm; (the attempts table, the summary, the report's markdown).
-    ``out``: the folder the pictures go to (a staging folder)."""
+    ``out``: the folder the pictures go to (a staging folder). ``done``: attempts of earlier runs (a results
+    folder's table); its draws are not picked again and its rows join the summary. ``on_draw(table, seconds)`` is
+    called after each draw with every attempt so far, so a long study keeps each draw as it finishes."""
     from graspaug.sim.objects import folder_meshes, prepare_objects
 
     folders = draw_folders(networks, draws)
+    earlier = set() if done is None or done.empty else set(int(d) for d in done.draw)
     sim, rows, skipped, seconds = params.sim, [], {}, {}
     for d, folder in folders.items():
+        if d in earlier:
+            log.info("real-picks draw %d: in the results table already, not picked again", d)
+            continue
         began = time.perf_counter()
         surface, card = card_surface(folder, fallback_surface)
         check_camera(card, sim.cell, folder)
@@ -183,19 +191,44 @@ def run(
         objects = prepare_objects((), (), Path("."), *physics, meshes, None, params.workers)
         jobs, arms = jobs_for_draw(d, folder, objects, attempts, params.seed, pictures), [*draw_arms(folder)]
         log.info("real-picks draw %d: %d objects × %d attempts, arms %s", d, len(objects), attempts, arms)
-        done = run_trials(jobs, sim, params.render.crop, params.workers)
-        for row in done:
+        picked = run_trials(jobs, sim, params.render.crop, params.workers)
+        for row in picked:
             row["draw"] = d
-        rows += done
+        rows += picked
         seconds[d] = round(time.perf_counter() - began)
-        log.info("real-picks draw %d: %d attempts in %d s", d, len(done), seconds[d])
-    table = pd.DataFrame([{k: row.get(k) for k in ATTEMPT_COLUMNS} for row in rows])
-    table["success"] = table.success.astype(bool)
+        log.info("real-picks draw %d: %d attempts in %d s", d, len(picked), seconds[d])
+        table = attempts_table(rows, done)
+        if on_draw is not None:
+            on_draw(table, seconds)
+    table = attempts_table(rows, done)
+    if table.empty:
+        raise DataError(f"draws {sorted(folders)}: every one is in the results table already; nothing to pick")
     summary = pick_summary(table, list(dict.fromkeys(table.arm)), sim.n_bootstrap, params.seed)
     summary |= {"never_held": never_held(table), "skipped": skipped, "seconds": seconds, "attempts": attempts}
+    summary["kept_before"] = sorted(earlier & set(folders))
     if pictures:
         draw_pictures(rows, out)
     return table, summary, report_markdown(table, summary)
+
+
+def attempts_table(rows: list[dict], done: pd.DataFrame | None = None) -> pd.DataFrame:
+    """One row per attempt (:data:`ATTEMPT_COLUMNS`), earlier runs' ``done`` first."""
+    table = pd.DataFrame([{k: row.get(k) for k in ATTEMPT_COLUMNS} for row in rows], columns=list(ATTEMPT_COLUMNS))
+    if done is not None and not done.empty:
+        table = pd.concat([done[list(ATTEMPT_COLUMNS)], table], ignore_index=True) if len(table) else done.copy()
+    return table.assign(success=table.success.astype(bool))
+
+
+def earlier_attempts(folder: Path, attempts: int) -> tuple[pd.DataFrame | None, dict]:
+    """The attempts table and meta of a results folder from an earlier run (``None`` where there is none); a run
+    with another ``--attempts`` is refused: its draws would not be alike."""
+    table, meta = folder / "attempts.parquet", folder / "meta.json"
+    if not table.is_file():
+        return None, {}
+    meta = json.loads(meta.read_text()) if meta.is_file() else {}
+    if meta.get("attempts") not in (None, attempts):
+        raise DataError(f"{folder}: its draws have {meta['attempts']} attempts an object and arm, this run {attempts}")
+    return pd.read_parquet(table), meta
 
 
 def draw_pictures(rows: list[dict], out: Path) -> None:
@@ -224,7 +257,9 @@ def report_markdown(table: pd.DataFrame, summary: dict) -> str:
         "# Picks of real objects by arm",
         "",
         f"{summary['objects']} objects (object × draw), {summary['attempts']} attempts each and arm, draws "
-        f"{summary['draws']}; an object's attempts are one unit (its share of successes).",
+        f"{summary['draws']}; an object's attempts are one unit (its share of successes)."
+        + (f" Draws {summary['kept_before']}: in the results table already, not picked again." if summary.get(
+            "kept_before") else ""),
         "",
         "| who | objects | attempts | before (none@50) | after (targeted@50) |",
         "|---|---|---|---|---|",
