@@ -258,8 +258,11 @@ def report_markdown(table: pd.DataFrame, summary: dict) -> str:
         "",
         f"{summary['objects']} objects (object × draw), {summary['attempts']} attempts each and arm, draws "
         f"{summary['draws']}; an object's attempts are one unit (its share of successes)."
-        + (f" Draws {summary['kept_before']}: in the results table already, not picked again." if summary.get(
-            "kept_before") else ""),
+        + (
+            f" Draws {summary['kept_before']}: in the results table already, not picked again."
+            if summary.get("kept_before")
+            else ""
+        ),
         "",
         "| who | objects | attempts | before (none@50) | after (targeted@50) |",
         "|---|---|---|---|---|",
