@@ -9,7 +9,14 @@ import pandas as pd
 import pytest
 from typer.testing import CliRunner
 
-from graspaug.experiments.cell.picks import ANTIPODAL, hardest_objects, never_held, pick_power, pick_summary
+from graspaug.experiments.cell.picks import (
+    ANTIPODAL,
+    hardest_objects,
+    never_held,
+    pick_power,
+    pick_ranking,
+    pick_summary,
+)
 from graspaug.pipeline.cli import app
 
 KEPT = "results/attribution-real-objects-4000/networks"
@@ -45,8 +52,32 @@ def test_pick_summary_reads_the_control_first_and_clusters_attempts_by_object():
     if not unclear["control_shows"]:
         assert unclear["contrasts"]["targeted_vs_none"]["verdict"].startswith("the cell cannot tell")
     assert len(hardest_objects(attempts, 5)) == 5 and isinstance(never_held(attempts), list)
+    assert "ranking" not in summary  # no scores in this table
     power = pick_power(attempts[attempts.draw == 0], "none@150", "none@50", 70, [2, 4, 8], 0.1)
     assert power["pilot_objects"] == 20 and 0 < power["power"][2] < power["power"][4] <= power["power"][8] <= 1
+
+
+def test_the_ranking_compares_networks_on_the_same_executed_grasps():
+    """Every network scores every executed grasp: the one whose scores follow the outcomes ranks them better."""
+    rng = np.random.default_rng(1)
+    n = 3 * 25 * 8
+    success = rng.random(n) < 0.3
+    attempts = pd.DataFrame({
+        "draw": np.repeat([0, 1, 2], n // 3), "object": np.repeat(np.arange(75), 8), "success": success,
+        "score_none@50": rng.random(n), "score_targeted@50": rng.random(n),
+        "score_none@150": np.clip(success * 0.4 + rng.random(n) * 0.6, 0, 1),
+    })  # fmt: skip
+    attempts.loc[::7, "score_none@50"] = np.nan  # no grasp planned: not an executed grasp
+    ranking = pick_ranking(attempts)
+    assert ranking["grasps"] == int(attempts["score_none@50"].notna().sum())
+    assert ranking["arms"]["none@150"]["mean"] > 0.8 and abs(ranking["arms"]["none@50"]["mean"] - 0.5) < 0.1
+    assert ranking["contrasts"]["control"]["verdict"] == "higher" and ranking["contrasts"]["control"]["over"] == "draws"
+    assert ranking["contrasts"]["targeted_vs_none"]["verdict"] == "not shown (the interval holds zero)"
+    one = pick_ranking(attempts[attempts.draw == 0])
+    assert one["contrasts"]["control"]["over"] == "objects" and one["contrasts"]["control"]["n"] == 25
+    flat = pick_ranking(attempts.assign(**{"score_none@150": rng.random(n)}))
+    if not flat["control_shows"]:
+        assert flat["contrasts"]["targeted_vs_none"]["verdict"].startswith("the cell cannot tell")
 
 
 def test_the_kept_networks_pick_a_few_real_objects(repo_root, tmp_path, monkeypatch):
@@ -65,6 +96,11 @@ def test_the_kept_networks_pick_a_few_real_objects(repo_root, tmp_path, monkeypa
     assert done.exit_code == 0, done.output
     table = pd.read_parquet(tmp_path / "results" / "picks" / "attempts.parquet")
     assert len(table) == 2 * 2 * 4 and set(table.draw) == {0}
+    scores = table[["score_none@50", "score_targeted@50", "score_none@100"]]  # every network, every executed grasp
+    planned = table.outcome != "no_grasp"
+    assert scores[planned].notna().all().all() and scores[~planned].isna().all().all()
+    own = table[(table.arm == "none@50") & planned]
+    assert np.allclose(own["score_none@50"], own.quality, atol=1e-5)  # a network's own grasp: the quality it planned
     again = CliRunner().invoke(app, [*pick, "--out", str(tmp_path / "again"), "--results", "picks"])
     assert again.exit_code == 0 and "in the results table already" in again.output, again.output
     assert pd.read_parquet(tmp_path / "results" / "picks" / "attempts.parquet").equals(table)  # not picked again

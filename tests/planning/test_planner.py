@@ -31,7 +31,7 @@ from graspaug.io.sources import pybullet_sources
 from graspaug.nets.gqcnn import GQCNN
 from graspaug.nets.settings import GQCNNConfig
 from graspaug.pipeline.cli import app
-from graspaug.planning import ModelCard, NoGraspFound, PlanningError, load_planner, plan_grasp, plan_grasps
+from graspaug.planning import ModelCard, NoGraspFound, Planner, PlanningError, load_planner, plan_grasp, plan_grasps
 from graspaug.render.camera import look_at
 from graspaug.render.depth import render_depth
 from graspaug.render.settings import CropGeometry, Intrinsics, ViewpointRanges
@@ -397,6 +397,10 @@ def test_network_crops_are_what_the_network_scored(scene, model_path):
                 torch.from_numpy(crops).unsqueeze(1), torch.tensor([g.depth for g in grasps], dtype=torch.float32)
             )
         assert np.allclose(quality.numpy(), [g.quality for g in grasps], atol=1e-5)
+        for g in grasps:  # Planner.score rates a given grasp (another planner's) as plan rated it
+            assert np.allclose(planner.score(depth, intrinsics, g.grasp), [g.quality], atol=1e-5)
+    with pytest.raises(PlanningError, match="no network to score"):
+        Planner(None).score(depth, intrinsics, grasps[0].grasp)
 
 
 def test_the_picture_enlarges_the_object(scene, model_path, tmp_path):

@@ -509,7 +509,8 @@ def combine_picks(folder: Path) -> dict:
 
 
 def picks_figures(result: dict, study: str) -> dict[str, str]:
-    """``<study>/<arm>`` (success rate, ``mean [low, high]``), ``<study>/<contrast>`` and its ``/verdict``."""
+    """``<study>/<arm>`` (success rate, ``mean [low, high]``), ``<study>/<contrast>`` and its ``/verdict``; the
+    networks' ranking as ``<study>/ranking/<arm>`` (ROC AUC), ``<study>/ranking/<contrast>`` and its ``/verdict``."""
 
     def text(c, sign=""):
         return "n/a" if c["low"] is None else f"{c['mean']:{sign}.3f} [{c['low']:{sign}.3f}, {c['high']:{sign}.3f}]"
@@ -518,6 +519,11 @@ def picks_figures(result: dict, study: str) -> dict[str, str]:
     for name, c in result["contrasts"].items():
         out[f"{study}/{name}"] = text(c, "+")
         out[f"{study}/{name}/verdict"] = c["verdict"]
+    ranking = result.get("ranking") or {}
+    out |= {f"{study}/ranking/{arm}": text(c) for arm, c in ranking.get("arms", {}).items()}
+    for name, c in ranking.get("contrasts", {}).items():
+        out[f"{study}/ranking/{name}"] = text(c, "+")
+        out[f"{study}/ranking/{name}/verdict"] = c["verdict"]
     return out
 
 

@@ -214,6 +214,31 @@ class Planner:
         crops = crops_from_depth_image(adapter.image(depth), virtual.centers, virtual.angles, geometry)
         return crops, virtual.widths / geometry.factor
 
+    def score(
+        self,
+        depth: np.ndarray,
+        intrinsics: Intrinsics | dict,
+        grasps: ImageGrasps,
+        camera_distance: float | None = None,
+        fill_missing: bool = False,
+    ) -> np.ndarray:
+        """The network's success probability (N,) of each of ``grasps`` (image grasps on ``depth`` (H, W) m, as
+        :meth:`plan` returns them, e.g. another planner's), seen as :meth:`plan` sees them (the image resampled
+        to the training camera). Same arguments as :meth:`plan`; the random antipodal planner has no scores."""
+        if self.net is None:
+            raise PlanningError("the random antipodal planner has no network to score grasps with")
+        depth = check_depth(depth, fill_missing)
+        intrinsics = intrinsics_for(depth.shape, intrinsics)
+        distance = float(np.median(depth)) if camera_distance is None else float(camera_distance)
+        adapter = camera_adapter(self.card, intrinsics, distance)
+        before = torch.get_num_threads()
+        if self.threads:
+            torch.set_num_threads(self.threads)
+        try:
+            return self.policy(adapter.virtual).quality(adapter.image(depth), adapter.to_virtual(grasps))
+        finally:
+            torch.set_num_threads(before)
+
     @staticmethod
     def _planned(
         g: ImageGrasps, quality: float, elapsed: float, candidates: int, intrinsics: Intrinsics

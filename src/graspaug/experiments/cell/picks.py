@@ -13,7 +13,7 @@ draw it is the objects' bootstrap (attempts resampled with their object).
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 import numpy as np
 import pandas as pd
@@ -66,6 +66,71 @@ def pick_summary(attempts: pd.DataFrame, arms: Sequence[str], n_resamples: int =
         if a in arms and b in arms:
             diffs = {d: (g[a] - g[b]).to_numpy() for d, g in by_draw.items()}
             out["contrasts"][name] = _interval(diffs, n_resamples, seed) | {"a": a, "b": b}
+    _read_control_first(out)
+    ranking = pick_ranking(attempts, n_resamples, seed)
+    if ranking:
+        out["ranking"] = ranking
+    return out
+
+
+def pick_ranking(attempts: pd.DataFrame, n_resamples: int = 2000, seed: int = 0) -> dict:
+    """Each network's ranking of the cell's outcomes: the ROC AUC of its success probability (``score_<arm>``)
+    against the outcome of every executed grasp of the draw (every arm's attempts that planned one, the antipodal
+    arm's too, so every network scores the same grasps), and the paired AUC differences ``control`` and
+    ``targeted_vs_none`` (control first, as :func:`pick_summary`). A ranking needs fewer attempts than a rate: it
+    uses every executed grasp, not only each network's own best. Intervals: t over the draws' AUCs with two draws
+    or more, else the objects' bootstrap of the one draw. ``{}`` where the table holds no scores."""
+    from graspaug.experiments.stats import weighted_roc_auc
+
+    arms = [c.removeprefix("score_") for c in attempts.columns if c.startswith("score_")]
+    if not arms:
+        return {}
+    executed = attempts.dropna(subset=[f"score_{a}" for a in arms])
+    by_draw = {int(d): g for d, g in executed.groupby("draw") if g.success.nunique() == 2}
+    if not by_draw:
+        return {"grasps": int(len(executed)), "arms": {}, "contrasts": {}, "control_shows": False}
+
+    def auc(g: pd.DataFrame, arm: str) -> float:
+        return float(weighted_roc_auc(g.success.to_numpy(bool), g[f"score_{arm}"].to_numpy(float), np.ones(len(g))))
+
+    def interval(
+        values: Callable[[pd.DataFrame], float], boot_values: Callable[[pd.DataFrame, ObjectBootstrap], np.ndarray]
+    ) -> dict:
+        if len(by_draw) >= 2:
+            t = draw_test([values(g) for g in by_draw.values()])
+            return {
+                "mean": t["mean"],
+                "low": t["low"],
+                "high": t["high"],
+                "p": t["p"],
+                "over": "draws",
+                "n": len(by_draw),
+            }
+        (g,) = by_draw.values()
+        boot = ObjectBootstrap(g.object.to_numpy(), n_resamples, seed)
+        low, high = percentile_interval(boot_values(g, boot))
+        return {"mean": values(g), "low": low, "high": high, "p": None, "over": "objects", "n": int(g.object.nunique())}
+
+    def boot_auc(g: pd.DataFrame, boot: ObjectBootstrap, arm: str) -> np.ndarray:
+        return boot.roc_auc(g.success.to_numpy(bool), g[f"score_{arm}"].to_numpy(float))
+
+    out = {"grasps": int(sum(len(g) for g in by_draw.values())), "draws": sorted(by_draw), "arms": {}, "contrasts": {}}
+    for arm in arms:
+        out["arms"][arm] = interval(lambda g, a=arm: auc(g, a), lambda g, b, a=arm: boot_auc(g, b, a))
+    control = max((a for a in arms if a.startswith("none@") and a != "none@50"), default="none@150", key=_size)
+    for name, (a, b) in {"control": (control, "none@50"), "targeted_vs_none": ("targeted@50", "none@50")}.items():
+        if a in arms and b in arms:
+            c = interval(
+                lambda g, a=a, b=b: auc(g, a) - auc(g, b),
+                lambda g, bt, a=a, b=b: boot_auc(g, bt, a) - boot_auc(g, bt, b),
+            )
+            out["contrasts"][name] = c | {"a": a, "b": b}
+    _read_control_first(out)
+    return out
+
+
+def _read_control_first(out: dict) -> None:
+    """Each contrast's verdict, the control's first: where it does not show, every other is "the cell cannot tell"."""
     control = out["contrasts"].get("control")
     shows = control is not None and control["low"] is not None and control["low"] > 0
     out["control_shows"] = shows
@@ -74,7 +139,6 @@ def pick_summary(attempts: pd.DataFrame, arms: Sequence[str], n_resamples: int =
             c["verdict"] = _verdict(c)
         else:
             c["verdict"] = "the cell cannot tell (the positive control does not show)"
-    return out
 
 
 def _size(arm: str) -> int:

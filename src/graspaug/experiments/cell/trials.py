@@ -33,6 +33,9 @@ class ObjectJob:
     drop_seeds: tuple[int, ...]
     plan_seeds: tuple[int, ...]
     record: bool
+    #: (arm, model.pt) of networks that also score each executed grasp (its success probability in ``score_<arm>``):
+    #: every network rates the same grasps, so their ranking of the cell's outcomes can be compared
+    scorers: tuple[tuple[str, str], ...] = ()
 
 
 def model_path(seed_dir: Path, base_size: int, ratio: float, pool: str = "targeted") -> Path:
@@ -170,7 +173,7 @@ def _policy(model: str | None, layout, sampler, cem, crop_size: int, out_size: i
     return _cached_policy(path, (stat.st_mtime_ns, stat.st_size), layout, sampler, cem, crop_size, out_size)
 
 
-@functools.lru_cache(maxsize=4)
+@functools.lru_cache(maxsize=8)
 def _cached_policy(model: str | None, version, layout, sampler, cem, crop_size: int, out_size: int):
     """A :class:`graspaug.planning.Planner`: the public planner is the one the robot uses. A
     checkpoint without a model card gets the render params' crop sizes."""
@@ -204,9 +207,14 @@ def run_object(
     for attempt, (drop_seed, plan_seed) in enumerate(zip(job.drop_seeds, job.plan_seeds)):
         rng = np.random.default_rng(plan_seed)
         record = job.record and attempt == 0
+        scores: dict[str, float | None] = {arm: None for arm, _ in job.scorers}
 
-        def plan(depth, camera, k, rng=rng):
-            return next(iter(policy.plan(depth, k, rng, camera_distance=camera.height, fill_missing=True)), None)
+        def plan(depth, camera, k, rng=rng, scores=scores):
+            planned = next(iter(policy.plan(depth, k, rng, camera_distance=camera.height, fill_missing=True)), None)
+            for arm, path in job.scorers if planned is not None else ():  # the same image the planner saw
+                scorer = _policy(path, layout, sampler, cem, crop_size, out_size)
+                scores[arm] = float(scorer.score(depth, k, planned.grasp, camera.height, fill_missing=True)[0])
+            return planned
 
         result = run_trial(
             job.sim_object,
@@ -245,6 +253,7 @@ def run_object(
                 "planning_time": result.planning_time,
                 "_depth": result.depth,
                 "_frames": result.frames,
+                **{f"score_{arm}": q for arm, q in scores.items()},
             }
         )
     return rows

@@ -127,15 +127,18 @@ RECORDED = 12  # objects whose first attempt is recorded in every arm (the pictu
 
 def jobs_for_draw(draw: int, folder: Path, objects, attempts: int, seed: int, pictures: bool) -> list[ObjectJob]:
     """An :class:`ObjectJob` per object and arm; an object's drops and planner seeds are drawn from ``seed`` and
-    its name, the same in every arm (and every draw: the same object is dropped alike)."""
+    its name, the same in every arm (and every draw: the same object is dropped alike). Every network of the draw
+    scores each executed grasp (``score_<arm>``), for their ranking of the cell's outcomes."""
     jobs = []
     for index, obj in enumerate(objects):
         record = pictures and index < RECORDED  # frames of the first attempt: a success and a failure to draw
         drops = tuple(int(shape_rng(seed, obj.name, f"sim-drop-{a}").integers(2**31 - 1)) for a in range(attempts))
         plans = tuple(int(shape_rng(seed, obj.name, f"sim-plan-{a}").integers(2**31 - 1)) for a in range(attempts))
+        scorers = tuple((arm, str(folder / name / "model.pt")) for arm, name in draw_arms(folder).items())
         for arm, name in (draw_arms(folder) | {ANTIPODAL: None}).items():
             model = None if name is None else str(folder / name / "model.pt")
-            jobs.append(ObjectJob(arm, 0, model, obj.name, obj.kind, obj.body, drops, plans, record))
+            job = ObjectJob(arm, 0, model, obj.name, obj.kind, obj.body, drops, plans, record, scorers)
+            jobs.append(job)
     return jobs
 
 
@@ -212,10 +215,13 @@ def run(
 
 
 def attempts_table(rows: list[dict], done: pd.DataFrame | None = None) -> pd.DataFrame:
-    """One row per attempt (:data:`ATTEMPT_COLUMNS`), earlier runs' ``done`` first."""
-    table = pd.DataFrame([{k: row.get(k) for k in ATTEMPT_COLUMNS} for row in rows], columns=list(ATTEMPT_COLUMNS))
+    """One row per attempt (:data:`ATTEMPT_COLUMNS` and each network's ``score_<arm>`` of the executed grasp),
+    earlier runs' ``done`` first."""
+    scores = list(dict.fromkeys(k for row in rows for k in row if k.startswith("score_")))
+    columns = [*ATTEMPT_COLUMNS, *scores]
+    table = pd.DataFrame([{k: row.get(k) for k in columns} for row in rows], columns=columns)
     if done is not None and not done.empty:
-        table = pd.concat([done[list(ATTEMPT_COLUMNS)], table], ignore_index=True) if len(table) else done.copy()
+        table = pd.concat([done, table], ignore_index=True) if len(table) else done.copy()
     return table.assign(success=table.success.astype(bool))
 
 
@@ -276,6 +282,7 @@ def report_markdown(table: pd.DataFrame, summary: dict) -> str:
         "|---|---|---|",
         *(f"| {n} ({c['a']} − {c['b']}) | {text(c)} | {c['verdict']} |" for n, c in summary["contrasts"].items()),
         "",
+        *ranking_lines(summary.get("ranking") or {}, text),
         f"Objects no arm ever held ({len(summary['never_held'])}): {', '.join(summary['never_held']) or 'none'}.",
         "",
         "The hardest objects (success share by arm):",
@@ -283,6 +290,27 @@ def report_markdown(table: pd.DataFrame, summary: dict) -> str:
         hardest_objects(table).round(2).to_markdown(),
     ]
     return "\n".join(lines) + "\n"
+
+
+def ranking_lines(ranking: dict, text) -> list[str]:
+    """The report's lines on the networks' ranking of the executed grasps' outcomes (ROC AUC), if any."""
+    if not ranking:
+        return []
+    if not ranking["arms"]:
+        return [f"Ranking: {ranking['grasps']} executed grasps, all of one outcome in every draw: nothing to rank.", ""]
+    return [
+        f"Each network's ranking of the cell's outcomes: ROC AUC of its success probability against the outcome of "
+        f"every executed grasp of every arm ({ranking['grasps']} grasps; every network scores the same ones):",
+        "",
+        "| network | ROC AUC [95%] |",
+        "|---|---|",
+        *(f"| {a} | {text(c)} |" for a, c in ranking["arms"].items()),
+        "",
+        "| ranking contrast | AUC difference [95%] | verdict |",
+        "|---|---|---|",
+        *(f"| {n} ({c['a']} − {c['b']}) | {text(c)} | {c['verdict']} |" for n, c in ranking["contrasts"].items()),
+        "",
+    ]
 
 
 def write_results(folder: Path, table: pd.DataFrame, meta: dict) -> None:
