@@ -18,7 +18,8 @@ from sklearn.metrics import average_precision_score
 from typer.testing import CliRunner
 
 from graspaug.experiments.evaluate.numbers import test_ap as ap_of_models
-from graspaug.experiments.stats import ObjectBootstrap, nested_t_interval
+from graspaug.experiments.evaluate.words import printed_lines
+from graspaug.experiments.stats import ObjectBootstrap, nested_t_interval, verdict
 from graspaug.grasping.gripper import ParallelJawGripper
 from graspaug.io.checkpoints import finish_gqcnn_card, gqcnn_card, save_gqcnn
 from graspaug.nets.gqcnn import GQCNN, GQCNNConfig
@@ -71,6 +72,15 @@ def test_models_as_seeds_of_networks_give_each_networks_mean_with_the_verdict_in
     assert gain["mean"] == pytest.approx(full[1].mean() - full[0].mean())
     assert (gain["draws_low"], gain["draws_high"]) == pytest.approx((paired["low"], paired["high"]))
     assert gain["draws_low"] > 0  # less noise ranks better on every seed
+    assert verdict(gain) == "a gain in this draw of the data"  # seeds of one draw
+    over_draws = ap_of_models(labels, objects, weak | strong, 300, 0, seeds=3, replicates="draws")
+    across = over_draws["network_differences"]["strong0 (3 draws) − weak0 (3 draws)"]  # networks of 3 draws
+    assert (across["draws_low"], across["draws_high"], across["n_draws"]) == pytest.approx(
+        (paired["low"], paired["high"], 3)
+    )
+    assert verdict(across) == "a gain over 3 draws of the data"
+    printed = printed_lines(over_draws, "report.md")  # what evaluate prints: a method verdict, over the 3 draws
+    assert any(line.endswith("(a gain over 3 draws of the data)") for line in printed), printed
     assert "networks" not in ap_of_models(labels, objects, weak, 300, 0)
     with pytest.raises(ValueError, match="not networks of 2 seeds"):
         ap_of_models(labels, objects, weak, 300, 0, seeds=2)

@@ -82,6 +82,8 @@ def _networks(point: dict[str, float | None], resampled: dict[str, np.ndarray], 
     groups = [names[i : i + seeds] for i in range(0, len(names), seeds)]
     full = {g[0]: np.array([[np.nan if point[n] is None else point[n] for n in g]]) for g in groups}  # (1, S)
     boot = {g[0]: np.stack([resampled[n] for n in g])[None] for g in groups}  # (1, S, R)
+    if over == "draws":  # networks of S draws, one seed each: (S, 1), so a verdict says it covers S draws
+        full, boot = {k: v.T for k, v in full.items()}, {k: v.transpose(1, 0, 2) for k, v in boot.items()}
     label = {g[0]: f"{g[0]} ({seeds} {over})" for g in groups}
     first = groups[0][0]
     networks = {label[k]: nested_contrast(nested_t_interval(full[k], boot[k])) for k in full}

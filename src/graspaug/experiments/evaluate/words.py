@@ -37,6 +37,13 @@ def ap_text(c: dict, objects: int, spec: str = "+.4f") -> str:
     return interval_text(c, spec)
 
 
+def replicates(result: dict) -> int:
+    """How many replicates each arm of an evaluate ``result`` has (seeds of one draw, or networks of as many draws);
+    0 without ``--seeds``."""
+    first = next(iter(result.get("networks", {}).values()), None)
+    return 0 if first is None else int(first["n_seeds"] * first["n_draws"])
+
+
 def method_verdict(c: dict, n: int) -> str:
     """A replicated difference's verdict (:func:`~graspaug.experiments.stats.verdict`), given only with at least
     :data:`MIN_REPLICATES` replicates an arm."""
@@ -114,7 +121,7 @@ def report_markdown(result: dict, corpus: str, counts: dict, camera: str, shaped
         "other training seeds of the models.",
     ]
     if result.get("networks"):
-        n, over = next(iter(result["networks"].values()))["n_seeds"], result.get("replicates", "seeds")
+        n, over = replicates(result), result.get("replicates", "seeds")
         what = "training seeds of one draw of the data" if over == "seeds" else "networks of distinct draws of the data"
         lines += [
             "",
@@ -153,7 +160,7 @@ def printed_lines(result: dict, report) -> list[str]:
     lines = [f"{name}: test AP {ap_text(c, objects, '.4f')}" for name, c in result["models"].items()]
     lines += [f"{name}: {ap_text(c, objects)} ({SINGLE})" for name, c in result["differences"].items()]
     lines += [f"{name}: mean test AP {interval_text(c, '.4f')}" for name, c in result.get("networks", {}).items()]
-    n = next(iter(result.get("networks", {}).values()), {}).get("n_seeds", 0)
+    n = replicates(result)
     differences = result.get("network_differences", {})
     lines += [f"{name}: {interval_text(c)} ({method_verdict(c, n)})" for name, c in differences.items()]
     return lines + [f"({objects} objects, {result['datapoints']} datapoints; wrote {report})"]
