@@ -254,9 +254,9 @@ def report_markdown(table: pd.DataFrame, summary: dict) -> str:
     """The report: the table beside the paper's, rates and contrasts with their intervals and verdicts, the
     hardest objects and those no arm held."""
 
-    def text(c: dict) -> str:
-        ends = "no interval" if c["low"] is None else f"[{c['low']:+.3f}, {c['high']:+.3f}]"
-        return f"{c['mean']:+.3f} {ends} (95% over {c['over']}, n = {c['n']})"
+    def text(c: dict, sign: str = "+") -> str:  # sign "": a rate or an AUC, not a difference
+        ends = "no interval" if c["low"] is None else f"[{c['low']:{sign}.3f}, {c['high']:{sign}.3f}]"
+        return f"{c['mean']:{sign}.3f} {ends} (95% over {c['over']}, n = {c['n']})"
 
     paper = paper_table(summary)
     lines = [
@@ -276,7 +276,7 @@ def report_markdown(table: pd.DataFrame, summary: dict) -> str:
         "",
         "| arm | success rate [95%] |",
         "|---|---|",
-        *(f"| {a} | {text(c)} |" for a, c in summary["arms"].items()),
+        *(f"| {a} | {text(c, '')} |" for a, c in summary["arms"].items()),
         "",
         "| contrast | difference [95%] | verdict |",
         "|---|---|---|",
@@ -304,7 +304,7 @@ def ranking_lines(ranking: dict, text) -> list[str]:
         "",
         "| network | ROC AUC [95%] |",
         "|---|---|",
-        *(f"| {a} | {text(c)} |" for a, c in ranking["arms"].items()),
+        *(f"| {a} | {text(c, '')} |" for a, c in ranking["arms"].items()),
         "",
         "| ranking contrast | AUC difference [95%] | verdict |",
         "|---|---|---|",
