@@ -519,11 +519,15 @@ def picks_figures(result: dict, study: str) -> dict[str, str]:
     for name, c in result["contrasts"].items():
         out[f"{study}/{name}"] = text(c, "+")
         out[f"{study}/{name}/verdict"] = c["verdict"]
+        if c.get("per_draw"):
+            out[f"{study}/{name}/per_draw"] = ", ".join(f"{v:+.3f}" for v in c["per_draw"])
     ranking = result.get("ranking") or {}
     out |= {f"{study}/ranking/{arm}": text(c) for arm, c in ranking.get("arms", {}).items()}
     for name, c in ranking.get("contrasts", {}).items():
         out[f"{study}/ranking/{name}"] = text(c, "+")
         out[f"{study}/ranking/{name}/verdict"] = c["verdict"]
+        if c.get("per_draw"):
+            out[f"{study}/ranking/{name}/per_draw"] = ", ".join(f"{v:+.3f}" for v in c["per_draw"])
     return out
 
 

@@ -38,7 +38,8 @@ def _interval(values_by_draw: dict[int, np.ndarray], n_resamples: int, seed: int
     means = [float(np.mean(v)) for v in values_by_draw.values()]
     if len(values_by_draw) >= 2:
         t = draw_test(means)
-        return {"mean": t["mean"], "low": t["low"], "high": t["high"], "p": t["p"], "over": "draws", "n": len(means)}
+        out = {"mean": t["mean"], "low": t["low"], "high": t["high"], "p": t["p"], "over": "draws", "n": len(means)}
+        return out | {"per_draw": means}
     (values,) = values_by_draw.values()
     boot = ObjectBootstrap(np.arange(len(values)), n_resamples, seed)
     low, high = percentile_interval(boot.means(np.asarray(values, dtype=float)))
@@ -105,6 +106,7 @@ def pick_ranking(attempts: pd.DataFrame, n_resamples: int = 2000, seed: int = 0)
                 "p": t["p"],
                 "over": "draws",
                 "n": len(by_draw),
+                "per_draw": t["per_draw"],
             }
         (g,) = by_draw.values()
         boot = ObjectBootstrap(g.object.to_numpy(), n_resamples, seed)

@@ -245,7 +245,7 @@ def draw_pictures(rows: list[dict], out: Path) -> None:
         for success in (True, False):
             row = next((r for r in rows if r["arm"] == arm and r["success"] == success and r.get("_frames")), None)
             if row is not None:
-                pic = trial_picture(row, None)
+                pic = trial_picture(row, 0.0 if arm.startswith("none@") else 1.0)  # the network's ratio R
                 name = f"{arm.replace('@', '-')}-{'success' if success else 'failure'}.png"
                 pick_story(pic["depth"], pic["jaw"], pic["window"], pic["frames"], out / name, f"{arm}: {pic['title']}")
 
