@@ -217,8 +217,8 @@ def confirm_design_command(
     "report.md, summary.json and a success and a failure picture of each network arm to `--out`; with `--results` "
     "one row per attempt to `results/<NAME>/attempts.parquet` (`graspaug results` recomputes every figure), each "
     "draw as it finishes; a draw already there is not picked again (the summary covers every draw kept).\n\n"
-    "Cost on 2 cores: about 1.1 s an attempt on one core (the pilot: 800 attempts in 881 s), so a draw of 71 objects × "
-    "10 attempts × 4 arms about 40 min with `--workers 2`.",
+    "Cost on 2 cores (AMD EPYC): a draw of 74 objects × 10 attempts × 4 arms took 2,028 s with `--workers 2` beside "
+    "a training run (the pilot: 800 attempts in 881 s on one core).",
 )
 def real_picks_command(
     networks: Path = typer.Option(
