@@ -37,13 +37,28 @@ def _interval(values_by_draw: dict[int, np.ndarray], n_resamples: int, seed: int
     objects' bootstrap of the one draw."""
     means = [float(np.mean(v)) for v in values_by_draw.values()]
     if len(values_by_draw) >= 2:
-        t = draw_test(means)
-        out = {"mean": t["mean"], "low": t["low"], "high": t["high"], "p": t["p"], "over": "draws", "n": len(means)}
-        return out | {"per_draw": means}
+        return _over_draws(means)
     (values,) = values_by_draw.values()
     boot = ObjectBootstrap(np.arange(len(values)), n_resamples, seed)
-    low, high = percentile_interval(boot.means(np.asarray(values, dtype=float)))
-    return {"mean": means[0], "low": low, "high": high, "p": None, "over": "objects", "n": int(len(values))}
+    return _over_objects(means[0], boot.means(np.asarray(values, dtype=float)), len(values))
+
+
+def _over_draws(per_draw: list[float]) -> dict:
+    """A quantity's mean and 95% t-interval over its per-draw values (:func:`draw_test`)."""
+    t = draw_test(per_draw)
+    out = {"mean": t["mean"], "low": t["low"], "high": t["high"], "p": t["p"], "over": "draws", "n": len(per_draw)}
+    return out | {"per_draw": t["per_draw"]}
+
+
+def _over_objects(mean: float, resampled: np.ndarray, n_objects: int) -> dict:
+    """A one-draw quantity's ``mean`` and the percentile interval of its objects' bootstrap ``resampled`` (R,)."""
+    low, high = percentile_interval(resampled)
+    return {"mean": mean, "low": low, "high": high, "p": None, "over": "objects", "n": int(n_objects)}
+
+
+def _control_arm(arms: Sequence[str]) -> str:
+    """The positive control's arm: the largest none@B above 50 (none@150 in the confirmatory study)."""
+    return max((a for a in arms if a.startswith("none@") and a != "none@50"), default="none@150", key=_size)
 
 
 def pick_summary(attempts: pd.DataFrame, arms: Sequence[str], n_resamples: int = 2000, seed: int = 0) -> dict:
@@ -60,8 +75,7 @@ def pick_summary(attempts: pd.DataFrame, arms: Sequence[str], n_resamples: int =
     out["attempts_per_arm"] = {a: int((attempts.arm == a).sum()) for a in arms}
     for arm in arms:
         out["arms"][arm] = _interval({d: g[arm].to_numpy() for d, g in by_draw.items()}, n_resamples, seed)
-    control = max((a for a in arms if a.startswith("none@") and a != "none@50"), default="none@150", key=_size)
-    pairs = {"control": (control, "none@50"), "targeted_vs_none": ("targeted@50", "none@50")}
+    pairs = {"control": (_control_arm(arms), "none@50"), "targeted_vs_none": ("targeted@50", "none@50")}
     pairs |= {f"{a}_vs_antipodal": (a, ANTIPODAL) for a in arms if a != ANTIPODAL}
     for name, (a, b) in pairs.items():
         if a in arms and b in arms:
@@ -98,20 +112,10 @@ def pick_ranking(attempts: pd.DataFrame, n_resamples: int = 2000, seed: int = 0)
         values: Callable[[pd.DataFrame], float], boot_values: Callable[[pd.DataFrame, ObjectBootstrap], np.ndarray]
     ) -> dict:
         if len(by_draw) >= 2:
-            t = draw_test([values(g) for g in by_draw.values()])
-            return {
-                "mean": t["mean"],
-                "low": t["low"],
-                "high": t["high"],
-                "p": t["p"],
-                "over": "draws",
-                "n": len(by_draw),
-                "per_draw": t["per_draw"],
-            }
+            return _over_draws([values(g) for g in by_draw.values()])
         (g,) = by_draw.values()
         boot = ObjectBootstrap(g.object.to_numpy(), n_resamples, seed)
-        low, high = percentile_interval(boot_values(g, boot))
-        return {"mean": values(g), "low": low, "high": high, "p": None, "over": "objects", "n": int(g.object.nunique())}
+        return _over_objects(values(g), boot_values(g, boot), g.object.nunique())
 
     def boot_auc(g: pd.DataFrame, boot: ObjectBootstrap, arm: str) -> np.ndarray:
         return boot.roc_auc(g.success.to_numpy(bool), g[f"score_{arm}"].to_numpy(float))
@@ -119,8 +123,10 @@ def pick_ranking(attempts: pd.DataFrame, n_resamples: int = 2000, seed: int = 0)
     out = {"grasps": int(sum(len(g) for g in by_draw.values())), "draws": sorted(by_draw), "arms": {}, "contrasts": {}}
     for arm in arms:
         out["arms"][arm] = interval(lambda g, a=arm: auc(g, a), lambda g, b, a=arm: boot_auc(g, b, a))
-    control = max((a for a in arms if a.startswith("none@") and a != "none@50"), default="none@150", key=_size)
-    for name, (a, b) in {"control": (control, "none@50"), "targeted_vs_none": ("targeted@50", "none@50")}.items():
+    for name, (a, b) in {
+        "control": (_control_arm(arms), "none@50"),
+        "targeted_vs_none": ("targeted@50", "none@50"),
+    }.items():
         if a in arms and b in arms:
             c = interval(
                 lambda g, a=a, b=b: auc(g, a) - auc(g, b),
