@@ -200,12 +200,9 @@ def run(
         rows += picked
         seconds[d] = round(time.perf_counter() - began)
         log.info("real-picks draw %d: %d attempts in %d s", d, len(picked), seconds[d])
-        table = attempts_table(rows, done)
         if on_draw is not None:
-            on_draw(table, seconds)
-    table = attempts_table(rows, done)
-    if table.empty:
-        raise DataError(f"draws {sorted(folders)}: every one is in the results table already; nothing to pick")
+            on_draw(attempts_table(rows, done), seconds)
+    table = attempts_table(rows, done)  # never empty: a draw is picked now or was kept before
     summary = pick_summary(table, list(dict.fromkeys(table.arm)), sim.n_bootstrap, params.seed)
     summary |= {"never_held": never_held(table), "skipped": skipped, "seconds": seconds, "attempts": attempts}
     summary["kept_before"] = sorted(earlier & set(folders))
