@@ -7,6 +7,7 @@ import logging
 import math
 import os
 import time
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -14,7 +15,7 @@ from typing import Any
 import numpy as np
 import torch
 
-from graspaug.planning.camera import camera_adapter, check_depth, intrinsics_for
+from graspaug.planning.camera import CameraAdapter, camera_adapter, check_depth, intrinsics_for
 from graspaug.planning.card import ModelCard
 from graspaug.planning.errors import NoGraspFound, PlanningError
 from graspaug.planning.grasps import ImageGrasps, jaw_endpoints, opening_widths
@@ -146,13 +147,10 @@ class Planner:
         table's distance along the optical axis) defaults to the image's median depth. Raises
         :class:`PlanningError` for bad input."""
         start = time.perf_counter()
-        depth = check_depth(depth, fill_missing)
-        intrinsics = intrinsics_for(depth.shape, intrinsics)
+        depth, intrinsics, adapter = self._view(depth, intrinsics, camera_distance, fill_missing)
         if top < 1:
             raise PlanningError(f"top must be >= 1, got {top}")
         rng = rng if isinstance(rng, np.random.Generator) else np.random.default_rng(rng)
-        distance = float(np.median(depth)) if camera_distance is None else float(camera_distance)
-        adapter = camera_adapter(self.card, intrinsics, distance)
         if not adapter.identity:
             log.info(
                 "planning on a virtual camera: image scaled %.3f × %.3f, depths shifted %+.3f m",
@@ -169,13 +167,8 @@ class Planner:
                 fits = opening_widths(adapter.to_original(g), intrinsics.fx, intrinsics.fy) <= widest
                 return fits & antipodal_in_image(image, g, self.sampler, reach)
 
-        before = torch.get_num_threads()
-        if self.threads:
-            torch.set_num_threads(self.threads)
-        try:
+        with self._torch_threads():
             ranked = self.policy(adapter.virtual).plan_ranked(image, rng, top, accept)
-        finally:
-            torch.set_num_threads(before)
         if ranked is None:
             return []
         grasps, quality, candidates = ranked
@@ -200,13 +193,10 @@ class Planner:
         grasp's jaw opening (n,) in crop pixels. Same arguments as :meth:`plan`."""
         from graspaug.render.crops import crops_from_depth_image
 
-        depth = check_depth(depth, fill_missing)
-        intrinsics = intrinsics_for(depth.shape, intrinsics)
+        depth, intrinsics, adapter = self._view(depth, intrinsics, camera_distance, fill_missing)
         geometry = self.card.geometry
         if not grasps:
             return np.zeros((0, geometry.out_size, geometry.out_size), np.float32), np.zeros(0)
-        distance = float(np.median(depth)) if camera_distance is None else float(camera_distance)
-        adapter = camera_adapter(self.card, intrinsics, distance)
         image = ImageGrasps(
             *(np.concatenate([getattr(g.grasp, k) for g in grasps]) for k in ("centers", "angles", "depths", "widths"))
         )
@@ -227,15 +217,29 @@ class Planner:
         to the training camera). Same arguments as :meth:`plan`; the random antipodal planner has no scores."""
         if self.net is None:
             raise PlanningError("the random antipodal planner has no network to score grasps with")
+        depth, intrinsics, adapter = self._view(depth, intrinsics, camera_distance, fill_missing)
+        with self._torch_threads():
+            return self.policy(adapter.virtual).quality(adapter.image(depth), adapter.to_virtual(grasps))
+
+    def _view(
+        self, depth: np.ndarray, intrinsics: Intrinsics | dict, camera_distance: float | None, fill_missing: bool
+    ) -> tuple[np.ndarray, Intrinsics, CameraAdapter]:
+        """The checked depth image (H, W) m, its camera, and the adapter to the card's training camera
+        (the table at ``camera_distance`` m, or the image's median depth) that :meth:`plan`,
+        :meth:`network_crops` and :meth:`score` all see it through."""
         depth = check_depth(depth, fill_missing)
         intrinsics = intrinsics_for(depth.shape, intrinsics)
         distance = float(np.median(depth)) if camera_distance is None else float(camera_distance)
-        adapter = camera_adapter(self.card, intrinsics, distance)
+        return depth, intrinsics, camera_adapter(self.card, intrinsics, distance)
+
+    @contextmanager
+    def _torch_threads(self):
+        """Torch runs on :attr:`threads` threads inside (its setting unchanged with 0), restored after."""
         before = torch.get_num_threads()
         if self.threads:
             torch.set_num_threads(self.threads)
         try:
-            return self.policy(adapter.virtual).quality(adapter.image(depth), adapter.to_virtual(grasps))
+            yield
         finally:
             torch.set_num_threads(before)
 

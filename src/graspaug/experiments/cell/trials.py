@@ -198,6 +198,7 @@ def run_object(
     """Every attempt of one object in one arm: a row per attempt (plus depth and frames for the
     first attempt when ``job.record``). The planner fills the sensor's missing pixels from the
     nearest valid one."""
+    from graspaug.planning import check_depth
     from graspaug.sim.settings import DepthNoise
     from graspaug.sim.trials import TrialSettings, run_trial
 
@@ -210,10 +211,11 @@ def run_object(
         scores: dict[str, float | None] = {arm: None for arm, _ in job.scorers}
 
         def plan(depth, camera, k, rng=rng, scores=scores):
-            planned = next(iter(policy.plan(depth, k, rng, camera_distance=camera.height, fill_missing=True)), None)
-            for arm, path in job.scorers if planned is not None else ():  # the same image the planner saw
+            depth = check_depth(depth, fill_missing=True)  # filled once: the planner and every scorer see it
+            planned = next(iter(policy.plan(depth, k, rng, camera_distance=camera.height)), None)
+            for arm, path in job.scorers if planned is not None else ():
                 scorer = _policy(path, layout, sampler, cem, crop_size, out_size)
-                scores[arm] = float(scorer.score(depth, k, planned.grasp, camera.height, fill_missing=True)[0])
+                scores[arm] = float(scorer.score(depth, k, planned.grasp, camera.height)[0])
             return planned
 
         result = run_trial(
