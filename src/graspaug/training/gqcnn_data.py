@@ -165,11 +165,16 @@ def training_set(variant: Variant, split: ExperimentSplit, corpora: Corpora) -> 
     return data, info
 
 
-def test_set(original: Path, shapes: pd.DataFrame | None = None) -> tuple[GraspArrays, np.ndarray]:
-    """Every test-split datapoint of the original corpus (dataset folder ``original``) and its row in the index;
-    the split by the shape table ``shapes`` (the pipeline's: its rendered index holds none), or with None the
-    index's own ``split`` column (a dataset that carries it, as `graspaug evaluate`'s test sets do)."""
+def test_set(original: Path) -> tuple[GraspArrays, np.ndarray]:
+    """Every test-split datapoint of the original corpus (dataset folder ``original``) by its index's own
+    ``split`` column (a dataset that carries it, as `graspaug evaluate`'s test sets do) and its row in the index."""
     data = GraspImages.open(original)
-    index = data.index if shapes is None else with_split(data.index, shapes)
-    rows = np.flatnonzero((index.split == "test").to_numpy())
+    rows = np.flatnonzero((data.index.split == "test").to_numpy())
     return _arrays(data, rows), rows
+
+
+def split_test_set(original: Path, split: ExperimentSplit) -> tuple[GraspArrays, np.ndarray]:
+    """The test datapoints of ``split`` in the original corpus (dataset folder ``original``) and their rows in
+    its index: its test shapes' (:func:`load_split`: the pipeline's rendered index holds no split), or, for a
+    split that names none, the index's own (:func:`test_set`). The stage and its workers read them so."""
+    return shapes_datapoints(original, split.test) if split.test else test_set(original)

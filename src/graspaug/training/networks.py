@@ -45,7 +45,7 @@ from graspaug.training.gqcnn_data import (
     ExperimentSplit,
     shapes_datapoints,
     split_ids,
-    test_set,
+    split_test_set,
     training_set,
 )
 from graspaug.training.settings import TrainSettings
@@ -134,9 +134,7 @@ def train_network(job: NetworkJob, val: GraspArrays | None = None, test: GraspAr
     device = torch.device(job.device)
     train, info = training_set(job.variant, job.split, job.corpora)
     val = val if val is not None else shapes_datapoints(job.corpora.original, job.split.validation)[0]
-    if test is None:  # on a worker: the test split's shapes, as the stage read them
-        test = shapes_datapoints(job.corpora.original, job.split.test)[0] if job.split.test else None
-        test = test if test is not None else test_set(job.corpora.original)[0]
+    test = test if test is not None else split_test_set(job.corpora.original, job.split)[0]
     members = [GQCNN(job.net) for _ in job.inits]
     for net, init in zip(members, job.inits, strict=True):
         net.load_state_dict(init)
@@ -402,17 +400,16 @@ def train_paired(
     card: dict,
     label: str,
     workers: Workers | int = 1,
-    shapes=None,
 ) -> dict[int, list[dict]]:
     """Train ``variants`` for every training seed of the ``gqcnn`` params as :mod:`train_gqcnn
     <graspaug.pipeline.stages.train_gqcnn>` does (the seed's initial weights and noise streams, validated on
     ``split.validation``, tested on the test split of ``corpora.original``), each seed into
     ``out_dir``/s<seed>/ with its ``test_rows.npy``, ``val_rows.npy`` and ``split.json``; every seed's networks
-    on ``workers`` at once (:func:`train_jobs`); ``shapes``: the shape table that holds the split
-    (:func:`~graspaug.training.gqcnn_data.test_set`). Returns training seed → the networks' summaries
+    on ``workers`` at once (:func:`train_jobs`), tested on :func:`~graspaug.training.gqcnn_data.split_test_set`.
+    Returns training seed → the networks' summaries
     (:func:`train_network`)."""
     val, val_rows = shapes_datapoints(corpora.original, split.validation)
-    test, test_rows = test_set(corpora.original, shapes)
+    test, test_rows = split_test_set(corpora.original, split)
     jobs = []
     for seed in gqcnn.seeds:
         inits, noise_seeds = seed_members(gqcnn.net, global_seed, seed, gqcnn.members)

@@ -84,7 +84,7 @@ def run(params: Params, round_: int) -> None:
         pd.DataFrame({"shape_id": real}).to_csv(folder / "real.csv", index=False)
         corpora, card = Corpora(original, {b: folder / "dataset"}), seed_card(params.render, params.grasps, params.seed)
         workers, seeds = network_workers(params.workers), network_seed(params.seed, params.data_seed, draws_apart)
-        train_paired(variants, split, gq, seeds, device, nets, corpora, card, label, workers, shapes)
+        train_paired(variants, split, gq, seeds, device, nets, corpora, card, label, workers)
         seed_dirs, corpus = {s: nets / f"s{s}" for s in gq.seeds}, read_table(original / "index.parquet")
         history, curve = pd.read_csv(before / "history.csv"), pd.read_csv(before / "curve.csv")
         errors, history, followed = score_round(seed_dirs, variants, ARMS, corpus, failures, history, round_, cfg.worst)

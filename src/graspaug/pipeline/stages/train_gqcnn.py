@@ -35,7 +35,7 @@ from graspaug.pipeline.paths import (
 )
 from graspaug.pipeline.stages import StageError
 from graspaug.plots import validation_curves
-from graspaug.training.gqcnn_data import Corpora, load_split, shapes_datapoints, test_set
+from graspaug.training.gqcnn_data import Corpora, load_split, shapes_datapoints, split_test_set
 from graspaug.training.networks import (
     NetworkJob,
     network_seed,
@@ -78,7 +78,7 @@ def run(params: Params, seed: int) -> None:
     global_seed = network_seed(params.seed, params.data_seed, params.independent_draws)
     inits, noise_seeds = seed_members(cfg.net, global_seed, seed, cfg.members)
     val, val_rows = shapes_datapoints(corpora.original, split.validation)
-    test, test_rows = test_set(corpora.original, shapes)
+    test, test_rows = split_test_set(corpora.original, split)
     plan = seed_plan(variants, cfg.members, len(split.validation), val_rows, test_rows, device)
     log.info("train_gqcnn seed %d: %s", seed, plan)
     log_precision(f"train_gqcnn seed {seed}", "gqcnn.train.precision", cfg.train.precision, device, GQCNN_GPU_BFLOAT16)
