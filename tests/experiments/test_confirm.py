@@ -11,8 +11,8 @@ import yaml
 from scipy import stats
 
 from graspaug.errors import DataError
-from graspaug.experiments import confirm
-from graspaug.experiments.confirm_results import check_plan_history, combine_confirm, read_plan, read_plan_result
+from graspaug.experiments.confirm import numbers as confirm
+from graspaug.experiments.confirm.tables import check_plan_history, combine_confirm, read_plan, read_plan_result
 
 PLAN = {
     "format": "graspaug.confirm-plan/1",

@@ -267,7 +267,7 @@ def study_kind(folder: Path) -> str:
     """The study a results folder holds: ``confirm`` where it has a plan (``plan.yaml``), ``picks`` where it has a
     table of pick attempts (``attempts.parquet``), else its name's first word (``attribution-real-objects``:
     ``attribution``)."""
-    from graspaug.experiments.confirm_results import PLAN
+    from graspaug.experiments.confirm.tables import PLAN
 
     if (Path(folder) / PLAN).is_file():
         return "confirm"
@@ -278,8 +278,8 @@ def study_kind(folder: Path) -> str:
 
 def history_problems(results_dir: Path) -> list[str]:
     """What git says is wrong with the results folders whose history matters: a confirmatory study's plan committed
-    after its data, edited, or a draw dropped (:func:`~graspaug.experiments.confirm_results.check_plan_history`)."""
-    from graspaug.experiments.confirm_results import check_plan_history
+    after its data, edited, or a draw dropped (:func:`~graspaug.experiments.confirm.tables.check_plan_history`)."""
+    from graspaug.experiments.confirm.tables import check_plan_history
 
     folders = sorted(p for p in Path(results_dir).iterdir() if p.is_dir()) if Path(results_dir).is_dir() else []
     return [p for folder in folders if study_kind(folder) == "confirm" for p in check_plan_history(folder)]
@@ -492,7 +492,8 @@ def precision_figures(result: dict, study: str = "precision") -> dict[str, str]:
 
 
 def _confirm():
-    from graspaug.experiments.confirm_results import combine_confirm, confirm_figures
+    from graspaug.experiments.confirm.tables import combine_confirm
+    from graspaug.experiments.confirm.words import confirm_figures
 
     return combine_confirm, confirm_figures
 

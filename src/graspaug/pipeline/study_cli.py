@@ -191,7 +191,7 @@ def confirm_design_command(
 ) -> None:
     import json
 
-    from graspaug.experiments.confirm_results import design
+    from graspaug.experiments.confirm.tables import design
 
     def arm(text: str, hint: str) -> tuple:
         pool, _, rest = text.partition("/")

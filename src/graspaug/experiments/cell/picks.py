@@ -18,7 +18,7 @@ from collections.abc import Callable, Sequence
 import numpy as np
 import pandas as pd
 
-from graspaug.experiments.confirm import draw_test
+from graspaug.experiments.confirm.numbers import draw_test
 from graspaug.experiments.stats import ObjectBootstrap, percentile_interval
 
 ANTIPODAL = "antipodal"
@@ -198,7 +198,7 @@ def pick_power(attempts: pd.DataFrame, a: str, b: str, n_objects: int, draws: Se
     pilot's attempts: the SD of the per-object difference of success shares, so one draw's value has SD
     ``sd / √n_objects`` (the draws' own spread beyond their objects is not in a one-draw pilot: the power is an upper
     bound), against a true difference ``effect``; the power of the t over ``draws`` draws for each count."""
-    from graspaug.experiments.confirm import power
+    from graspaug.experiments.confirm.numbers import power
 
     rates = object_rates(attempts)
     diffs = (rates[a] - rates[b]).to_numpy()

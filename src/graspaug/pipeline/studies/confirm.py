@@ -1,15 +1,15 @@
 """``graspaug study confirm``: the draws of a committed confirmatory plan (issue #74).
 
-The plan (``results/<name>/plan.yaml``, :func:`graspaug.experiments.confirm_results.read_plan`) names the profile,
+The plan (``results/<name>/plan.yaml``, :func:`graspaug.experiments.confirm.tables.read_plan`) names the profile,
 the draws (data seeds) and the training seeds of each draw. The study refuses to run from a plan that git does not
 hold unchanged, or whose profile now gives other params than the plan recorded (``params_sha256``). Each draw is one
 task on a Dask cluster (:func:`~graspaug.pipeline.studies.draws.run_on_cluster`): a clone of the project's HEAD in
 ``workdir``/draw<k> sharing its DVC cache, with the profile's params and ``data_seed: k``, runs ``dvc repro
 train_gqcnn@<s>`` for each planned seed (the per-object stages come from the run cache: with ``independent_draws``
 a draw redraws only its split and what follows it). As each draw ends its tables go into the plan's folder at once
-(:func:`~graspaug.experiments.confirm_results.add_confirm_draw`; commit them as they come), and a failed draw is
+(:func:`~graspaug.experiments.confirm.tables.add_confirm_draw`; commit them as they come), and a failed draw is
 named while the others go on. A draw already in the folder is not run again. Once every planned draw is in,
-:func:`~graspaug.experiments.confirm_results.combine_confirm` reads the plan's tests.
+:func:`~graspaug.experiments.confirm.tables.combine_confirm` reads the plan's tests.
 """
 
 from __future__ import annotations
@@ -22,14 +22,14 @@ from pathlib import Path
 
 from graspaug.errors import DataError
 from graspaug.experiments.ap.numbers import test_labels
-from graspaug.experiments.confirm_results import (
+from graspaug.experiments.confirm.tables import (
     PLAN,
     add_confirm_draw,
     check_plan_history,
     combine_confirm,
-    confirm_figures,
     read_plan,
 )
+from graspaug.experiments.confirm.words import confirm_figures
 from graspaug.io.tables import read_table
 from graspaug.pipeline.params.model import params_dict
 from graspaug.pipeline.paths import SHAPES_TABLE, gqcnn_dir

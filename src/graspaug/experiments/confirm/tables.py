@@ -32,7 +32,8 @@ import pandas as pd
 import yaml
 
 from graspaug.errors import DataError
-from graspaug.experiments import confirm
+from graspaug.experiments.confirm import numbers as confirm
+from graspaug.experiments.confirm.words import sentence_fields
 from graspaug.experiments.stats import weighted_average_precision
 
 PLAN = "plan.yaml"
@@ -232,7 +233,7 @@ def read_plan_result(plan: Mapping, values: Mapping[int, Mapping[str, float]]) -
     else:
         verdict, sentence = "not shown", words["not_shown"]
     result = {"control": control | {"shows": shows}, "primary": primary | {"verdict": verdict}, "secondary": secondary}
-    result["sentence"] = sentence.format(**_fields(primary), control=_fields(control))
+    result["sentence"] = sentence.format(**sentence_fields(primary), control=sentence_fields(control))
     curve = plan.get("exchange")
     if curve and shows:
         sizes = curve["sizes"]
@@ -241,48 +242,6 @@ def read_plan_result(plan: Mapping, values: Mapping[int, Mapping[str, float]]) -
         result["exchange"] = confirm.exchange_rate_on_curve(sizes, grid, arm, 1 - alpha) | {"arm": curve["arm"]}
     result["per_draw_ap"] = {str(d): values[d] for d in draws}
     return result
-
-
-def _fields(c: Mapping) -> dict:
-    return {
-        "mean": f"{c['mean']:+.4f}",
-        "low": f"{c['low']:+.4f}",
-        "high": f"{c['high']:+.4f}",
-        "p": f"{c['p']:.3f}" if c["p"] >= 0.001 else f"{c['p']:.1e}",
-        "draws": c["n_draws"],
-    }
-
-
-def confirm_figures(result: dict, study: str) -> dict[str, str]:
-    """The figures a document quotes, by key: ``<study>/status``, and once complete ``<study>/control``,
-    ``<study>/primary`` (``mean [low, high], p = P``), ``<study>/primary/verdict``, ``<study>/sentence``,
-    ``<study>/<secondary>`` and its ``/verdict``, ``<study>/worth`` (the exchange rate)."""
-    out = {f"{study}/status": result["status"]}
-    if not result["complete"]:
-        return out
-    for key in ("control", "primary"):
-        out[f"{study}/{key}"] = test_text(result[key])
-    out[f"{study}/primary/verdict"] = result["primary"]["verdict"]
-    out[f"{study}/control/verdict"] = "shows" if result["control"]["shows"] else "does not show"
-    out[f"{study}/sentence"] = result["sentence"]
-    for name, c in result["secondary"].items():
-        holm = f" (Holm p = {c['p_holm']:.3f})" if c.get("p_holm") is not None else ""
-        out[f"{study}/{name}"] = test_text(c) + holm
-        if "verdict" in c:
-            out[f"{study}/{name}/verdict"] = c["verdict"]
-    if "exchange" in result:
-        e = result["exchange"]
-        low = "≤ {}".format(e["sizes"][0]) if e["low"] is None else f"{e['low']:.0f}"
-        high = "≥ {}".format(e["sizes"][-1]) if e["high"] is None else f"{e['high']:.0f}"
-        worth = f"outside the curve ({e['outside']})" if e["worth"] is None else f"{e['worth']:.0f}"
-        out[f"{study}/worth"] = f"{worth} real objects [{low}, {high}]"
-    return out
-
-
-def test_text(c: Mapping) -> str:
-    """``+0.0300 [+0.0100, +0.0500], p = 0.012`` of a :func:`~graspaug.experiments.confirm.draw_test`."""
-    f = _fields(c)
-    return f"{f['mean']} [{f['low']}, {f['high']}], p = {f['p']}"
 
 
 def _git(root: Path, *args: str) -> str:

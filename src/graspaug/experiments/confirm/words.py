@@ -1,0 +1,49 @@
+"""The confirmatory study's words: the figures a document quotes from a plan's result (:func:`confirm_figures`), each
+test as ``mean [low, high], p = P`` (:func:`test_text`)."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+
+def sentence_fields(c: Mapping) -> dict:
+    """A test's fields as a plan's sentences name them: ``mean``, ``low``, ``high`` (signed), ``p``, ``draws``."""
+    return {
+        "mean": f"{c['mean']:+.4f}",
+        "low": f"{c['low']:+.4f}",
+        "high": f"{c['high']:+.4f}",
+        "p": f"{c['p']:.3f}" if c["p"] >= 0.001 else f"{c['p']:.1e}",
+        "draws": c["n_draws"],
+    }
+
+
+def confirm_figures(result: dict, study: str) -> dict[str, str]:
+    """The figures a document quotes, by key: ``<study>/status``, and once complete ``<study>/control``,
+    ``<study>/primary`` (``mean [low, high], p = P``), ``<study>/primary/verdict``, ``<study>/sentence``,
+    ``<study>/<secondary>`` and its ``/verdict``, ``<study>/worth`` (the exchange rate)."""
+    out = {f"{study}/status": result["status"]}
+    if not result["complete"]:
+        return out
+    for key in ("control", "primary"):
+        out[f"{study}/{key}"] = test_text(result[key])
+    out[f"{study}/primary/verdict"] = result["primary"]["verdict"]
+    out[f"{study}/control/verdict"] = "shows" if result["control"]["shows"] else "does not show"
+    out[f"{study}/sentence"] = result["sentence"]
+    for name, c in result["secondary"].items():
+        holm = f" (Holm p = {c['p_holm']:.3f})" if c.get("p_holm") is not None else ""
+        out[f"{study}/{name}"] = test_text(c) + holm
+        if "verdict" in c:
+            out[f"{study}/{name}/verdict"] = c["verdict"]
+    if "exchange" in result:
+        e = result["exchange"]
+        low = "≤ {}".format(e["sizes"][0]) if e["low"] is None else f"{e['low']:.0f}"
+        high = "≥ {}".format(e["sizes"][-1]) if e["high"] is None else f"{e['high']:.0f}"
+        worth = f"outside the curve ({e['outside']})" if e["worth"] is None else f"{e['worth']:.0f}"
+        out[f"{study}/worth"] = f"{worth} real objects [{low}, {high}]"
+    return out
+
+
+def test_text(c: Mapping) -> str:
+    """``+0.0300 [+0.0100, +0.0500], p = 0.012`` of a :func:`~graspaug.experiments.confirm.numbers.draw_test`."""
+    f = sentence_fields(c)
+    return f"{f['mean']} [{f['low']}, {f['high']}], p = {f['p']}"
