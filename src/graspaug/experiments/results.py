@@ -265,14 +265,17 @@ def recompute(results_dir: Path) -> tuple[dict[str, str], dict[str, dict]]:
 
 def study_kind(folder: Path) -> str:
     """The study a results folder holds: ``confirm`` where it has a plan (``plan.yaml``), ``picks`` where it has a
-    table of pick attempts (``attempts.parquet``), else its name's first word (``attribution-real-objects``:
-    ``attribution``)."""
+    table of pick attempts (``attempts.parquet``), ``external`` where it has one table of predictions of a
+    confirmatory study's networks on an external test set (``predictions.parquet``), else its name's first word
+    (``attribution-real-objects``: ``attribution``)."""
     from graspaug.experiments.confirm.tables import PLAN
 
     if (Path(folder) / PLAN).is_file():
         return "confirm"
     if (Path(folder) / "attempts.parquet").is_file():
         return "picks"
+    if (Path(folder) / "predictions.parquet").is_file():
+        return "external"
     return Path(folder).name.split("-")[0]
 
 
@@ -532,8 +535,15 @@ def picks_figures(result: dict, study: str) -> dict[str, str]:
     return out
 
 
+def _external():
+    from graspaug.experiments.confirm.external import combine_external, external_figures
+
+    return combine_external, external_figures
+
+
 STUDIES = {
     "picks": (combine_picks, picks_figures),
+    "external": (lambda folder: _external()[0](folder), lambda result, study: _external()[1](result, study)),
     "confirm": (lambda folder: _confirm()[0](folder), lambda result, study: _confirm()[1](result, study)),
     "attribution": (combine_attribution, attribution_figures),
     "lifelong": (combine_lifelong, lifelong_figures),

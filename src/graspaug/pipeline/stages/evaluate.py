@@ -39,6 +39,21 @@ Params = params_model(
 )
 
 
+def card_test_set(params: Params, card: ModelCard, raw: dict, params_file: Path | None, sources: list, cache: Path):
+    """The test set of ``sources`` made by a network's card (its ``test_set_rules``, unless ``params_file`` gave the
+    params; its camera, crop and gripper), from or into ``cache``: (the params used, the recipe, the rules, the cached
+    folder, its counts, its :class:`GraspImages`, its :class:`GraspArrays`)."""
+    rules = None if params_file is not None else raw.get("test_set_rules")  # --params overrides the card
+    params = with_sections(params, rules) if rules else params
+    i, keys = params.ingest, {k: getattr(card, k) for k in CARD_KEYS}
+    recipe = recipe_for(i.surface, i.max_faces, i.max_file_mb, params.grasps, params.render, params.seed, keys)
+    folder = cached_test_set(sources, recipe, cache, params.workers, params.render.shard_rows)
+    counts = json.loads((folder / "counts.json").read_text())
+    data = GraspImages.open(folder / "gqcnn")
+    arrays = GraspArrays(data.images(), data.read("z"), data.read("labels"))
+    return params, recipe, rules, folder, counts, data, arrays
+
+
 def run(
     params: Params,
     models: list[Path],
@@ -76,15 +91,8 @@ def run(
             if differs:
                 raise DataError(f"model {name}: its card's {differs[0]} differs from {first}'s; evaluate them apart")
         replicates = None if seeds is None else replicate_kind(raw, seeds)
-        rules = None if params_file is not None else raw[first].get("test_set_rules")  # --params overrides the card
-        params = with_sections(params, rules) if rules else params
-
-        i, card = params.ingest, {k: getattr(cards[first], k) for k in CARD_KEYS}
-        recipe = recipe_for(i.surface, i.max_faces, i.max_file_mb, params.grasps, params.render, params.seed, card)
-        folder = cached_test_set(sources, recipe, cache, params.workers, params.render.shard_rows)
-        counts = json.loads((folder / "counts.json").read_text())
-        data = GraspImages.open(folder / "gqcnn")
-        arrays = GraspArrays(data.images(), data.read("z"), data.read("labels"))
+        test = card_test_set(params, cards[first], raw[first], params_file, sources, cache)
+        params, recipe, rules, folder, counts, data, arrays = test
         device = resolve_device(params.device)
         probabilities = {name: predict(net.to(device), arrays, device) for name, net in nets.items()}
         ids = data.index["shape_id"].to_numpy()

@@ -1,0 +1,140 @@
+"""A confirmatory study's networks read on an external test set (issue #82): the same kept networks of every draw,
+one fixed set of objects from another source (``../shared/external/ycb78``), in a folder of its own beside the
+study's (``results/<study>-<set>/``), so that the plan's folder holds only what the plan named.
+
+* ``test.parquet`` — the external datapoints (``label``, ``object``), one test set for every draw;
+* ``predictions.parquet`` — each network's P(success) of every datapoint, one float32 column per network,
+  ``<draw>/<seed>/<pool>/<B>-<R>`` (:func:`~graspaug.experiments.confirm.tables.column`);
+* ``meta.json`` — the arms (name → pool, B, R), the draws, the contrasts (name → [a, b]; the first one the positive
+  control), the bootstrap's resamples and seed, the counts, the command, commit, date, wall time and machine.
+
+Two readouts, each a contrast's mean over the draws with the interval of
+:func:`~graspaug.experiments.stats.nested_t_interval` (draws as replicates, one seed each, plus the objects'
+bootstrap; the draws are paired by draw, never by position):
+
+* ``pooled``: AP over every datapoint (the study's own statistic);
+* ``per_object``: the mean over the objects that hold a positive of each object's own AP, so a few objects with
+  most positives do not decide it. Which readout a claim reads is fixed by a plan before its data; on a study that
+  did not plan it, it is exploratory.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Mapping
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from graspaug.errors import DataError
+from graspaug.experiments.confirm.tables import column
+from graspaug.experiments.stats import ObjectBootstrap, nested_t_interval, weighted_average_precision
+
+FILES = ("test.parquet", "predictions.parquet", "meta.json")
+READOUTS = ("pooled", "per_object")
+
+
+def per_object_ap(labels: np.ndarray, objects: np.ndarray, scores: np.ndarray) -> pd.Series:
+    """Each object's own AP (object → AP) over the objects that hold at least one positive datapoint."""
+    frame = pd.DataFrame({"label": np.asarray(labels, dtype=bool), "object": objects, "score": scores})
+    out = {}
+    for name, rows in frame.groupby("object", sort=True):
+        if rows.label.any():
+            y, p = rows.label.to_numpy(), rows.score.to_numpy()
+            out[name] = float(weighted_average_precision(y, p, np.ones(len(rows))))
+    return pd.Series(out, dtype=float)
+
+
+def network_values(labels, objects, scores, n_resamples: int, seed: int) -> dict[str, tuple[float, np.ndarray]]:
+    """One network's two readouts, each (value on every object, (n_resamples,) values under the objects' resamples):
+    the same resamples for every network (the same ``seed``), so differences are paired."""
+    boot = ObjectBootstrap(objects, n_resamples, seed)
+    ones = np.ones(len(labels), dtype=np.float32)
+    pooled = (float(weighted_average_precision(labels, scores, ones)), boot.average_precision(labels, scores))
+    aps = per_object_ap(labels, objects, scores)
+    held = ObjectBootstrap(aps.index.to_numpy(), n_resamples, seed)
+    per_object = (float(aps.mean()), held.means(aps.to_numpy()))
+    return {"pooled": pooled, "per_object": per_object}
+
+
+def combine_external(folder: Path) -> dict:
+    """The external readouts of a folder (module docstring): per arm its mean AP over the draws, per contrast its
+    nested interval, per-draw values and the count of draws it is positive in, for both readouts; the counts."""
+    folder = Path(folder)
+    missing = [f for f in FILES if not (folder / f).is_file()]
+    if missing:
+        raise DataError(f"{folder}: lacks {', '.join(missing)} (an external check's folder holds {', '.join(FILES)})")
+    meta = json.loads((folder / "meta.json").read_text())
+    test, predictions = pd.read_parquet(folder / "test.parquet"), pd.read_parquet(folder / "predictions.parquet")
+    labels, objects = test.label.to_numpy().astype(bool), test.object.to_numpy()
+    draws, seed, n = [int(d) for d in meta["draws"]], int(meta.get("seed", 0)), int(meta["n_resamples"])
+    values: dict[str, dict[str, list]] = {r: {} for r in READOUTS}
+    for arm, key in meta["arms"].items():
+        rows = {r: [] for r in READOUTS}
+        for d in draws:
+            name = column(d, 0, (key[0], int(key[1]), float(key[2])))
+            if name not in predictions:
+                raise DataError(f"{folder}/predictions.parquet: no column {name!r} (draw {d}'s {arm} network)")
+            for r, v in network_values(labels, objects, predictions[name].to_numpy(), n, seed).items():
+                rows[r].append(v)
+        for r in READOUTS:
+            values[r][arm] = rows[r]
+    out = {"draws": draws, "counts": meta["counts"], "contrasts": {}, "arms": {}}
+    for r in READOUTS:
+        out["arms"][r] = {arm: float(np.mean([v[0] for v in vs])) for arm, vs in values[r].items()}
+        pairs = meta["contrasts"].items()
+        out["contrasts"][r] = {name: _contrast(values[r][a], values[r][b]) for name, (a, b) in pairs}
+    control = next(iter(meta["contrasts"]))
+    for r in READOUTS:
+        c = out["contrasts"][r][control]
+        c["shows"] = c["low"] is not None and c["low"] > 0
+    out["control"] = control
+    return out
+
+
+def _contrast(a: list, b: list) -> dict:
+    """Arm a − arm b, paired by draw: the nested interval over the draws (one seed each) and the objects."""
+    full = np.array([[x[0] - y[0]] for x, y in zip(a, b)])  # (D, 1)
+    resampled = np.stack([x[1] - y[1] for x, y in zip(a, b)])[:, None, :]  # (D, 1, R)
+    c = nested_t_interval(full, resampled)
+    per_draw = full[:, 0]
+    return c | {"per_draw": [float(v) for v in per_draw], "positive_draws": int((per_draw > 0).sum())}
+
+
+def external_figures(result: Mapping, study: str) -> dict[str, str]:
+    """The figures a document quotes: ``<study>/counts``; per readout (``pooled``, ``per_object``)
+    ``<study>/<readout>/<contrast>`` (``mean [low, high]``), its ``/draws`` (``k of D draws positive``), the
+    control's ``<study>/<readout>/control/verdict`` (shows / does not show) and ``<study>/<readout>/arm/<arm>``."""
+    c = result["counts"]
+    out = {
+        f"{study}/counts": f"{c['objects']} objects with datapoints ({c['objects_with_positive']} with a positive), "
+        f"{c['datapoints']:,} datapoints, {c['positives']:,} positive"
+    }
+    for r in READOUTS:
+        for name, x in result["contrasts"][r].items():
+            no_interval = f"{x['mean']:+.4f} (no interval: {len(x['per_draw'])} draw)"
+            interval = no_interval if x["low"] is None else f"{x['mean']:+.4f} [{x['low']:+.4f}, {x['high']:+.4f}]"
+            out[f"{study}/{r}/{name}"] = interval
+            out[f"{study}/{r}/{name}/draws"] = f"{x['positive_draws']} of {len(x['per_draw'])} draws positive"
+        shows = result["contrasts"][r][result["control"]]["shows"]
+        out[f"{study}/{r}/control/verdict"] = "shows" if shows else "does not show"
+        out |= {f"{study}/{r}/arm/{arm}": f"{v:.4f}" for arm, v in result["arms"][r].items()}
+    return out
+
+
+def write_external(folder: Path, labels, objects, predictions: Mapping[str, np.ndarray], meta: Mapping) -> None:
+    """Write an external check's folder (module docstring): the test datapoints, the predictions, ``meta.json``
+    last (a folder without it is an unfinished one)."""
+    from graspaug.experiments.kept import write_predictions
+    from graspaug.io.atomic import atomic_path
+
+    folder.mkdir(parents=True, exist_ok=True)
+    (folder / "meta.json").unlink(missing_ok=True)
+    test = pd.DataFrame({"label": np.asarray(labels, dtype=np.int8), "object": np.asarray(objects)})
+    with atomic_path(folder / "test.parquet") as tmp:
+        test.to_parquet(tmp, index=False)
+    columns = {k: np.asarray(v, dtype=np.float32) for k, v in predictions.items()}
+    write_predictions(columns, folder / "predictions.parquet")
+    with atomic_path(folder / "meta.json") as tmp:
+        tmp.write_text(json.dumps(dict(meta), indent=1) + "\n")

@@ -1,0 +1,123 @@
+"""A confirmatory study's kept networks on an external test set (issue #82): the two readouts, paired by draw, and
+the committed YCB table made again from the kept networks where ../shared/external/ycb78 is at hand."""
+
+import json
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from graspaug.errors import DataError
+from graspaug.experiments.confirm.external import combine_external, external_figures, per_object_ap, write_external
+from graspaug.experiments.confirm.tables import column
+from graspaug.experiments.stats import weighted_average_precision
+
+ROOT = Path(__file__).resolve().parents[2]
+YCB = ROOT.parent / "shared" / "external" / "ycb78"
+COMMITTED = ROOT / "results" / "real-objects-confirm-ycb78"
+ARMS = {"none@50": ["targeted", 50, 0.0], "none@150": ["targeted", 150, 0.0], "targeted@50": ["targeted", 50, 1.0]}
+
+
+def _folder(tmp_path, effect: float, draws=(10, 11, 12, 13)) -> Path:
+    """An external folder of 30 objects: none@150 beats none@50 by ``effect`` in the scores' signal, each draw with
+    its own noise; targeted@50 equals none@50 but for draw noise."""
+    rng = np.random.default_rng(3)
+    objects = np.repeat([f"o{i:02d}" for i in range(30)], 40)
+    labels = rng.random(len(objects)) < 0.1
+    labels[::40] = True  # every object holds a positive
+    predictions = {}
+    for d in draws:
+        base = labels + rng.normal(0, 1.0, len(labels))
+        for arm, key in ARMS.items():
+            signal = effect if arm == "none@150" else 0.0
+            predictions[column(d, 0, (key[0], key[1], key[2]))] = (
+                base + signal * labels + rng.normal(0, 0.1, len(labels))
+            )
+    meta = {
+        "arms": ARMS,
+        "draws": list(draws),
+        "contrasts": {"real_data": ["none@150", "none@50"], "targeted_vs_none@50": ["targeted@50", "none@50"]},
+        "n_resamples": 200,
+        "seed": 0,
+        "counts": {
+            "objects": 30,
+            "objects_with_positive": 30,
+            "datapoints": len(labels),
+            "positives": int(labels.sum()),
+        },
+    }
+    write_external(tmp_path / "ext", labels, objects, predictions, meta)
+    return tmp_path / "ext"
+
+
+def test_both_readouts_pair_by_draw_and_the_control_shows_only_when_it_is_there(tmp_path):
+    strong = combine_external(_folder(tmp_path / "a", effect=2.0))
+    for readout in ("pooled", "per_object"):
+        control = strong["contrasts"][readout]["real_data"]
+        assert control["shows"] and control["positive_draws"] == 4 and control["low"] > 0
+        null = strong["contrasts"][readout]["targeted_vs_none@50"]
+        assert null["low"] < 0 < null["high"]
+    flat = combine_external(_folder(tmp_path / "b", effect=0.0))
+    assert not flat["contrasts"]["pooled"]["real_data"]["shows"]
+    figures = external_figures(strong, "x")
+    assert figures["x/pooled/control/verdict"] == "shows" and figures["x/pooled/real_data/draws"].startswith("4 of 4")
+    # the pooled value of a draw is the AP over every datapoint, the per-object one the mean of the objects' APs
+    test, p = pd.read_parquet(tmp_path / "a/ext/test.parquet"), pd.read_parquet(tmp_path / "a/ext/predictions.parquet")
+    col = p[column(10, 0, ("targeted", 150, 0.0))].to_numpy()
+    y, ones = test.label.to_numpy().astype(bool), np.ones(len(test))
+    a150, a50 = (
+        weighted_average_precision(y, col, ones),
+        weighted_average_precision(y, p[column(10, 0, ("targeted", 50, 0.0))].to_numpy(), ones),
+    )
+    assert strong["contrasts"]["pooled"]["real_data"]["per_draw"][0] == pytest.approx(a150 - a50)
+    objects = per_object_ap(y, test.object.to_numpy(), col)
+    assert len(objects) == 30 and objects.between(0, 1).all()
+
+
+def test_a_missing_network_or_file_is_named(tmp_path):
+    folder = _folder(tmp_path, effect=1.0)
+    p = pd.read_parquet(folder / "predictions.parquet").drop(columns=[column(12, 0, ("targeted", 50, 1.0))])
+    p.to_parquet(folder / "predictions.parquet")
+    with pytest.raises(DataError, match=r"draw 12's targeted@50"):
+        combine_external(folder)
+    (folder / "test.parquet").unlink()
+    with pytest.raises(DataError, match="lacks test.parquet"):
+        combine_external(folder)
+
+
+@pytest.mark.skipif(not YCB.is_dir() or not COMMITTED.is_dir(), reason="needs ../shared/external/ycb78")
+def test_the_committed_ycb_table_is_what_the_kept_networks_predict(tmp_path):
+    """Two YCB objects and draw 10's kept networks, made again from nothing: the datapoints and predictions of the
+    committed table for those objects, to float32."""
+    meta = json.loads((COMMITTED / "meta.json").read_text())
+    test = pd.read_parquet(COMMITTED / "test.parquet")
+    objects = ["025_mug", "077_rubiks_cube"]
+    corpus = tmp_path / "ycb"
+    corpus.mkdir()
+    for name in objects:
+        shutil.copy(YCB / f"{name}.stl", corpus)
+    study = tmp_path / "study"
+    (study / "networks").mkdir(parents=True)
+    shutil.copy(ROOT / "results/real-objects-confirm/plan.yaml", study)
+    shutil.copytree(ROOT / "results/real-objects-confirm/networks/d10-s0", study / "networks/d10-s0")
+    env = {**os.environ, "DVC_NO_ANALYTICS": "1"}
+    out = tmp_path / "out"
+    cmd = [str(Path(sys.executable).parent / "graspaug"), "study", "external", str(study), "--corpus", str(corpus)]
+    done = subprocess.run([*cmd, "--out", str(out), "--cache", str(tmp_path / "cache")], env=env, capture_output=True)
+    # one draw: no interval over draws, which the figures cannot print; the tables are what is compared
+    assert (out / "predictions.parquet").is_file(), done.stderr.decode()[-2000:]
+    again, made = pd.read_parquet(out / "test.parquet"), pd.read_parquet(out / "predictions.parquet")
+    committed = pd.read_parquet(COMMITTED / "predictions.parquet")
+    for name in objects:
+        ids = [o for o in set(test.object) if o.endswith(name) or name in o]
+        assert ids, f"{name} not in the committed test set"
+        mine, theirs = again.object.str.contains(name).to_numpy(), test.object.isin(ids).to_numpy()
+        assert mine.sum() == theirs.sum() and again.label[mine].sum() == test.label[theirs].sum()
+        for key in meta["arms"].values():
+            c = column(10, 0, (key[0], int(key[1]), float(key[2])))
+            np.testing.assert_allclose(np.sort(made[c][mine]), np.sort(committed[c][theirs]), atol=1e-5)
