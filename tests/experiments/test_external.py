@@ -121,3 +121,42 @@ def test_the_committed_ycb_table_is_what_the_kept_networks_predict(tmp_path):
         for key in meta["arms"].values():
             c = column(10, 0, (key[0], int(key[1]), float(key[2])))
             np.testing.assert_allclose(np.sort(made[c][mine]), np.sort(committed[c][theirs]), atol=1e-5)
+
+
+def test_a_plans_external_set_is_read_with_its_own_control_and_holm(tmp_path):
+    """A plan's ``test_sets`` entry: the set's readout per draw, the plan's tests in order, gated by the set's own
+    control, and the nested p agreeing with its interval."""
+    import yaml
+
+    from graspaug.experiments.confirm.tables import external_result, external_sets
+    from graspaug.experiments.confirm.words import confirm_figures
+
+    folder = _folder(tmp_path, effect=2.0)
+    test, predictions = pd.read_parquet(folder / "test.parquet"), pd.read_parquet(folder / "predictions.parquet")
+    test.to_parquet(folder / "test-ycb78.parquet")
+    for d in (10, 11, 12, 13):
+        predictions[[c for c in predictions if c.startswith(f"{d}/")]].to_parquet(
+            folder / f"predictions-ycb78-d{d}-s0.parquet"
+        )
+    plan = yaml.safe_load((ROOT / "results/real-objects-confirm/plan.yaml").read_text())
+    plan |= {"draws": [10, 11, 12, 13], "arms": ARMS, "secondary": [{"name": "t", "a": "targeted@50", "b": "none@50"}]}
+    plan["control"] = {"name": "real_data", "a": "none@150", "b": "none@50"}
+    plan["test_sets"] = {
+        "heldout": {"readout": "pooled"},
+        "ycb78": {"corpus": "x", "readout": "per_object", "resamples": 300},
+    }
+    assert list(external_sets(plan)) == ["ycb78"]
+    r = external_result(folder, plan, "ycb78")
+    assert r["readout"] == "per_object" and r["control"]["shows"] and r["control"]["p"] < 0.05 < r["primary"]["p"]
+    assert r["primary"]["verdict"] == "not shown" and r["secondary"]["t"]["verdict"] == "not shown"
+    assert (r["control"]["low"] > 0) == (r["control"]["p"] < 0.05)
+    figures = confirm_figures({"status": "complete", "complete": True, "external": {"ycb78": r}} | _heldout(r), "s")
+    assert figures["s/ycb78/control/verdict"] == "shows" and figures["s/ycb78/primary/verdict"] == "not shown"
+    (folder / "predictions-ycb78-d12-s0.parquet").unlink()
+    with pytest.raises(DataError, match="draw 12's ycb78 predictions are missing"):
+        external_result(folder, plan, "ycb78")
+
+
+def _heldout(r: dict) -> dict:
+    """A held-out result shaped as :func:`combine_confirm` gives it (the external one stands in for it)."""
+    return {k: r[k] for k in ("control", "primary", "secondary", "sentence")}

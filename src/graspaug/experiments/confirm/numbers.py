@@ -265,3 +265,46 @@ def _not_rejected(values: np.ndarray, level: float) -> bool:
     """Whether the two-sided t at ``level`` does not reject a zero mean of ``values``."""
     t = draw_test(values, level)
     return t["low"] is not None and t["low"] <= 0 <= t["high"]
+
+
+def nested_draw_test(full: np.ndarray, resampled: np.ndarray, level: float = 0.95) -> dict:
+    """A contrast's test over draws on ONE test set that every draw shares (an external set): the interval of
+    :func:`~graspaug.experiments.stats.nested_t_interval` (the draws' t part and the objects' bootstrap part, since
+    a fixed set of objects is not redrawn with the draws) and the two-sided p that goes with it, the ``1 − level`` at
+    which that interval's end reaches 0 (so ``p < 1 − level`` exactly when the interval excludes 0).
+
+    Parameters
+    ----------
+    full : (D, S) — the contrast of draw d, seed s on all the set's objects
+    resampled : (D, S, R) — the same under each of R resamples of the objects (the same resamples in every cell)
+
+    Returns
+    -------
+    dict — :func:`nested_t_interval`'s keys and ``p`` (None without an interval), ``per_draw`` (the draws' means over
+    seeds)
+    """
+    from scipy.optimize import brentq
+
+    from graspaug.experiments.stats import nested_t_interval, variance_parts
+
+    out = nested_t_interval(full, resampled, level) | {"p": None}
+    out["per_draw"] = [float(v) for v in np.asarray(full, dtype=float).mean(axis=1)]
+    if out["low"] is None:
+        return out
+    units, objects = variance_parts(full, resampled)
+    objects = objects[np.isfinite(objects)]
+    s2, v = units.var(ddof=1) / len(units), objects.var(ddof=1)
+    mean = abs(out["mean"])
+
+    def half(lv: float) -> float:
+        t, z = stats.t.ppf(0.5 + lv / 2, len(units) - 1), stats.norm.ppf(0.5 + lv / 2)
+        return float(np.sqrt(t * t * s2 + z * z * v)) - mean
+
+    lo, hi = 1e-12, 1 - 1e-12
+    if half(lo) >= 0:
+        p = 1.0
+    elif half(hi) <= 0:
+        p = 1e-12
+    else:
+        p = 1.0 - brentq(half, lo, hi, xtol=1e-14)
+    return out | {"p": float(p)}

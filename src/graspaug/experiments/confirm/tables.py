@@ -34,6 +34,7 @@ import yaml
 from graspaug.errors import DataError
 from graspaug.experiments.confirm import numbers as confirm
 from graspaug.experiments.confirm.words import sentence_fields
+from graspaug.experiments.kept import write_predictions
 from graspaug.experiments.stats import weighted_average_precision
 
 PLAN = "plan.yaml"
@@ -92,13 +93,24 @@ def column(draw: int, seed: int, key: tuple) -> str:
 
 
 def add_confirm_draw(
-    folder: Path, plan: Mapping, draw: int, seed_dirs: Mapping[int, Path], labels, objects, meta: dict, roles: dict
+    folder: Path,
+    plan: Mapping,
+    draw: int,
+    seed_dirs: Mapping[int, Path],
+    labels,
+    objects,
+    meta: dict,
+    roles: dict,
+    external: Mapping[str, tuple] | None = None,
 ) -> None:
     """Add one finished draw to ``folder``: its predictions per seed, ``test-d<draw>.parquet``, its rows of
     ``networks.parquet``, the kept seed-0 networks (the plan's ``keep`` arms) with ``objects.json`` (``roles``: the
-    draw's split by role, shape ids), and ``meta.json`` last. A draw the plan does not list is refused."""
+    draw's split by role, shape ids), each external test set's predictions (``external``: set name → (labels,
+    objects, seed → column → P(success)); ``test-<set>.parquet`` once, the same for every draw,
+    ``predictions-<set>-d<draw>-s<seed>.parquet``), and ``meta.json`` last. A draw the plan does not list, or an
+    external set the plan does not name or whose datapoints differ from an earlier draw's, is refused."""
     from graspaug.experiments.ap.numbers import collect, test_predictions
-    from graspaug.experiments.kept import keep_networks, write_predictions
+    from graspaug.experiments.kept import keep_networks
     from graspaug.io.atomic import atomic_path
     from graspaug.training.variants import Variant
 
@@ -120,6 +132,18 @@ def add_confirm_draw(
     test = pd.DataFrame({"label": np.asarray(labels, dtype=np.int8), "object": np.asarray(objects)})
     with atomic_path(folder / f"test-d{draw}.parquet") as tmp:
         test.to_parquet(tmp, index=False)
+    for name, (set_labels, set_objects, by_seed) in (external or {}).items():
+        if name not in external_sets(plan):
+            raise DataError(f"test set {name!r} is not one the plan names ({', '.join(external_sets(plan))})")
+        table = pd.DataFrame({"label": np.asarray(set_labels, dtype=np.int8), "object": np.asarray(set_objects)})
+        path = folder / f"test-{name}.parquet"
+        if path.is_file() and not pd.read_parquet(path).equals(table):
+            raise DataError(f"{path}: draw {draw}'s {name} datapoints differ from the earlier draws' (one set for all)")
+        with atomic_path(path) as tmp:
+            table.to_parquet(tmp, index=False)
+        for s, columns in by_seed.items():
+            columns = {k: np.asarray(v, dtype=np.float32) for k, v in columns.items()}
+            write_predictions(columns, folder / f"predictions-{name}-d{draw}-s{s}.parquet")
     networks = runs[["draw", *[c for c in runs.columns if c != "draw"]]]
     if networks_file.is_file():
         others = pd.read_parquet(networks_file)
@@ -201,7 +225,50 @@ def combine_confirm(folder: Path) -> dict:
         out["status"] = f"in progress: {len(done)} of {len(planned)} planned draws"
         return out
     values = {d: draw_values(folder, plan, d, sorted(plan["seeds"])) for d in planned}
-    return out | {"status": "complete"} | read_plan_result(plan, values)
+    external = {name: external_result(folder, plan, name) for name in external_sets(plan)}
+    return out | {"status": "complete"} | read_plan_result(plan, values) | ({"external": external} if external else {})
+
+
+def external_sets(plan: Mapping) -> dict[str, dict]:
+    """The plan's external test sets (``test_sets``: name → ``corpus``, ``readout`` ``pooled`` or ``per_object``,
+    ``resamples``), read beside each draw's own held-out objects, each gated by its own control."""
+    return {k: dict(v) for k, v in (plan.get("test_sets") or {}).items() if isinstance(v, Mapping) and v.get("corpus")}
+
+
+def external_result(folder: Path, plan: Mapping, name: str) -> dict:
+    """The plan's tests on its external set ``name``: per draw, seed and arm the set's readout (its ``readout``:
+    pooled AP or the mean of per-object AP) on all objects and under the objects' resamples (one set, the same
+    resamples for every network), each contrast by :func:`~graspaug.experiments.confirm.numbers.nested_draw_test`."""
+    from graspaug.experiments.confirm.external import network_values
+
+    spec = external_sets(plan)[name]
+    readout, n = spec.get("readout", "pooled"), int(spec.get("resamples", 1000))
+    test = pd.read_parquet(folder / f"test-{name}.parquet")
+    labels, objects = test.label.to_numpy().astype(bool), test.object.to_numpy()
+    draws, seeds = sorted(int(d) for d in plan["draws"]), sorted(plan["seeds"])
+    cells: dict[tuple, tuple] = {}
+    for d in draws:
+        for s in seeds:
+            path = folder / f"predictions-{name}-d{d}-s{s}.parquet"
+            if not path.is_file():
+                raise DataError(f"{path}: draw {d}'s {name} predictions are missing")
+            predictions = pd.read_parquet(path)
+            for arm in plan["arms"]:
+                col = column(d, s, arm_key(plan, arm))
+                if col not in predictions:
+                    raise DataError(f"{path}: no column {col!r}")
+                cells[d, s, arm] = network_values(labels, objects, predictions[col].to_numpy(), n, 0)[readout]
+
+    def test_of(c):
+        full = np.array([[cells[d, s, c["a"]][0] - cells[d, s, c["b"]][0] for s in seeds] for d in draws])
+        boot = np.array([[cells[d, s, c["a"]][1] - cells[d, s, c["b"]][1] for s in seeds] for d in draws])
+        return confirm.nested_draw_test(full, boot, 1 - float(plan["alpha"]))
+
+    out = read_plan_tests(plan, test_of)
+    arms = {arm: float(np.mean([cells[d, s, arm][0] for d in draws for s in seeds])) for arm in plan["arms"]}
+    held = test.groupby("object").label.any()
+    counts = {"objects": int(len(held)), "objects_with_positive": int(held.sum()), "datapoints": int(len(test))}
+    return out | {"readout": readout, "arms": arms, "counts": counts | {"positives": int(test.label.sum())}}
 
 
 def read_plan_result(plan: Mapping, values: Mapping[int, Mapping[str, float]]) -> dict:
@@ -213,17 +280,40 @@ def read_plan_result(plan: Mapping, values: Mapping[int, Mapping[str, float]]) -
     def diff(spec):
         return [values[d][spec["a"]] - values[d][spec["b"]] for d in draws]
 
-    control = confirm.draw_test(diff(plan["control"]), 1 - alpha)
+    result = read_plan_tests(plan, lambda spec: confirm.draw_test(diff(spec), 1 - alpha), diff)
+    curve = plan.get("exchange")
+    if curve and result["control"]["shows"]:
+        sizes = curve["sizes"]
+        grid = np.array([[values[d][f"none@{b}"] for b in sizes] for d in draws])
+        arm = np.array([values[d][curve["arm"]] for d in draws])
+        result["exchange"] = confirm.exchange_rate_on_curve(sizes, grid, arm, 1 - alpha) | {"arm": curve["arm"]}
+    result["per_draw_ap"] = {str(d): values[d] for d in draws}
+    return result
+
+
+def read_plan_tests(plan: Mapping, test_of, diff=None) -> dict:
+    """The plan's tests in its fixed sequence, each ``test_of(spec)`` (a spec names arms ``a`` and ``b``; a test
+    gives ``mean``, ``low``, ``high``, ``p``, ``n_draws``): the control first (it "shows" when p < alpha and its mean
+    is positive; if not, the verdict is "uninformative"), the primary, then the secondary family under Holm (an
+    equivalence verdict where a secondary names a ``margin`` and ``diff(spec)``, the per-draw values, is given);
+    with the plan's sentence."""
+    alpha = float(plan["alpha"])
+    control = test_of(plan["control"])
     shows = control["p"] is not None and control["p"] < alpha and control["mean"] > 0
-    primary = confirm.draw_test(diff(plan["primary"]), 1 - alpha)
-    secondary = {s["name"]: confirm.draw_test(diff(s), 1 - alpha) for s in plan["secondary"] if "a" in s}
+    primary = test_of(plan["primary"])
+    secondary = {s["name"]: test_of(s) for s in plan["secondary"] if "a" in s}
     adjusted = confirm.holm({k: v["p"] for k, v in secondary.items()})
     for name, c in secondary.items():
         c["p_holm"] = adjusted[name]
         spec = next(s for s in plan["secondary"] if s.get("name") == name)
-        if "margin" in spec:
+        if "margin" in spec and diff is not None:
             c["equivalence"] = confirm.tost(diff(spec), float(spec["margin"]), alpha)
             c["verdict"] = confirm.equivalence_verdict(c, c["equivalence"], alpha, adjusted[name])
+        elif not shows:
+            c["verdict"] = confirm.UNINFORMATIVE
+        else:
+            held = adjusted[name] is not None and adjusted[name] < alpha
+            c["verdict"] = ("higher" if c["mean"] > 0 else "lower") if held else "not shown"
     words = plan["words"]
     if not shows:
         verdict, sentence = confirm.UNINFORMATIVE, words["uninformative"]
@@ -234,13 +324,6 @@ def read_plan_result(plan: Mapping, values: Mapping[int, Mapping[str, float]]) -
         verdict, sentence = "not shown", words["not_shown"]
     result = {"control": control | {"shows": shows}, "primary": primary | {"verdict": verdict}, "secondary": secondary}
     result["sentence"] = sentence.format(**sentence_fields(primary), control=sentence_fields(control))
-    curve = plan.get("exchange")
-    if curve and shows:
-        sizes = curve["sizes"]
-        grid = np.array([[values[d][f"none@{b}"] for b in sizes] for d in draws])
-        arm = np.array([values[d][curve["arm"]] for d in draws])
-        result["exchange"] = confirm.exchange_rate_on_curve(sizes, grid, arm, 1 - alpha) | {"arm": curve["arm"]}
-    result["per_draw_ap"] = {str(d): values[d] for d in draws}
     return result
 
 

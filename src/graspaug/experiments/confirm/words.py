@@ -34,6 +34,15 @@ def confirm_figures(result: dict, study: str) -> dict[str, str]:
         out[f"{study}/{name}"] = test_text(c) + holm
         if "verdict" in c:
             out[f"{study}/{name}/verdict"] = c["verdict"]
+    for name, r in result.get("external", {}).items():
+        out[f"{study}/{name}/control"] = test_text(r["control"])
+        out[f"{study}/{name}/control/verdict"] = "shows" if r["control"]["shows"] else "does not show"
+        out[f"{study}/{name}/primary"] = test_text(r["primary"])
+        out[f"{study}/{name}/primary/verdict"] = r["primary"]["verdict"]
+        for key, c in r["secondary"].items():
+            holm = f" (Holm p = {c['p_holm']:.3f})" if c.get("p_holm") is not None else ""
+            out[f"{study}/{name}/{key}"] = test_text(c) + holm
+            out[f"{study}/{name}/{key}/verdict"] = c["verdict"]
     if "exchange" in result:
         e = result["exchange"]
         low = "≤ {}".format(e["sizes"][0]) if e["low"] is None else f"{e['low']:.0f}"

@@ -25,8 +25,11 @@ from graspaug.experiments.ap.numbers import test_labels
 from graspaug.experiments.confirm.tables import (
     PLAN,
     add_confirm_draw,
+    arm_key,
     check_plan_history,
+    column,
     combine_confirm,
+    external_sets,
     read_plan,
 )
 from graspaug.experiments.confirm.words import confirm_figures
@@ -72,6 +75,23 @@ def draw_roles(clone: Path, seed: int, objects) -> dict:
     shapes = read_table(clone / SHAPES_TABLE).set_index("shape_id")
     sources = {s: {"source": str(shapes.source[s]).split(":", 1)[-1], "scale": float(shapes.scale[s])} for s in test}
     return {"base": roles["base"], "validation": list(roles["validation"]), "test": test, "test_sources": sources}
+
+
+def draw_external(project: Path, plan: dict, spec: dict, draw: int, seed_dirs: dict) -> tuple:
+    """One draw's networks on a plan's external test set (``spec``: its ``corpus``, relative to the project or
+    absolute): (labels, objects, seed → column → P(success)); the test set is made once and cached in the project's
+    ``.graspaug-cache/evaluate`` (the same for every draw: the networks' cards give the same rules)."""
+    from graspaug.experiments.ap.numbers import network_folder
+    from graspaug.pipeline.studies.external import predict_on
+
+    corpus = Path(spec["corpus"])
+    corpus = corpus if corpus.is_absolute() else (project / corpus).resolve()
+    keys = {arm: arm_key(plan, arm) for arm in plan["arms"]}
+    by_seed, labels, objects = {}, None, None
+    for s, seed_dir in seed_dirs.items():
+        models = {column(draw, s, k): network_folder(seed_dir, k) / "model.pt" for k in keys.values()}
+        labels, objects, by_seed[s], _, _ = predict_on(models, corpus, project / ".graspaug-cache" / "evaluate")
+    return labels, objects, by_seed
 
 
 def run(
@@ -120,7 +140,9 @@ def run(
         meta = provenance(clone, command) | {"seconds": result["seconds"], "plan": PLAN}
         meta["params"] = {k: v for k, v in params_dict(params[draw]).items() if k not in ("data_seed", "data")}
         roles = draw_roles(clone, min(seed_dirs), objects)
-        add_confirm_draw(folder, plan, draw, seed_dirs, labels, objects, meta, roles)
+        sets = external_sets(plan).items()
+        external = {name: draw_external(project, plan, spec, draw, seed_dirs) for name, spec in sets}
+        add_confirm_draw(folder, plan, draw, seed_dirs, labels, objects, meta, roles, external)
         log.info("draw %d: done in %d s; its tables are in %s (commit them)", draw, result["seconds"], folder)
 
     jobs = {d: (run_draw, (project, d, workdir / f"draw{d}", params[d], sorted(plan["seeds"]))) for d in todo}

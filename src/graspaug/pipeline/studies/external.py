@@ -57,40 +57,48 @@ def planned_contrasts(plan: dict, arms: dict) -> dict[str, list[str]]:
     return out
 
 
-def run(study: Path, corpus: Path, out: Path, cache: Path, unit_scale: float, n_resamples: int, command: str) -> str:
-    """Predict every kept network of ``study`` on the test set of ``corpus``; write ``out``; the lines to print."""
+def predict_on(models: dict, corpus: Path, cache: Path, unit_scale: float = 1.0) -> tuple:
+    """Every model of ``models`` (column name → model.pt; their cards must give one test set) on the test set of
+    ``corpus``, made by the first model's card as ``graspaug evaluate`` makes it, from or into ``cache``: (labels,
+    objects, column → P(success), the cached folder, its ingest counts)."""
     from graspaug.device import resolve_device
-    from graspaug.experiments.confirm.external import combine_external, external_figures
     from graspaug.io.checkpoints import read_gqcnn
     from graspaug.io.sources import folder_sources
     from graspaug.pipeline.stages.evaluate import Params, card_test_set
-    from graspaug.pipeline.studies.draws import provenance
     from graspaug.planning.card import ModelCard
     from graspaug.training.gqcnn import predict
 
-    began = time.perf_counter()
     if not corpus.is_dir():
         raise DataError(f"--corpus {corpus}: no such folder")
-    plan = read_plan(study / PLAN)
-    draws, arms, models = kept_networks(study)
-    contrasts = planned_contrasts(plan, arms)
     sources = folder_sources(corpus, unit_scale, None)
     if not sources:
         raise DataError(f"--corpus {corpus}: no mesh files (.obj .stl .ply .off .glb) in it")
-    first = models[(draws[0], next(iter(arms)))]
+    first = next(iter(models.values()))
     net, raw = read_gqcnn(first)
     card = ModelCard.from_dict(raw, net.config.image_input)
     params, recipe, rules, folder, counts, data, arrays = card_test_set(Params(), card, raw, None, sources, cache)
     device = resolve_device(params.device)
     predictions = {}
-    for (draw, arm), model in models.items():
-        net, raw_d = read_gqcnn(model)
-        if raw_d.get("test_set_rules") != raw.get("test_set_rules"):
+    for name, model in models.items():
+        net, raw_m = read_gqcnn(model)
+        if raw_m.get("test_set_rules") != raw.get("test_set_rules"):
             raise DataError(f"{model}: its card's test-set rules differ from {first}'s; it needs another test set")
-        pool, b, r = arms[arm]
-        predictions[column(draw, 0, (pool, int(b), float(r)))] = predict(net.to(device), arrays, device)
-        log.info("draw %d %s: predicted %d datapoints", draw, arm, len(arrays.labels))
-    labels, objects = arrays.labels, data.index["shape_id"].to_numpy()
+        predictions[name] = predict(net.to(device), arrays, device)
+        log.info("%s: predicted %d datapoints of %s", name, len(arrays.labels), corpus.name)
+    return arrays.labels, data.index["shape_id"].to_numpy(), predictions, folder, counts
+
+
+def run(study: Path, corpus: Path, out: Path, cache: Path, unit_scale: float, n_resamples: int, command: str) -> str:
+    """Predict every kept network of ``study`` on the test set of ``corpus``; write ``out``; the lines to print."""
+    from graspaug.experiments.confirm.external import combine_external, external_figures
+    from graspaug.pipeline.studies.draws import provenance
+
+    began = time.perf_counter()
+    plan = read_plan(study / PLAN)
+    draws, arms, models = kept_networks(study)
+    contrasts = planned_contrasts(plan, arms)
+    named = {column(d, 0, (arms[a][0], int(arms[a][1]), float(arms[a][2]))): m for (d, a), m in models.items()}
+    labels, objects, predictions, folder, counts = predict_on(named, corpus, cache, unit_scale)
     held = {o for o, y in zip(objects, labels) if y}
     meta = provenance(Path.cwd(), command) | {
         "study": str(study),
