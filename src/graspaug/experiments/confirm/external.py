@@ -80,16 +80,39 @@ def combine_external(folder: Path) -> dict:
                 rows[r].append(v)
         for r in READOUTS:
             values[r][arm] = rows[r]
-    out = {"draws": draws, "counts": meta["counts"], "contrasts": {}, "arms": {}}
+    positives = pd.Series(labels).groupby(objects).sum().sort_values(ascending=False, kind="stable")
+    top4 = float(positives.iloc[:4].sum() / max(positives.sum(), 1))
+    out = {"draws": draws, "counts": meta["counts"] | {"top4_share": top4}, "contrasts": {}, "arms": {}}
     for r in READOUTS:
         out["arms"][r] = {arm: float(np.mean([v[0] for v in vs])) for arm, vs in values[r].items()}
         pairs = meta["contrasts"].items()
         out["contrasts"][r] = {name: _contrast(values[r][a], values[r][b]) for name, (a, b) in pairs}
     control = next(iter(meta["contrasts"]))
+    out["subsets"] = {}
+    for subset, keep in subsets(labels, objects, meta.get("object_scale")).items():
+        rows = {arm: [] for arm in meta["arms"]}
+        for arm, key in meta["arms"].items():
+            for d in draws:
+                p = predictions[column(d, 0, (key[0], int(key[1]), float(key[2])))].to_numpy()
+                rows[arm].append(network_values(labels[keep], objects[keep], p[keep], n, seed)["pooled"])
+        a, b = meta["contrasts"][control]
+        out["subsets"][subset] = _contrast(rows[a], rows[b]) | {"objects": int(len(set(objects[keep])))}
     for r in READOUTS:
         c = out["contrasts"][r][control]
         c["shows"] = c["low"] is not None and c["low"] > 0
     out["control"] = control
+    return out
+
+
+def subsets(labels: np.ndarray, objects: np.ndarray, scale: Mapping[str, float] | None) -> dict[str, np.ndarray]:
+    """The datapoints of the subsets the control is also read on, exploratory (chosen after looking at the pooled
+    one): ``without_top4`` (all but the four objects holding the most positives), and where the objects' fit scales
+    are known, ``real_size`` (objects kept at their real size) and ``fitted`` (shrunk to fit the gripper)."""
+    positives = pd.Series(labels).groupby(objects).sum().sort_values(ascending=False, kind="stable")
+    out = {"without_top4": ~np.isin(objects, positives.index[:4])}
+    if scale:
+        fitted = np.array([scale[o] < 1.0 for o in objects])
+        out |= {"real_size": ~fitted, "fitted": fitted}
     return out
 
 
@@ -109,8 +132,12 @@ def external_figures(result: Mapping, study: str) -> dict[str, str]:
     c = result["counts"]
     out = {
         f"{study}/counts": f"{c['objects']} objects with datapoints ({c['objects_with_positive']} with a positive), "
-        f"{c['datapoints']:,} datapoints, {c['positives']:,} positive"
+        f"{c['datapoints']:,} datapoints, {c['positives']:,} positive",
+        f"{study}/top4_share": f"{c['top4_share']:.0%}",
     }
+    for subset, x in result.get("subsets", {}).items():
+        interval = f"{x['mean']:+.4f} [{x['low']:+.4f}, {x['high']:+.4f}]" if x["low"] is not None else "n/a"
+        out[f"{study}/subset/{subset}/control"] = f"{interval} on {x['objects']} objects"
     for r in READOUTS:
         for name, x in result["contrasts"][r].items():
             no_interval = f"{x['mean']:+.4f} (no interval: {len(x['per_draw'])} draw)"

@@ -91,6 +91,7 @@ def predict_on(models: dict, corpus: Path, cache: Path, unit_scale: float = 1.0)
 def run(study: Path, corpus: Path, out: Path, cache: Path, unit_scale: float, n_resamples: int, command: str) -> str:
     """Predict every kept network of ``study`` on the test set of ``corpus``; write ``out``; the lines to print."""
     from graspaug.experiments.confirm.external import combine_external, external_figures
+    from graspaug.io.tables import read_table
     from graspaug.pipeline.studies.draws import provenance
 
     began = time.perf_counter()
@@ -100,6 +101,7 @@ def run(study: Path, corpus: Path, out: Path, cache: Path, unit_scale: float, n_
     named = {column(d, 0, (arms[a][0], int(arms[a][1]), float(arms[a][2]))): m for (d, a), m in models.items()}
     labels, objects, predictions, folder, counts = predict_on(named, corpus, cache, unit_scale)
     held = {o for o, y in zip(objects, labels) if y}
+    shapes = read_table(folder / "shapes.parquet").set_index("shape_id")
     meta = provenance(Path.cwd(), command) | {
         "study": str(study),
         "corpus": str(corpus),
@@ -116,6 +118,7 @@ def run(study: Path, corpus: Path, out: Path, cache: Path, unit_scale: float, n_
             "positives": int(labels.sum()),
             "ingest": counts,
         },
+        "object_scale": {o: float(shapes.scale[o]) for o in sorted(set(objects))},  # < 1: shrunk by the fit rule
         "seconds": round(time.perf_counter() - began),
         "machine": machine(),
     }
