@@ -169,9 +169,9 @@ def test_evaluate_prints_each_models_ap_and_the_paired_difference(project):
         root, str(models[0]), str(models[1]), "--corpus", str(corpus), "--resamples", "200", "--seeds", "2"
     )
     assert seeds.exit_code == 0, seeds.output
-    assert f"{models[0]} (2 seeds): mean test AP" in seeds.output
+    assert "none@4 (2 seeds): mean test AP" in seeds.output  # the arm named by its cards' training set
     as_networks = json.loads((root / "reports/evaluate/evaluate.json").read_text())
-    assert as_networks["networks"][f"{models[0]} (2 seeds)"]["n_seeds"] == 2
+    assert as_networks["networks"]["none@4 (2 seeds)"]["n_seeds"] == 2
     assert as_networks["network_differences"] == {}
     report_md = (root / "reports/evaluate/report.md").read_text()
     assert "arms of 2 replicates each (`--seeds 2`; their cards say they are training seeds of one draw" in report_md
@@ -412,3 +412,73 @@ def test_the_confirmatory_networks_make_their_test_set_by_their_cards(repo_root,
     shaped = json.loads((out / "evaluate.json").read_text())["shaped_by"]
     assert shaped["size"] == "fit" and shaped["rules"].startswith("the models' cards")
     assert "not evidence about the method" in done.output  # two single networks: no method verdict
+
+    nets = repo_root / "results/real-objects-confirm/networks"  # none@50 of draws 10-12, then targeted@50 of them
+    none = [str(nets / f"d{d}-s0/targeted-50-0/model.pt") for d in (10, 11, 12)]
+    targeted = [str(nets / f"d{d}-s0/targeted-50-1/model.pt") for d in (10, 11, 12)]
+    figures = []
+    for arm in (targeted, targeted[::-1]):  # the second arm's draws in order, then reversed
+        again = _evaluate(tmp_path, *none, *arm, "--corpus", str(objects), "--out", str(out), "--cache",
+                          str(tmp_path / "c"), "--seeds", "3", "--force", params=None)  # fmt: skip
+        assert again.exit_code == 0, again.output
+        report = json.loads((out / "evaluate.json").read_text())
+        figures.append({k: report[k] for k in ("differences", "networks", "network_differences")})
+    assert figures[0] == figures[1]  # replicate k paired with replicate k: the same draw, the same seed
+    assert list(figures[0]["networks"]) == ["none@50 (3 draws)", "targeted@50 (3 draws)"]
+    assert list(figures[0]["differences"]) == [f"targeted@50 − none@50 (d{d} s0)" for d in (10, 11, 12)]
+    report_md = (out / "report.md").read_text()
+    assert "/model.pt (3" not in report_md and "training seeds not covered" not in report_md
+    odd = [*none, *targeted[:2], str(nets / "d13-s0/targeted-50-1/model.pt")]
+    odd = _evaluate(tmp_path, *odd, "--corpus", str(objects), "--out", str(out), "--cache", str(tmp_path / "c"),
+                    "--seeds", "3", params=None)  # fmt: skip
+    assert odd.exit_code == 2 and len(odd.output.strip().splitlines()) == 1, odd.output
+    assert "d13-s0/targeted-50-1/model.pt (data_seed 13, training seed 0) has no partner" in odd.output
+
+
+def test_arms_are_paired_by_the_cards_draw_and_seed_and_named_by_their_training_set(repo_root):
+    """The kept confirmatory networks' cards: the second arm's draws in any order are paired with the first's by
+    draw and training seed, so test_ap gives the same figures; arms are named none@50, targeted@50, random@50,
+    none@150; what cannot be paired is refused naming the field and the files."""
+    from graspaug.errors import DataError
+    from graspaug.experiments.evaluate.testset import arrange_arms, replicate_name
+
+    nets = repo_root / "results/real-objects-confirm/networks"
+    if not nets.is_dir():
+        pytest.skip("the confirmatory study's kept networks are needed")
+    card = {
+        f"d{d}/{v}": json.loads((nets / f"d{d}-s0/{v}/card.json").read_text())
+        for d in (10, 11, 12)
+        for v in ("targeted-50-0", "targeted-50-1", "random-50-1", "targeted-150-0")
+    }
+    rng = np.random.default_rng(3)
+    objects = np.repeat([f"o{i}" for i in range(10)], 30)
+    labels = rng.random(len(objects)) < 0.3
+    noise = {name: rng.normal(0, 1 + i / 10, len(labels)) for i, name in enumerate(card)}
+
+    def figures(names: list[str]) -> dict:
+        order, kind, arms = arrange_arms({n: card[n] for n in names}, 3)
+        assert kind == "draws"
+        pairs = [replicate_name(card[n]) for n in order[:3]]
+        probabilities = {n: labels + noise[n] for n in order}
+        return ap_of_models(labels, objects, probabilities, 200, 0, 3, kind, arms, pairs)
+
+    arms = ("targeted-50-0", "targeted-50-1", "random-50-1", "targeted-150-0")
+    given = [f"d{d}/{v}" for v in arms for d in (10, 11, 12)]
+    mixed = [f"d{d}/{v}" for v in arms for d in ((10, 11, 12) if v == "targeted-50-0" else (12, 10, 11))]
+    in_order, shuffled = figures(given), figures(mixed)
+    assert in_order == shuffled
+    assert list(in_order["networks"]) == [f"{a} (3 draws)" for a in ("none@50", "targeted@50", "random@50", "none@150")]
+    assert "targeted@50 − none@50 (d11 s0)" in in_order["differences"]
+    within = in_order["differences"]["targeted@50 − none@50 (d11 s0)"]["mean"]
+    assert within == pytest.approx(
+        in_order["models"]["d11/targeted-50-1"]["mean"] - in_order["models"]["d11/targeted-50-0"]["mean"]
+    )
+    with pytest.raises(DataError, match=r"d13/targeted-50-1 \(data_seed 13, training seed 0\) has no partner"):
+        card["d13/targeted-50-1"] = json.loads((nets / "d13-s0/targeted-50-1/card.json").read_text())
+        arrange_arms(
+            {n: card[n] for n in ["d10/targeted-50-0", "d11/targeted-50-0", "d11/targeted-50-1", "d13/targeted-50-1"]},
+            2,
+        )
+    seedless = {"a": card["d10/targeted-50-0"], "b": {**card["d11/targeted-50-0"], "training_set": {}}}
+    with pytest.raises(DataError, match="model b's card has no training_set.seed"):
+        arrange_arms(seedless, 2)

@@ -15,10 +15,19 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+from tqdm import tqdm
+
 from graspaug.device import resolve_device
 from graspaug.errors import DataError
 from graspaug.experiments.evaluate.numbers import test_ap
-from graspaug.experiments.evaluate.testset import CARD_KEYS, cached_test_set, recipe_for, replicate_kind, shaped_by
+from graspaug.experiments.evaluate.testset import (
+    CARD_KEYS,
+    arrange_arms,
+    cached_test_set,
+    recipe_for,
+    replicate_name,
+    shaped_by,
+)
 from graspaug.experiments.evaluate.words import printed_lines, report_markdown, rules_source
 from graspaug.io.checkpoints import read_gqcnn
 from graspaug.io.gqcnn import GraspImages
@@ -75,7 +84,11 @@ def run(
             differs += [] if raw[name].get("test_set_rules") == raw[first].get("test_set_rules") else ["test_set_rules"]
             if differs:
                 raise DataError(f"model {name}: its card's {differs[0]} differs from {first}'s; evaluate them apart")
-        replicates = None if seeds is None else replicate_kind(raw, seeds)
+        replicates, arms, pairs = None, None, None
+        if seeds is not None:  # replicate k of every arm: the same draw and training seed, whatever the order given
+            order, replicates, arms = arrange_arms(raw, seeds)
+            nets = {name: nets[name] for name in order}
+            pairs = [replicate_name(raw[name]) for name in order[:seeds]]
         rules = None if params_file is not None else raw[first].get("test_set_rules")  # --params overrides the card
         params = with_sections(params, rules) if rules else params
 
@@ -86,9 +99,10 @@ def run(
         data = GraspImages.open(folder / "gqcnn")
         arrays = GraspArrays(data.images(), data.read("z"), data.read("labels"))
         device = resolve_device(params.device)
-        probabilities = {name: predict(net.to(device), arrays, device) for name, net in nets.items()}
+        bar = tqdm(nets.items(), desc="evaluate: predict", unit="network", leave=False)
+        probabilities = {name: predict(net.to(device), arrays, device) for name, net in bar}
         ids = data.index["shape_id"].to_numpy()
-        result = test_ap(arrays.labels, ids, probabilities, n_resamples, params.seed, seeds, replicates)
+        result = test_ap(arrays.labels, ids, probabilities, n_resamples, params.seed, seeds, replicates, arms, pairs)
 
         made = shaped_by(recipe, counts, params_file, unit_scale) | {"rules": rules_source(params_file, rules)}
         camera = f"the models' camera ({cards[first].camera_distance[0]:g}-{cards[first].camera_distance[1]:g} m)"
