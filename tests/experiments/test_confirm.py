@@ -247,3 +247,20 @@ def test_a_malformed_or_binary_plan_is_refused_in_one_line(tmp_path):
         out = CliRunner().invoke(app, ["study", "confirm", "--plan", str(plan), "--project", str(tmp_path)])
         assert out.exit_code == 2, out.output
         assert says in out.output and str(plan.name) in out.output and "bug" not in out.output, out.output
+
+
+def test_a_deleted_draw_file_is_named_with_its_draw(plan_repo):
+    """`graspaug results --check` once a done draw's table is deleted: exit 2, one line naming the draw and the file
+    that is gone and how to restore it."""
+    from typer.testing import CliRunner
+
+    from graspaug.pipeline.cli import app
+
+    repo, folder = plan_repo
+    _draw_tables(folder, [0, 1, 2])  # every planned draw done, and its test and predictions tables gone
+    with pytest.raises(DataError, match=r"draw 0's test-d0.parquet is gone \(networks.parquet holds the draw\)"):
+        combine_confirm(folder)
+    checked = CliRunner().invoke(app, ["results", "--root", str(repo), "--check", "--out", str(repo / "out")])
+    line = checked.output.strip()
+    assert checked.exit_code == 2 and "\n" not in line, checked.output
+    assert "draw 0's test-d0.parquet is gone" in line and "git checkout -- " in line

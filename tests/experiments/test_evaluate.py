@@ -222,6 +222,15 @@ def test_bad_folders_and_models_are_refused_in_one_line(project, tmp_path):
     (tmp_path / "broken.pt").write_text("not a checkpoint")
     broken = _evaluate(root, str(models[0]), str(tmp_path / "broken.pt"), "--corpus", str(corpus))
     assert broken.exit_code == 2 and "broken.pt" in broken.output and len(broken.output.splitlines()) == 1
+    (tmp_path / "noise.pt").write_bytes(np.random.default_rng(0).bytes(3000))  # torch's advice was weights_only
+    (tmp_path / "truncated.pt").write_bytes(models[0].read_bytes()[:5000])
+    torch.save({"config": object.__new__(GQCNNConfig)}, tmp_path / "objects.pt")  # a save holding more than tensors
+    for name, says in (("noise.pt", "not the zip archive"), ("truncated.pt", "not the zip archive"),
+                       ("objects.pt", "objects other than tensors")):  # fmt: skip
+        corrupt = _evaluate(root, str(tmp_path / name), "--corpus", str(corpus))
+        line = corrupt.output.strip()
+        assert corrupt.exit_code == 2 and f"model {tmp_path / name}: not a checkpoint (" in line and says in line, line
+        assert "weights_only" not in line and "\n" not in line, line
     uneven = _evaluate(root, *map(str, models), str(root / "m2.pt"), "--corpus", str(corpus), "--seeds", "2")
     assert uneven.exit_code == 2 and "--seeds 2: 3 models are not arms of 2 replicates" in uneven.output
 

@@ -258,7 +258,11 @@ def recompute(results_dir: Path) -> tuple[dict[str, str], dict[str, dict]]:
         if kind not in STUDIES:
             raise DataError(f"{folder}: not a study folder (known: {', '.join(STUDIES)})")
         combine, figures_of = STUDIES[kind]
-        results[folder.name] = combine(folder)
+        try:
+            results[folder.name] = combine(folder)
+        except FileNotFoundError as exc:  # a committed table deleted: name it, not only its path
+            gone = exc.filename or str(exc)
+            raise DataError(f"{folder}: {gone} is gone; restore it from git (git checkout -- {gone})") from None
         figures |= figures_of(results[folder.name], folder.name)
     return figures, results
 

@@ -181,7 +181,14 @@ def machine() -> str:
 
 
 def draw_values(folder: Path, plan: Mapping, draw: int, seeds: list[int]) -> dict[str, float]:
-    """One draw's mean test AP over its seeds of every plan arm, by arm name."""
+    """One draw's mean test AP over its seeds of every plan arm, by arm name. A file of the draw that is gone is a
+    :class:`DataError` naming the draw and the file."""
+    for name in [f"test-d{draw}.parquet", *(f"predictions-d{draw}-s{s}.parquet" for s in seeds)]:
+        if not (folder / name).is_file():
+            raise DataError(
+                f"{folder}: draw {draw}'s {name} is gone (networks.parquet holds the draw); restore it from git "
+                f"(git checkout -- {folder / name}) or run the draw again"
+            )
     test = pd.read_parquet(folder / f"test-d{draw}.parquet")
     labels = test.label.to_numpy()
     out: dict[str, list[float]] = {arm: [] for arm in plan["arms"]}
