@@ -491,3 +491,25 @@ def test_arms_are_paired_by_the_cards_draw_and_seed_and_named_by_their_training_
     seedless = {"a": card["d10/targeted-50-0"], "b": {**card["d11/targeted-50-0"], "training_set": {}}}
     with pytest.raises(DataError, match="model b's card has no training_set.seed"):
         arrange_arms(seedless, 2)
+
+
+def test_a_mean_aps_interval_stays_inside_aps_range():
+    """Two seeds (t on 1 degree of freedom: a wide interval) of a near-perfect arm: the arm's mean-AP interval is
+    clipped to [0, 1] and says so; a difference's to [-1, 1]; an interval inside the range is left as it is."""
+    rng = np.random.default_rng(5)
+    objects = np.repeat([f"o{i}" for i in range(12)], 25)
+    labels = rng.random(len(objects)) < 0.3
+    perfect = {"p0": labels * 1.0, "p1": labels + rng.normal(0, 0.8, len(labels))}
+    weak = {"w0": rng.random(len(labels)), "w1": labels + rng.normal(0, 0.9, len(labels))}
+    out = ap_of_models(labels, objects, perfect | weak, 200, 0, seeds=2, arms=["good@50", "bad@50"])
+    good = out["networks"]["good@50 (2 seeds)"]
+    assert good["clipped"] and good["draws_high"] == 1.0 and 0 <= good["draws_low"] < good["mean"] < 1
+    raw = nested_t_interval(np.array([[out["models"][n]["mean"] for n in perfect]]),
+                            np.stack([ObjectBootstrap(objects, 200, 0).average_precision(labels, p)
+                                      for p in perfect.values()])[None])  # fmt: skip
+    assert raw["high"] > 1 and good["draws_low"] == pytest.approx(max(raw["low"], 0))
+    for c in [*out["networks"].values(), *out["network_differences"].values()]:
+        assert 0 <= c["draws_low"] <= c["draws_high"] <= 1 or c in out["network_differences"].values()
+        assert -1 <= c["draws_low"] <= c["draws_high"] <= 1
+    assert any(line.endswith("(clipped to [0, 1])") for line in printed_lines(out, "report.md"))
+    assert list(out["differences"]) == ["bad@50 − good@50 (replicate 1)", "bad@50 − good@50 (replicate 2)"]
