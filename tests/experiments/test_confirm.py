@@ -212,3 +212,55 @@ def test_graspaug_results_check_reads_the_plans_history(plan_repo):
     _git(repo, "commit", "-qam", "a looser alpha")
     edited = CliRunner().invoke(app, ["results", "--root", str(repo), "--check", "--out", str(repo / "out")])
     assert edited.exit_code == 2 and "changed after its first commit" in edited.output
+
+
+def test_a_plans_words_print_the_level_its_alpha_gives(tmp_path):
+    """An alpha of 0.10 gives 90% intervals: words labelled "(95%, ..." are refused; ``{level}`` says 90%."""
+    values = {d: {"none@50": 0.5, "none@150": 0.6 + 0.01 * d, "targeted@50": 0.55 + 0.005 * d, "random@50": 0.5}
+              for d in range(3)}  # fmt: skip
+    loose = PLAN | {"alpha": 0.1}
+    loose["words"] = PLAN["words"] | {"raises": "raises AP by {mean} [{low}, {high}] ({level}, {draws} draws)"}
+    result = read_plan_result(loose, values)
+    assert result["primary"]["verdict"] == "raises" and "(90%, 3 draws)" in result["sentence"]
+    assert result["primary"]["high"] - result["primary"]["low"] < read_plan_result(PLAN, values)["primary"]["high"] - \
+        read_plan_result(PLAN, values)["primary"]["low"]  # fmt: skip
+    (tmp_path / "plan.yaml").write_text(yaml.safe_dump(loose | {"words": PLAN["words"] | {"raises": "up (95%, {p})"}}))
+    with pytest.raises(DataError, match=r"words.raises labels its interval \(95%, but alpha 0.1 gives 90% intervals"):
+        read_plan(tmp_path / "plan.yaml")
+    (tmp_path / "plan.yaml").write_text(yaml.safe_dump(PLAN | {"words": PLAN["words"] | {"raises": "up (95%, {p})"}}))
+    assert read_plan(tmp_path / "plan.yaml")["alpha"] == 0.05
+
+
+def test_a_malformed_or_binary_plan_is_refused_in_one_line(tmp_path):
+    """`graspaug study confirm --plan` on broken YAML, a binary file or a YAML list: exit 2, naming the file."""
+    from typer.testing import CliRunner
+
+    from graspaug.pipeline.cli import app
+
+    broken, binary, listed = tmp_path / "broken.yaml", tmp_path / "model.pt", tmp_path / "list.yaml"
+    broken.write_text("format: graspaug.confirm-plan/1\narms: {none@50: [targeted, 50\n")
+    binary.write_bytes(bytes(range(256)) * 4)
+    listed.write_text("- a\n- b\n")
+    for plan, says in ((broken, "not valid YAML at line"), (binary, "not a text file"), (listed, "it holds a list")):
+        with pytest.raises(DataError, match=says):
+            read_plan(plan)
+        out = CliRunner().invoke(app, ["study", "confirm", "--plan", str(plan), "--project", str(tmp_path)])
+        assert out.exit_code == 2, out.output
+        assert says in out.output and str(plan.name) in out.output and "bug" not in out.output, out.output
+
+
+def test_a_deleted_draw_file_is_named_with_its_draw(plan_repo):
+    """`graspaug results --check` once a done draw's table is deleted: exit 2, one line naming the draw and the file
+    that is gone and how to restore it."""
+    from typer.testing import CliRunner
+
+    from graspaug.pipeline.cli import app
+
+    repo, folder = plan_repo
+    _draw_tables(folder, [0, 1, 2])  # every planned draw done, and its test and predictions tables gone
+    with pytest.raises(DataError, match=r"draw 0's test-d0.parquet is gone \(networks.parquet holds the draw\)"):
+        combine_confirm(folder)
+    checked = CliRunner().invoke(app, ["results", "--root", str(repo), "--check", "--out", str(repo / "out")])
+    line = checked.output.strip()
+    assert checked.exit_code == 2 and "\n" not in line, checked.output
+    assert "draw 0's test-d0.parquet is gone" in line and "git checkout -- " in line

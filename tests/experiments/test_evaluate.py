@@ -169,9 +169,9 @@ def test_evaluate_prints_each_models_ap_and_the_paired_difference(project):
         root, str(models[0]), str(models[1]), "--corpus", str(corpus), "--resamples", "200", "--seeds", "2"
     )
     assert seeds.exit_code == 0, seeds.output
-    assert f"{models[0]} (2 seeds): mean test AP" in seeds.output
+    assert "none@4 (2 seeds): mean test AP" in seeds.output  # the arm named by its cards' training set
     as_networks = json.loads((root / "reports/evaluate/evaluate.json").read_text())
-    assert as_networks["networks"][f"{models[0]} (2 seeds)"]["n_seeds"] == 2
+    assert as_networks["networks"]["none@4 (2 seeds)"]["n_seeds"] == 2
     assert as_networks["network_differences"] == {}
     report_md = (root / "reports/evaluate/report.md").read_text()
     assert "arms of 2 replicates each (`--seeds 2`; their cards say they are training seeds of one draw" in report_md
@@ -222,6 +222,15 @@ def test_bad_folders_and_models_are_refused_in_one_line(project, tmp_path):
     (tmp_path / "broken.pt").write_text("not a checkpoint")
     broken = _evaluate(root, str(models[0]), str(tmp_path / "broken.pt"), "--corpus", str(corpus))
     assert broken.exit_code == 2 and "broken.pt" in broken.output and len(broken.output.splitlines()) == 1
+    (tmp_path / "noise.pt").write_bytes(np.random.default_rng(0).bytes(3000))  # torch's advice was weights_only
+    (tmp_path / "truncated.pt").write_bytes(models[0].read_bytes()[:5000])
+    torch.save({"config": object.__new__(GQCNNConfig)}, tmp_path / "objects.pt")  # a save holding more than tensors
+    for name, says in (("noise.pt", "not the zip archive"), ("truncated.pt", "not the zip archive"),
+                       ("objects.pt", "objects other than tensors")):  # fmt: skip
+        corrupt = _evaluate(root, str(tmp_path / name), "--corpus", str(corpus))
+        line = corrupt.output.strip()
+        assert corrupt.exit_code == 2 and f"model {tmp_path / name}: not a checkpoint (" in line and says in line, line
+        assert "weights_only" not in line and "\n" not in line, line
     uneven = _evaluate(root, *map(str, models), str(root / "m2.pt"), "--corpus", str(corpus), "--seeds", "2")
     assert uneven.exit_code == 2 and "--seeds 2: 3 models are not arms of 2 replicates" in uneven.output
 
@@ -412,3 +421,95 @@ def test_the_confirmatory_networks_make_their_test_set_by_their_cards(repo_root,
     shaped = json.loads((out / "evaluate.json").read_text())["shaped_by"]
     assert shaped["size"] == "fit" and shaped["rules"].startswith("the models' cards")
     assert "not evidence about the method" in done.output  # two single networks: no method verdict
+
+    nets = repo_root / "results/real-objects-confirm/networks"  # none@50 of draws 10-12, then targeted@50 of them
+    none = [str(nets / f"d{d}-s0/targeted-50-0/model.pt") for d in (10, 11, 12)]
+    targeted = [str(nets / f"d{d}-s0/targeted-50-1/model.pt") for d in (10, 11, 12)]
+    figures = []
+    for arm in (targeted, targeted[::-1]):  # the second arm's draws in order, then reversed
+        again = _evaluate(tmp_path, *none, *arm, "--corpus", str(objects), "--out", str(out), "--cache",
+                          str(tmp_path / "c"), "--seeds", "3", "--force", params=None)  # fmt: skip
+        assert again.exit_code == 0, again.output
+        report = json.loads((out / "evaluate.json").read_text())
+        figures.append({k: report[k] for k in ("differences", "networks", "network_differences")})
+    assert figures[0] == figures[1]  # replicate k paired with replicate k: the same draw, the same seed
+    assert list(figures[0]["networks"]) == ["none@50 (3 draws)", "targeted@50 (3 draws)"]
+    assert list(figures[0]["differences"]) == [f"targeted@50 − none@50 (d{d} s0)" for d in (10, 11, 12)]
+    report_md = (out / "report.md").read_text()
+    assert "/model.pt (3" not in report_md and "training seeds not covered" not in report_md
+    odd = [*none, *targeted[:2], str(nets / "d13-s0/targeted-50-1/model.pt")]
+    odd = _evaluate(tmp_path, *odd, "--corpus", str(objects), "--out", str(out), "--cache", str(tmp_path / "c"),
+                    "--seeds", "3", params=None)  # fmt: skip
+    assert odd.exit_code == 2 and len(odd.output.strip().splitlines()) == 1, odd.output
+    assert "d13-s0/targeted-50-1/model.pt (data_seed 13, training seed 0) has no partner" in odd.output
+
+
+def test_arms_are_paired_by_the_cards_draw_and_seed_and_named_by_their_training_set(repo_root):
+    """The kept confirmatory networks' cards: the second arm's draws in any order are paired with the first's by
+    draw and training seed, so test_ap gives the same figures; arms are named none@50, targeted@50, random@50,
+    none@150; what cannot be paired is refused naming the field and the files."""
+    from graspaug.errors import DataError
+    from graspaug.experiments.evaluate.testset import arrange_arms, replicate_name
+
+    nets = repo_root / "results/real-objects-confirm/networks"
+    if not nets.is_dir():
+        pytest.skip("the confirmatory study's kept networks are needed")
+    card = {
+        f"d{d}/{v}": json.loads((nets / f"d{d}-s0/{v}/card.json").read_text())
+        for d in (10, 11, 12)
+        for v in ("targeted-50-0", "targeted-50-1", "random-50-1", "targeted-150-0")
+    }
+    rng = np.random.default_rng(3)
+    objects = np.repeat([f"o{i}" for i in range(10)], 30)
+    labels = rng.random(len(objects)) < 0.3
+    noise = {name: rng.normal(0, 1 + i / 10, len(labels)) for i, name in enumerate(card)}
+
+    def figures(names: list[str]) -> dict:
+        order, kind, arms = arrange_arms({n: card[n] for n in names}, 3)
+        assert kind == "draws"
+        pairs = [replicate_name(card[n]) for n in order[:3]]
+        probabilities = {n: labels + noise[n] for n in order}
+        return ap_of_models(labels, objects, probabilities, 200, 0, 3, kind, arms, pairs)
+
+    arms = ("targeted-50-0", "targeted-50-1", "random-50-1", "targeted-150-0")
+    given = [f"d{d}/{v}" for v in arms for d in (10, 11, 12)]
+    mixed = [f"d{d}/{v}" for v in arms for d in ((10, 11, 12) if v == "targeted-50-0" else (12, 10, 11))]
+    in_order, shuffled = figures(given), figures(mixed)
+    assert in_order == shuffled
+    assert list(in_order["networks"]) == [f"{a} (3 draws)" for a in ("none@50", "targeted@50", "random@50", "none@150")]
+    assert "targeted@50 − none@50 (d11 s0)" in in_order["differences"]
+    within = in_order["differences"]["targeted@50 − none@50 (d11 s0)"]["mean"]
+    assert within == pytest.approx(
+        in_order["models"]["d11/targeted-50-1"]["mean"] - in_order["models"]["d11/targeted-50-0"]["mean"]
+    )
+    with pytest.raises(DataError, match=r"d13/targeted-50-1 \(data_seed 13, training seed 0\) has no partner"):
+        card["d13/targeted-50-1"] = json.loads((nets / "d13-s0/targeted-50-1/card.json").read_text())
+        arrange_arms(
+            {n: card[n] for n in ["d10/targeted-50-0", "d11/targeted-50-0", "d11/targeted-50-1", "d13/targeted-50-1"]},
+            2,
+        )
+    seedless = {"a": card["d10/targeted-50-0"], "b": {**card["d11/targeted-50-0"], "training_set": {}}}
+    with pytest.raises(DataError, match="model b's card has no training_set.seed"):
+        arrange_arms(seedless, 2)
+
+
+def test_a_mean_aps_interval_stays_inside_aps_range():
+    """Two seeds (t on 1 degree of freedom: a wide interval) of a near-perfect arm: the arm's mean-AP interval is
+    clipped to [0, 1] and says so; a difference's to [-1, 1]; an interval inside the range is left as it is."""
+    rng = np.random.default_rng(5)
+    objects = np.repeat([f"o{i}" for i in range(12)], 25)
+    labels = rng.random(len(objects)) < 0.3
+    perfect = {"p0": labels * 1.0, "p1": labels + rng.normal(0, 0.8, len(labels))}
+    weak = {"w0": rng.random(len(labels)), "w1": labels + rng.normal(0, 0.9, len(labels))}
+    out = ap_of_models(labels, objects, perfect | weak, 200, 0, seeds=2, arms=["good@50", "bad@50"])
+    good = out["networks"]["good@50 (2 seeds)"]
+    assert good["clipped"] and good["draws_high"] == 1.0 and 0 <= good["draws_low"] < good["mean"] < 1
+    raw = nested_t_interval(np.array([[out["models"][n]["mean"] for n in perfect]]),
+                            np.stack([ObjectBootstrap(objects, 200, 0).average_precision(labels, p)
+                                      for p in perfect.values()])[None])  # fmt: skip
+    assert raw["high"] > 1 and good["draws_low"] == pytest.approx(max(raw["low"], 0))
+    for c in [*out["networks"].values(), *out["network_differences"].values()]:
+        assert 0 <= c["draws_low"] <= c["draws_high"] <= 1 or c in out["network_differences"].values()
+        assert -1 <= c["draws_low"] <= c["draws_high"] <= 1
+    assert any(line.endswith("(clipped to [0, 1])") for line in printed_lines(out, "report.md"))
+    assert list(out["differences"]) == ["bad@50 − good@50 (replicate 1)", "bad@50 − good@50 (replicate 2)"]

@@ -128,3 +128,55 @@ def test_bad_input_is_one_line(repo_root, tmp_path, monkeypatch):
                     "--params", str(params), "--out", str(tmp_path / "o3"))  # fmt: skip
     assert camera.exit_code == 2 and "trained for a camera 0.65-0.75 m" in camera.output, camera.output
     assert not (tmp_path / "o1").exists() and not (tmp_path / "o3").exists()  # nothing half-written
+
+
+def test_two_objects_carry_no_interval_and_the_report_says_so():
+    """One draw of two objects: a bootstrap over two objects gives three values, no interval; the summary, its
+    verdicts and the report say why instead of printing +0.000 [+0.000, +0.000]."""
+    from graspaug.pipeline.studies.real_picks import report_markdown
+
+    rows = [{"draw": 0, "arm": arm, "object": f"o{o}", "attempt": a, "success": bool((o + a) % 2)}
+            for arm in ("none@50", "targeted@50", "none@150") for o in range(2) for a in range(4)]  # fmt: skip
+    attempts = pd.DataFrame(rows)
+    summary = pick_summary(attempts, ["none@50", "targeted@50", "none@150"]) | {"never_held": [], "attempts": 4}
+    control = summary["contrasts"]["control"]
+    assert control["low"] is None and control["high"] is None
+    assert control["verdict"] == "no interval: 2 objects (an objects' bootstrap needs 5 or more)"
+    report = report_markdown(attempts, summary)
+    assert "[+0.000, +0.000]" not in report and "+0.000 (no interval: 2 objects" in report
+
+
+def test_without_its_corpora_real_picks_says_which_corpus_it_needs(tmp_path, monkeypatch):
+    """The defaults with no ../shared/corpora: exit 2, one line naming --corpora, the corpus and where it comes from
+    (not an unexpected BadParameter)."""
+    monkeypatch.chdir(tmp_path)
+    out = CliRunner().invoke(app, ["study", "real-picks"])
+    assert out.exit_code == 2, out.output
+    assert len(out.output.strip().splitlines()) == 1 and "bug" not in out.output, out.output
+    assert "--corpora: ../shared/corpora: no such folder" in out.output and "Google Scanned Objects" in out.output
+    assert "--objects" in out.output
+
+
+def test_objects_in_millimetres_load_with_unit_scale_in_evaluates_formats(tmp_path):
+    """--objects reads every mesh evaluate reads (.off and .glb too) in --unit-scale metres per unit; mm files read
+    as metres are skipped with advice that names an option real-picks has."""
+    import trimesh
+
+    from graspaug.pipeline.params.profiles import profile_params
+    from graspaug.pipeline.studies.real_picks import corpus_meshes, object_sources
+
+    objects = tmp_path / "objects"
+    (objects / "sub").mkdir(parents=True)
+    trimesh.creation.box(extents=[50, 30, 80]).export(objects / "box.off")
+    trimesh.creation.cylinder(radius=20, height=90).export(objects / "sub" / "can.glb")
+    surface = profile_params("real_objects").ingest.surface
+    sources = object_sources(objects, 0.001)
+    assert len(sources) == 2 and {s.path.suffix for s in sources} == {".off", ".glb"}
+    meshes, missed = corpus_meshes(objects, [s.shape_id for s in sources], surface, None, 0.001)
+    assert len(meshes) == 2 and not missed
+    assert all(0.02 < max(m.extents) < 0.2 for _, m in meshes)  # real size, metres
+    _, missed = corpus_meshes(objects, [s.shape_id for s in object_sources(objects, 1.0)], surface, None, 1.0)
+    assert len(missed) == 2 and all("--unit-scale 0.001 (evaluate, study real-picks --objects)" in r
+                                    for r in missed.values()), missed  # fmt: skip
+    help_text = CliRunner().invoke(app, ["study", "real-picks", "--help"], env={"COLUMNS": "250"}).output
+    assert "--unit-scale" in help_text and ".glb" in help_text

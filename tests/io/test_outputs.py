@@ -246,3 +246,15 @@ def test_a_folder_that_cannot_be_written_is_refused_before_any_work():
     assert lines[0].startswith(f"refused the output folder {top / 'ro'} cannot be written")
     assert lines[1].startswith(f"refused the output folder {top / 'ro/new'} cannot be written: {top / 'ro'} refuses")
     assert lines[2] == f"accepted {top / 'ok/new'}"
+
+
+def test_an_output_folder_under_a_file_blames_the_path_given(tmp_path):
+    """``--out afile/sub``: the user's path and the file in its way are named, not an internal probe file."""
+    from graspaug.io.outputs import check_output_folder
+
+    (tmp_path / "afile").write_text("a file, not a folder")
+    for out in (tmp_path / "afile" / "sub", tmp_path / "afile" / "sub" / "deeper"):
+        with pytest.raises(DataError) as refused:
+            check_output_folder(out, "evaluate")
+        assert str(out) in str(refused.value) and f"{tmp_path / 'afile'} is a file" in str(refused.value)
+        assert "probe" not in str(refused.value)

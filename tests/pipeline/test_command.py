@@ -88,3 +88,32 @@ def test_a_study_keeps_only_the_networks_its_run_trains():
     assert kept_networks(generate, only) == [("targeted", 50, 0.0), ("targeted", 50, 1.0)]
     both = SimpleNamespace(augment_base_sizes=(50,), pools=("targeted", "real"), control_ratios=None)
     assert ("real", 50, 1.0) in kept_networks(generate, both)
+
+
+def test_every_commands_help_keeps_its_placeholders():
+    """The help is markdown: a placeholder such as ``d<k>-s0/`` or ``results/<NAME>/`` outside backticks was taken
+    for an HTML tag and dropped ("d-s0/ each"). Every command's --help prints every ``<...>`` its texts hold."""
+    import re
+
+    import typer
+    from typer.testing import CliRunner
+
+    from graspaug.pipeline.cli import app
+
+    def commands(group, path):
+        for name, command in group.commands.items():
+            if hasattr(command, "commands"):
+                yield from commands(command, [*path, name])
+            else:
+                yield [*path, name], command
+
+    checked = 0
+    for path, command in commands(typer.main.get_command(app), []):
+        texts = [command.help or "", *(getattr(p, "help", None) or "" for p in command.params)]
+        wanted = {m for text in texts for m in re.findall(r"<[\w@.-]+>", text)}
+        shown = CliRunner().invoke(app, [*path, "--help"], env={"COLUMNS": "400"})
+        assert shown.exit_code == 0, shown.output
+        lost = sorted(p for p in wanted if p not in shown.output)
+        assert not lost, f"graspaug {' '.join(path)} --help drops {lost}"
+        checked += bool(wanted)
+    assert checked >= 5  # real-picks, confirm, from-failures, plan, export-dexnet, ... hold placeholders

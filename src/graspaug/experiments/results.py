@@ -258,25 +258,30 @@ def recompute(results_dir: Path) -> tuple[dict[str, str], dict[str, dict]]:
         if kind not in STUDIES:
             raise DataError(f"{folder}: not a study folder (known: {', '.join(STUDIES)})")
         combine, figures_of = STUDIES[kind]
-        results[folder.name] = combine(folder)
+        try:
+            results[folder.name] = combine(folder)
+        except FileNotFoundError as exc:  # a committed table deleted: name it, not only its path
+            gone = exc.filename or str(exc)
+            raise DataError(f"{folder}: {gone} is gone; restore it from git (git checkout -- {gone})") from None
         figures |= figures_of(results[folder.name], folder.name)
     return figures, results
 
 
 def study_kind(folder: Path) -> str:
     """The study a results folder holds: ``confirm`` where it has a plan (``plan.yaml``), ``picks`` where it has a
-    table of pick attempts (``attempts.parquet``), ``external`` where it has one table of predictions of a
-    confirmatory study's networks on an external test set (``predictions.parquet``), else its name's first word
-    (``attribution-real-objects``: ``attribution``)."""
+    table of pick attempts (``attempts.parquet``), else its name's first word (``attribution-real-objects``:
+    ``attribution``), or ``external`` where that names no study and it holds one table of predictions of a
+    confirmatory study's networks on an external test set (``predictions.parquet``)."""
     from graspaug.experiments.confirm.tables import PLAN
 
     if (Path(folder) / PLAN).is_file():
         return "confirm"
     if (Path(folder) / "attempts.parquet").is_file():
         return "picks"
-    if (Path(folder) / "predictions.parquet").is_file():
+    named = Path(folder).name.split("-")[0]
+    if named not in STUDIES and (Path(folder) / "predictions.parquet").is_file():
         return "external"
-    return Path(folder).name.split("-")[0]
+    return named
 
 
 def history_problems(results_dir: Path) -> list[str]:

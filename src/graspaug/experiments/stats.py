@@ -82,22 +82,63 @@ class ObjectBootstrap:
         """(n_resamples,) AP of ``scores`` (N,) for ``labels`` (N,) under every resample: the same figures as
         :func:`weighted_average_precision` with each datapoint weighted by its object's count (tied scores grouped,
         as sklearn's), computed from the objects' counts up to each threshold that holds a positive, so one network
-        costs (R × objects × positive thresholds) rather than (R × N): 35,000 datapoints of 73 objects, 2,000
-        resamples, in about 0.05 s instead of 2 s."""
+        costs (R × objects × positive thresholds) rather than (R × N).
+
+        Each datapoint is binned at once by (object, the first threshold holding a positive at or below its score),
+        the bins summed up the thresholds, and the positives gained at a threshold read off the running true
+        positives (no positive lies between two such thresholds), so the resamples take two products of whole
+        counts (exact in float32 while every sum stays below 2²⁴, else in float64) and the precisions are summed a
+        cache-sized block of resamples at a time: about 3× faster than the object loop it replaces (48 networks ×
+        23,524 datapoints × 68 objects, 1,000 resamples: 12.8 s against 39.4 s on a loaded 2-core machine;
+        :meth:`average_precision_by_objects`, kept as the reference), the same figures (equal to 1e-9 by test; bit
+        for bit in ``bench/bootstrap_speed.py``)."""
+        order = np.argsort(-np.asarray(scores), kind="stable")
+        s, y = np.asarray(scores)[order], np.asarray(labels, dtype=bool)[order]
+        obj = self.object_index[order]
+        group = np.cumsum(np.r_[True, s[1:] != s[:-1]]) - 1  # each datapoint's group of tied scores, highest first
+        held = np.unique(group[y])  # the thresholds that hold a positive: only they add to AP
+        if len(held) == 0:
+            return np.full(len(self.object_counts), np.nan)
+        at = np.searchsorted(held, group)  # the first such threshold that counts the datapoint as seen
+        keep = at < len(held)
+        cells = obj[keep] * len(held) + at[keep]
+        size = self.n_objects * len(held)
+        seen = np.bincount(cells, minlength=size).reshape(self.n_objects, -1).cumsum(axis=1)
+        hits = np.bincount(cells[y[keep]], minlength=size).reshape(self.n_objects, -1).cumsum(axis=1)
+        exact32 = float(self.object_counts.sum(axis=1).max()) * float(np.bincount(self.object_index).max()) < 2**24
+        dtype = np.float32 if exact32 else np.float64  # whole numbers: exact either way below 2²⁴ (float32)
+        counts, hits, seen = self.object_counts.astype(dtype), hits.astype(dtype), seen.astype(dtype)
+        tp, seen = counts @ hits, np.maximum(counts @ seen, 1)  # (R, thresholds); 1 where none seen: precision 0
+        found = np.zeros(len(counts))
+        step = max(1, 2**17 // len(held))  # resamples at a time: (step, thresholds) blocks that stay in the cache
+        for r in range(0, len(counts), step):
+            positive = np.diff(tp[r : r + step], axis=1, prepend=dtype(0))  # gained at each: whole numbers, exact
+            precision = np.divide(tp[r : r + step], seen[r : r + step], dtype=np.float64)
+            precision *= positive
+            found[r : r + step] = precision.sum(axis=1)
+        total = tp[:, -1].astype(float)  # each resample's positives
+        out = np.full(len(counts), np.nan)
+        np.divide(found, total, out=out, where=total > 0)
+        return out
+
+    def average_precision_by_objects(self, labels: np.ndarray, scores: np.ndarray) -> np.ndarray:
+        """:meth:`average_precision` as it was computed before, one object at a time (35,000 datapoints of 73
+        objects, 2,000 resamples, in about 0.05 s against the weighted AP's 2 s): the reference the faster one is
+        tested and timed against (``bench/bootstrap_speed.py``)."""
         order = np.argsort(-np.asarray(scores), kind="stable")
         s, y = np.asarray(scores)[order], np.asarray(labels, dtype=bool)[order]
         obj = self.object_index[order]
         new_group = np.r_[True, s[1:] != s[:-1]]
-        group = np.cumsum(new_group) - 1  # each datapoint's group of tied scores, highest first
+        group = np.cumsum(new_group) - 1
         starts = np.flatnonzero(new_group)
         ends = np.r_[starts[1:], len(s)]
-        held = np.unique(group[y])  # the thresholds that hold a positive: only they add to AP
+        held = np.unique(group[y])
         if len(held) == 0:
             return np.full(len(self.object_counts), np.nan)
         lo, hi = starts[held], ends[held]
-        seen = np.zeros((self.n_objects, len(held)))  # datapoints of each object up to each such threshold
-        hits = np.zeros((self.n_objects, len(held)))  # positives of each object up to each threshold
-        gained = np.zeros((self.n_objects, len(held)))  # positives of each object at each threshold
+        seen = np.zeros((self.n_objects, len(held)))
+        hits = np.zeros((self.n_objects, len(held)))
+        gained = np.zeros((self.n_objects, len(held)))
         for o in np.unique(obj):
             where = np.flatnonzero(obj == o)
             where_pos = where[y[where]]

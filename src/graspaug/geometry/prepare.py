@@ -30,7 +30,10 @@ class PreparedShape:
 FIT_SHARE = 0.9  # size `fit`: a shape too wide for the gripper is scaled until its narrowest side is this share of it
 #: How many times too wide for the gripper a shape must be for its reject to name the likely unit mistake.
 UNIT_MISTAKE = 100.0
-UNIT_HINT = "millimetres read as metres? give the unit: --unit-scale 0.001 (evaluate), data.unit_scale: 0.001 (ingest)"
+UNIT_HINT = (
+    "millimetres read as metres? give the unit: --unit-scale 0.001 (evaluate, study real-picks --objects), "
+    "data.unit_scale: 0.001 (ingest)"
+)
 
 
 def too_wide(smallest: float, max_width: float, why: str = "") -> MeshRejected:

@@ -242,6 +242,19 @@ def save_gqcnn(path: str | os.PathLike, net, summary: dict[str, Any], card: dict
         torch.save(state, f)
 
 
+def _unreadable(path: Path, exc: Exception) -> str:
+    """Why ``torch.load`` could not read ``path``, in the user's words: what the file looks like (not a zip archive:
+    no PyTorch save; a truncated archive; a pickle of objects other than tensors and plain values), never torch's
+    advice to turn ``weights_only`` off (which would run code from the file)."""
+    import zipfile
+
+    if not zipfile.is_zipfile(path):
+        return "not the zip archive torch.save writes: a corrupt, truncated or other kind of file"
+    if type(exc).__name__ == "UnpicklingError":
+        return "a PyTorch save holding objects other than tensors and plain values, which graspaug does not load"
+    return f"a damaged PyTorch archive: {type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else 'truncated'}"
+
+
 def read_gqcnn(path: str | os.PathLike):
     """A trained GQ-CNN (a :class:`~graspaug.nets.gqcnn.GQCNNEnsemble` for a checkpoint of
     several members) on the CPU in eval mode, and its model card (a dict; None for a
@@ -260,8 +273,7 @@ def read_gqcnn(path: str | os.PathLike):
     try:
         saved = torch.load(path, map_location="cpu", weights_only=True)
     except Exception as exc:  # noqa: BLE001 - torch raises many types for a file that is no checkpoint
-        why = f"{type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else 'truncated'}"
-        raise CheckpointMismatch(f"model {path}: not a readable PyTorch checkpoint ({why})") from None
+        raise CheckpointMismatch(f"model {path}: not a checkpoint ({_unreadable(path, exc)})") from None
     if not isinstance(saved, dict) or "state_dict" not in saved or "config" not in saved:
         raise CheckpointMismatch(f"model {path}: not a GQ-CNN checkpoint of graspaug (no config and state_dict)")
     config = GQCNNConfig(

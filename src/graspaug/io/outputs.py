@@ -138,6 +138,8 @@ def _check_writable(folder: Path, out: Path) -> None:
     parent, where the command would make it): a read-only or foreign folder is refused before any work."""
     while not folder.exists() and folder != folder.parent:
         folder = folder.parent
+    if not folder.is_dir():  # a file where a folder of the path belongs (--out afile/sub)
+        raise DataError(f"the output folder {out} cannot be made: {folder} is a file, not a folder; choose another")
     try:
         fd, probe = tempfile.mkstemp(prefix=".graspaug-probe-", dir=folder)
     except OSError as exc:

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import errno
 import logging
+import re
 import warnings
 from pathlib import Path
 
@@ -80,11 +81,28 @@ def is_system_error(exc: BaseException) -> bool:
     return isinstance(exc, OSError) and exc.errno is not None and exc.errno not in INPUT_ERRNOS
 
 
+def keep_placeholders(text: str | None) -> str | None:
+    """``text`` (a help text, rendered as markdown) with every ``<`` outside a code span escaped, so a placeholder
+    such as ``d<k>-s0/`` or ``results/<name>/`` is printed, not taken for an HTML tag and dropped. Idempotent."""
+    if not text:
+        return text
+    parts = text.split("`")
+    parts[::2] = [re.sub(r"(?<!\\)<", r"\\<", part) for part in parts[::2]]  # even parts: outside backticks
+    return "`".join(parts)
+
+
 class Command(TyperCommand):
     """A command that keeps the exit-code contract (:data:`EXIT_CODES`): an error of bad input is one line and exit
     2, the system failing (:func:`is_system_error`) or any other exception one line and exit 3; ``--debug``
     re-raises them (the traceback). Warnings are logged, each distinct one once (:class:`WarningsOnce`);
     ``--debug`` leaves Python's warning filters as they are."""
+
+    def format_help(self, ctx, formatter) -> None:
+        self.help = keep_placeholders(self.help)
+        for param in self.params:
+            if getattr(param, "help", None):
+                param.help = keep_placeholders(param.help)
+        super().format_help(ctx, formatter)
 
     def invoke(self, ctx):
         if _debug["on"]:
@@ -109,7 +127,10 @@ class Command(TyperCommand):
                 typer.echo(f"error: {_one_line(exc)}", err=True)
                 raise typer.Exit(code=2) from None
             except Exception as exc:  # noqa: BLE001 - the contract: one line, exit 3, the traceback with --debug
-                if type(exc).__module__.startswith("click"):
+                if type(exc).__name__ in ("BadParameter", "UsageError"):  # raised by a command's body (typer's click)
+                    typer.echo(f"error: {_one_line_usage(exc)}", err=True)
+                    raise typer.Exit(code=2) from None
+                if type(exc).__module__.startswith(("click", "typer._click")):
                     raise
                 typer.echo(
                     f"error: unexpected {type(exc).__name__}: {_one_line(exc)} (a bug? `graspaug --debug` shows "
@@ -117,6 +138,14 @@ class Command(TyperCommand):
                     err=True,
                 )
                 raise typer.Exit(code=3) from None
+
+
+def _one_line_usage(exc: BaseException) -> str:
+    """A usage error raised by a command's body as one line: ``--option: message`` (click's own words otherwise)."""
+    hint = getattr(exc, "param_hint", None)
+    if isinstance(hint, str) and hasattr(exc, "message"):
+        return " ".join(f"{hint}: {exc.message}".split())
+    return " ".join((exc.format_message() if hasattr(exc, "format_message") else str(exc)).split())
 
 
 def _one_line(exc: BaseException) -> str:

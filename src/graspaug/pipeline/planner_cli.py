@@ -156,9 +156,12 @@ def evaluate_command(
         None,
         "--seeds",
         min=2,
-        help="The models are training seeds of networks, this many each, one network's after another (e.g. 8 "
-        "models with --seeds 4: two networks): also prints each network's mean AP and each network's paired "
-        "difference to the first (seed k with seed k), 95% over the seeds (t) and the objects (bootstrap).",
+        help="The models are arms of this many replicates each (training seeds of one draw, or networks of as many "
+        "draws), one arm's after another (e.g. 8 models with --seeds 4: two arms), each arm's replicates in any order: "
+        "they are paired by their cards' draw (data_seed) and training seed, and refused when they cannot be. Arms are "
+        "named from the cards (none@50, targeted@50, random@50, none@150); also prints each arm's mean AP and each "
+        "arm's paired difference to the first, 95% over the replicates (t) and the objects (bootstrap), clipped to "
+        "AP's range, and each model's difference to the first arm's model of the same draw and seed.",
     ),
 ) -> None:
     import graspaug.pipeline.stages.evaluate as command

@@ -253,7 +253,15 @@ def real_picks_command(
     ),
     draws: list[int] = typer.Option(None, "--draws", help="Only these draws (default: every d<k>-s0 there)."),
     corpora: Path = typer.Option(Path("../shared/corpora"), "--corpora", help="Where the test objects' files are."),
-    objects: Path = typer.Option(None, "--objects", help="Pick the meshes of this folder instead (metres)."),
+    objects: Path = typer.Option(
+        None,
+        "--objects",
+        help="Pick every mesh under this folder instead (.obj .stl .ply .off .glb, any file name, as evaluate reads "
+        "--corpus; metres unless --unit-scale).",
+    ),
+    unit_scale: float = typer.Option(
+        1.0, "--unit-scale", min=1e-9, help="Metres per file unit of --objects' meshes (0.001: mm files)."
+    ),
     attempts: int = typer.Option(10, "--attempts", min=1, help="Attempts per object and arm (paper: 10)."),
     limit: int = typer.Option(None, "--limit", min=1, help="Only the first N objects of each draw (a timing)."),
     params: Path = typer.Option(None, "--params", help="The params file of the cell (default: built-in defaults)."),
@@ -274,7 +282,13 @@ def real_picks_command(
 
     _logging()
     if objects is None and not corpora.is_dir():
-        raise typer.BadParameter(f"{corpora}: no such folder", param_hint="--corpora")
+        raise typer.BadParameter(
+            f"{corpora}: no such folder. The draws' test objects are Google Scanned Objects meshes (gso300/ and "
+            "gso100/, metres: the corpora the networks' project ingested, its data.path; the real_objects profile's is "
+            "../shared/corpora), found by file name; point --corpora at your copy, or pick the meshes of any folder "
+            "with --objects",
+            param_hint="--corpora",
+        )
     meta = provenance(Path("."), _command_line())  # the code that runs, before any commit made while it runs
     settings = load_stage_params(params, sim_stage).model_copy(update={"n_jobs": workers})
     surface = lambda: profile_params(profile).ingest.surface  # noqa: E731 (read only for cards without rules)
@@ -289,7 +303,8 @@ def real_picks_command(
         real_picks.write_results(kept, table, meta | {"attempts": attempts, "seconds": every, "runs": runs})
 
     with output_folder(out, "study real-picks", [networks, corpora, objects], force) as tmp:
-        table, summary, text = real_picks.run(*args, tmp, pictures=True, done=done, on_draw=keep if kept else None)
+        on_draw = keep if kept else None
+        table, summary, text = real_picks.run(*args, tmp, True, done, on_draw, unit_scale)
         (tmp / "report.md").write_text(text)
         (tmp / "summary.json").write_text(json.dumps(summary, indent=1, default=str))
     typer.echo(text)

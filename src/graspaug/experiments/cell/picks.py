@@ -50,10 +50,19 @@ def _over_draws(per_draw: list[float]) -> dict:
     return out | {"per_draw": t["per_draw"]}
 
 
+#: The fewest objects an objects' bootstrap gives an interval over: below it, resampling a handful of objects gives a
+#: few distinct values (two objects: three), and a percentile of them is no interval.
+MIN_OBJECTS = 5
+
+
 def _over_objects(mean: float, resampled: np.ndarray, n_objects: int) -> dict:
-    """A one-draw quantity's ``mean`` and the percentile interval of its objects' bootstrap ``resampled`` (R,)."""
+    """A one-draw quantity's ``mean`` and the percentile interval of its objects' bootstrap ``resampled`` (R,); no
+    interval over fewer than :data:`MIN_OBJECTS` objects, and ``why`` says so."""
+    out = {"mean": mean, "low": None, "high": None, "p": None, "over": "objects", "n": int(n_objects)}
+    if n_objects < MIN_OBJECTS:
+        return out | {"why": f"no interval: {n_objects} objects (an objects' bootstrap needs {MIN_OBJECTS} or more)"}
     low, high = percentile_interval(resampled)
-    return {"mean": mean, "low": low, "high": high, "p": None, "over": "objects", "n": int(n_objects)}
+    return out | {"low": low, "high": high}
 
 
 def _control_arm(arms: Sequence[str]) -> str:
@@ -155,7 +164,7 @@ def _size(arm: str) -> int:
 
 def _verdict(c: dict) -> str:
     if c["low"] is None:
-        return "no interval"
+        return c.get("why", "no interval")
     if c["low"] > 0:
         return "higher"
     if c["high"] < 0:

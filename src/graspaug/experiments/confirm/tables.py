@@ -23,6 +23,7 @@ from __future__ import annotations
 import io
 import json
 import platform
+import re
 import subprocess
 from collections.abc import Mapping
 from pathlib import Path
@@ -64,7 +65,16 @@ def read_plan(path: Path) -> dict:
     path = Path(path)
     if not path.is_file():
         raise DataError(f"{path}: no plan; a confirmatory study runs only from a committed plan.yaml")
-    plan = yaml.safe_load(path.read_text()) or {}
+    try:
+        plan = yaml.safe_load(path.read_text()) or {}
+    except UnicodeDecodeError:
+        raise DataError(f"{path}: not a text file; a plan is a YAML file (results/<name>/plan.yaml)") from None
+    except yaml.YAMLError as e:
+        mark = getattr(e, "problem_mark", None)
+        where = "" if mark is None else f" at line {mark.line + 1}, column {mark.column + 1}"
+        raise DataError(f"{path}: not valid YAML{where}: {getattr(e, 'problem', None) or e}") from None
+    if not isinstance(plan, dict):
+        raise DataError(f"{path}: a plan is a YAML mapping of {', '.join(PLAN_KEYS)}; it holds a {type(plan).__name__}")
     missing = [k for k in PLAN_KEYS if k not in plan]
     if missing:
         raise DataError(f"{path}: the plan lacks {', '.join(missing)}")
@@ -77,7 +87,20 @@ def read_plan(path: Path) -> dict:
     unknown = sorted(named - set(plan["arms"]))
     if unknown:
         raise DataError(f"{path}: hypotheses name arms the plan does not define: {', '.join(unknown)}")
+    level = interval_level(plan["alpha"])
+    for key, words in plan["words"].items():
+        for stated in re.findall(r"\((\d+(?:\.\d+)?)%", str(words)):
+            if f"{stated}%" != level:
+                raise DataError(
+                    f"{path}: words.{key} labels its interval ({stated}%, but alpha {plan['alpha']} gives {level} "
+                    "intervals; write ({level}, ...) and the level used is filled in"
+                )
     return plan
+
+
+def interval_level(alpha: float) -> str:
+    """The two-sided level of a plan's intervals, 1 − ``alpha``, as a plan's words print it: ``95%``, ``90%``."""
+    return f"{100 * (1 - float(alpha)):.10g}%"
 
 
 def arm_key(plan: Mapping, arm: str) -> tuple[str, int, float]:
@@ -182,7 +205,14 @@ def machine() -> str:
 
 
 def draw_values(folder: Path, plan: Mapping, draw: int, seeds: list[int]) -> dict[str, float]:
-    """One draw's mean test AP over its seeds of every plan arm, by arm name."""
+    """One draw's mean test AP over its seeds of every plan arm, by arm name. A file of the draw that is gone is a
+    :class:`DataError` naming the draw and the file."""
+    for name in [f"test-d{draw}.parquet", *(f"predictions-d{draw}-s{s}.parquet" for s in seeds)]:
+        if not (folder / name).is_file():
+            raise DataError(
+                f"{folder}: draw {draw}'s {name} is gone (networks.parquet holds the draw); restore it from git "
+                f"(git checkout -- {folder / name}) or run the draw again"
+            )
     test = pd.read_parquet(folder / f"test-d{draw}.parquet")
     labels = test.label.to_numpy()
     out: dict[str, list[float]] = {arm: [] for arm in plan["arms"]}
@@ -323,7 +353,8 @@ def read_plan_tests(plan: Mapping, test_of, diff=None) -> dict:
     else:
         verdict, sentence = "not shown", words["not_shown"]
     result = {"control": control | {"shows": shows}, "primary": primary | {"verdict": verdict}, "secondary": secondary}
-    result["sentence"] = sentence.format(**sentence_fields(primary), control=sentence_fields(control))
+    fields = sentence_fields(primary) | {"level": interval_level(alpha)}
+    result["sentence"] = sentence.format(**fields, control=sentence_fields(control))
     return result
 
 

@@ -266,15 +266,63 @@ def _arm_field(card: dict, field: str):
     return card.get("training_set", {}).get(field) if field in ("pool", "base_size", "ratio") else card.get(field)
 
 
-def replicate_kind(cards: dict[str, dict], k: int) -> str:
-    """What the ``k`` consecutive models of each arm are replicates over, from their cards (model name → card, in
-    order): ``seeds`` (training seeds of one draw of the data) or ``draws`` (networks of distinct draws). A model
-    whose pool, base size, ratio, training rule or test-set rules (:data:`ARM_FIELDS`) differ from its arm's first,
-    or two models that are the same replicate, are a :class:`DataError` naming the first field that differs."""
-    names = list(cards)
+#: What pairs the replicates of two arms (``evaluate --seeds``): the card's draw of the data and training seed.
+PAIR_FIELDS = ("data_seed", "seed")
+
+
+def _pair_key(card: dict) -> tuple:
+    return card.get("data_seed"), card.get("training_set", {}).get("seed")
+
+
+def arm_name(card: dict) -> str:
+    """An arm's name from a model card's training set: ``<pool>@<base size>`` (``targeted@50``), ``none@<base size>``
+    at ratio 0 (the base set alone, whatever pool the card names), ``<pool>×<ratio>@<base size>`` at another ratio."""
+    ts = card.get("training_set", {})
+    ratio, base = ts.get("ratio"), ts.get("base_size")
+    if ratio is None or base is None:
+        return "an arm of unknown training set"
+    if float(ratio) == 0:
+        return f"none@{base}"
+    return f"{ts.get('pool')}@{base}" if float(ratio) == 1 else f"{ts.get('pool')}×{float(ratio):g}@{base}"
+
+
+def replicate_name(card: dict) -> str:
+    """A replicate's name from its card: ``d<draw> s<training seed>`` (``d10 s0``)."""
+    draw, seed = _pair_key(card)
+    return f"d{draw} s{seed}"
+
+
+def arrange_arms(cards: dict[str, dict], k: int) -> tuple[list[str], str, list[str]]:
+    """The models of ``evaluate --seeds k`` as arms of ``k`` replicates, paired by their cards.
+
+    ``cards``: model name → card, in the order given; each ``k`` consecutive models are one arm. Within an arm the
+    pool, base size, ratio, training rule and test-set rules (:data:`ARM_FIELDS`) must agree, and no two models may
+    be the same replicate; every arm must hold the same replicates (draw ``data_seed`` and training seed, the
+    :data:`PAIR_FIELDS`) as the first, in any order (cards that record no draw, all of them, are paired by training
+    seed). Anything else is a :class:`DataError` naming the field and the
+    files.
+
+    Returns
+    -------
+    names : the models, arm by arm, each arm's replicates in the order (draw, seed): replicate k of every arm is the
+        same draw and training seed, whatever order they were given in
+    kind : ``seeds`` (training seeds of one draw of the data) or ``draws`` (networks of distinct draws)
+    arms : each arm's name (:func:`arm_name`; the first model's name added where two arms would share one)
+    """
+    given = list(cards)
+    for name in given:
+        if _pair_key(cards[name])[1] is None:
+            raise DataError(f"--seeds {k}: model {name}'s card has no training_set.seed, so it cannot be paired")
+    undrawn = [name for name in given if _pair_key(cards[name])[0] is None]  # older cards: one draw, not recorded
+    if undrawn and len(undrawn) < len(given):
+        drawn = next(name for name in given if name not in undrawn)
+        raise DataError(
+            f"--seeds {k}: model {undrawn[0]}'s card has no data_seed (its draw) but {drawn}'s has one, so they cannot "
+            "be paired"
+        )
+    groups = [given[start : start + k] for start in range(0, len(given), k)]
     kinds = set()
-    for start in range(0, len(names), k):
-        arm = names[start : start + k]
+    for arm in groups:
         head = cards[arm[0]]
         for name in arm[1:]:
             for field in ARM_FIELDS:
@@ -283,11 +331,26 @@ def replicate_kind(cards: dict[str, dict], k: int) -> str:
                         f"--seeds {k}: model {name} is not a replicate of {arm[0]}: its card's {field} is "
                         f"{_arm_field(cards[name], field)!r}, not {_arm_field(head, field)!r}"
                     )
-        draws = [cards[n].get("data_seed") for n in arm]
-        seeds = [(cards[n].get("data_seed"), cards[n].get("training_set", {}).get("seed")) for n in arm]
-        if len(set(seeds)) < len(seeds):
-            raise DataError(f"--seeds {k}: models of arm {arm[0]} share a draw and training seed (the same replicate)")
-        kinds.add("draws" if None not in draws and len(set(draws)) == len(draws) else "seeds")
+        keys = [_pair_key(cards[n]) for n in arm]
+        if len(set(keys)) < len(keys):
+            twins = [n for n in arm if keys.count(_pair_key(cards[n])) > 1]
+            raise DataError(
+                f"--seeds {k}: models {twins[0]} and {twins[1]} share a draw (data_seed) and training seed: the same "
+                "replicate twice"
+            )
+        kinds.add("draws" if None not in keys[0] and len({d for d, _ in keys}) == len(keys) else "seeds")
     if len(kinds) > 1:
         raise DataError(f"--seeds {k}: some arms are replicates over seeds, others over draws; evaluate them apart")
-    return kinds.pop()
+    first = {_pair_key(cards[n]): n for n in groups[0]}
+    for arm in groups[1:]:
+        for name in arm:
+            if _pair_key(cards[name]) not in first:
+                draw, seed = _pair_key(cards[name])
+                raise DataError(
+                    f"--seeds {k}: model {name} (data_seed {draw}, training seed {seed}) has no partner of that draw "
+                    f"and seed in the first arm ({', '.join(groups[0])}); give every arm the same replicates"
+                )
+    names = [n for arm in groups for n in sorted(arm, key=lambda n: _pair_key(cards[n]))]
+    arms = [arm_name(cards[arm[0]]) for arm in groups]
+    arms = [a if arms.count(a) == 1 else f"{a} ({arm[0]})" for a, arm in zip(arms, groups, strict=True)]
+    return names, kinds.pop(), arms

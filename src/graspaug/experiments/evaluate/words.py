@@ -13,6 +13,8 @@ SIZE_WORDS = {
 
 #: What a paired difference of two single networks is, in the report and the printed lines: never a method's gain.
 SINGLE = "these two networks on these objects; training seeds not covered: not evidence about the method"
+#: What a paired difference of one replicate of two arms is (``--seeds``: the same draw and training seed in both).
+REPLICATE = "one replicate, the same draw and training seed in both arms: not evidence about the method alone"
 #: Replicates an arm needs for a verdict about a method (``--seeds K``).
 MIN_REPLICATES = 3
 NO_POSITIVE = "n/a (no positive datapoint: AP is undefined)"
@@ -107,12 +109,13 @@ def report_markdown(result: dict, corpus: str, counts: dict, camera: str, shaped
         ),
     ]
     if result["differences"]:
+        what = REPLICATE if result.get("networks") else SINGLE
         lines += [
             "",
             *table(
                 ["difference", "AP [95% interval over objects]", "what it is"],
                 result["differences"],
-                lambda c: [ap_text(c, objects), SINGLE],
+                lambda c: [ap_text(c, objects), what],
             ),
         ]
     lines += [
@@ -128,7 +131,13 @@ def report_markdown(result: dict, corpus: str, counts: dict, camera: str, shaped
             f"The models as arms of {n} replicates each (`--seeds {n}`; their cards say they are {what}): each arm's "
             f"mean test AP, and each arm's paired difference to the first (replicate k with replicate k), 95% over "
             f"the {over} (t on {n - 1} degrees of freedom) and the objects (their bootstrap's variance), added in "
-            "quadrature. "
+            "quadrature"
+            + (
+                " (an interval that left AP's range is clipped to it: [0, 1] for a mean AP, [−1, 1] for a difference; "
+                "that drops only values AP cannot take, so its coverage is unchanged). "
+                if any(c.get("clipped") for c in _arm_contrasts(result))
+                else ". "
+            )
             + (
                 "Over seeds of one draw, a verdict covers that draw of the training data only."
                 if over == "seeds"
@@ -153,13 +162,23 @@ def report_markdown(result: dict, corpus: str, counts: dict, camera: str, shaped
     return "\n".join(lines) + "\n"
 
 
+def _arm_contrasts(result: dict) -> list[dict]:
+    """Every arm's mean and every arms' difference of an evaluate ``result`` with ``--seeds``."""
+    return [*result.get("networks", {}).values(), *result.get("network_differences", {}).values()]
+
+
 def printed_lines(result: dict, report) -> list[str]:
     """What ``graspaug evaluate`` prints: each model's test AP, each single-network difference as what it is
     (:data:`SINGLE`), each arm's mean and difference with ``--seeds``, and where the ``report`` is."""
     objects = result["objects"]
     lines = [f"{name}: test AP {ap_text(c, objects, '.4f')}" for name, c in result["models"].items()]
-    lines += [f"{name}: {ap_text(c, objects)} ({SINGLE})" for name, c in result["differences"].items()]
-    lines += [f"{name}: mean test AP {interval_text(c, '.4f')}" for name, c in result.get("networks", {}).items()]
+    what = REPLICATE if result.get("networks") else SINGLE
+    lines += [f"{name}: {ap_text(c, objects)} ({what})" for name, c in result["differences"].items()]
+    clipped = " (clipped to [0, 1])"
+    lines += [
+        f"{name}: mean test AP {interval_text(c, '.4f')}{clipped if c.get('clipped') else ''}"
+        for name, c in result.get("networks", {}).items()
+    ]
     n = replicates(result)
     differences = result.get("network_differences", {})
     lines += [f"{name}: {interval_text(c)} ({method_verdict(c, n)})" for name, c in differences.items()]

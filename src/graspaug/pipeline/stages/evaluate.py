@@ -15,10 +15,19 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+from tqdm import tqdm
+
 from graspaug.device import resolve_device
 from graspaug.errors import DataError
 from graspaug.experiments.evaluate.numbers import test_ap
-from graspaug.experiments.evaluate.testset import CARD_KEYS, cached_test_set, recipe_for, replicate_kind, shaped_by
+from graspaug.experiments.evaluate.testset import (
+    CARD_KEYS,
+    arrange_arms,
+    cached_test_set,
+    recipe_for,
+    replicate_name,
+    shaped_by,
+)
 from graspaug.experiments.evaluate.words import printed_lines, report_markdown, rules_source
 from graspaug.io.checkpoints import read_gqcnn
 from graspaug.io.gqcnn import GraspImages
@@ -90,13 +99,18 @@ def run(
             differs += [] if raw[name].get("test_set_rules") == raw[first].get("test_set_rules") else ["test_set_rules"]
             if differs:
                 raise DataError(f"model {name}: its card's {differs[0]} differs from {first}'s; evaluate them apart")
-        replicates = None if seeds is None else replicate_kind(raw, seeds)
+        replicates, arms, pairs = None, None, None
+        if seeds is not None:  # replicate k of every arm: the same draw and training seed, whatever the order given
+            order, replicates, arms = arrange_arms(raw, seeds)
+            nets = {name: nets[name] for name in order}
+            pairs = [replicate_name(raw[name]) for name in order[:seeds]]
         test = card_test_set(params, cards[first], raw[first], params_file, sources, cache)
         params, recipe, rules, folder, counts, data, arrays = test
         device = resolve_device(params.device)
-        probabilities = {name: predict(net.to(device), arrays, device) for name, net in nets.items()}
+        bar = tqdm(nets.items(), desc="evaluate: predict", unit="network", leave=False)
+        probabilities = {name: predict(net.to(device), arrays, device) for name, net in bar}
         ids = data.index["shape_id"].to_numpy()
-        result = test_ap(arrays.labels, ids, probabilities, n_resamples, params.seed, seeds, replicates)
+        result = test_ap(arrays.labels, ids, probabilities, n_resamples, params.seed, seeds, replicates, arms, pairs)
 
         made = shaped_by(recipe, counts, params_file, unit_scale) | {"rules": rules_source(params_file, rules)}
         camera = f"the models' camera ({cards[first].camera_distance[0]:g}-{cards[first].camera_distance[1]:g} m)"

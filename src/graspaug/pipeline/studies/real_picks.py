@@ -101,14 +101,31 @@ def check_camera(card: dict, cell, where: Path) -> None:
         raise DataError(f"{where}: trained for intrinsics {card['intrinsics']}, the cell's are {ours}")
 
 
-def corpus_meshes(corpora: Path, ids: list[str], surface, limit: int | None) -> tuple[list, dict[str, str]]:
-    """The meshes of the objects ``ids`` (shape ids as ingest names them) found in the folder ``corpora``, each
-    loaded, closed and sized as ingest does (``surface``); those not found or broken, with the reason."""
+def object_sources(folder: Path, unit_scale: float) -> list:
+    """Every mesh file under ``folder`` (``--objects``: the formats and names evaluate reads, each in ``unit_scale``
+    metres per file unit); a missing folder or one without a mesh is a :class:`DataError`."""
+    from graspaug.geometry.loading import MESH_SUFFIXES
+    from graspaug.io.sources import folder_sources
+
+    if not Path(folder).is_dir():
+        raise DataError(f"--objects {folder}: no such folder")
+    sources = folder_sources(folder, unit_scale, None)
+    if not sources:
+        raise DataError(f"--objects {folder} holds no mesh file ({', '.join(MESH_SUFFIXES)})")
+    return sources
+
+
+def corpus_meshes(
+    corpora: Path, ids: list[str], surface, limit: int | None, unit_scale: float = 1.0
+) -> tuple[list, dict[str, str]]:
+    """The meshes of the objects ``ids`` (shape ids as ingest names them) found in the folder ``corpora`` (files in
+    ``unit_scale`` metres per unit), each loaded, closed and sized as ingest does (``surface``); those not found or
+    broken, with the reason."""
     from graspaug.geometry.loading import MeshRejected, load_shape
     from graspaug.geometry.prepare import prepare_shape
     from graspaug.io.sources import folder_sources
 
-    by_id = {s.shape_id: s for s in folder_sources(corpora, 1.0, None)}
+    by_id = {s.shape_id: s for s in folder_sources(corpora, unit_scale, None)}
     meshes, skipped = [], {}
     for shape_id in ids[:limit] if limit else ids:
         source = by_id.get(shape_id)
@@ -116,7 +133,7 @@ def corpus_meshes(corpora: Path, ids: list[str], surface, limit: int | None) -> 
             skipped[shape_id] = f"not found in {corpora}"
             continue
         try:
-            meshes.append((shape_id, prepare_shape(load_shape(source.path, 1.0), surface).mesh))
+            meshes.append((shape_id, prepare_shape(load_shape(source.path, source.unit_scale), surface).mesh))
         except (MeshRejected, OSError, ValueError) as exc:
             skipped[shape_id] = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
     return meshes, skipped
@@ -161,12 +178,14 @@ def run(
     pictures: bool,
     done: pd.DataFrame | None = None,
     on_draw=None,
+    unit_scale: float = 1.0,
 ) -> tuple[pd.DataFrame, dict, str]:
     """Pick every object of every draw in every arm; (the attempts table, the summary, the report's markdown).
     ``out``: the folder the pictures go to (a staging folder). ``done``: attempts of earlier runs (a results
     folder's table); its draws are not picked again and its rows join the summary. ``on_draw(table, seconds)`` is
-    called after each draw with every attempt so far, so a long study keeps each draw as it finishes."""
-    from graspaug.sim.objects import folder_meshes, prepare_objects
+    called after each draw with every attempt so far, so a long study keeps each draw as it finishes.
+    ``unit_scale``: metres per file unit of ``objects_dir``'s meshes."""
+    from graspaug.sim.objects import prepare_objects
 
     folders = draw_folders(networks, draws)
     earlier = set() if done is None or done.empty else set(int(d) for d in done.draw)
@@ -178,12 +197,9 @@ def run(
         began = time.perf_counter()
         surface, card = card_surface(folder, fallback_surface)
         check_camera(card, sim.cell, folder)
-        if objects_dir is not None:
-            try:
-                meshes, missed = folder_meshes(objects_dir, surface, label="real-picks")
-            except ValueError as exc:  # a folder with no (usable) mesh: one line
-                raise DataError(str(exc).replace("sim.objects_path", "--objects")) from None
-            meshes = meshes[:limit] if limit else meshes
+        if objects_dir is not None:  # every mesh under it, read as evaluate reads --corpus (formats, --unit-scale)
+            ids = [source.shape_id for source in object_sources(objects_dir, unit_scale)]
+            meshes, missed = corpus_meshes(objects_dir, ids, surface, limit, unit_scale)
         else:
             meshes, missed = corpus_meshes(corpora, test_objects(folder), surface, limit)
         if not meshes:
@@ -252,7 +268,9 @@ def report_markdown(table: pd.DataFrame, summary: dict) -> str:
     hardest objects and those no arm held."""
 
     def text(c: dict, sign: str = "+") -> str:  # sign "": a rate or an AUC, not a difference
-        ends = "no interval" if c["low"] is None else f"[{c['low']:{sign}.3f}, {c['high']:{sign}.3f}]"
+        if c["low"] is None:  # too few objects or draws: say why, print no interval
+            return f"{c['mean']:{sign}.3f} ({c.get('why', 'no interval')}; n = {c['n']} {c['over']})"
+        ends = f"[{c['low']:{sign}.3f}, {c['high']:{sign}.3f}]"
         return f"{c['mean']:{sign}.3f} {ends} (95% over {c['over']}, n = {c['n']})"
 
     paper = paper_table(summary)
