@@ -37,7 +37,8 @@ from graspaug.io.gqcnn import GraspImages
 from graspaug.io.tables import read_table
 from graspaug.rng import shape_rng
 from graspaug.training.gqcnn import GraspArrays
-from graspaug.training.variants import SAMPLED_POOLS, Variant
+from graspaug.training.settings import SAMPLED_POOLS
+from graspaug.training.variants import Variant
 
 
 @dataclass(frozen=True)

@@ -14,15 +14,10 @@ datapoints, from extra camera views of themselves, as targeted at (B, R) adds. A
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 from graspaug.errors import DataError
-from graspaug.training.settings import POOLS
-
-SAMPLED_POOLS = ("balanced", "views")
-"""Arms of the base shapes alone that mirror targeted at their (B, R): ``balanced`` (batches drawn at targeted's
-positive share) and ``views`` (as many more datapoints as targeted adds, from extra views of the base shapes)."""
+from graspaug.training.settings import POOLS, check_networks
 
 
 @dataclass(frozen=True, order=True)
@@ -72,37 +67,6 @@ def listed_variants(networks) -> list[Variant]:
     """The networks of an explicit list of (pool, B, R) (``gqcnn.networks``), in its order, ratio 0 of any pool as
     the targeted network (:func:`network_variant`)."""
     return [network_variant(str(p), int(b), float(r)) for p, b, r in networks]
-
-
-def check_networks(networks, base_sizes, ratios, augment_base_sizes, pools, control_ratios=None) -> str | None:
-    """Why the explicit list ``networks`` (``gqcnn.networks``) cannot be trained with these ``generate`` and ``gqcnn``
-    settings (one line naming the key), or None: a 1:0 network needs its B among generate.base_sizes; a pool of
-    :data:`POOLS` at R > 0 needs to be among gqcnn.pools, B among gqcnn.augment_base_sizes and R among its
-    :func:`pool_ratios`; ``balanced`` and ``views`` need targeted at their (B, R) generated the same way."""
-    seen = set()
-    for entry in networks:
-        pool, b, r = str(entry[0]), int(entry[1]), float(entry[2])
-        where = f"gqcnn.networks: [{pool}, {b}, {r:g}]"
-        if pool not in POOLS + SAMPLED_POOLS:
-            return f"{where}: unknown pool; known: {', '.join(POOLS + SAMPLED_POOLS)}"
-        v = network_variant(pool, b, r)
-        if v in seen:
-            return f"{where}: listed twice (ratio 0 of any pool is the targeted network)"
-        seen.add(v)
-        if r == 0:
-            if b not in base_sizes:
-                return f"{where}: base size {b} is not among generate.base_sizes {list(base_sizes)}"
-            continue
-        if b not in augment_base_sizes:
-            return f"{where}: base size {b} is not among gqcnn.augment_base_sizes {list(augment_base_sizes)}"
-        mirrored = "targeted" if pool in SAMPLED_POOLS else pool
-        if mirrored not in pools:
-            return f"{where}: pool {mirrored} is not among gqcnn.pools {list(pools)} (generate makes no such shapes)"
-        if r not in pool_ratios(mirrored, ratios, control_ratios):
-            return f"{where}: ratio {r:g} is not among the ratios generate makes for {mirrored} {list(ratios)}"
-        if math.floor(r * b + 0.5) < 1:  # graspaug.augment.candidates.ratio_count
-            return f"{where}: ratio {r:g} of {b} base shapes adds no shape"
-    return None
 
 
 def seed_networks(networks, base_sizes, ratios, augment_base_sizes, ceiling: bool, pools=POOLS, control_ratios=None):

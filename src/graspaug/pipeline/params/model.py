@@ -32,7 +32,7 @@ from graspaug.pipeline.params.score import ScoreParams
 from graspaug.pipeline.params.sim import SimParams
 from graspaug.pipeline.params.voxelize import VoxelizeParams
 from graspaug.settings import is_settings
-from graspaug.training.variants import check_networks
+from graspaug.training.settings import check_networks
 
 _Sections = params_model(
     "All parameters of the pipeline (the whole ``params.yaml``).",
