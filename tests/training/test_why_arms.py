@@ -71,7 +71,7 @@ def test_the_why_profile_trains_exactly_its_plans_arms(repo_root):
     for key in ("independent_draws", "data", "ingest", "render"):
         assert getattr(why, key) == getattr(confirm, key), key
     assert why.gqcnn.train == confirm.gqcnn.train and why.gqcnn.train.min_steps == why.gqcnn.train.max_steps == 8000
-    assert (why.gqcnn.val_shapes, why.gqcnn.seeds, why.gqcnn.extra_views) == (50, (0,), 5)
+    assert (why.gqcnn.val_shapes, why.gqcnn.seeds, why.gqcnn.extra_views) == (50, (0,), 6)
     # generate makes 400 targeted shapes for B = 200 at 1:2 (the paper's robot networks: 200 + 409)
     from graspaug.augment.candidates import pool_size, ratio_count
 
