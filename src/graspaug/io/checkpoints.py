@@ -102,6 +102,12 @@ def gqcnn_card(crop, intrinsics, viewpoints, gripper, label_threshold: float, gl
     }
 
 
+CARD_SAMPLING = ("positive_share", "target_positive_share", "drawn_positive_share", "views_datapoints")
+"""How a network's batches were drawn, copied from its summary's ``train`` into its card where there: its training
+set's positive share, a ``balanced`` network's target share, the share of positives it drew, a ``views`` network's
+extra-view datapoints."""
+
+
 def finish_gqcnn_card(
     card: dict[str, Any] | None,
     summary: dict[str, Any],
@@ -129,6 +135,7 @@ def finish_gqcnn_card(
             "best_step": train.get("best_step"),
             "members": train.get("members", 1),
             "precision": train.get("precision"),
+            **{k: train[k] for k in CARD_SAMPLING if k in train},
         },
         "validation_ap": summary["validation"].get("ap"),
         "test_ap": summary["test"].get("ap"),

@@ -274,6 +274,19 @@ def render_command(
     run_stage(lambda p: stage.run(p, corpus), load_stage_params(params, stage))
 
 
+stage_command(
+    "render-views",
+    "Render the original shapes again from `gqcnn.extra_views` more camera views per stable pose, with new view seeds "
+    "(each shape's `render-views` stream): the same grasps, poses, crops and labels as `graspaug render`, other "
+    "views. The `views` networks (gqcnn.networks) add as many of their base shapes' extra-view datapoints as "
+    "targeted adds generated ones. Per object, with no split: every draw shares it; `gqcnn.extra_views` 0 writes an "
+    "empty corpus.\n\nWrites `data/gqcnn/views/` (as `graspaug render` writes a corpus) and "
+    "`reports/timing/render/views.json`.\n\n{params}\n\nAlso `gqcnn.extra_views`, `grasps.gripper`, "
+    "`grasps.threshold`, `seed` and `n_jobs`.",
+    "render",
+)
+
+
 @app.command(
     name="train-gqcnn",
     help="Train every GQ-CNN (Dex-Net 2.0) of one training seed as a paired set (paper Section IV-C): `targeted` at "

@@ -37,6 +37,7 @@ def render_corpus(
     seed: int,
     workers: int,
     label: str,
+    stream: str = "render",
 ) -> tuple[dict[str, pd.DataFrame], list]:
     """Render every shape of ``shapes`` with its grasps, in parallel.
 
@@ -47,6 +48,8 @@ def render_corpus(
     mesh_dir, suffix : the folder and file-name suffix of the shapes' meshes (:func:`graspaug.io.meshes.mesh_path`)
     settings, hand, seed : as :func:`graspaug.render.dataset.render_file` takes them
     workers, label : worker processes and progress label of :func:`graspaug.parallel.parallel_map`
+    stream : the purpose of each shape's random stream (``render``; ``render-views``: other camera views of the
+        same shapes, the ``views`` corpus)
 
     Returns
     -------
@@ -68,7 +71,7 @@ def render_corpus(
                 rows[["axis_x", "axis_y", "axis_z"]].to_numpy(),
             )
         )
-    results = parallel_map(lambda job: render_file(*job, settings, hand, seed), jobs, workers, label)
+    results = parallel_map(lambda job: render_file(*job, settings, hand, seed, stream), jobs, workers, label)
     return by_shape, results
 
 

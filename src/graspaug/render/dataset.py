@@ -245,9 +245,17 @@ def datapoints_index(shapes, by_shape: dict, results: list, threshold: float) ->
 
 
 def render_file(
-    path: Path, shape_id: str, centers: np.ndarray, axes: np.ndarray, settings: RenderSettings, hand, seed: int
+    path: Path,
+    shape_id: str,
+    centers: np.ndarray,
+    axes: np.ndarray,
+    settings: RenderSettings,
+    hand,
+    seed: int,
+    stream: str = "render",
 ) -> tuple[ShapeDatapoints | None, str | None]:
-    """One shape's datapoints, or None and why there are none."""
+    """One shape's datapoints, or None and why there are none; its random choices (camera views, grasp subsets) from
+    the shape's stream ``stream`` of ``seed`` (:func:`graspaug.rng.shape_rng`)."""
     if len(centers) == 0:
         return None, "the shape has no grasps"
     try:
@@ -255,7 +263,7 @@ def render_file(
     except Exception as exc:  # a broken file is skipped with its reason, not fatal
         return None, f"mesh could not be read: {exc}"
     try:
-        data = render_shape(mesh, centers, axes, hand, settings, shape_rng(seed, shape_id, "render"))
+        data = render_shape(mesh, centers, axes, hand, settings, shape_rng(seed, shape_id, stream))
     except Exception as exc:  # a degenerate mesh (no hull, no volume) is skipped with its reason
         return None, f"rendering failed: {type(exc).__name__}: {exc}"
     if len(data) == 0:

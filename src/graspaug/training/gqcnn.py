@@ -120,6 +120,62 @@ def classification_metrics(labels: np.ndarray, probability: np.ndarray) -> dict[
     }
 
 
+class BatchSampler:
+    """The row indices of one member's training batches, drawn with its generator ``gen`` from a training set of
+    ``labels`` (N,) 0/1: epoch by epoch (every row once per pass in a fresh random order, a pass's remainder left
+    out), or, with ``positive_share``, from the positive and the negative rows apart, each epoch by epoch, so that
+    the first s batches hold round(s · share · ``batch``) positives: the share of positives drawn is
+    ``positive_share`` to within half a datapoint over the run (the ``balanced`` networks). ``drawn`` and
+    ``positives`` count what it has drawn."""
+
+    def __init__(self, labels: torch.Tensor, batch: int, gen: torch.Generator, positive_share: float | None = None):
+        self.labels, self.batch, self.gen, self.share = labels, batch, gen, positive_share
+        self.drawn = self.positives = self.steps = 0
+        if positive_share is None:
+            self.order, self.cursor = torch.randperm(len(labels), generator=gen), 0
+            return
+        if not 0.0 <= positive_share <= 1.0:
+            raise ValueError(f"positive share must lie in [0, 1], got {positive_share}")
+        self.rows = [torch.nonzero(labels == 1).flatten(), torch.nonzero(labels != 1).flatten()]
+        for rows, wanted, name in zip(self.rows, (positive_share > 0, positive_share < 1), ("positive", "negative")):
+            if wanted and not len(rows):
+                raise ValueError(f"positive share {positive_share:g} asks for {name} datapoints; the set has none")
+        self.orders = [torch.randperm(len(r), generator=gen) if len(r) else r for r in self.rows]
+        self.cursors = [0, 0]
+
+    def _take(self, part: int, k: int) -> torch.Tensor:
+        """``k`` rows of part ``part`` (0: positives, 1: negatives), continuing its pass and starting new ones."""
+        out = []
+        while k > 0:
+            if self.cursors[part] >= len(self.orders[part]):
+                self.orders[part], self.cursors[part] = torch.randperm(len(self.rows[part]), generator=self.gen), 0
+            got = self.orders[part][self.cursors[part] : self.cursors[part] + k]
+            self.cursors[part] += len(got)
+            out.append(self.rows[part][got])
+            k -= len(got)
+        return torch.cat(out) if out else torch.zeros(0, dtype=torch.long)
+
+    def __call__(self) -> torch.Tensor:
+        """The next batch's row indices (``batch``,)."""
+        self.steps += 1
+        if self.share is None:
+            if self.cursor + self.batch > len(self.order):
+                self.order, self.cursor = torch.randperm(len(self.labels), generator=self.gen), 0
+            idx = self.order[self.cursor : self.cursor + self.batch]
+            self.cursor += self.batch
+        else:
+            due = math.floor(self.steps * self.share * self.batch + 0.5) - self.positives
+            idx = torch.cat([self._take(0, due), self._take(1, self.batch - due)])
+        self.drawn += len(idx)
+        self.positives += int(self.labels[idx].sum())
+        return idx
+
+    @property
+    def drawn_share(self) -> float | None:
+        """The share of positives among the datapoints drawn so far (None before the first batch)."""
+        return self.positives / self.drawn if self.drawn else None
+
+
 def cosine_lr(step: int, steps: int, final: float) -> float:
     """Learning-rate factor at ``step`` (0-based) of ``steps``: 1 at the start, ``final`` at the last step."""
     return final + (1 - final) * 0.5 * (1 + math.cos(math.pi * step / max(steps - 1, 1)))
@@ -149,6 +205,7 @@ def train_members(
     gens: list[torch.Generator],
     on_log: MemberLogCallback | None = None,
     progress: bool = True,
+    positive_share: float | None = None,
 ) -> list[dict]:
     """Train the K networks ``nets`` (one config) at once, as one :class:`GQCNNStack`, for
     ``settings.steps_for(len(train))`` SGD steps each, on batches drawn epoch by epoch from
@@ -161,11 +218,12 @@ def train_members(
     bfloat16 mixed precision (``torch.autocast``); the weights, the optimizer, the loss and every
     evaluation stay float32. With ``settings.ema_decay > 0`` the evaluated and kept weights are
     an exponential moving average of the trained ones (``torch.optim.swa_utils.AveragedModel``),
-    updated every step.
+    updated every step. With ``positive_share`` every member's batches hold that share of positives
+    (:class:`BatchSampler`; the ``balanced`` networks), else they are drawn epoch by epoch.
     ``on_log(member, step, metrics)`` gets each member's mean loss and train accuracy since the
     last evaluation, the learning rate and the validation AP / accuracy. Returns per member the
     steps, the best step, its validation AP and predictions (N_val,) (None without ``val``), and
-    throughput (the samples of every member)."""
+    throughput (the samples of every member) and the share of positives among the datapoints it drew."""
     if len(train) < 2:
         raise ValueError(f"need at least 2 training datapoints, got {len(train)}")
     if len(gens) != len(nets):
@@ -191,17 +249,14 @@ def train_members(
     images = torch.from_numpy(np.ascontiguousarray(train.images)).unsqueeze(1)
     z = torch.from_numpy(np.ascontiguousarray(train.z, dtype=np.float32))
     labels = torch.from_numpy(np.asarray(train.labels, dtype=np.int64))
-    orders, cursors = [torch.randperm(len(train), generator=gen) for gen in gens], [0] * k
     batch_size = min(settings.batch_size, len(train))
+    samplers = [BatchSampler(labels, batch_size, gen, positive_share) for gen in gens]
     best = [{"step": steps, "val_ap": float("nan"), "state": None} for _ in nets]
     loss_sum, correct, seen, start = torch.zeros(k), torch.zeros(k), 0, time.perf_counter()
     for step in tqdm(range(1, steps + 1), desc="train GQ-CNN", unit="step", disable=not progress):
         crops, depths, targets = [], [], []
         for m, gen in enumerate(gens):  # each member's batch and noise from its own generator
-            if cursors[m] + batch_size > len(orders[m]):
-                orders[m], cursors[m] = torch.randperm(len(train), generator=gen), 0
-            idx = orders[m][cursors[m] : cursors[m] + batch_size]
-            cursors[m] += batch_size
+            idx = samplers[m]()
             batch, depth = augment(images[idx], z[idx], settings.noise, gen)
             crops.append(batch)
             depths.append(depth)
@@ -258,6 +313,7 @@ def train_members(
             "val_predictions": b.get("val_predictions"),
             "train_seconds": seconds,
             "samples_per_second": k * steps * batch_size / seconds,
+            "drawn_positive_share": samplers[m].drawn_share,
         }
-        for b in best
+        for m, b in enumerate(best)
     ]

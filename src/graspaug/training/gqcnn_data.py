@@ -10,7 +10,11 @@ Datapoints are :class:`~graspaug.training.gqcnn.GraspArrays`. A network is a
   the first round(R × B) shapes of that pool in the corpus of base size B's generated shapes;
 * ``real`` at B and R: the base shapes plus the first round(R × B) shapes of the real pool
   (more train-split shapes, in a seeded order);
-* ``ceiling``: every train-split shape outside validation.
+* ``ceiling``: every train-split shape outside validation;
+* ``balanced`` at B and R: the B base shapes alone, its batches drawn at the positive share of targeted at (B, R)
+  (``target_positive_share`` of its info; :class:`~graspaug.training.gqcnn.BatchSampler`);
+* ``views`` at B and R: the B base shapes plus as many datapoints as targeted at (B, R) adds, drawn in a seeded
+  order from the extra camera views of the base shapes (the ``views`` corpus, :attr:`Corpora.views`).
 
 Validation is a fixed, seeded set of train-split shapes that lie in no base set and in no
 pool: the same for every variant, pool and training seed, never trained on. Ratio 0 of any
@@ -33,16 +37,19 @@ from graspaug.io.gqcnn import GraspImages
 from graspaug.io.tables import read_table
 from graspaug.rng import shape_rng
 from graspaug.training.gqcnn import GraspArrays
+from graspaug.training.settings import SAMPLED_POOLS
 from graspaug.training.variants import Variant
 
 
 @dataclass(frozen=True)
 class Corpora:
     """The rendered GQ-CNN dataset folders the networks read: ``original`` (the ingested shapes)
-    and ``generated``, base size → the folder of that base set's generated shapes (both pools)."""
+    and ``generated``, base size → the folder of that base set's generated shapes (both pools); ``views``: the
+    original shapes rendered from extra camera views (the ``views`` networks), or None."""
 
     original: Path
     generated: Mapping[int, Path] = field(default_factory=dict)
+    views: Path | None = None
 
 
 @dataclass(frozen=True)
@@ -138,8 +145,68 @@ def training_shapes(variant: Variant, split: ExperimentSplit) -> tuple[list[str]
     return shapes, extra
 
 
+def targeted_added(base_size: int, ratio: float, corpora: Corpora) -> tuple[int, int]:
+    """(datapoints, positives) that targeted at (``base_size``, ``ratio``) adds to its base set: those of the first
+    round(R × B) targeted shapes in the corpus of base size B's generated shapes (labels read from its index)."""
+    if base_size not in corpora.generated:
+        raise DataError(f"targeted at B = {base_size} needs the rendered generated shapes of that base size")
+    index = read_table(Path(corpora.generated[base_size]) / "index.parquet")
+    rows = (index.pool == "targeted") & (index.order < ratio_count(ratio, base_size))
+    return int(rows.sum()), int(index.label[rows].sum())
+
+
+def targeted_share(variant: Variant, split: ExperimentSplit, corpora: Corpora) -> float:
+    """The positive share of the training set of targeted at ``variant``'s (B, R): its base shapes' datapoints in
+    the original corpus and those of :func:`targeted_added` (what a ``balanced`` network's batches are drawn at)."""
+    data = GraspImages.open(corpora.original)
+    base = data.index.shape_id.isin(set(split.base[variant.base_size])).to_numpy()
+    n, positives = targeted_added(variant.base_size, variant.ratio, corpora)
+    total = int(base.sum()) + n
+    if not total:
+        raise DataError(f"{variant.name}: targeted at its (B, R) has no datapoint to take a positive share of")
+    return (int(data.read("labels", np.flatnonzero(base)).sum()) + positives) / total
+
+
+def views_rows(variant: Variant, split: ExperimentSplit, corpora: Corpora) -> tuple[np.ndarray, int]:
+    """The rows of the ``views`` corpus that a ``views`` network adds: as many datapoints as targeted at its (B, R)
+    adds (:func:`targeted_added`), the first of the base shapes' extra-view datapoints in an order seeded by B alone
+    (so a smaller ratio's rows are a prefix of a larger one's); and that count."""
+    if corpora.views is None:
+        raise DataError(f"{variant.name} needs the original shapes rendered from extra views (gqcnn.extra_views)")
+    index = read_table(Path(corpora.views) / "index.parquet")
+    wanted, _ = targeted_added(variant.base_size, variant.ratio, corpora)
+    rows = np.flatnonzero(index.shape_id.isin(set(split.base[variant.base_size])).to_numpy())
+    if wanted > len(rows):
+        raise DataError(
+            f"{variant.name} needs {wanted} extra-view datapoints of its base shapes (what targeted adds); the views "
+            f"corpus holds {len(rows)} (raise gqcnn.extra_views)"
+        )
+    order = shape_rng(variant.base_size, "gqcnn", "views-order").permutation(len(rows))
+    return np.sort(rows[order[:wanted]]), wanted
+
+
 def training_set(variant: Variant, split: ExperimentSplit, corpora: Corpora) -> tuple[GraspArrays, dict]:
-    """A variant's training datapoints, read from ``corpora``, and their counts."""
+    """A variant's training datapoints, read from ``corpora``, and their counts (a ``balanced`` network's also
+    ``target_positive_share``, the share its batches are drawn at; a ``views`` network's ``views_datapoints``)."""
+    if variant.pool in SAMPLED_POOLS:
+        base, rows = shapes_datapoints(corpora.original, split.base[variant.base_size])
+        parts, extra = [base], {}
+        if variant.pool == "balanced":
+            extra = {"target_positive_share": round(targeted_share(variant, split, corpora), 6)}
+        else:
+            view_rows, wanted = views_rows(variant, split, corpora)
+            if len(view_rows):
+                parts.append(_arrays(GraspImages.open(corpora.views), view_rows))
+            extra = {"original_datapoints": len(base), "views_datapoints": wanted}
+        data = _concat(parts)
+        info = {
+            "original_shapes": len(split.base[variant.base_size]),
+            "generated_shapes_asked": 0,
+            "generated_shapes": 0,
+            "datapoints": len(data),
+            "positive_share": round(float(data.labels.mean()), 4) if len(data) else None,
+        }
+        return data, info | extra
     shapes, n_generated = training_shapes(variant, split)
     data, rows = shapes_datapoints(corpora.original, shapes)
     parts, generated_shapes = [data], 0

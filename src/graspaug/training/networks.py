@@ -144,7 +144,8 @@ def train_network(job: NetworkJob, val: GraspArrays | None = None, test: GraspAr
     def log(m: int, step: int, metrics: dict) -> None:  # history.csv names members only in an ensemble
         history.append({**({"member": m} if len(members) > 1 else {}), "step": step, **metrics})
 
-    fits = train_members(members, train, val, job.train, device, gens, on_log=log, progress=False)
+    share = info.get("target_positive_share")  # a balanced network's batches are drawn at targeted's share
+    fits = train_members(members, train, val, job.train, device, gens, on_log=log, progress=False, positive_share=share)
     kept = GQCNNStack(members).to(device, memory_format=torch.channels_last)  # the kept weights, one pass
     val_ps = [f["val_predictions"] for f in fits]
     if any(p is None for p in val_ps):
@@ -167,6 +168,7 @@ def train_network(job: NetworkJob, val: GraspArrays | None = None, test: GraspAr
             "steps": fits[0]["steps"],
             "best_step": fits[0]["best_step"] if single else [f["best_step"] for f in fits],
             "batch_size": job.train.batch_size,
+            "drawn_positive_share": _by_member_list([round(f["drawn_positive_share"], 6) for f in fits]),
             "precision": resolve_precision(
                 job.train.precision, device, GQCNN_GPU_BFLOAT16
             ).label,  # as resolved where it trained
@@ -197,6 +199,11 @@ def train_network(job: NetworkJob, val: GraspArrays | None = None, test: GraspAr
         "samples_per_second": fits[0]["samples_per_second"],  # every member's samples
         "threads": torch.get_num_threads(),  # torch threads it trained with
     }
+
+
+def _by_member_list(values: list):
+    """One value for a network of one member, else the list by member."""
+    return values[0] if len(values) == 1 else values
 
 
 def seed_card(render, grasps, global_seed: int, ingest=None, data_seed: int | None = None, train=None) -> dict:
@@ -290,6 +297,10 @@ def _by_member(value):
     return {f"m{m}": v for m, v in enumerate(value)} if isinstance(value, list) else value
 
 
+SEED_TABLE_EXTRAS = ("target_positive_share", "drawn_positive_share", "views_datapoints")
+"""What a ``balanced`` or ``views`` network adds to its row of the seed's report (:func:`seed_table`)."""
+
+
 def seed_table(summaries: list[dict]) -> dict:
     """The seed's networks (its report): pool → base size → ratio → validation / test AP and ROC AUC,
     datapoints, steps, the kept step (per member of an ensemble: ``{"m0": …}``)."""
@@ -303,6 +314,7 @@ def seed_table(summaries: list[dict]) -> dict:
             "datapoints": s["train"]["datapoints"],
             "steps": s["train"]["steps"],
             "best_step": _by_member(s["train"]["best_step"]),
+            **{k: _by_member(s["train"][k]) for k in SEED_TABLE_EXTRAS if k in s["train"]},
         }
     return out
 

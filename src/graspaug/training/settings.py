@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from typing import Literal
 
 from graspaug.settings import Field, settings
@@ -158,3 +159,41 @@ positive control), ``recon`` (the real pool's shapes decoded from their own late
 augmentation), ``primitives`` (random assemblies of primitives: procedural objects, no real parent) and
 ``procedural`` (objects of pybullet's procedural ``random_urdfs`` corpus added as they are: what a researcher whose own
 corpus is real objects gets for free)."""
+
+SAMPLED_POOLS = ("balanced", "views")
+"""Arms of the base shapes alone that mirror targeted at their (B, R): ``balanced`` (batches drawn at targeted's
+positive share) and ``views`` (as many more datapoints as targeted adds, from extra views of the base shapes)."""
+
+
+def check_networks(networks, base_sizes, ratios, augment_base_sizes, pools, control_ratios=None) -> str | None:
+    """Why the explicit list ``networks`` (``gqcnn.networks``) cannot be trained with these ``generate`` and ``gqcnn``
+    settings (one line naming the key), or None: a 1:0 network needs its B among generate.base_sizes; a pool of
+    :data:`POOLS` at R > 0 needs to be among gqcnn.pools, B among gqcnn.augment_base_sizes and R among the
+    ratios it is generated at (every nonzero one of ``ratios`` for targeted, ``control_ratios`` for the others where
+    given: :func:`graspaug.training.variants.pool_ratios`); ``balanced`` and ``views`` need targeted at their (B, R)
+    generated the same way."""
+    seen = set()
+    for entry in networks:
+        pool, b, r = str(entry[0]), int(entry[1]), float(entry[2])
+        where = f"gqcnn.networks: [{pool}, {b}, {r:g}]"
+        if pool not in POOLS + SAMPLED_POOLS:
+            return f"{where}: unknown pool; known: {', '.join(POOLS + SAMPLED_POOLS)}"
+        v = ("targeted" if r == 0 else pool, b, r)  # ratio 0 of any pool is the targeted network
+        if v in seen:
+            return f"{where}: listed twice (ratio 0 of any pool is the targeted network)"
+        seen.add(v)
+        if r == 0:
+            if b not in base_sizes:
+                return f"{where}: base size {b} is not among generate.base_sizes {list(base_sizes)}"
+            continue
+        if b not in augment_base_sizes:
+            return f"{where}: base size {b} is not among gqcnn.augment_base_sizes {list(augment_base_sizes)}"
+        mirrored = "targeted" if pool in SAMPLED_POOLS else pool
+        if mirrored not in pools:
+            return f"{where}: pool {mirrored} is not among gqcnn.pools {list(pools)} (generate makes no such shapes)"
+        made = ratios if mirrored == "targeted" or control_ratios is None else control_ratios
+        if r not in {float(x) for x in made if x > 0}:
+            return f"{where}: ratio {r:g} is not among the ratios generate makes for {mirrored} {list(ratios)}"
+        if math.floor(r * b + 0.5) < 1:  # graspaug.augment.candidates.ratio_count
+            return f"{where}: ratio {r:g} of {b} base shapes adds no shape"
+    return None

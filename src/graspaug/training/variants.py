@@ -5,13 +5,19 @@ Pools: ``targeted`` / ``random`` (interpolants), ``recon`` (the real pool's shap
 AutoEncoder alone), ``real`` (more real train shapes) and the ``ceiling`` (every train shape
 outside validation; no base size or ratio). Ratio 0 of any pool but the ceiling is the base set
 alone: the ``targeted`` network (:func:`network_variant`).
+
+Two arms add no shapes (:data:`SAMPLED_POOLS`): ``balanced`` at (B, R), the B base shapes alone with batches drawn
+so that their positive share is that of targeted at (B, R); ``views`` at (B, R), the B base shapes with as many more
+datapoints, from extra camera views of themselves, as targeted at (B, R) adds. A seed's networks are the matrix of
+:func:`seed_variants`, or an explicit list (``gqcnn.networks``, :func:`listed_variants`).
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
-from graspaug.training.settings import POOLS
+from graspaug.errors import DataError
+from graspaug.training.settings import POOLS, check_networks
 
 
 @dataclass(frozen=True, order=True)
@@ -55,3 +61,21 @@ def seed_variants(base_sizes, ratios, augment_base_sizes, ceiling: bool, pools=P
         for r in pool_ratios(p, ratios, control_ratios)
     ]
     return out + ([Variant("ceiling")] if ceiling else [])
+
+
+def listed_variants(networks) -> list[Variant]:
+    """The networks of an explicit list of (pool, B, R) (``gqcnn.networks``), in its order, ratio 0 of any pool as
+    the targeted network (:func:`network_variant`)."""
+    return [network_variant(str(p), int(b), float(r)) for p, b, r in networks]
+
+
+def seed_networks(networks, base_sizes, ratios, augment_base_sizes, ceiling: bool, pools=POOLS, control_ratios=None):
+    """Every network of a seed: those of the explicit list ``networks`` (``gqcnn.networks``, checked by
+    :func:`check_networks`: a :class:`~graspaug.errors.DataError` naming the key) and the ceiling, or with an
+    empty list the matrix of :func:`seed_variants`."""
+    if not networks:
+        return seed_variants(base_sizes, ratios, augment_base_sizes, ceiling, pools, control_ratios)
+    problem = check_networks(networks, base_sizes, ratios, augment_base_sizes, pools, control_ratios)
+    if problem:
+        raise DataError(problem)
+    return listed_variants(networks) + ([Variant("ceiling")] if ceiling else [])

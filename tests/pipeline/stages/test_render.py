@@ -171,3 +171,24 @@ def test_a_mesh_that_cannot_be_rendered_is_skipped_with_its_reason(tmp_path):
         0,
     )
     assert data is None and reason.startswith("mesh could not be read")
+
+
+def test_render_views_renders_the_originals_from_other_views_and_nothing_at_zero(tmp_path):
+    """render-views (the why study's `views` networks): the same shapes and grasps as render@original seen from new
+    camera views, `gqcnn.extra_views` per pose; at 0 (every other profile) an empty corpus."""
+    params = make_project(tmp_path)
+    assert run_stage(tmp_path, "render", params).exit_code == 0
+    assert run_stage(tmp_path, "render-views", params).exit_code == 0
+    empty = GraspImages.open(tmp_path / "data/gqcnn/views")
+    assert len(empty) == 0 and json.loads((tmp_path / "data/gqcnn/views/dataset.json").read_text())["extra_views"] == 0
+    result = run_stage(tmp_path, "render-views", {**params, "gqcnn": {"extra_views": 2}})
+    assert result.exit_code == 0, result.output
+    original = GraspImages.open(tmp_path / "data/gqcnn/original").index
+    views = GraspImages.open(tmp_path / "data/gqcnn/views").index
+    assert set(views.shape_id) == set(original.shape_id) and set(views.grasp_id) <= set(original.grasp_id)
+    per_pose = views.groupby(["shape_id", "pose_id"]).image_id.nunique()
+    assert per_pose.max() == 2  # two views of each pose, where the original has one
+    assert original.groupby(["shape_id", "pose_id"]).image_id.nunique().max() == 1
+    assert not set(views.camera_height.round(6)) & set(original.camera_height.round(6))  # new camera seeds
+    timing = json.loads((tmp_path / "reports/timing/render/views.json").read_text())
+    assert timing["datapoints"] == len(views) and timing["extra_views"] == 2

@@ -204,10 +204,22 @@ def network_folder(seed_dir: Path, key: Key) -> Path:
     return Path(seed_dir) / network_variant(*key).name
 
 
+SAMPLING_KEYS = ("target_positive_share", "drawn_positive_share", "views_datapoints")
+"""What a ``balanced`` or ``views`` network's summary adds (:func:`collect`'s ``train_<key>`` columns, where any
+network of the table has one)."""
+
+
+def _mean(value):
+    """A per-member list as its mean; a number as it is."""
+    return float(np.mean(value)) if isinstance(value, list) else value
+
+
 def collect(seed_dirs: Mapping[int, Path], variants) -> pd.DataFrame:
     """One row per network and seed: pool, base_size, ratio, seed, val_ap, test_ap, test_roc_auc,
     train_datapoints, train_positive_share, train_steps, generated_shapes_asked and generated_shapes (the pool's shapes
-    it was given: fewer when some did not mesh or yield datapoints; each None when its summary does not say).
+    it was given: fewer when some did not mesh or yield datapoints; each None when its summary does not say), and
+    ``train_<key>`` of :data:`SAMPLING_KEYS` where a network's summary holds it (a ``balanced`` network's target and
+    drawn positive shares, a ``views`` network's extra-view datapoints; an ensemble's mean over its members).
     ``seed_dirs``: training seed → the folder of its networks (the seeds in this order)."""
     rows = []
     for seed, seed_dir in seed_dirs.items():
@@ -230,6 +242,7 @@ def collect(seed_dirs: Mapping[int, Path], variants) -> pd.DataFrame:
                     "train_steps": s.get("train", {}).get("steps"),
                     "generated_shapes_asked": s.get("train", {}).get("generated_shapes_asked"),
                     "generated_shapes": s.get("train", {}).get("generated_shapes"),
+                    **{f"train_{k}": _mean(s["train"][k]) for k in SAMPLING_KEYS if k in s.get("train", {})},
                 }
             )
     return pd.DataFrame(rows)

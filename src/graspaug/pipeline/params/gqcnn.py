@@ -63,6 +63,23 @@ class GQCNNParams:
         "generate.ratios); null: every nonzero ratio, as targeted. The real-objects profile: [1.0] (the paper's ratios "
         "for targeted, the controls at 1:1); contrasts between two pools use the ratios both have.",
     )
+    networks: tuple[tuple[str, int, float], ...] = Field(
+        (),
+        description="An explicit list of the networks each seed trains, each [pool, B, R], in place of the matrix of "
+        "generate.base_sizes x generate.ratios x pools (empty: the matrix; the ceiling still follows `ceiling`). "
+        "[targeted, B, 0.0] is the base set alone (none@B); a pool of `pools` at R > 0 needs B among "
+        "augment_base_sizes and R among the ratios generate makes for it; `balanced` (the B base shapes alone, "
+        "batches drawn at the positive share of targeted at (B, R)) and `views` (the B base shapes plus as many "
+        "datapoints from `extra_views` more camera views of themselves as targeted at (B, R) adds) need targeted "
+        "at (B, R). The why profile: exactly its plan's arms.",
+    )
+    extra_views: int = Field(
+        0,
+        ge=0,
+        description="Extra camera views per stable pose of every original shape, rendered with new view seeds by "
+        "the render_views stage (data/gqcnn/views, shared by every draw) for the `views` networks (0: none, the "
+        "stage writes an empty corpus).",
+    )
     members: int = Field(
         1,
         ge=1,

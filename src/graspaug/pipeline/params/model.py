@@ -15,6 +15,8 @@ import json
 from pathlib import Path
 from typing import Any
 
+from pydantic import model_validator
+
 from graspaug.io.settings import CorpusSettings
 from graspaug.pipeline.params.ae import AEParams
 from graspaug.pipeline.params.base import BaseParams, ParamsError, load, params_model, parse
@@ -30,8 +32,9 @@ from graspaug.pipeline.params.score import ScoreParams
 from graspaug.pipeline.params.sim import SimParams
 from graspaug.pipeline.params.voxelize import VoxelizeParams
 from graspaug.settings import is_settings
+from graspaug.training.settings import check_networks
 
-Params = params_model(
+_Sections = params_model(
     "All parameters of the pipeline (the whole ``params.yaml``).",
     data=(CorpusSettings, "Where the shape corpus comes from."),
     ingest=IngestParams,
@@ -47,6 +50,30 @@ Params = params_model(
     lifelong=LifelongParams,
     sim=SimParams,
 )
+
+
+def networks_problem(generate: GenerateParams, gqcnn: GQCNNParams) -> str | None:
+    """Why ``gqcnn.networks`` cannot be trained with these ``generate`` and ``gqcnn`` settings (one line naming the
+    key: :func:`graspaug.training.variants.check_networks`; a ``views`` network also needs ``gqcnn.extra_views``),
+    or None."""
+    sizes = (generate.base_sizes, generate.ratios, gqcnn.augment_base_sizes)
+    problem = check_networks(gqcnn.networks, *sizes, gqcnn.pools, gqcnn.control_ratios)
+    if problem is None and not gqcnn.extra_views and any(str(n[0]) == "views" for n in gqcnn.networks):
+        problem = "gqcnn.networks: a views network needs gqcnn.extra_views > 0 (extra camera views of its base shapes)"
+    return problem
+
+
+class Params(_Sections):
+    """All parameters of the pipeline (the whole ``params.yaml``)."""
+
+    @model_validator(mode="after")
+    def _networks_generated(self) -> Params:
+        """The explicit networks (``gqcnn.networks``) are ones ``generate`` makes the shapes of: checked with the
+        whole file (``graspaug profile``, the check_params stage); train_gqcnn checks them again itself."""
+        problem = networks_problem(self.generate, self.gqcnn)
+        if problem:
+            raise ValueError(problem)
+        return self
 
 
 def parse_params(raw: Any) -> BaseParams:

@@ -1,9 +1,8 @@
 """Stage ``train_gqcnn``: every GQ-CNN of one training seed, as a paired set.
 
-Networks (``experiments.variants.seed_variants``): targeted at every base size × ratio of ``generate``; the other
-``gqcnn.pools`` at every nonzero ratio of ``gqcnn.augment_base_sizes``; the ceiling. All start from the seed's
-initial weights and noise stream, are validated on the same ``gqcnn.val_shapes`` train shapes and keep the weights
-of their best validation AP (``gqcnn.members`` > 1: ensembles); tested on every test datapoint of the corpus.
+Networks (``training.variants.seed_networks``): ``generate`` × ``gqcnn.pools``, or ``gqcnn.networks``; the ceiling. All
+start from the seed's initial weights and noise stream, are validated on the same ``gqcnn.val_shapes`` train shapes
+and keep the weights of their best validation AP (``gqcnn.members`` > 1: ensembles); tested on the corpus's test set.
 
 Outputs: ``models/gqcnn/s<seed>/`` (one folder per network, ``test_rows.npy``, ``val_rows.npy``, ``split.json``),
 ``metrics/gqcnn/s<seed>.json`` (test and validation AP, means over the networks), ``reports/gqcnn/networks/
@@ -51,7 +50,7 @@ from graspaug.training.networks import (
     seed_timing,
     train_jobs,
 )
-from graspaug.training.variants import seed_variants
+from graspaug.training.variants import seed_networks
 
 log = logging.getLogger(__name__)
 
@@ -69,11 +68,12 @@ def run(params: Params, seed: int) -> None:
     cfg, gen, start = params.gqcnn, params.generate, time.perf_counter()
     if seed not in cfg.seeds:
         raise StageError(f"seed {seed} is not in gqcnn.seeds {list(cfg.seeds)}")
-    corpora = Corpora(gqcnn_dir("original"), {b: gqcnn_dir(f"gen_{b}") for b in cfg.augment_base_sizes})
+    generated = {b: gqcnn_dir(f"gen_{b}") for b in cfg.augment_base_sizes}  # views: render_views, empty at 0 views
+    corpora = Corpora(gqcnn_dir("original"), generated, gqcnn_dir("views"))
     shapes = read_table(SHAPES_TABLE)  # too few for the validation set: a DataError, printed in one line
     split = load_split(corpora.original, shapes, list(gen.base_sizes), cfg.val_shapes, params.data_seed)
-    sizes = (gen.base_sizes, gen.ratios, cfg.augment_base_sizes)
-    variants = seed_variants(*sizes, cfg.ceiling, cfg.pools, cfg.control_ratios)
+    sizes = (gen.base_sizes, gen.ratios, cfg.augment_base_sizes, cfg.ceiling, cfg.pools, cfg.control_ratios)
+    variants = seed_networks(cfg.networks, *sizes)
     device = resolve_device(params.device)
     global_seed = network_seed(params.seed, params.data_seed, params.independent_draws)
     inits, noise_seeds = seed_members(cfg.net, global_seed, seed, cfg.members)
