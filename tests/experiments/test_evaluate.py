@@ -453,3 +453,24 @@ def test_ycb78_balls_get_datapoints(tmp_path):
     counts = _tiny_test_set(corpus, 1.0, tmp_path / "set", size="fit")
     assert counts["shapes"] == 4 and counts["with_datapoints"] == 4, counts
 
+
+@pytest.mark.skipif(not YCB78.is_dir(), reason="the ycb78 meshes are not on this machine")
+def test_the_same_meshes_in_millimetres_give_the_same_test_set(tmp_path):
+    """Ten ycb78 meshes (open scans among them) in metres, and copies of them in millimetres read with unit scale
+    0.001: the same shapes, datapoints and positives (the files differ by float noise only)."""
+    names = (
+        "005_tomato_soup_can", "007_tuna_fish_can", "010_potted_meat_can", "011_banana", "012_strawberry",
+        "013_apple", "014_lemon", "017_orange", "025_mug", "040_large_marker",
+    )  # fmt: skip
+    metres, millimetres = tmp_path / "m", tmp_path / "mm"
+    metres.mkdir(), millimetres.mkdir()
+    for name in names:
+        shutil.copy(YCB78 / f"{name}.stl", metres)
+        mesh = trimesh.load(YCB78 / f"{name}.stl", process=False)
+        mesh.apply_scale(1000.0)
+        mesh.export(millimetres / f"{name}.stl")
+    in_m = _tiny_test_set(metres, 1.0, tmp_path / "set_m")
+    in_mm = _tiny_test_set(millimetres, 0.001, tmp_path / "set_mm")
+    assert in_m["datapoints"] > 100 and in_m["positives"] > 10, in_m
+    for key in ("shapes", "rejected", "with_datapoints", "datapoints", "positives"):
+        assert in_mm[key] == in_m[key], (key, in_m, in_mm)
