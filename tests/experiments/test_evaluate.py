@@ -34,6 +34,12 @@ GSO300 = next(
     REPO / "absent",
 )
 
+#: The 78 YCB meshes (STL, metres) beside the project, where they are.
+YCB78 = next(
+    (p for p in (REPO.parent / "shared/external/ycb78", REPO.parents[1] / "shared/external/ycb78") if p.is_dir()),
+    REPO / "absent",
+)
+
 
 def test_ap_and_paired_differences_over_objects():
     rng = np.random.default_rng(0)
@@ -513,3 +519,59 @@ def test_a_mean_aps_interval_stays_inside_aps_range():
         assert -1 <= c["draws_low"] <= c["draws_high"] <= 1
     assert any(line.endswith("(clipped to [0, 1])") for line in printed_lines(out, "report.md"))
     assert list(out["differences"]) == ["bad@50 − good@50 (replicate 1)", "bad@50 − good@50 (replicate 2)"]
+
+
+def _tiny_test_set(corpus: Path, unit_scale: float, folder: Path, size: str = "real") -> dict:
+    """The test set of the meshes in ``corpus`` (``unit_scale`` m per file unit) by the tiny profile's params and a
+    tiny model's card, built into ``folder``: its counts."""
+    import dataclasses
+
+    from graspaug.experiments.evaluate.testset import CARD_KEYS, build_test_set, recipe_for
+    from graspaug.io.sources import folder_sources
+    from graspaug.pipeline.params.base import parse, parse_yaml
+    from graspaug.pipeline.stages.evaluate import Params
+    from graspaug.planning.card import ModelCard
+
+    params = parse(parse_yaml(profile_yaml("tiny", REPO / "profiles")), Params)
+    raw = gqcnn_card(CropGeometry(), Intrinsics(), ViewpointRanges(), ParallelJawGripper(), 0.0005, 0)
+    card = ModelCard.from_dict(raw, "depth")
+    i = params.ingest
+    surface = dataclasses.replace(i.surface, size=size)
+    values = {k: getattr(card, k) for k in CARD_KEYS}
+    recipe = recipe_for(surface, i.max_faces, i.max_file_mb, params.grasps, params.render, params.seed, values)
+    folder.mkdir()
+    return build_test_set(folder_sources(corpus, unit_scale), recipe, folder, 1, 1000)
+
+
+@pytest.mark.skipif(not YCB78.is_dir(), reason="the ycb78 meshes are not on this machine")
+def test_ycb78_balls_get_datapoints(tmp_path):
+    """The tennis ball, racquetball, golf ball and small marble rest in any orientation (no stable pose reaches
+    Dex-Net's 0.01): they are rendered in drawn orientations, not skipped with '0 stable poses'."""
+    corpus = tmp_path / "balls"
+    corpus.mkdir()
+    for name in ("056_tennis_ball", "057_racquetball", "058_golf_ball", "063-b_marbles"):
+        shutil.copy(YCB78 / f"{name}.stl", corpus)
+    counts = _tiny_test_set(corpus, 1.0, tmp_path / "set", size="fit")
+    assert counts["shapes"] == 4 and counts["with_datapoints"] == 4, counts
+
+
+@pytest.mark.skipif(not YCB78.is_dir(), reason="the ycb78 meshes are not on this machine")
+def test_the_same_meshes_in_millimetres_give_the_same_test_set(tmp_path):
+    """Ten ycb78 meshes (open scans among them) in metres, and copies of them in millimetres read with unit scale
+    0.001: the same shapes, datapoints and positives (the files differ by float noise only)."""
+    names = (
+        "005_tomato_soup_can", "007_tuna_fish_can", "010_potted_meat_can", "011_banana", "012_strawberry",
+        "013_apple", "014_lemon", "017_orange", "025_mug", "040_large_marker",
+    )  # fmt: skip
+    metres, millimetres = tmp_path / "m", tmp_path / "mm"
+    metres.mkdir(), millimetres.mkdir()
+    for name in names:
+        shutil.copy(YCB78 / f"{name}.stl", metres)
+        mesh = trimesh.load(YCB78 / f"{name}.stl", process=False)
+        mesh.apply_scale(1000.0)
+        mesh.export(millimetres / f"{name}.stl")
+    in_m = _tiny_test_set(metres, 1.0, tmp_path / "set_m")
+    in_mm = _tiny_test_set(millimetres, 0.001, tmp_path / "set_mm")
+    assert in_m["datapoints"] > 100 and in_m["positives"] > 10, in_m
+    for key in ("shapes", "rejected", "with_datapoints", "datapoints", "positives"):
+        assert in_mm[key] == in_m[key], (key, in_m, in_mm)

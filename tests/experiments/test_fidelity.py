@@ -151,3 +151,45 @@ def test_mesh_graspness_is_the_grasps_stages_share_of_positive_grasps(tmp_path):
     score, count = mesh_graspness(path, "box", settings, 3)
     table, _ = grasps_of_shape(path, "box", settings, 3)
     assert count == len(table) > 0 and score == pytest.approx(table.success.mean())
+
+
+def test_a_figure_undefined_on_the_shapes_drawn_says_so_and_the_table_is_still_made():
+    """Own meshes whose parents all have graspness 0 (every resample draws such parents), a pool with no rendered
+    datapoints, parents without datapoints: each ratio over 0 is undefined (NaN), named with its reason in the
+    table and in the report, never a ZeroDivisionError that stops the fidelity stage."""
+    from graspaug.experiments.fidelity.numbers import coverage_mmd, heldout_summary
+
+    meshes = {f"c{i}": trimesh.creation.box((0.01 * (i + 1), 0.03, 0.02)) for i in range(3)}
+    graspness = {"a": 0.0, "b": 0.0, "c0": 0.2, "c1": 0.0, "c2": 0.1}
+    parents = pd.DataFrame({"shape_id": list(meshes), "parent_a": "a", "parent_b": "b", "alpha": 0.5})
+    rendered = pd.DataFrame({"shape_id": pd.Series(dtype=str), "label": pd.Series(dtype=int)})  # none rendered
+    pool = pool_shapes(meshes, graspness, rendered, 64, 0, parents, {"a": 0, "b": 0})
+    reference = pool_shapes(meshes, graspness, rendered, 64, 1).clouds
+    table = fidelity_table({"own": pool}, reference, 50, np.random.default_rng(0))
+    row = table.iloc[0]
+    assert row.graspness == pytest.approx(0.1) and np.isfinite(row.one_nna)
+    for figure in ("graspness_kept", "positive_share", "datapoints_kept"):
+        assert pd.isna(row[figure]) and figure in row.undefined
+    assert "the parents' graspness is 0" in row.undefined and "no datapoints" in row.undefined
+    report = fidelity_markdown(table, 3, len(reference))
+    assert "undefined: the parents' graspness is 0" in report and "undefined: no datapoints" in report
+    assert "Undefined figures" in report
+    assert set(fidelity_headline(table)) == {"own_datapoints_per_shape", "own_one_nna"}  # no NaN metric written
+
+    # parents whose graspness is 0 on some resamples only: the point value stands, those resamples are named
+    some = pool_shapes(meshes, graspness | {"a": 0.3}, rendered, 64, 0, parents.assign(parent_a=["a", "b", "b"]))
+    kept = fidelity_table({"some": some}, reference, 200, np.random.default_rng(0)).iloc[0]
+    assert np.isfinite(kept.graspness_kept) and "resamples (left out of its interval)" in kept.undefined
+    assert "graspness_kept" in kept.undefined and kept.graspness_kept_lo <= kept.graspness_kept
+    assert np.isnan(coverage_mmd(np.zeros((0, 0)))).all()
+
+    per_shape = pd.DataFrame(
+        {
+            "meshed": [True, True],
+            **{f"graspness_{w}": [0.1, 0.2] for w in ("before", "after")},
+            **{f"{k}_{w}": [0, 0] for k in ("datapoints", "positives") for w in ("before", "after")},
+            **{f"{k}_{w}": [1.0, 2.0] for k in ("stable_poses", "grasps_rendered") for w in ("before", "after")},
+        }
+    )
+    summary = heldout_summary(per_shape)
+    assert np.isnan(summary["positive_before"]) and np.isnan(summary["positive_after"])

@@ -114,5 +114,24 @@ def test_a_closed_non_convex_body_keeps_its_triangles(tmp_path):
     assert np.allclose(
         np.sort(prepared.mesh.vertices, axis=0),
         np.sort(torus.vertices * scale + prepared.normalization.offset, axis=0),
-        atol=1e-9,
+        atol=0.5e-6 * scale + 1e-12,  # read to 1 µm (VERTEX_DIGITS)
     )
+
+
+def test_a_file_in_millimetres_reads_as_the_same_metres(tmp_path):
+    """A float32 STL of a scan in metres and its copy in millimetres (its float32 vertices ×1000, 1e-9 m of noise
+    apart) read with unit scale 0.001 give the same vertices, bit for bit: coordinates are read to 1 µm, and the
+    decimator after them sees one mesh, not two triangulations."""
+    rng = np.random.default_rng(0)
+    mesh = trimesh.creation.icosphere(3, 0.03)
+    mesh.vertices = np.round(mesh.vertices + rng.uniform(-0.001, 0.001, mesh.vertices.shape), 5)  # 10 µm digits
+    mesh.export(tmp_path / "m.stl")
+    millimetres = trimesh.load(tmp_path / "m.stl", process=False)
+    millimetres.apply_scale(1000.0)
+    millimetres.export(tmp_path / "mm.stl")
+    in_m, in_mm = load_shape(tmp_path / "m.stl"), load_shape(tmp_path / "mm.stl", unit_scale=0.001)
+    raw_m = trimesh.load(tmp_path / "m.stl", process=False).vertices
+    raw_mm = trimesh.load(tmp_path / "mm.stl", process=False).vertices * 0.001
+    assert not np.array_equal(raw_m, raw_mm) and np.abs(raw_m - raw_mm).max() < 1e-8  # float noise apart
+    np.testing.assert_array_equal(in_m.mesh.faces, in_mm.mesh.faces)
+    np.testing.assert_array_equal(in_m.mesh.vertices, in_mm.mesh.vertices)

@@ -99,3 +99,14 @@ def test_crops_that_would_leave_the_image_are_not_rendered():
         assert crop_inside_image(u, v, angle, settings.crop, settings.intrinsics).all()
         reach = 47.5 * (np.abs(np.cos(angle)) + np.abs(np.sin(angle)))
         assert np.all((u - reach >= 0) & (u + reach <= 639) & (v - reach >= 0) & (v + reach <= 479))
+
+
+def test_a_ball_gets_datapoints():
+    """A ball has no stable pose the solver gives above Dex-Net's 0.01 (it rests in any orientation): it is
+    rendered in uniformly drawn orientations instead of being skipped with '0 stable poses'."""
+    ball = trimesh.creation.icosphere(3, 0.025)
+    axes = np.random.default_rng(0).normal(size=(200, 3))
+    axes /= np.linalg.norm(axes, axis=1, keepdims=True)
+    data = render_shape(ball, np.zeros((200, 3)), axes, HAND, RenderSettings(), np.random.default_rng(0))
+    assert data.n_poses == RenderSettings().max_poses and len(data) > 0
+    assert len(np.unique(data.columns["pose_id"])) > 1

@@ -57,3 +57,27 @@ def test_a_box_rests_on_its_faces_with_the_larger_faces_likelier():
 def test_a_cube_lands_on_each_face_equally_often():
     poses = stable_poses(trimesh.creation.box((0.05, 0.05, 0.05)))
     np.testing.assert_allclose(poses.probabilities, np.full(6, 1 / 6), atol=1e-12)
+
+
+def test_a_ball_rests_in_any_orientation_each_as_likely():
+    """An icosphere's hull spreads its landing probability over 1,280 facets, none above 0.001, so the solver
+    alone leaves it no pose Dex-Net keeps (>= 0.01): it gets N_ROUND orientations drawn uniformly, equally likely,
+    the same ones every time (the stages that recompute poses number them alike), each resting on the table."""
+    from graspaug.render.stable_poses import N_ROUND, ROUND_PROBABILITY, round_poses
+
+    ball = trimesh.creation.icosphere(3, 0.03)
+    poses = stable_poses(ball)
+    assert poses.round and len(poses) == N_ROUND and np.all(poses.probabilities >= ROUND_PROBABILITY)
+    np.testing.assert_allclose(poses.probabilities, 1 / N_ROUND)
+    np.testing.assert_array_equal(poses.transforms, stable_poses(ball).transforms)  # deterministic from the seed
+    assert not np.array_equal(poses.transforms, stable_poses(ball, seed=1).transforms)
+    for transform in poses.transforms:
+        rested = ball.copy().apply_transform(transform)
+        assert rested.bounds[0, 2] == pytest.approx(0.0, abs=1e-12)
+        np.testing.assert_allclose(rested.center_mass[:2], 0.0, atol=1e-9)
+        np.testing.assert_allclose(transform[:3, :3] @ transform[:3, :3].T, np.eye(3), atol=1e-12)
+    # uniform over rotations: the table normal in the object frame averages to 0, its squares to 1/3
+    up = round_poses(ball.convex_hull, 4000, seed=0).transforms[:, 2, :3]
+    np.testing.assert_allclose(up.mean(axis=0), 0.0, atol=0.05)
+    np.testing.assert_allclose((up**2).mean(axis=0), 1 / 3, atol=0.03)
+    assert not stable_poses(trimesh.creation.box((0.05, 0.05, 0.05))).round  # a cube keeps its six faces

@@ -27,6 +27,11 @@ MESH_SUFFIXES = (".obj", ".stl", ".ply", ".off", ".glb")
 
 # extents below this share of the largest one make a shape flat (no volume)
 _FLAT_RATIO = 1e-4
+#: Vertex coordinates are read to this many decimals of a metre (1 µm, far below any scan's accuracy): the digits
+#: beyond are float noise of the file's unit (a float32 file in mm and one in m of one object differ by 1e-9 m), and
+#: the decimator, whose collapses tie on flat faces, would turn that noise into another triangulation, other
+#: sampled grasps and another test set.
+VERTEX_DIGITS = 6
 
 
 class MeshRejected(Exception):
@@ -114,6 +119,7 @@ def load_shape(
         if not np.isfinite(p.vertices).all():
             raise MeshRejected("non-finite vertex coordinates (NaN or inf)")
         p.apply_scale(unit_scale)
+        p.vertices = np.round(p.vertices, VERTEX_DIGITS)  # to 1 µm: the same file in mm or m gives the same metres
         p.merge_vertices()  # STL and some PLY store each triangle's corners separately
 
     mesh = trimesh.util.concatenate(pieces) if len(pieces) > 1 else pieces[0].copy()

@@ -8,6 +8,11 @@ lies beyond; probability flows along topples to resting triangles; coplanar rest
 (normals equal to 3 decimals) are one pose. Trimesh walks a networkx graph one triangle at a
 time (~0.15 s for a 900-triangle hull); this takes a few milliseconds and gives the same poses
 (tests/render/test_stable_poses.py).
+
+A round object (a ball, a marble) rests in any orientation: its hull's many facets each hold a sliver of the
+probability, none reaching the :data:`ROUND_PROBABILITY` that Dex-Net prunes below, so it would get no pose at all.
+Such an object gets :data:`N_ROUND` orientations drawn uniformly over all rotations instead, each as likely
+(``1 / N_ROUND``), drawn by a fixed seed (``seed``) so that every stage recomputing them gets the same.
 """
 
 from __future__ import annotations
@@ -16,16 +21,24 @@ from dataclasses import dataclass
 
 import numpy as np
 import trimesh
+from scipy.spatial.transform import Rotation
+
+#: An object whose likeliest stable pose is less likely than this is round: it rests in any orientation.
+ROUND_PROBABILITY = 0.01
+#: Orientations a round object is given, each with probability 1 / N_ROUND.
+N_ROUND = 10
 
 
 @dataclass(frozen=True)
 class StablePoses:
     """``transforms`` (P, 4, 4): each moves the object (in its own frame) to rest on the table
     plane z = 0 with z up; ``probabilities`` (P,): chance of landing in that pose when dropped
-    in a uniformly random orientation. Most probable first."""
+    in a uniformly random orientation. Most probable first. ``round``: the object rests in any orientation
+    and these are uniformly drawn ones (:data:`N_ROUND`, equally likely)."""
 
     transforms: np.ndarray
     probabilities: np.ndarray
+    round: bool = False  # uniformly drawn orientations of a round object, not the solver's poses
 
     def __len__(self) -> int:
         return len(self.probabilities)
@@ -79,9 +92,19 @@ def _topple_targets(hull: trimesh.Trimesh, center: np.ndarray) -> tuple[np.ndarr
     return target, ~unstable
 
 
-def stable_poses(mesh: trimesh.Trimesh, center_of_mass: np.ndarray | None = None) -> StablePoses:
+def round_poses(hull: trimesh.Trimesh, n: int = N_ROUND, seed: int = 0) -> StablePoses:
+    """``n`` orientations of a round object drawn uniformly over all rotations (``seed``), each resting on the
+    table (its lowest ``hull`` vertex at z = 0, the origin above the table's origin), each with probability 1/n."""
+    transforms = np.tile(np.eye(4), (n, 1, 1))
+    transforms[:, :3, :3] = Rotation.random(n, random_state=np.random.default_rng(seed)).as_matrix()
+    transforms[:, 2, 3] = -np.min(np.einsum("pj,vj->pv", transforms[:, 2, :3], hull.vertices), axis=1)
+    return StablePoses(transforms=transforms, probabilities=np.full(n, 1.0 / n), round=True)
+
+
+def stable_poses(mesh: trimesh.Trimesh, center_of_mass: np.ndarray | None = None, seed: int = 0) -> StablePoses:
     """All resting poses of ``mesh`` (meters) with their probabilities (those sum to 1 up to
-    triangles whose topple chain loops, which are dropped)."""
+    triangles whose topple chain loops, which are dropped); for a round object, whose likeliest pose is below
+    :data:`ROUND_PROBABILITY` (or that has none), :func:`round_poses` drawn by ``seed``."""
     hull = mesh.convex_hull
     center = np.asarray(mesh.center_mass if center_of_mass is None else center_of_mass, dtype=float)
     prior = _landing_probabilities(hull.triangles, center)
@@ -108,5 +131,7 @@ def stable_poses(mesh: trimesh.Trimesh, center_of_mass: np.ndarray | None = None
         y = np.cross(z, x)
         pose[:3, :3] = np.stack([x, y / np.linalg.norm(y), z])
         pose[2, 3] = -np.min(hull.vertices @ pose[2, :3])
+    if not len(probabilities) or probabilities.max() < ROUND_PROBABILITY:
+        return round_poses(hull, N_ROUND, seed)
     order = np.argsort(-probabilities, kind="stable")
     return StablePoses(transforms=transforms[order], probabilities=probabilities[order])

@@ -68,11 +68,21 @@ def chamfer_matrix(a: Sequence[np.ndarray], b: Sequence[np.ndarray]) -> np.ndarr
     return out
 
 
+def ratio(numerator: float, denominator: float) -> float:
+    """``numerator / denominator``, NaN (undefined) where the denominator is 0 or not finite: a figure undefined on
+    some data says so rather than stopping the stage."""
+    denominator = float(denominator)
+    return float(numerator) / denominator if denominator and np.isfinite(denominator) else np.nan
+
+
 def coverage_mmd(pool_to_reference: np.ndarray) -> tuple[float, float]:
-    """Coverage and minimum matching distance (m) from the Chamfer distances (pool, reference)."""
+    """Coverage and minimum matching distance (m) from the Chamfer distances (pool, reference); both NaN without
+    pool or reference shapes."""
     d = np.asarray(pool_to_reference, dtype=float)
+    if d.size == 0:
+        return np.nan, np.nan
     covered = np.unique(d.argmin(axis=1))
-    return len(covered) / d.shape[1], float(d.min(axis=0).mean())
+    return ratio(len(covered), d.shape[1]), float(d.min(axis=0).mean())
 
 
 def one_nn_accuracy(pool_pool: np.ndarray, reference_reference: np.ndarray, pool_reference: np.ndarray) -> float:
@@ -210,19 +220,43 @@ FIGURES = (
 )
 """The figures of :func:`fidelity_table`, each with its interval."""
 
+UNDEFINED = {
+    "graspness_kept": "the parents' graspness is 0",
+    "positive_share": "no datapoints",
+    "datapoints_kept": "the parents have no datapoints",
+}
+"""Why a figure of :func:`fidelity_table` can be undefined on the shapes drawn (a ratio over 0)."""
+
 
 def _shape_figures(pool: PoolShapes, i: np.ndarray) -> dict:
+    """The shape figures of ``pool`` over its shapes ``i``: NaN where undefined on them (:data:`UNDEFINED`), None
+    where the pool has no such figure (real shapes keep no parents' figures)."""
     graspness = float(pool.graspness[i].mean())
-    kept = graspness / float(np.mean(pool.parents[i])) if np.isfinite(pool.parents).all() else np.nan
     counts = pool.parent_datapoints
-    known = counts is not None and np.isfinite(counts).all() and counts[i].sum() > 0
     return {
         "graspness": graspness,
-        "graspness_kept": kept,
-        "positive_share": float(pool.positives[i].sum() / max(pool.datapoints[i].sum(), 1)),
+        "graspness_kept": ratio(graspness, np.mean(pool.parents[i])) if np.isfinite(pool.parents).all() else None,
+        "positive_share": ratio(pool.positives[i].sum(), pool.datapoints[i].sum()),
         "datapoints_per_shape": float(pool.datapoints[i].mean()),
-        "datapoints_kept": float(pool.datapoints[i].sum() / counts[i].sum()) if known else np.nan,
+        "datapoints_kept": (
+            ratio(pool.datapoints[i].sum(), counts[i].sum())
+            if counts is not None and np.isfinite(counts).all()
+            else None
+        ),
     }
+
+
+def _undefined(figure: str, point, samples: list) -> str | None:
+    """What :func:`fidelity_table` says of a ``figure`` undefined at its ``point`` value or on some resamples
+    (``samples``: its values over them), None when it is defined everywhere or does not apply."""
+    missing = sum(v is not None and not np.isfinite(v) for v in samples)
+    if point is None or figure not in UNDEFINED:
+        return None
+    if not np.isfinite(point):
+        return f"{figure}: {UNDEFINED[figure]}"
+    if missing:
+        return f"{figure}: {UNDEFINED[figure]} in {missing} of {len(samples)} resamples (left out of its interval)"
+    return None
 
 
 def fidelity_table(
@@ -242,8 +276,10 @@ def fidelity_table(
     Returns
     -------
     DataFrame — one row per pool: ``pool``, ``shapes``, ``distinct_parents``, ``alphas``, the median
-    sorted extents ``extent_small``/``extent_middle``/``extent_large`` (m), and per figure its value
-    and ``<figure>_lo``/``<figure>_hi``
+    sorted extents ``extent_small``/``extent_middle``/``extent_large`` (m), per figure its value
+    and ``<figure>_lo``/``<figure>_hi`` (NaN or None where undefined: a ratio over 0, e.g. the parents' graspness
+    0 on every shape), and ``undefined``: which figures were undefined, and why, on the pool or on how many
+    resamples ("" when none was)
     """
     rr_full = chamfer_matrix(reference, reference)
     rows = []
@@ -259,10 +295,13 @@ def fidelity_table(
             samples.append(_shape_figures(pool, shapes) | resampled_distances(pp, rr_full, pr, i, j))
         row = {"pool": name, "shapes": n, "distinct_parents": pool.distinct_parents, "alphas": json.dumps(pool.alphas)}
         row |= dict(zip(("extent_small", "extent_middle", "extent_large"), np.median(pool.extents, axis=0).tolist()))
+        notes = []
         for figure in FIGURES:
-            low, high = percentile_interval(np.array([s[figure] for s in samples]))
+            values = [s[figure] for s in samples]
+            low, high = percentile_interval(np.array(values, dtype=float))
             row |= {figure: point[figure], f"{figure}_lo": low, f"{figure}_hi": high}
-        rows.append(row)
+            notes.append(_undefined(figure, point[figure], values))
+        rows.append(row | {"undefined": "; ".join(n for n in notes if n)})
     return pd.DataFrame(rows)
 
 
@@ -333,8 +372,8 @@ def heldout_summary(per_shape: pd.DataFrame) -> dict:
         "datapoints_kept": dp["ratio"],
         "datapoints_kept_low": dp["low"],
         "datapoints_kept_high": dp["high"],
-        "positive_before": float(meshed.positives_before.sum() / before.sum()),  # pooled, as the dataset's share
-        "positive_after": float(meshed.positives_after.sum() / after.sum()),
+        "positive_before": ratio(meshed.positives_before.sum(), before.sum()),  # pooled, as the dataset's share
+        "positive_after": ratio(meshed.positives_after.sum(), after.sum()),  # NaN: no datapoints
     } | {
         f"{k}_{w}": float(np.nanmean(meshed[f"{k}_{w}"]))
         for k in ("stable_poses", "grasps_rendered")

@@ -8,13 +8,24 @@ import pandas as pd
 
 
 def fidelity_markdown(table: pd.DataFrame, base_size: int, reference_count: int) -> str:
-    """The fidelity table in words and numbers: value [95% interval] per pool and figure."""
+    """The fidelity table in words and numbers: value [95% interval] per pool and figure; a figure undefined on the
+    pool's shapes (a ratio over 0) reads "undefined: why", one undefined on some resamples is named under the table,
+    and one that does not apply to the pool reads "-"."""
+
+    def notes(row) -> dict[str, str]:
+        text = row.get("undefined")
+        text = text if isinstance(text, str) else ""
+        return {note.split(": ", 1)[0]: note.split(": ", 1)[1] for note in text.split("; ") if note}
+
+    def number(v) -> bool:
+        return v is not None and not pd.isna(v) and np.isfinite(v)
 
     def cell(row, f: str, digits: int) -> str:
         v, lo, hi = row[f], row[f"{f}_lo"], row[f"{f}_hi"]
-        if v is None or not np.isfinite(v):
-            return "-"
-        return f"{v:.{digits}f} [{lo:.{digits}f}, {hi:.{digits}f}]"
+        if not number(v):
+            return f"undefined: {notes(row)[f]}" if f in notes(row) else "-"
+        interval = f"[{lo:.{digits}f}, {hi:.{digits}f}]" if number(lo) and number(hi) else "[undefined]"
+        return f"{v:.{digits}f} {interval}"
 
     lines = [
         f"# Fidelity of the pools at B = {base_size}, before any training",
@@ -39,6 +50,9 @@ def fidelity_markdown(table: pd.DataFrame, base_size: int, reference_count: int)
             f"| {cell(row, 'datapoints_kept', 2)} | {cell(row, 'coverage', 2)} "
             f"| {mmd} | {cell(row, 'one_nna', 2)} | {extents} |"
         )
+    undefined = [f"- {row.pool}: {row['undefined']}." for _, row in table.iterrows() if notes(row)]
+    if undefined:
+        lines += ["", "Undefined figures (a ratio over 0 on the shapes drawn):", *undefined]
     return "\n".join(lines) + "\n"
 
 
