@@ -149,7 +149,7 @@ class TrainSettings:
         return int(min(self.max_steps, max(self.min_steps, -(-self.epochs * n_datapoints // self.batch_size))))
 
 
-POOLS = ("targeted", "random", "real", "recon", "blend", "warp", "primitives", "procedural")
+POOLS = ("targeted", "random", "real", "recon", "blend", "warp", "primitives", "procedural", "own")
 """Pools of augmented networks, in report order: ``targeted`` / ``random`` (interpolants of the
 base set's rare-and-graspable neighbours / of random pairs), ``real`` (more real train shapes, the
 positive control), ``recon`` (the real pool's shapes decoded from their own latents), ``blend``
@@ -157,4 +157,5 @@ positive control), ``recon`` (the real pool's shapes decoded from their own late
 ``warp`` (each targeted pair's nearer parent under a random smooth deformation: the handcrafted
 augmentation), ``primitives`` (random assemblies of primitives: procedural objects, no real parent) and
 ``procedural`` (objects of pybullet's procedural ``random_urdfs`` corpus added as they are: what a researcher whose own
-corpus is real objects gets for free)."""
+corpus is real objects gets for free) and ``own`` (the targeted recipe decoded by an AutoEncoder-Critic trained on the
+base set alone: the augmentation without the train split's other shapes)."""
