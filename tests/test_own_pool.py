@@ -80,7 +80,7 @@ def test_dvc_repro_own_pool_from_an_ae_of_the_base_set_alone(repo_root, tmp_path
     assert summary["n_train"] == 6 and (summary["epochs_ae"], summary["epochs_critic"]) == (150, 1)
     assert all(summary[k] is not None and 0 <= summary[k] <= 1 for k in ("iou_base", "main_iou_base"))
     metrics = json.loads((work / "metrics/train_ae_own/6.json").read_text())
-    assert metrics["iou_base"] == summary["iou_base"] and metrics["main_iou_base"] == summary["main_iou_base"]
+    assert metrics == {k: summary[k] for k in ("shapes", "iou_base", "main_iou_base")} and metrics["shapes"] == 6
     own_z = pd.read_parquet(work / "models/ae_own/6/latents.parquet")
     main_z = pd.read_parquet(work / "data/latents.parquet").set_index("shape_id").z
     assert list(own_z.shape_id) == base and not np.allclose(np.stack(own_z.z), np.stack(main_z.loc[base]))
