@@ -25,6 +25,7 @@ def test_the_declared_contrasts():
         "warp_vs_none@50",
         "primitives_vs_none@50",
         "procedural_vs_none@50",
+        "own_vs_none@50",
         "targeted_vs_random@50",
         "targeted_vs_real@50",
         "recon_vs_real@50",
@@ -36,6 +37,7 @@ def test_the_declared_contrasts():
         "primitives_vs_real@50",
         "targeted_vs_primitives@50",
         "targeted_vs_procedural@50",
+        "targeted_vs_own@50",
     ]
     baseline = {c.name: c for c in declared_contrasts([50, 200], [0.0, 0.5, 1.0], [50], {})}["warp_vs_none@50"]
     assert dict((k, w) for w, k in baseline.terms) == {
@@ -72,6 +74,7 @@ def test_the_declared_contrasts():
         "warp/50-1",
         "primitives/50-1",
         "procedural/50-1",
+        "own/50-1",
         "ceiling",
     ]
     assert "recon/50-1" not in [v.name for v in seed_variants([50], [0.0, 1.0], [50], False, ("targeted", "real"))]

@@ -34,7 +34,7 @@ def test_an_explicit_list_trains_exactly_its_networks_and_an_empty_one_the_matri
 @pytest.mark.parametrize(
     "entry, words",
     [
-        (["own", 50, 1.0], "unknown pool"),
+        (["mystery", 50, 1.0], "unknown pool"),
         (["targeted", 100, 0.0], "generate.base_sizes"),
         (["targeted", 200, 1.0], "gqcnn.augment_base_sizes"),
         (["recon", 50, 1.0], "gqcnn.pools"),
@@ -197,3 +197,14 @@ def test_balanced_and_views_train_for_real_and_report_their_shares_and_counts(co
     table = seed_table([targeted, balanced, views])
     assert table["balanced"]["4"]["1"]["target_positive_share"] == target
     assert table["views"]["4"]["1"]["views_datapoints"] == 24
+
+
+def test_an_explicit_list_of_networks_makes_only_the_shapes_its_networks_train_on():
+    """``networks_at``: generate and train_ae_own read which pools, at which ratios, a base size needs; balanced and
+    views need targeted's shapes at their (B, R); without a list, None (every pool of gqcnn.pools)."""
+    from graspaug.training.settings import networks_at
+
+    networks = [["targeted", 50, 0.0], ["balanced", 50, 1.0], ["random", 50, 1.0], ["targeted", 200, 2.0]]
+    assert networks_at(networks, 50) == {"targeted": {1.0}, "random": {1.0}}
+    assert networks_at(networks, 200) == {"targeted": {2.0}}
+    assert networks_at(networks, 100) == {} and networks_at([], 50) is None

@@ -195,3 +195,21 @@ def control_runners(
         "procedural": lambda: procedural_batches(procedural, surface, workers, f"procedural {base_size}"),
     }
     return {name: make() for name, make in runners.items() if name in pools}
+
+
+def own_source(ae, train_params: dict, latents, base: BaseSet, k: int, meshes: Callable):
+    """The own pool's :class:`graspaug.augment.pools.OwnSource`: ``base`` (its ids, graspness and pitches) with the
+    latents of ``latents`` (a table: ``shape_id``, ``z``, the base set encoded by ``ae``) and the rarity among them
+    (``k`` neighbours), decoded by ``ae`` through ``meshes`` (:func:`mesh_batches` but its AE, shapes and label: a
+    function ``meshes(ae, base=..., label=...)``); a :class:`graspaug.errors.DataError` unless ``ae`` was trained on
+    exactly ``base``'s shapes (``train_params["train_ids"]``, as ``train_ae_own`` records them)."""
+    from graspaug.augment.pools import BaseSet, OwnSource
+    from graspaug.augment.scores import rarity
+    from graspaug.errors import DataError
+
+    ids = [str(s) for s in base.ids]
+    if list(train_params.get("train_ids", [])) != ids:
+        raise DataError(f"the own AE-Critic of base set {len(ids)} was not trained on that base set alone")
+    z = np.stack(latents.set_index("shape_id").z.loc[ids].to_numpy()).astype(np.float32)
+    shapes = BaseSet(base.ids, z, rarity(z, k), base.graspness, base.pitch)
+    return OwnSource(shapes, meshes(ae, base=shapes, label=f"generate {len(ids)} own"))

@@ -16,6 +16,7 @@ ID_LETTERS = {
     "warp": "w",
     "primitives": "p",
     "procedural": "x",
+    "own": "o",
     "failure": "f",
 }  # gen_<B>_<letter><order>
 
@@ -73,11 +74,18 @@ def pool_tables(
 
 
 def pool_summary(
-    base_size: int, needed: int, pools: dict, targeted: TargetedStream, index, reject_rows: list[dict]
+    base_size: int,
+    needed: int,
+    pools: dict,
+    targeted: TargetedStream,
+    index,
+    reject_rows: list[dict],
+    own: TargetedStream | None = None,
 ) -> tuple[dict, dict[str, float]]:
     """The ``generate`` stage's metrics for the pools (name → (kept, rejected) Decoded lists), and
     each pool's share of usable decodes. Every pool gets ``kept``, ``tried``, ``kept_share`` and
-    its :func:`pool_makeup`; the targeted pool also how its stream was widened."""
+    its :func:`pool_makeup`; the targeted pool also how its stream was widened, and so does the own pool (``own``: its
+    stream, the targeted recipe on the own AutoEncoder-Critic's latents)."""
 
     reasons = pd.Series([r["reason"].split(":")[0] for r in reject_rows], dtype=object)
     kept_share = {name: len(kept) / max(1, len(kept) + len(rejected)) for name, (kept, rejected) in pools.items()}
@@ -89,15 +97,18 @@ def pool_summary(
             "kept_share": round(kept_share[name], 4),
             **pool_makeup(index[index.pool == name]),
         }
-    targeted_rows = index[index.pool == "targeted"]
-    summary["targeted"] |= {
-        "by_rarity": int((targeted_rows.selected_by == "rarity").sum()),
-        "by_graspness": int((targeted_rows.selected_by == "graspness").sum()),
-        "k_used": targeted.extra,
-        "alphas_used": targeted.alphas,
-        "percentile_used": targeted.percentile,
-        "widening": targeted.notes,
-    }
+    for name, stream in (("targeted", targeted), ("own", own)):
+        if stream is None or name not in summary:
+            continue
+        rows = index[index.pool == name]
+        summary[name] |= {
+            "by_rarity": int((rows.selected_by == "rarity").sum()),
+            "by_graspness": int((rows.selected_by == "graspness").sum()),
+            "k_used": stream.extra,
+            "alphas_used": stream.alphas,
+            "percentile_used": stream.percentile,
+            "widening": stream.notes,
+        }
     summary["rejects"] = {str(k): int(v) for k, v in reasons.value_counts().sort_index().items()}
     summary["kept_watertight_one_piece_share"] = round(float((index.watertight & index.one_piece).mean()), 4)
     return summary, kept_share

@@ -85,7 +85,7 @@ def base_set(ids: np.ndarray, latents: pd.DataFrame, scores: pd.DataFrame, voxel
 
 Pools = dict[str, tuple[list[Decoded], list[Decoded]]]
 # what generate makes, in index order
-GENERATED_POOLS = ("targeted", "random", "recon", "blend", "warp", "primitives", "procedural")
+GENERATED_POOLS = ("targeted", "random", "recon", "blend", "warp", "primitives", "procedural", "own")
 FOLLOWERS = ("blend", "warp")  # the controls that follow the targeted pool's candidates (its parents and weights)
 PRIMITIVE_TRIES = 20  # the primitives stream holds this many assemblies per shape needed
 Runner = Callable[[list[Candidate]], list[Decoded]]
@@ -100,6 +100,24 @@ class ReconSource:
     run_batch: Callable[[list[Candidate]], list[Decoded]]
 
 
+@dataclass(frozen=True)
+class OwnSource:
+    """What the ``own`` pool is made from: ``shapes``, the base set as its own AutoEncoder-Critic (trained on the base
+    set alone) sees it (a :class:`BaseSet`: the same ids, graspness and pitches; that AE's latents and the rarity
+    among them), and ``run_batch``, :func:`.decode.mesh_batches` over them with that AE."""
+
+    shapes: BaseSet
+    run_batch: Callable[[list[Candidate]], list[Decoded]]
+
+
+def targeted_stream(shapes: BaseSet, cfg: GenerateSettings) -> TargetedStream:
+    """The targeted recipe's candidates on ``shapes``: its rare, and separately graspable, shapes paired with their
+    N-th … (N+K)-th latent neighbours at ``cfg.alphas`` (widened as :class:`TargetedStream` says)."""
+    return TargetedStream(
+        shapes.z, shapes.rarity, shapes.graspness, cfg.percentile, cfg.first_neighbour, cfg.extra_neighbours, cfg.alphas
+    )
+
+
 def fill_pools(
     base: BaseSet,
     cfg: GenerateSettings,
@@ -110,7 +128,8 @@ def fill_pools(
     controls: dict[str, Runner] | None = None,
     procedural: int = 0,
     control_ratios: Sequence[float] | None = None,
-) -> tuple[Pools, TargetedStream, int]:
+    own: OwnSource | None = None,
+) -> tuple[Pools, TargetedStream, int, TargetedStream | None]:
     """Fill each of ``pools`` (of :data:`GENERATED_POOLS`; the targeted one always) to
     ``pool_size(cfg.ratios, B)`` kept shapes (the pools but targeted: ``pool_size(control_ratios, B)`` when
     ``control_ratios`` is given, ``gqcnn.control_ratios``): ``targeted`` and ``random`` (seeded by
@@ -122,20 +141,24 @@ def fill_pools(
     ``warp`` (:func:`.decode.warp_batches`) on the targeted pool's candidates (its kept ones first: the same
     parents and weights), ``primitives`` (:func:`.decode.primitive_batches`) on assemblies 0, 1, … of
     :class:`PrimitiveStream` (:data:`PRIMITIVE_TRIES` per shape needed), ``procedural``
-    (:func:`.decode.procedural_batches`) on objects 0, 1, … of its shuffled corpus (``procedural``: how many).
+    (:func:`.decode.procedural_batches`) on objects 0, 1, … of its shuffled corpus (``procedural``: how many), and
+    ``own``: the targeted recipe (:func:`targeted_stream`, the same settings) on ``own`` (:class:`OwnSource`: the
+    base set's latents and rarity under its own AutoEncoder-Critic, decoded by it).
 
     Returns (pools: name → (kept, rejected) Decoded lists, in :data:`GENERATED_POOLS` order, the
-    targeted stream as widened, shapes per pool); a :class:`graspaug.errors.DataError` if a pool's
-    candidates run out first, or a pool is asked for without its source or runner.
+    targeted stream as widened, shapes per pool, the own pool's stream as widened or None); a
+    :class:`graspaug.errors.DataError` if a pool's candidates run out first, or a pool is asked for without its
+    source or runner.
     """
     base_size = len(base.ids)
     needed = pool_size(cfg.ratios, base_size)
     control = needed if control_ratios is None else pool_size(control_ratios, base_size)  # the other pools' size
-    targeted_stream = TargetedStream(
-        base.z, base.rarity, base.graspness, cfg.percentile, cfg.first_neighbour, cfg.extra_neighbours, cfg.alphas
-    )
+    targeted = targeted_stream(base, cfg)
     if "recon" in pools and recon is None:
         raise DataError(f"generate {base_size}: the recon pool needs the real pool's shapes")
+    if "own" in pools and own is None:
+        raise DataError(f"generate {base_size}: the own pool needs the base set's own AutoEncoder-Critic")
+    own_stream = targeted_stream(own.shapes, cfg) if own and "own" in pools else None
     controls = controls or {}
     for name in ("blend", "warp", "primitives", "procedural"):
         if name in pools and name not in controls:
@@ -147,16 +170,17 @@ def fill_pools(
             "with data.source: pybullet it has nothing to add)"
         )
     streams = {
-        "targeted": (targeted_stream, run_batch),
+        "targeted": (targeted, run_batch),
         "random": (RandomStream(base_size, cfg.alphas, np.random.default_rng([seed, BASE_SEED, base_size])), run_batch),
         "recon": (ReconStream(len(recon.shapes.ids)), recon.run_batch) if recon else None,
         "primitives": (PrimitiveStream(PRIMITIVE_TRIES * control), controls.get("primitives")),
         "procedural": (ProceduralStream(procedural), controls.get("procedural")),
+        "own": (own_stream, own.run_batch) if own_stream else None,
     }
     out = {}
     for name in (p for p in GENERATED_POOLS if p == "targeted" or p in pools):
         if name in FOLLOWERS:
-            streams[name] = (FollowStream([d.candidate for d in out["targeted"][0]], targeted_stream), controls[name])
+            streams[name] = (FollowStream([d.candidate for d in out["targeted"][0]], targeted), controls[name])
         stream, runner = streams[name]
         if name == "recon":  # the real pool's first shapes, each decoded once: a failed decode is a gap, not replaced
             out[name] = decode_each(stream, min(control, len(recon.shapes.ids)), runner)
@@ -165,7 +189,7 @@ def fill_pools(
             out[name] = fill_pool(stream, needed if name == "targeted" else control, runner)
         except PoolExhausted as exc:
             raise DataError(f"generate {base_size}, {name} pool: {exc}") from None
-    return out, targeted_stream, needed
+    return out, targeted, needed, own_stream
 
 
 @dataclass(frozen=True)
@@ -174,7 +198,8 @@ class GeneratedSet:
 
     index : one row per kept shape in pool order (:func:`graspaug.augment.pool_tables.pool_tables` columns
         plus ``rarity_vs_base``, the rarity of its latent against the base set; NaN for the warp and primitives
-        pools, whose shapes have no latent)
+        pools, whose shapes have no latent; the own pool's ``z`` and rarity are in its own AutoEncoder-Critic's
+        latent space, against the base set's latents there)
     rejects : one row per rejected decode (:data:`REJECT_COLUMNS`)
     base_table : the base set with its scores (:func:`graspaug.augment.pool_tables.base_scores_table`)
     kept : the kept decodes (Decoded, with their meshes in m), in ``index`` order
@@ -205,11 +230,13 @@ def generated_set(
     n_examples: int,
     recon_shapes: BaseSet | None = None,
     procedural_ids: Sequence[str] = (),
+    own: tuple[BaseSet, TargetedStream] | None = None,
 ) -> GeneratedSet:
     """The :class:`GeneratedSet` of ``pools`` (:func:`fill_pools`: the pools, the targeted stream
     and the shapes per pool) for ``base``; ``k``: the rarity's neighbours; ``n_examples``: targeted
     decodes to picture; ``recon_shapes``: the shapes the recon pool reconstructs; ``procedural_ids``: the
-    procedural pool's objects in stream order."""
+    procedural pool's objects in stream order; ``own``: the base set under its own AutoEncoder-Critic and the own
+    pool's stream."""
     base_size = len(base.ids)
     sources = {name: (base.ids, base.z) for name in pools}
     if recon_shapes is not None:
@@ -224,11 +251,19 @@ def generated_set(
         )
     if "procedural" in pools:  # object k of the shuffled procedural corpus: not a parent of this corpus, no latent
         sources["procedural"] = (np.asarray(procedural_ids), np.full((len(procedural_ids), base.z.shape[1]), np.nan))
+    own_shapes, own_stream = own if own is not None and "own" in pools else (None, None)
+    if own_shapes is not None:  # the own AE's latents: their own space, whose size may differ
+        sources["own"] = (own_shapes.ids, own_shapes.z)
     rows, reject_rows = pool_tables(sources, pools, base_size)
     index = pd.DataFrame(rows)
-    index["rarity_vs_base"] = latent_rarity(base.z, k, np.stack(index.z.to_numpy()))
+    mine = (index.pool == "own").to_numpy()
+    index["rarity_vs_base"] = np.nan
+    z = list(index.z)
+    index.loc[~mine, "rarity_vs_base"] = latent_rarity(base.z, k, _stacked(z, ~mine, base.z.shape[1]))
+    if own_shapes is not None:
+        index.loc[mine, "rarity_vs_base"] = latent_rarity(own_shapes.z, k, _stacked(z, mine, own_shapes.z.shape[1]))
     base_table = base_scores_table(base.ids, base.rarity, base.graspness, targeted.percentile)
-    summary, kept_share = pool_summary(base_size, needed, pools, targeted, index, reject_rows)
+    summary, kept_share = pool_summary(base_size, needed, pools, targeted, index, reject_rows, own_stream)
     return GeneratedSet(
         index,
         pd.DataFrame(reject_rows, columns=REJECT_COLUMNS),
@@ -237,7 +272,7 @@ def generated_set(
         summary,
         kept_share,
         example_decodes(pools, n_examples),
-        targeted.notes,
+        targeted.notes + [f"own pool: {note}" for note in (own_stream.notes if own_stream else [])],
         [
             f"only {100 * share:.1f}% of the {name} pool's decodes were usable meshes"
             for name, share in kept_share.items()
@@ -257,14 +292,22 @@ def generate_pools(
     controls: dict[str, Runner] | None = None,
     procedural_ids: Sequence[str] = (),
     control_ratios: Sequence[float] | None = None,
+    own: OwnSource | None = None,
 ) -> GeneratedSet:
     """:func:`fill_pools` then :func:`generated_set` (``k``: the rarity's neighbours; ``procedural_ids``: the
-    procedural pool's objects in stream order; ``control_ratios``: the ratios of the pools but targeted)."""
-    filled, targeted, needed = fill_pools(
-        base, cfg, seed, run_batch, pools, recon, controls, len(procedural_ids), control_ratios
+    procedural pool's objects in stream order; ``control_ratios``: the ratios of the pools but targeted; ``own``: the
+    own pool's source)."""
+    filled, targeted, needed, own_stream = fill_pools(
+        base, cfg, seed, run_batch, pools, recon, controls, len(procedural_ids), control_ratios, own
     )
-    recon_shapes = recon.shapes if recon else None
-    return generated_set(base, filled, targeted, needed, k, cfg.n_examples, recon_shapes, procedural_ids)
+    recon_shapes, mine = recon.shapes if recon else None, (own.shapes, own_stream) if own_stream else None
+    return generated_set(base, filled, targeted, needed, k, cfg.n_examples, recon_shapes, procedural_ids, mine)
+
+
+def _stacked(z: list[np.ndarray], rows: np.ndarray, width: int) -> np.ndarray:
+    """The latents ``z`` of ``rows`` (a mask) stacked (n, ``width``), (0, ``width``) for none."""
+    picked = [z[i] for i in np.flatnonzero(rows)]
+    return np.stack(picked) if picked else np.zeros((0, width), np.float32)
 
 
 def latent_rarity(z_base: np.ndarray, k: int, z: np.ndarray) -> np.ndarray:
@@ -284,9 +327,12 @@ def example_decodes(pools: Pools, n_examples: int) -> list[Decoded]:
 
 def tsne_groups(base: BaseSet, index: pd.DataFrame, perplexity: float, seed: int) -> tuple[np.ndarray, list[str]]:
     """(xy (B + G, 2), groups (B + G,)): the t-SNE of the base latents followed by the G generated
-    ones that have a latent (``index.z`` not NaN: not the warp and primitives pools), and each point's group
+    ones that have a latent in the base latents' space (``index.z`` not NaN: not the warp and primitives pools; not
+    the own pool, whose latents are its own AutoEncoder-Critic's), and each point's group
     (``base`` or ``generated (<selected_by>)``)."""
-    z = np.stack(index.z.to_numpy())
+    shared = (index.pool != "own").to_numpy()
+    index = index[shared]
+    z = np.stack(index.z.to_numpy()) if len(index) else np.zeros((0, base.z.shape[1]))
     known = np.isfinite(z).all(axis=1)  # a primitive assembly has no latent
     xy = tsne_2d(np.concatenate([base.z, z[known]]), perplexity, seed)
     groups = ["base"] * len(base.ids) + [f"generated ({s})" for s in index.selected_by[known]]

@@ -22,6 +22,24 @@ def floats_written_as_floats(raw: Any, section: str, key: str) -> Any:
 
 
 @settings
+class OwnGeneratorSettings:
+    """The `own` pool's generator: an AutoEncoder-Critic trained on the base set alone (ae.net, ae.train but epochs)."""
+
+    epochs_ae: int | None = Field(
+        None,
+        ge=1,
+        description="Phase 1 epochs of the own AE on its B base shapes; null: as many SGD steps as the main AE's "
+        "ae.train.epochs_ae took on the train split (epochs scaled by its batches per epoch over the base set's).",
+    )
+    epochs_critic: int | None = Field(
+        None,
+        ge=1,
+        description="Phase 2 epochs (AE-Critic, critic warm-up scaled alike); null: as many SGD steps as the main "
+        "AE-Critic's ae.train.epochs_critic took on the train split.",
+    )
+
+
+@settings
 class GenerateSettings:
     """New shapes from rare and graspable neighbours of each base set (paper Section III-C)."""
 
@@ -72,6 +90,11 @@ class GenerateSettings:
         default_factory=PrimitiveSettings,
         description="The primitives pool (gqcnn.pools): random assemblies of 1 to max_parts (5) primitives, no real "
         "parent, sized by the ingest rule.",
+    )
+    own: OwnGeneratorSettings = Field(
+        default_factory=OwnGeneratorSettings,
+        description="The own pool (gqcnn.pools): the targeted recipe with an AutoEncoder-Critic trained on the base "
+        "set alone (stage train_ae_own), so no geometry beyond the base set enters.",
     )
 
     @model_validator(mode="before")

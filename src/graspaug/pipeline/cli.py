@@ -108,6 +108,29 @@ stage_command(
     "`seed`, `device`.",
     "ae",
 )
+
+
+@app.command(
+    name="train-ae-own",
+    help="The own pool's generator for one augmented base set of B shapes: the AutoEncoder and AE-Critic of "
+    "`train-ae` (ae.net, ae.train) trained on that base set's voxel grids alone, for as many SGD steps as the main "
+    "AE-Critic took on the train split unless `generate.own` names the epochs; nothing when `own` is not in "
+    "gqcnn.pools.\n\nWrites `models/ae_own/<B>/` (`ae_critic.pt` with the ids it trained on, `latents.parquet`, "
+    "`summary.json`: reconstruction IoU on the base set and the test split beside the main AE-Critic's, DVCLive logs "
+    "in `live/`) and `metrics/train_ae_own/<B>.json`.\n\n{params}\n\nAlso `generate.base_sizes`, `data_seed` (the "
+    "base set), `gqcnn.pools`, `gqcnn.augment_base_sizes`, `seed`, `device`.",
+    cls=_with_params("train_ae_own", "ae"),
+)
+def train_ae_own_command(
+    base_size: int = typer.Option(
+        ..., "--base-size", "-b", help="The base set size B (one of gqcnn.augment_base_sizes)."
+    ),
+    params: Path = ParamsOption,
+) -> None:
+    stage = _stage("train_ae_own")
+    run_stage(lambda p: stage.run(p, base_size), load_stage_params(params, stage))
+
+
 stage_command(
     "embed",
     "Encode every shape with the AE-Critic: `data/latents.parquet` (shape_id, split, z) and a 2-D t-SNE map "

@@ -21,6 +21,29 @@ AE_CRITIC_MODEL = Path("models/ae_critic.pt")
 TRAIN_AE_LIVE = Path("metrics/train_ae")
 TRAIN_AE_SUMMARY = Path("metrics/train_ae.json")  # the headline: test IoU per arm, the critic's AUC
 TRAIN_AE_REPORT = Path("reports/train_ae/summary.json")  # everything the stage measured
+# train_ae_own (one folder per augmented base size B): the own pool's AE-Critic, trained on base set B alone
+
+
+def ae_own_dir(base_size: int) -> Path:
+    return Path(f"models/ae_own/{base_size}")
+
+
+def ae_own_model(base_size: int) -> Path:  # its train_params name the shapes it trained on (train_ids)
+    return ae_own_dir(base_size) / "ae_critic.pt"
+
+
+def ae_own_latents(base_size: int) -> Path:  # the base set's latents as the own AE-Critic encodes them
+    return ae_own_dir(base_size) / "latents.parquet"
+
+
+def ae_own_summary(base_size: int) -> Path:
+    return ae_own_dir(base_size) / "summary.json"
+
+
+def ae_own_metrics(base_size: int) -> Path:
+    return Path(f"metrics/train_ae_own/{base_size}.json")
+
+
 # embed
 LATENTS = Path("data/latents.parquet")
 TSNE_CSV = Path("reports/embed/tsne.csv")

@@ -95,3 +95,19 @@ def summary_headline(summary: dict[str, float | None]) -> dict[str, float | None
     ``iou_extra``: the λ = 0 control, ``iou_critic``) and the critic's held-out ROC AUC (``auc``)."""
     arms = {"iou_ae": "ae", "iou_extra": "ae_extra", "iou_critic": "ae_critic"}
     return {**{key: summary.get(f"{arm}_iou_test") for key, arm in arms.items()}, "auc": summary.get("critic_auc")}
+
+
+def fit_ae_critic(
+    live_dir: Path, train: torch.Tensor, test: torch.Tensor, net, cfg, device: torch.device, seed: int
+) -> tuple[AutoEncoder, Critic, ArmTrainer]:
+    """An AutoEncoder of config ``net`` (phase 1, arm ``ae``), then the AE-Critic from it (phase 2, arm
+    ``ae_critic``; no λ = 0 control), trained on the ``train`` grids with ``cfg`` (AETrainConfig) as ``train_ae``
+    trains them, random numbers from ``seed``; returns (AE, critic, the :class:`ArmTrainer` with their figures)."""
+    from graspaug.training.autoencoder import train_ae_critic, train_autoencoder
+
+    torch.manual_seed(seed)
+    gen = torch.Generator().manual_seed(seed)
+    arms, ae, critic = ArmTrainer(live_dir, train, test, device), AutoEncoder(net), Critic(net)
+    arms.fit("ae", ae, None, lambda cb: train_autoencoder(ae, train, cfg, device, gen, cb), 5, cfg.epochs_ae)
+    arms.fit("ae_critic", ae, critic, lambda cb: train_ae_critic(ae, critic, train, cfg, device, gen, cb))
+    return ae, critic, arms

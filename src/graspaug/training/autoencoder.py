@@ -99,6 +99,25 @@ def checkpoint_params(cfg: AETrainConfig, device: torch.device) -> dict:
     return dataclasses.asdict(cfg) | {"precision": resolve_precision(cfg.precision, device).label}
 
 
+def batches_per_epoch(n_shapes: int, batch_size: int) -> int:
+    """Optimizer steps of one epoch over ``n_shapes`` in batches of ``batch_size`` (a last batch of one shape is
+    dropped, as the training phases drop it)."""
+    return sum(1 for i in range(0, n_shapes, batch_size) if min(batch_size, n_shapes - i) > 1)
+
+
+def step_matched(
+    cfg: AETrainConfig, n_from: int, n_to: int, epochs_ae: int | None = None, epochs_critic: int | None = None
+) -> AETrainConfig:
+    """``cfg`` for a training set of ``n_to`` shapes that takes as many SGD steps as ``cfg`` takes on ``n_from``:
+    each phase's epochs times :func:`batches_per_epoch` of ``n_from`` over that of ``n_to``, rounded up, unless
+    ``epochs_ae`` / ``epochs_critic`` name them; the critic warm-up keeps its share of phase 2 (rounded)."""
+    scale = batches_per_epoch(n_from, cfg.batch_size) / max(1, batches_per_epoch(n_to, cfg.batch_size))
+    phase_1 = epochs_ae if epochs_ae is not None else math.ceil(cfg.epochs_ae * scale)
+    phase_2 = epochs_critic if epochs_critic is not None else math.ceil(cfg.epochs_critic * scale)
+    warmup = round(cfg.critic_warmup * phase_2 / cfg.epochs_critic) if cfg.epochs_critic else 0
+    return dataclasses.replace(cfg, epochs_ae=phase_1, epochs_critic=phase_2, critic_warmup=min(warmup, phase_2))
+
+
 def phase_1_schedule(opt: torch.optim.Optimizer, cfg: AETrainConfig) -> torch.optim.lr_scheduler.LambdaLR:
     """Phase 1's learning rate, stepped once per epoch: ``lr_ae`` throughout (``lr_schedule: constant``), or a
     cosine from ``lr_ae`` towards 0 over ``epochs_ae`` (``cosine``: lr_ae · ½(1 + cos(π · epoch / epochs_ae)) in

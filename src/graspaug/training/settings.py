@@ -150,7 +150,7 @@ class TrainSettings:
         return int(min(self.max_steps, max(self.min_steps, -(-self.epochs * n_datapoints // self.batch_size))))
 
 
-POOLS = ("targeted", "random", "real", "recon", "blend", "warp", "primitives", "procedural")
+POOLS = ("targeted", "random", "real", "recon", "blend", "warp", "primitives", "procedural", "own")
 """Pools of augmented networks, in report order: ``targeted`` / ``random`` (interpolants of the
 base set's rare-and-graspable neighbours / of random pairs), ``real`` (more real train shapes, the
 positive control), ``recon`` (the real pool's shapes decoded from their own latents), ``blend``
@@ -158,7 +158,8 @@ positive control), ``recon`` (the real pool's shapes decoded from their own late
 ``warp`` (each targeted pair's nearer parent under a random smooth deformation: the handcrafted
 augmentation), ``primitives`` (random assemblies of primitives: procedural objects, no real parent) and
 ``procedural`` (objects of pybullet's procedural ``random_urdfs`` corpus added as they are: what a researcher whose own
-corpus is real objects gets for free)."""
+corpus is real objects gets for free) and ``own`` (the targeted recipe decoded by an AutoEncoder-Critic trained on the
+base set alone: the augmentation without the train split's other shapes)."""
 
 SAMPLED_POOLS = ("balanced", "views")
 """Arms of the base shapes alone that mirror targeted at their (B, R): ``balanced`` (batches drawn at targeted's
@@ -197,3 +198,17 @@ def check_networks(networks, base_sizes, ratios, augment_base_sizes, pools, cont
         if math.floor(r * b + 0.5) < 1:  # graspaug.augment.candidates.ratio_count
             return f"{where}: ratio {r:g} of {b} base shapes adds no shape"
     return None
+
+
+def networks_at(networks, base_size: int) -> dict[str, set[float]] | None:
+    """The generated pools an explicit ``gqcnn.networks`` list trains on at ``base_size``, each with the ratios it is
+    trained at (``balanced`` and ``views`` at (B, R) need targeted's shapes at (B, R)); None without a list (then
+    every pool of ``gqcnn.pools`` at every augmented base size), so ``generate`` and ``train_ae_own`` make only the
+    shapes some network trains on."""
+    if not networks:
+        return None
+    out: dict[str, set[float]] = {}
+    for pool, b, r in networks:
+        if int(b) == int(base_size) and float(r) > 0:
+            out.setdefault("targeted" if pool in SAMPLED_POOLS else str(pool), set()).add(float(r))
+    return out

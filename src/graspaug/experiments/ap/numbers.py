@@ -13,14 +13,14 @@ network is read:
 * ``targeted_vs_none@B``: mean over R > 0 of AP(targeted, B, R) − AP(B, 1:0);
 * ``targeted_vs_none_chosen@B``: the same at the ratio chosen on mean validation AP;
 * ``warp_vs_none@B``, ``primitives_vs_none@B``, ``procedural_vs_none@B``: the same for the no-network baselines
-  when trained;
+  when trained, and ``own_vs_none@B`` for the own pool (the targeted recipe, its AE-Critic trained on the base set);
 * ``<a>_vs_<b>@B`` for the pool pairs of :data:`PAIRS` whose pools are trained: mean over R > 0 of
   AP(a, B, R) − AP(b, B, R), equal shape counts (``targeted_vs_random``, ``targeted_vs_real``,
   ``recon_vs_real``: what decoding alone costs, ``targeted_vs_recon``: what interpolation and
   selection add to a decoded shape, ``blend_vs_recon``, ``targeted_vs_blend``: what the latent
   space adds over mixing the same parents' signed distance fields; ``warp_vs_real``, ``targeted_vs_warp``,
   ``primitives_vs_real``, ``targeted_vs_primitives``, ``targeted_vs_procedural``: the baselines a researcher tries
-  first);
+  first; ``targeted_vs_own``: what the main AE-Critic's geometry from train shapes beyond the base set adds);
 * with ``gqcnn.control_ratios``, a pool's mean runs over its own ratios (:func:`graspaug.training.variants.pool_ratios`)
   and a pair's over the ratios both pools have;
 * ``<pool>_vs_real_datapoints@B``: the same pools against real shapes at as many training
@@ -69,11 +69,14 @@ PAIRS = {  # pool a vs pool b at equal shape counts: what the difference measure
     ("primitives", "real"): "random assemblies of primitives vs as many more real shapes",
     ("targeted", "primitives"): "the paper's method vs procedural objects",
     ("targeted", "procedural"): "the paper's method vs the procedural corpus' objects added as they are",
+    ("targeted", "own"): "what the AE-Critic's geometry from train shapes beyond the base set adds (own: its AE-Critic "
+    "trained on the base set alone)",
 }
 NONE_CONTRASTS = (
     "warp",
     "primitives",
     "procedural",
+    "own",
 )  # pools whose own `<pool>_vs_none@B` is declared beside targeted's
 
 

@@ -53,7 +53,9 @@ class GQCNNParams:
         "network, by mixing the parents' signed distance fields), `warp` (each targeted pair's nearer parent under a "
         "random smooth deformation: scale, shear, taper, bend), `primitives` (random assemblies of 1 to "
         "generate.primitives.max_parts boxes, cylinders, spheres, capsules and rings), `procedural` (pybullet's "
-        "random_urdfs objects as they are, beside a corpus of your own: what procedural objects give for free); "
+        "random_urdfs objects as they are, beside a corpus of your own: what procedural objects give for free), "
+        "`own` (the targeted recipe decoded by an AutoEncoder-Critic trained on the base set alone, stage "
+        "train_ae_own: the augmentation without the other train shapes' geometry); "
         "`generate` makes the generated "
         "ones. `targeted` is always trained.",
     )

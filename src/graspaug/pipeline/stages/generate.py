@@ -1,15 +1,15 @@
 """Stage ``generate``: for one base set of B train shapes (``generate@50`` …), pools of new shapes.
 
-Targeted: the base set's rare, and separately graspable, shapes with their N-th … (N+K)-th latent
-neighbours, ``(1 - α) z_a + α z_b`` decoded by the AE-Critic and meshed (paper Section III-C);
-random: random pairs; recon: the real pool's shapes (the GQ-CNN experiment's order) from their own
-latents; blend: the targeted pairs with no network; warp: each targeted pair's nearer parent randomly deformed;
-primitives: random assemblies of primitives; procedural: pybullet's random_urdfs objects as they are (beside a
-corpus of your own). ``gqcnn.pools`` says which; each holds ``ceil(max ratio × B)`` kept shapes, the first
-``round(R × B)`` ratio R's set; a failed shape is replaced by the next candidate, except in the recon pool, whose
-shape k is the real pool's shape k (a failed decode is dropped, and said in the summary). Writes
-``data/generated/<B>/`` (``meshes/``, ``index``, ``rejects`` and ``base.parquet``), ``metrics/generate/<B>.json``,
-``reports/generate/<B>/`` (summary, pictures)."""
+Targeted: the base set's rare, and separately graspable, shapes with their N-th … (N+K)-th latent neighbours,
+``(1 - α) z_a + α z_b`` decoded by the AE-Critic and meshed (paper Section III-C); own: the same with the AE-Critic of
+``train_ae_own@B``, trained on the base set alone; random: random pairs; recon: the real pool's shapes (the GQ-CNN
+experiment's order) from their own latents; blend: the targeted pairs with no network; warp: each targeted pair's nearer
+parent randomly deformed; primitives: random assemblies of primitives; procedural: pybullet's random_urdfs objects as
+they are (beside a corpus of your own). ``gqcnn.pools`` says which; each holds ``ceil(max ratio × B)`` kept shapes, the
+first ``round(R × B)`` ratio R's set; a failed shape is replaced by the next candidate, except in the recon pool, whose
+shape k is the real pool's shape k (a failed decode is dropped, and said in the summary). Writes ``data/generated/<B>/``
+(``meshes/``, ``index``, ``rejects`` and ``base.parquet``), ``metrics/generate/<B>.json``, ``reports/generate/<B>/``
+(summary, pictures)."""
 
 from __future__ import annotations
 
@@ -19,7 +19,7 @@ from functools import partial
 
 import numpy as np
 
-from graspaug.augment.decode import PROCEDURAL_SEED, control_runners, mesh_batches, procedural_sources
+from graspaug.augment.decode import PROCEDURAL_SEED, control_runners, mesh_batches, own_source, procedural_sources
 from graspaug.augment.pool_tables import generate_headline
 from graspaug.augment.pools import GENERATED_POOLS, ReconSource, base_ids, base_set, generate_pools, tsne_groups
 from graspaug.device import resolve_device
@@ -38,6 +38,7 @@ from graspaug.pipeline.params.ingest import IngestParams
 from graspaug.pipeline.params.score import ScoreParams
 from graspaug.plots import generated_pairs, scatter_2d
 from graspaug.training.gqcnn_data import load_split
+from graspaug.training.settings import networks_at
 
 log = logging.getLogger(__name__)
 
@@ -53,29 +54,33 @@ Params = params_model(
 
 
 def run(params: Params, base_size: int) -> None:
-    start = time.perf_counter()
-    cfg = params.generate
+    start, cfg, gq = time.perf_counter(), params.generate, params.gqcnn
     shapes, latents, scores = (read_table(path) for path in (paths.SHAPES_TABLE, paths.LATENTS, paths.SCORES))
     voxels = read_voxels(paths.VOXELS)
     ids = base_ids(shapes, cfg.base_sizes, base_size, params.data_seed)
     base = base_set(ids, latents, scores, voxels, params.score.k)
 
     ae, _, _ = load_autoencoder(paths.AE_CRITIC_MODEL, params.ae.net)
-    meshes = partial(mesh_batches, ae, resolve_device(params.device), settings=cfg.decode, workers=params.workers)
-    gq = params.gqcnn
-    pools, recon = [p for p in GENERATED_POOLS if p in gq.pools], None
+    meshes = partial(mesh_batches, device=resolve_device(params.device), settings=cfg.decode, workers=params.workers)
+    wanted = networks_at(gq.networks, base_size)  # with gqcnn.networks: only the shapes a listed network trains on
+    pools, recon, own = [p for p in GENERATED_POOLS if p in gq.pools and (wanted is None or p in wanted)], None, None
+    if wanted and wanted.get("targeted"):
+        cfg = cfg.model_copy(update={"ratios": sorted({0.0, *wanted["targeted"]})})
     if "recon" in pools:  # the real pool as the GQ-CNN experiment draws it
         split = load_split(paths.gqcnn_dir("original"), shapes, list(cfg.base_sizes), gq.val_shapes, params.data_seed)
         real = base_set(np.array(split.real_pool), latents, scores, voxels, params.score.k)
-        recon = ReconSource(real, meshes(real, label=f"generate {base_size} recon"))
+        recon = ReconSource(real, meshes(ae, base=real, label=f"generate {base_size} recon"))
+    if "own" in pools:  # the base set under the AE-Critic that train_ae_own@B trained on it alone
+        own_ae, _, trained = load_autoencoder(paths.ae_own_model(base_size), params.ae.net)
+        own = own_source(own_ae, trained, read_table(paths.ae_own_latents(base_size)), base, params.score.k, meshes)
     solids = [read_mesh(mesh_path(paths.SHAPES_DIR, s)) for s in ids] if {"blend", "warp"} & set(pools) else []
     surface = params.ingest.surface  # the warp and primitives pools' shapes are sized as ingest sizes a shape
     key = [params.data_seed, PROCEDURAL_SEED, base_size]  # the procedural corpus less this one's sources, shuffled
     procedural = procedural_sources(list(shapes.source), key) if "procedural" in pools else []
     controls = control_runners(pools, solids, cfg, surface, params.data_seed, base_size, params.workers, procedural)
-    run_batch, procedural_ids = meshes(base, label=f"generate {base_size}"), [s.shape_id for s in procedural]
+    run_batch, procedural_ids = meshes(ae, base=base, label=f"generate {base_size}"), [s.shape_id for s in procedural]
     inputs = (base, cfg, params.data_seed, run_batch, params.score.k, pools, recon, controls, procedural_ids)
-    out = generate_pools(*inputs, control_ratios=gq.control_ratios)  # the pools but targeted at their own ratios
+    out = generate_pools(*inputs, control_ratios=gq.control_ratios, own=own)  # all but targeted at their own ratios
     for level, message in [(logging.INFO, n) for n in out.notes] + [(logging.WARNING, w) for w in out.warnings]:
         log.log(level, "generate %d: %s", base_size, message)
 
