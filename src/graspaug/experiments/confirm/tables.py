@@ -261,7 +261,8 @@ def combine_confirm(folder: Path) -> dict:
 
 def external_sets(plan: Mapping) -> dict[str, dict]:
     """The plan's external test sets (``test_sets``: name → ``corpus``, ``readout`` ``pooled`` or ``per_object``,
-    ``resamples``), read beside each draw's own held-out objects, each gated by its own control."""
+    ``resamples``, and its own ``words``), read beside each draw's own held-out objects, each gated by its own
+    control."""
     return {k: dict(v) for k, v in (plan.get("test_sets") or {}).items() if isinstance(v, Mapping) and v.get("corpus")}
 
 
@@ -294,7 +295,7 @@ def external_result(folder: Path, plan: Mapping, name: str) -> dict:
         boot = np.array([[cells[d, s, c["a"]][1] - cells[d, s, c["b"]][1] for s in seeds] for d in draws])
         return confirm.nested_draw_test(full, boot, 1 - float(plan["alpha"]))
 
-    out = read_plan_tests(plan, test_of)
+    out = read_plan_tests(plan, test_of, words=spec.get("words"))
     arms = {arm: float(np.mean([cells[d, s, arm][0] for d in draws for s in seeds])) for arm in plan["arms"]}
     held = test.groupby("object").label.any()
     counts = {"objects": int(len(held)), "objects_with_positive": int(held.sum()), "datapoints": int(len(test))}
@@ -321,12 +322,12 @@ def read_plan_result(plan: Mapping, values: Mapping[int, Mapping[str, float]]) -
     return result
 
 
-def read_plan_tests(plan: Mapping, test_of, diff=None) -> dict:
+def read_plan_tests(plan: Mapping, test_of, diff=None, words: Mapping | None = None) -> dict:
     """The plan's tests in its fixed sequence, each ``test_of(spec)`` (a spec names arms ``a`` and ``b``; a test
     gives ``mean``, ``low``, ``high``, ``p``, ``n_draws``): the control first (it "shows" when p < alpha and its mean
     is positive; if not, the verdict is "uninformative"), the primary, then the secondary family under Holm (an
     equivalence verdict where a secondary names a ``margin`` and ``diff(spec)``, the per-draw values, is given);
-    with the plan's sentence."""
+    with the plan's sentence (``words``: another test set's own, else the plan's ``words``)."""
     alpha = float(plan["alpha"])
     control = test_of(plan["control"])
     shows = control["p"] is not None and control["p"] < alpha and control["mean"] > 0
@@ -344,7 +345,7 @@ def read_plan_tests(plan: Mapping, test_of, diff=None) -> dict:
         else:
             held = adjusted[name] is not None and adjusted[name] < alpha
             c["verdict"] = ("higher" if c["mean"] > 0 else "lower") if held else "not shown"
-    words = plan["words"]
+    words = words or plan["words"]
     if not shows:
         verdict, sentence = confirm.UNINFORMATIVE, words["uninformative"]
     elif primary["p"] < alpha:

@@ -39,6 +39,7 @@ def confirm_figures(result: dict, study: str) -> dict[str, str]:
         out[f"{study}/{name}/control/verdict"] = "shows" if r["control"]["shows"] else "does not show"
         out[f"{study}/{name}/primary"] = test_text(r["primary"])
         out[f"{study}/{name}/primary/verdict"] = r["primary"]["verdict"]
+        out[f"{study}/{name}/sentence"] = r["sentence"]
         for key, c in r["secondary"].items():
             holm = f" (Holm p = {c['p_holm']:.3f})" if c.get("p_holm") is not None else ""
             out[f"{study}/{name}/{key}"] = test_text(c) + holm
