@@ -13,6 +13,7 @@ import numpy as np
 import pybullet
 import pybullet_data
 
+from graspaug.grasping.gripper import ParallelJawGripper
 from graspaug.render.camera import CameraPose, look_at
 from graspaug.render.pybullet_depth import render_depth
 from graspaug.sim.objects import SimObject
@@ -29,11 +30,16 @@ def camera_pose(layout: CellLayout) -> CameraPose:
 
 
 class PickScene:
-    """A fresh physics world with the cell of ``layout`` and a Panda with ``hand``."""
+    """A fresh physics world with the cell of ``layout`` and a Panda with ``hand``, its fingers ``gripper``'s."""
 
     near, far = 0.05, 3.0  # depth camera clipping planes (m)
 
-    def __init__(self, layout: CellLayout = CellLayout(), hand: HandSettings = HandSettings()) -> None:
+    def __init__(
+        self,
+        layout: CellLayout = CellLayout(),
+        hand: HandSettings = HandSettings(),
+        gripper: ParallelJawGripper = ParallelJawGripper(),
+    ) -> None:
         self.layout = layout
         self.client = pybullet.connect(pybullet.DIRECT)
         c = self.client
@@ -53,7 +59,7 @@ class PickScene:
             useFixedBase=True,
             physicsClientId=c,
         )
-        self.robot = Panda(c, layout.robot_base, hand, layout.time_step)
+        self.robot = Panda(c, layout.robot_base, hand, layout.time_step, gripper)
         self.object: int | None = None
 
     # --- the object --------------------------------------------------------------------------

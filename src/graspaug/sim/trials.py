@@ -18,12 +18,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from graspaug.grasping.gripper import ParallelJawGripper
 from graspaug.planning.grasps import ImageGrasps
 from graspaug.planning.planner import PlannedGrasp
 from graspaug.render.camera import CameraPose
 from graspaug.render.settings import Intrinsics
 from graspaug.sim.objects import SimObject
-from graspaug.sim.panda import FINGER_OPEN, HandSettings
+from graspaug.sim.panda import HandSettings
 from graspaug.sim.scene import CellLayout, PickScene, camera_pose
 from graspaug.sim.sensor import sense_depth
 from graspaug.sim.settings import DepthNoise, TrialSettings
@@ -97,15 +98,17 @@ def run_trial(
     record: bool = False,
     obstacles: tuple[Obstacle, ...] = (),
     placement: tuple[np.ndarray, np.ndarray] | None = None,
+    gripper: ParallelJawGripper = ParallelJawGripper(),
 ) -> TrialResult:
     """Drop ``obj`` at the pose drawn from ``drop_seed``, then pick it with ``planner``'s grasp
     on the ``sensor``'s depth image (or the ``scripted`` one: the object's resting position (3,) m
     and quaternion (x, y, z, w) → table-frame grasp center (3,) m and jaw angle rad) and carry
     it to the bin. ``obstacles`` are static boxes added once the object rests. With ``placement``
     (position (3,) m, quaternion (x, y, z, w) of the object's body) the object is put there and
-    left to settle instead of dropped (a stable pose on the table, as the rendered datasets have it)."""
+    left to settle instead of dropped (a stable pose on the table, as the rendered datasets have it). The hand's
+    fingers and palm are ``gripper``'s (``grasps.gripper``: the gripper the grasps are labelled for)."""
     rng = np.random.default_rng(drop_seed)
-    with PickScene(layout, hand) as scene:
+    with PickScene(layout, hand, gripper) as scene:
         if placement is None:
             xy = rng.uniform(-settings.drop_offset, settings.drop_offset, size=2)
             orientation = random_orientation(rng)
@@ -192,7 +195,7 @@ def run_trial(
         held = scene.object_touches_robot()
         if record:
             frames.append(("over the bin", scene.color_frame()))
-        robot.set_fingers(2 * FINGER_OPEN)
+        robot.set_fingers(robot.open_width)
         robot.step(int(settings.release_time / layout.time_step))
         if record:
             frames.append(("released", scene.color_frame()))

@@ -193,16 +193,27 @@ def _cached_policy(model: str | None, version, layout, sampler, cem, crop_size: 
 
 
 def run_object(
-    job: ObjectJob, layout, hand, sampler, cem, crop_size: int, out_size: int, trial_settings=None, sensor=None
+    job: ObjectJob,
+    layout,
+    hand,
+    sampler,
+    cem,
+    crop_size: int,
+    out_size: int,
+    trial_settings=None,
+    sensor=None,
+    gripper=None,
 ) -> list[dict]:
     """Every attempt of one object in one arm: a row per attempt (plus depth and frames for the
     first attempt when ``job.record``). The planner fills the sensor's missing pixels from the
-    nearest valid one."""
+    nearest valid one. ``gripper``: the hand's geometry (``grasps.gripper``; None: the default Franka hand)."""
+    from graspaug.grasping.gripper import ParallelJawGripper
     from graspaug.planning import check_depth
     from graspaug.sim.settings import DepthNoise
     from graspaug.sim.trials import TrialSettings, run_trial
 
     trial_settings, sensor = trial_settings or TrialSettings(), sensor or DepthNoise()
+    gripper = gripper or ParallelJawGripper()
     policy = _policy(job.model, layout, sampler, cem, crop_size, out_size)
     rows = []
     for attempt, (drop_seed, plan_seed) in enumerate(zip(job.drop_seeds, job.plan_seeds)):
@@ -227,6 +238,7 @@ def run_object(
             settings=trial_settings,
             sensor=sensor,
             record=record,
+            gripper=gripper,
         )
         g = result.image_grasp or {}
         center = result.grasp_center
@@ -274,11 +286,11 @@ def trials_plan(objects: Sequence, chosen: dict, attempts: int, n_seeds: int, sk
     )
 
 
-def run_trials(jobs: Sequence[ObjectJob], sim, crop, workers) -> list[dict]:
+def run_trials(jobs: Sequence[ObjectJob], sim, crop, workers, gripper=None) -> list[dict]:
     """Every attempt of every job (:func:`run_object` on ``workers``, a process count or
     :class:`graspaug.parallel.Workers`): the rows of the jobs in order, one per attempt. ``sim``: the
     ``sim`` params section (cell, hand, sampler, CEM, trial settings, sensor); ``crop``: the render
-    params' crop (``crop_size``, ``out_size`` px)."""
+    params' crop (``crop_size``, ``out_size`` px); ``gripper``: ``grasps.gripper``, the hand that picks."""
     from graspaug.parallel import parallel_map
 
     work = functools.partial(
@@ -291,6 +303,7 @@ def run_trials(jobs: Sequence[ObjectJob], sim, crop, workers) -> list[dict]:
         out_size=crop.out_size,
         trial_settings=sim.trial,
         sensor=sim.sensor,
+        gripper=gripper,
     )
     return [row for rows in parallel_map(work, jobs, workers, "sim") for row in rows]
 

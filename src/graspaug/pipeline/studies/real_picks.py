@@ -194,7 +194,7 @@ def run(
         objects = prepare_objects((), (), Path("."), *physics, meshes, None, params.workers)
         jobs, arms = jobs_for_draw(d, folder, objects, attempts, params.seed, pictures), [*draw_arms(folder)]
         log.info("real-picks draw %d: %d objects × %d attempts, arms %s", d, len(objects), attempts, arms)
-        picked = run_trials(jobs, sim, params.render.crop, params.workers)
+        picked = run_trials(jobs, sim, params.render.crop, params.workers, params.grasps.gripper)
         for row in picked:
             row["draw"] = d
         rows += picked
