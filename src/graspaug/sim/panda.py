@@ -140,6 +140,10 @@ class Panda:
                 physicsClientId=client,
             )
         self.finger_target = self.open_width / 2
+        #: the robot's contacts at the hardest-pressing step watched so far (:meth:`move_line` with ``max_force``):
+        #: (robot link name, other body id, normal force N) per pair, and their total (N)
+        self.hardest: list[tuple[str, int, float]] = []
+        self.hardest_force = 0.0
         self.reset(REST_POSE)
 
     # --- state -------------------------------------------------------------------------------
@@ -224,6 +228,20 @@ class Panda:
             )
         )
 
+    def contacts(self) -> list[tuple[str, int, float]]:
+        """The robot's contacts with other bodies now: (robot link name, other body id, normal force N) per pair
+        of link and body, the forces of their contact points summed."""
+        pairs: dict[tuple[int, int], float] = {}
+        for c in pybullet.getContactPoints(bodyA=self.body, physicsClientId=self.client):
+            if c[2] != self.body:
+                pairs[(c[3], c[2])] = pairs.get((c[3], c[2]), 0.0) + c[9]
+        return [(self.link_name(link), other, force) for (link, other), force in pairs.items()]
+
+    def link_name(self, link: int) -> str:
+        if link < 0:
+            return "panda_link0"
+        return pybullet.getJointInfo(self.body, link, physicsClientId=self.client)[12].decode()
+
     def move_line(
         self, target, jaw_angle: float, speed: float | None = None, settle: float = 0.1, max_force: float | None = None
     ) -> float:
@@ -231,7 +249,7 @@ class Panda:
         pointing down at ``jaw_angle``, then hold the last target for ``settle`` s. With
         ``max_force`` (N) the robot's contacts with other bodies are watched and the motion stops
         at the first step where they press harder; returns the largest contact force seen (N),
-        0 when not watched."""
+        0 when not watched. The watched contacts of the hardest-pressing step so far are kept in :attr:`hardest`."""
         start, _ = self.grasp_pose()
         target = np.asarray(target, dtype=float)
         orientation = self.top_down(jaw_angle)
@@ -244,7 +262,10 @@ class Panda:
             self._command(arm)
             pybullet.stepSimulation(physicsClientId=self.client)
             if max_force is not None:
-                largest = max(largest, self.contact_force())
+                force = self.contact_force()
+                largest = max(largest, force)
+                if force > self.hardest_force:
+                    self.hardest, self.hardest_force = self.contacts(), force
             return max_force is None or largest <= max_force
 
         for i in range(1, steps + 1):

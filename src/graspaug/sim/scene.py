@@ -64,7 +64,8 @@ class PickScene:
 
     # --- the object --------------------------------------------------------------------------
     def add_object(self, obj: SimObject, position, orientation) -> int:
-        """Put ``obj`` at ``position`` (3,) m with quaternion ``orientation`` (x, y, z, w)."""
+        """Put ``obj`` at ``position`` (3,) m with quaternion ``orientation`` (x, y, z, w). Its hulls collide
+        where they lie: no collision margin (Bullet's default adds 1 mm around every convex mesh)."""
         c = self.client
         collision = pybullet.createCollisionShape(pybullet.GEOM_MESH, fileName=str(obj.collision), physicsClientId=c)
         visual = pybullet.createVisualShape(
@@ -84,6 +85,7 @@ class PickScene:
             lateralFriction=obj.lateral_friction,
             spinningFriction=obj.spinning_friction,
             rollingFriction=obj.rolling_friction,
+            collisionMargin=0.0,
             physicsClientId=c,
         )
         return self.object
@@ -151,6 +153,11 @@ class PickScene:
             np.all(np.abs(offset) < self.layout.bin_half_extent)
             and position[2] < self.layout.bin_position[2] + self.layout.bin_height
         )
+
+    def body_name(self, body: int) -> str:
+        """What ``body`` is in the cell: ``object``, ``table``, ``bin``, ``robot`` or ``obstacle``."""
+        names = {self.object: "object", self.table: "table", self.bin: "bin", self.robot.body: "robot"}
+        return names.get(body, "obstacle")
 
     def object_touches_robot(self) -> bool:
         return len(pybullet.getContactPoints(self.object, self.robot.body, physicsClientId=self.client)) > 0

@@ -49,9 +49,23 @@ class TrialResult:
     planning_time: float | None = None  # s
     candidates: int = 0
     contact_force: float = 0.0  # largest contact force (N) of the robot before the fingers closed
+    #: the robot's contacts at that hardest-pressing step: (robot link, what it touched, normal force N) per pair
+    contacts: list[tuple[str, str, float]] = field(default_factory=list)
+    shake_grip: float | None = None  # the grip (N a finger) friction needs to hold the object through the shake
     hand_error: tuple[float, float, float] = (0.0, 0.0, 0.0)  # where the hand went off the grasp: x, y (m), angle (rad)
     depth: np.ndarray | None = None
     frames: list[tuple[str, np.ndarray]] = field(default_factory=list)
+
+
+def shake_grip(mass: float, friction: float, settings: TrialSettings, layout: CellLayout) -> float:
+    """The grip (N a finger) that holds an object of ``mass`` kg by pad ``friction`` alone through the shake of
+    ``settings`` (its weight plus the peak load, both pads pulling): m g (1 + a) / (2 μ)."""
+    return float(mass * layout.gravity * (1 + settings.shake_acceleration) / (2 * friction))
+
+
+def contacts_text(contacts) -> str:
+    """A trial's hardest contacts in a line: ``panda_leftfinger–object 12.3 N; ...`` (empty: none)."""
+    return "; ".join(f"{link}–{other} {force:.1f} N" for link, other, force in contacts)
 
 
 def random_orientation(rng: np.random.Generator) -> np.ndarray:
@@ -169,6 +183,7 @@ def run_trial(
             frames.append(("pre-grasp", scene.color_frame()))
         if result.contact_force <= limit:
             result.contact_force = max(result.contact_force, robot.move_line(center, jaw_angle, max_force=limit))
+        result.contacts = [(link, scene.body_name(b), round(f, 3)) for link, b, f in robot.hardest]
         if result.contact_force > limit:
             result.outcome = "collision"
             if record:
@@ -185,6 +200,7 @@ def run_trial(
             result.outcome = "not_lifted"
             return result
         if settings.shake_acceleration > 0:
+            result.shake_grip = shake_grip(obj.mass, obj.lateral_friction * hand.finger_friction, settings, layout)
             scene.shake(settings.shake_acceleration * layout.gravity, settings.shake_pulse)
             if record:
                 frames.append(("shaken", scene.color_frame()))

@@ -102,7 +102,7 @@ def run_shape(job: ShapeGrasps, layout, hand, trial_settings, gripper=None) -> l
     (N, the robot's largest contact before the fingers closed). ``gripper``: the hand's geometry (``grasps.gripper``;
     None: the default Franka hand)."""
     from graspaug.grasping.gripper import ParallelJawGripper
-    from graspaug.sim.trials import run_trial
+    from graspaug.sim.trials import contacts_text, run_trial
 
     gripper = gripper or ParallelJawGripper()
 
@@ -141,6 +141,7 @@ def run_shape(job: ShapeGrasps, layout, hand, trial_settings, gripper=None) -> l
                 "axis_tilt": seen["tilt"],
                 "grasp_height": float(seen["height"]),
                 "contact_force": round(result.contact_force, 3),
+                "contacts": contacts_text(result.contacts),
             }
         )
     return rows

@@ -210,7 +210,7 @@ def run_object(
     from graspaug.grasping.gripper import ParallelJawGripper
     from graspaug.planning import check_depth
     from graspaug.sim.settings import DepthNoise
-    from graspaug.sim.trials import TrialSettings, run_trial
+    from graspaug.sim.trials import TrialSettings, contacts_text, run_trial
 
     trial_settings, sensor = trial_settings or TrialSettings(), sensor or DepthNoise()
     gripper = gripper or ParallelJawGripper()
@@ -264,6 +264,9 @@ def run_object(
                 "grasp_z": None if center is None else center[2],
                 "jaw_angle": result.jaw_angle,
                 "contact_force": round(result.contact_force, 3),
+                "contacts": contacts_text(result.contacts),
+                "shake_grip": result.shake_grip,
+                "mass": job.sim_object.mass,
                 "planning_time": result.planning_time,
                 "_depth": result.depth,
                 "_frames": result.frames,
