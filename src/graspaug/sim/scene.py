@@ -118,13 +118,17 @@ class PickScene:
         low, high = pybullet.getAABB(self.object, physicsClientId=self.client)
         return np.array(low), np.array(high)
 
-    def settle(self, max_time: float = 2.0, speed: float = 0.005) -> float:
-        """Step until the object moves slower than ``speed`` or ``max_time`` s pass; the time taken."""
+    def settle(self, max_time: float = 2.0, speed: float = 0.005, hold: float = 0.3) -> float:
+        """Step until the object has moved slower than ``speed`` for ``hold`` s (checked every 12 steps: a rocking
+        object passes through rest at each turn and rolls on) or ``max_time`` s pass; the time taken."""
         steps = int(round(max_time / self.layout.time_step))
+        slow, needed = 0, max(1, int(round(hold / (12 * self.layout.time_step))))
         for i in range(steps):
             self.robot.step(1)
-            if i % 12 == 11 and self.object_speed() < speed:
-                return (i + 1) * self.layout.time_step
+            if i % 12 == 11:
+                slow = slow + 1 if self.object_speed() < speed else 0
+                if slow >= needed:
+                    return (i + 1) * self.layout.time_step
         return max_time
 
     def shake(self, acceleration: float, pulse_time: float) -> None:

@@ -79,7 +79,7 @@ def random_orientation(rng: np.random.Generator) -> np.ndarray:
 GraspSource = Callable[[np.ndarray, CameraPose, Intrinsics], "PlannedGrasp | None"]
 
 
-ScriptedGrasp = Callable[[np.ndarray, np.ndarray], "tuple[np.ndarray, float]"]
+ScriptedGrasp = Callable[[np.ndarray, np.ndarray], "tuple[np.ndarray, float] | None"]
 
 
 def grasp_in_table_frame(
@@ -116,7 +116,7 @@ def run_trial(
 ) -> TrialResult:
     """Drop ``obj`` at the pose drawn from ``drop_seed``, then pick it with ``planner``'s grasp
     on the ``sensor``'s depth image (or the ``scripted`` one: the object's resting position (3,) m
-    and quaternion (x, y, z, w) → table-frame grasp center (3,) m and jaw angle rad) and carry
+    and quaternion (x, y, z, w) → table-frame grasp center (3,) m and jaw angle rad, or None: no grasp) and carry
     it to the bin. ``obstacles`` are static boxes added once the object rests. With ``placement``
     (position (3,) m, quaternion (x, y, z, w) of the object's body) the object is put there and
     left to settle instead of dropped (a stable pose on the table, as the rendered datasets have it). The hand's
@@ -164,8 +164,10 @@ def run_trial(
                 planned.candidates,
             )
         else:
-            center, jaw_angle = scripted(*scene.object_pose())
-            center, jaw_angle = np.asarray(center, dtype=float), float(jaw_angle)
+            grasp = scripted(*scene.object_pose())
+            if grasp is None:  # a scripted source may find no grasp (the oracle where nothing is reachable)
+                return result
+            center, jaw_angle = np.asarray(grasp[0], dtype=float), float(grasp[1])
         result.grasp_center, result.jaw_angle = tuple(float(x) for x in center), jaw_angle
         if settings.position_error > 0 or settings.angle_error > 0:  # where the hand really goes
             error = np.random.default_rng([drop_seed, 2]).normal(size=3)
