@@ -17,6 +17,7 @@ from graspaug.experiments.cell.picks import (
     pick_ranking,
     pick_summary,
 )
+from graspaug.experiments.cell.trials import ORACLE
 from graspaug.pipeline.cli import app
 
 KEPT = "results/attribution-real-objects-4000/networks"
@@ -95,11 +96,15 @@ def test_the_kept_networks_pick_a_few_real_objects(repo_root, tmp_path, monkeypa
     done = CliRunner().invoke(app, [*pick, "--workers", "2", "--out", str(out), "--results", "picks"])
     assert done.exit_code == 0, done.output
     table = pd.read_parquet(tmp_path / "results" / "picks" / "attempts.parquet")
-    assert len(table) == 2 * 2 * 4 and set(table.draw) == {0}
-    scores = table[["score_none@50", "score_targeted@50", "score_none@100"]]  # every network, every executed grasp
-    planned = table.outcome != "no_grasp"
+    assert len(table) == 2 * 2 * 5 and set(table.draw) == {0} and set(table.arm) >= {ORACLE, ANTIPODAL}
+    feasible = table.groupby("object").feasible.first()  # declared from geometry, the same in every arm
+    assert feasible["AllergenFree_JarroDophilus"] and (table.groupby("object").feasible.nunique() == 1).all()
+    assert table.contacts.notna().all() and (table.mass < 0.2).any() == (table.mass.min() < 0.2)
+    table_by_images = table[table.arm != ORACLE]  # the oracle plans on the mesh: no image for a network to score
+    scores = table_by_images[["score_none@50", "score_targeted@50", "score_none@100"]]  # every network, every grasp
+    planned = table_by_images.outcome != "no_grasp"
     assert scores[planned].notna().all().all() and scores[~planned].isna().all().all()
-    own = table[(table.arm == "none@50") & planned]
+    own = table_by_images[(table_by_images.arm == "none@50") & planned]
     assert np.allclose(own["score_none@50"], own.quality, atol=1e-5)  # a network's own grasp: the quality it planned
     again = CliRunner().invoke(app, [*pick, "--out", str(tmp_path / "again"), "--results", "picks"])
     assert again.exit_code == 0 and "in the results table already" in again.output, again.output
@@ -107,10 +112,12 @@ def test_the_kept_networks_pick_a_few_real_objects(repo_root, tmp_path, monkeypa
     other = CliRunner().invoke(app, [*pick[:-1], "3", "--out", str(tmp_path / "other"), "--results", "picks"])
     assert other.exit_code == 2 and "its draws have 2 attempts" in other.output, other.output
     summary = json.loads((out / "summary.json").read_text())
-    assert set(summary["arms"]) == {"none@50", "targeted@50", "none@100", ANTIPODAL}
+    assert set(summary["arms"]) == {"none@50", "targeted@50", "none@100", ANTIPODAL, ORACLE}
+    assert summary["feasible"]["all_object_draws"] == 2 and summary["feasible"]["object_draws"] >= 1
     assert summary["attempts_per_arm"] == {arm: 4 for arm in summary["arms"]} and summary["objects"] == 2
     assert summary["contrasts"]["control"]["a"] == "none@100"  # the exploratory study kept B = 50 and 100
     report = (out / "report.md").read_text()
+    assert report.splitlines()[2].startswith("Feasible objects first:") and "the oracle picks" in report
     assert "| paper (8 everyday objects, no interval) | 8 | 10 | 68% | 86% |" in report and "none@100" in report
 
 

@@ -23,7 +23,7 @@ import pandas as pd
 
 from graspaug.errors import DataError
 from graspaug.experiments.cell.picks import ANTIPODAL, hardest_objects, never_held, paper_table, pick_summary
-from graspaug.experiments.cell.trials import ObjectJob, run_trials
+from graspaug.experiments.cell.trials import ORACLE, ObjectJob, run_trials
 from graspaug.rng import shape_rng
 
 log = logging.getLogger(__name__)
@@ -126,25 +126,28 @@ RECORDED = 12  # objects whose first attempt is recorded in every arm (the pictu
 
 
 def jobs_for_draw(draw: int, folder: Path, objects, attempts: int, seed: int, pictures: bool) -> list[ObjectJob]:
-    """An :class:`ObjectJob` per object and arm; an object's drops and planner seeds are drawn from ``seed`` and
-    its name, the same in every arm (and every draw: the same object is dropped alike). Every network of the draw
-    scores each executed grasp (``score_<arm>``), for their ranking of the cell's outcomes."""
+    """An :class:`ObjectJob` per object and arm (the draw's networks, the ``antipodal`` floor and the ``oracle``
+    ceiling); an object's drops and planner seeds are drawn from ``seed`` and its name, the same in every arm (and
+    every draw: the same object is dropped alike). Every network of the draw scores each executed grasp of the
+    image-planning arms (``score_<arm>``), for their ranking of the cell's outcomes."""
     jobs = []
     for index, obj in enumerate(objects):
         record = pictures and index < RECORDED  # frames of the first attempt: a success and a failure to draw
         drops = tuple(int(shape_rng(seed, obj.name, f"sim-drop-{a}").integers(2**31 - 1)) for a in range(attempts))
         plans = tuple(int(shape_rng(seed, obj.name, f"sim-plan-{a}").integers(2**31 - 1)) for a in range(attempts))
         scorers = tuple((arm, str(folder / name / "model.pt")) for arm, name in draw_arms(folder).items())
-        for arm, name in (draw_arms(folder) | {ANTIPODAL: None}).items():
+        for arm, name in (draw_arms(folder) | {ANTIPODAL: None, ORACLE: None}).items():
             model = None if name is None else str(folder / name / "model.pt")
-            job = ObjectJob(arm, 0, model, obj.name, obj.kind, obj.body, drops, plans, record, scorers)
+            scored = () if arm == ORACLE else scorers
+            job = ObjectJob(arm, 0, model, obj.name, obj.kind, obj.body, drops, plans, record, scored)
             jobs.append(job)
     return jobs
 
 
 ATTEMPT_COLUMNS = (
     "draw", "seed", "arm", "object", "attempt", "drop_seed", "success", "outcome", "quality",
-    "grasp_x", "grasp_y", "grasp_z", "jaw_angle",
+    "grasp_x", "grasp_y", "grasp_z", "jaw_angle", "feasible", "feasible_share", "mass", "contact_force", "contacts",
+    "oracle_eps", "oracle_tilt",
 )  # fmt: skip
 
 
@@ -166,6 +169,7 @@ def run(
     ``out``: the folder the pictures go to (a staging folder). ``done``: attempts of earlier runs (a results
     folder's table); its draws are not picked again and its rows join the summary. ``on_draw(table, seconds)`` is
     called after each draw with every attempt so far, so a long study keeps each draw as it finishes."""
+    from graspaug.sim.feasibility import feasibility
     from graspaug.sim.objects import folder_meshes, prepare_objects
 
     folders = draw_folders(networks, draws)
@@ -191,12 +195,14 @@ def run(
             raise DataError(f"draw {d}: no object could be loaded ({why})")
         skipped |= {f"d{d}/{k}": v for k, v in missed.items()}
         physics = (sim.physics, params.seed, sim.vhacd_resolution)
+        rule = {name: feasibility(mesh, params.grasps.gripper.max_width) for name, mesh in meshes}  # before any pick
         objects = prepare_objects((), (), Path("."), *physics, meshes, None, params.workers)
         jobs, arms = jobs_for_draw(d, folder, objects, attempts, params.seed, pictures), [*draw_arms(folder)]
         log.info("real-picks draw %d: %d objects × %d attempts, arms %s", d, len(objects), attempts, arms)
-        picked = run_trials(jobs, sim, params.render.crop, params.workers, params.grasps.gripper)
+        picked = run_trials(jobs, sim, params.render.crop, params.workers, params.grasps.gripper, params.grasps)
         for row in picked:
             row["draw"] = d
+            row["feasible"], row["feasible_share"] = rule[row["object"]]["feasible"], rule[row["object"]]["share"]
         rows += picked
         seconds[d] = round(time.perf_counter() - began)
         log.info("real-picks draw %d: %d attempts in %d s", d, len(picked), seconds[d])
@@ -204,11 +210,41 @@ def run(
             on_draw(attempts_table(rows, done), seconds)
     table = attempts_table(rows, done)  # never empty: a draw is picked now or was kept before
     summary = pick_summary(table, list(dict.fromkeys(table.arm)), sim.n_bootstrap, params.seed)
+    summary["feasible"] = feasible_summary(table, sim.n_bootstrap, params.seed)
     summary |= {"never_held": never_held(table), "skipped": skipped, "seconds": seconds, "attempts": attempts}
     summary["kept_before"] = sorted(earlier & set(folders))
     if pictures:
         draw_pictures(rows, out)
     return table, summary, report_markdown(table, summary)
+
+
+#: The oracle's pick rate on feasible attempts below which the cell is not fit to compare planners (issue #83).
+ORACLE_FIT = 0.90
+
+
+def feasible_summary(table: pd.DataFrame, n_resamples: int, seed: int) -> dict:
+    """The picks on feasible objects (the ``feasible`` column, declared from geometry before any pick): counts of
+    feasible and all object-draws, :func:`pick_summary` of the feasible attempts, the oracle's rate there and
+    whether the cell is fit to compare planners (``oracle_fit``: the oracle picks at least :data:`ORACLE_FIT`),
+    and each arm's share of the oracle − antipodal span. ``{}`` where the table has no feasible attempt."""
+    if "feasible" not in table or not table.feasible.fillna(False).astype(bool).any():
+        return {}
+    feasible = table[table.feasible.fillna(False).astype(bool)]
+    pairs = table[["draw", "object"]].drop_duplicates()
+    out = {
+        "object_draws": int(len(feasible[["draw", "object"]].drop_duplicates())),
+        "all_object_draws": int(len(pairs)),
+        "attempts": int(len(feasible)),
+    }
+    out["summary"] = pick_summary(feasible, list(dict.fromkeys(feasible.arm)), n_resamples, seed)
+    arms = out["summary"]["arms"]
+    if ORACLE in arms:
+        oracle = arms[ORACLE]["mean"]
+        out["oracle_rate"], out["oracle_fit"] = oracle, bool(oracle >= ORACLE_FIT)
+        if ANTIPODAL in arms and oracle > arms[ANTIPODAL]["mean"]:
+            floor = arms[ANTIPODAL]["mean"]
+            out["span_share"] = {a: (c["mean"] - floor) / (oracle - floor) for a, c in arms.items()}
+    return out
 
 
 def attempts_table(rows: list[dict], done: pd.DataFrame | None = None) -> pd.DataFrame:
@@ -238,7 +274,7 @@ def draw_pictures(rows: list[dict], out: Path) -> None:
     """One success and one failure of each network arm (the first recorded of each), drawn as the cell's pictures."""
     from graspaug.experiments.cell.figures import pick_story, trial_picture
 
-    for arm in dict.fromkeys(r["arm"] for r in rows if r["arm"] != ANTIPODAL):
+    for arm in dict.fromkeys(r["arm"] for r in rows if r["arm"] not in (ANTIPODAL, ORACLE)):  # the networks
         for success in (True, False):
             row = next((r for r in rows if r["arm"] == arm and r["success"] == success and r.get("_frames")), None)
             if row is not None:
@@ -259,6 +295,7 @@ def report_markdown(table: pd.DataFrame, summary: dict) -> str:
     lines = [
         "# Picks of real objects by arm",
         "",
+        *feasible_lines(summary.get("feasible") or {}, text),
         f"{summary['objects']} objects (object × draw), {summary['attempts']} attempts each and arm, draws "
         f"{summary['draws']}; an object's attempts are one unit (its share of successes)."
         + (
@@ -287,6 +324,36 @@ def report_markdown(table: pd.DataFrame, summary: dict) -> str:
         hardest_objects(table).round(2).to_markdown(),
     ]
     return "\n".join(lines) + "\n"
+
+
+def feasible_lines(feasible: dict, text) -> list[str]:
+    """The report's first lines: success on the feasible objects (declared from geometry), the oracle's verdict on
+    the cell and each arm's share of the oracle − antipodal span."""
+    if not feasible:
+        return ["No feasible object (or no `feasible` column): every figure below is on all objects.", ""]
+    rate = feasible.get("oracle_rate")
+    verdict = (
+        "no oracle arm: whether the cell can tell planners apart is unknown"
+        if rate is None
+        else f"the oracle picks {rate:.0%} of feasible attempts: "
+        + ("the cell is fit to compare planners" if feasible["oracle_fit"] else
+           f"below {ORACLE_FIT:.0%}, the cell is NOT fit to compare planners (its physics caps success)")
+    )  # fmt: skip
+    span = feasible.get("span_share", {})
+    return [
+        f"Feasible objects first: {feasible['object_draws']} of {feasible['all_object_draws']} object-draws "
+        f"({feasible['attempts']} attempts); {verdict}.",
+        "",
+        "| arm (feasible objects) | success rate [95%] | share of oracle − antipodal |",
+        "|---|---|---|",
+        *(
+            f"| {a} | {text(c, '')} | {span[a]:.2f} |" if a in span else f"| {a} | {text(c, '')} | |"
+            for a, c in feasible["summary"]["arms"].items()
+        ),
+        "",
+        "All objects:",
+        "",
+    ]
 
 
 def ranking_lines(ranking: dict, text) -> list[str]:
