@@ -135,3 +135,24 @@ def test_bad_input_is_one_line(repo_root, tmp_path, monkeypatch):
                     "--params", str(params), "--out", str(tmp_path / "o3"))  # fmt: skip
     assert camera.exit_code == 2 and "trained for a camera 0.65-0.75 m" in camera.output, camera.output
     assert not (tmp_path / "o1").exists() and not (tmp_path / "o3").exists()  # nothing half-written
+
+
+def test_the_papers_protocol_picks_feasible_objects_each_from_one_pose(repo_root, tmp_path, monkeypatch):
+    corpus = repo_root.parent / "shared" / "corpora" / "gso100"
+    if not corpus.is_dir():
+        pytest.skip(f"{corpus} absent beside this clone")
+    objects = tmp_path / "objects"
+    objects.mkdir()
+    for name in SMALL:  # a bottle (feasible) and a doll's table (not: 8% of its landings fit the jaw)
+        shutil.copy(corpus / name, objects / name)
+    shutil.copytree(repo_root / "profiles", tmp_path / "profiles")
+    monkeypatch.chdir(tmp_path)
+    out = tmp_path / "out"
+    pick = ["study", "real-picks", "--networks", str(repo_root / KEPT), "--draws", "0", "--objects", str(objects)]
+    done = CliRunner().invoke(app, [*pick, "--attempts", "2", "--paper", "3", "--out", str(out), "--results", "p"])
+    assert done.exit_code == 0, done.output
+    table = pd.read_parquet(tmp_path / "results" / "p" / "attempts.parquet")
+    assert set(table.object) == {"AllergenFree_JarroDophilus"} and table.feasible.all()  # chosen by the rule
+    oracle = table[table.arm == ORACLE]
+    assert len(oracle) == 2 and oracle.grasp_x.nunique() == 1  # one pose: the oracle's grasp is the same each time
+    assert json.loads((out / "summary.json").read_text())["protocol"].startswith("paper: 3 feasible objects")

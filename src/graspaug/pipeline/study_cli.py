@@ -235,6 +235,9 @@ def real_picks_command(
     out: Path = typer.Option(Path("reports/study/real_picks"), "--out", help="Folder for the report and pictures."),
     force: bool = ForceOption,
     results: str = typer.Option(None, "--results", help="Also keep the attempts in results/<NAME>/ (real-picks)."),
+    paper: int = typer.Option(
+        None, "--paper", min=1, help="The paper's protocol: K feasible objects a draw, each in one fixed pose."
+    ),
 ) -> None:
     import json
 
@@ -262,7 +265,9 @@ def real_picks_command(
         real_picks.write_results(kept, table, meta | {"attempts": attempts, "seconds": every, "runs": runs})
 
     with output_folder(out, "study real-picks", [networks, corpora, objects], force) as tmp:
-        table, summary, text = real_picks.run(*args, tmp, pictures=True, done=done, on_draw=keep if kept else None)
+        table, summary, text = real_picks.run(
+            *args, tmp, pictures=True, done=done, on_draw=keep if kept else None, paper_k=paper
+        )
         (tmp / "report.md").write_text(text)
         (tmp / "summary.json").write_text(json.dumps(summary, indent=1, default=str))
     typer.echo(text)

@@ -100,6 +100,26 @@ def grasp_in_table_frame(
     return centers, np.arctan2(direction[:, 1], direction[:, 0])
 
 
+def resting_pose(
+    obj: SimObject,
+    drop_seed: int,
+    layout: CellLayout = CellLayout(),
+    settings: TrialSettings = TrialSettings(),
+    gripper: ParallelJawGripper = ParallelJawGripper(),
+) -> tuple[np.ndarray, np.ndarray]:
+    """Where ``obj`` comes to rest when dropped as :func:`run_trial` drops it with ``drop_seed``: its body's
+    position (3,) m and quaternion (x, y, z, w), a ``placement`` for attempts that all start from one pose."""
+    rng = np.random.default_rng(drop_seed)
+    with PickScene(layout, HandSettings(), gripper) as scene:
+        xy = rng.uniform(-settings.drop_offset, settings.drop_offset, size=2)
+        orientation = random_orientation(rng)
+        scene.add_object(obj, [xy[0], xy[1], 1.0], orientation)
+        low, _ = scene.object_bounds()
+        scene.move_object([xy[0], xy[1], 1.0 - low[2] + settings.drop_clearance], orientation)
+        scene.settle(settings.settle_time)
+        return scene.object_pose()
+
+
 def run_trial(
     obj: SimObject,
     drop_seed: int,

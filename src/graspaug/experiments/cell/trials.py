@@ -39,6 +39,9 @@ class ObjectJob:
     #: (arm, model.pt) of networks that also score each executed grasp (its success probability in ``score_<arm>``):
     #: every network rates the same grasps, so their ranking of the cell's outcomes can be compared
     scorers: tuple[tuple[str, str], ...] = ()
+    #: the paper's protocol: every attempt starts from this resting pose (position (3,) m, quaternion (x, y, z, w)),
+    #: the drop seeds drawing only the sensor's noise; None: each attempt is a fresh drop
+    placement: tuple | None = None
 
 
 def model_path(seed_dir: Path, base_size: int, ratio: float, pool: str = "targeted") -> Path:
@@ -260,6 +263,7 @@ def run_object(
             sensor=sensor,
             record=record,
             gripper=gripper,
+            placement=job.placement,
         )
         g = result.image_grasp or {}
         center = result.grasp_center

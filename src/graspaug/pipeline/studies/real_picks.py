@@ -125,11 +125,36 @@ def corpus_meshes(corpora: Path, ids: list[str], surface, limit: int | None) -> 
 RECORDED = 12  # objects whose first attempt is recorded in every arm (the pictures are drawn from them)
 
 
-def jobs_for_draw(draw: int, folder: Path, objects, attempts: int, seed: int, pictures: bool) -> list[ObjectJob]:
+def paper_objects(objects, rule: dict[str, dict], k: int, seed: int) -> list:
+    """The paper's protocol's objects: ``k`` of ``objects`` that the feasibility ``rule`` (name → its
+    :func:`~graspaug.sim.feasibility.feasibility`) declares feasible, a seeded choice (by the rule, never by an
+    outcome); all of them where fewer are feasible."""
+    feasible = sorted((o for o in objects if rule[o.name]["feasible"]), key=lambda o: o.name)
+    order = np.random.default_rng([seed, 83]).permutation(len(feasible))[:k]
+    return [feasible[i] for i in sorted(order)]
+
+
+def fixed_poses(objects, seed: int, layout, settings, gripper) -> dict[str, tuple]:
+    """Each object's one resting pose of the paper's protocol: where its first drop (seed from ``seed`` and its
+    name) comes to rest in the cell (:func:`graspaug.sim.trials.resting_pose`)."""
+    from graspaug.sim.trials import resting_pose
+
+    poses = {}
+    for obj in objects:
+        drop = int(shape_rng(seed, obj.name, "sim-fixed-pose").integers(2**31 - 1))
+        position, quaternion = resting_pose(obj.body, drop, layout, settings, gripper)
+        poses[obj.name] = (tuple(float(x) for x in position), tuple(float(x) for x in quaternion))
+    return poses
+
+
+def jobs_for_draw(
+    draw: int, folder: Path, objects, attempts: int, seed: int, pictures: bool, poses: dict | None = None
+) -> list[ObjectJob]:
     """An :class:`ObjectJob` per object and arm (the draw's networks, the ``antipodal`` floor and the ``oracle``
     ceiling); an object's drops and planner seeds are drawn from ``seed`` and its name, the same in every arm (and
     every draw: the same object is dropped alike). Every network of the draw scores each executed grasp of the
-    image-planning arms (``score_<arm>``), for their ranking of the cell's outcomes."""
+    image-planning arms (``score_<arm>``), for their ranking of the cell's outcomes. ``poses`` (object name →
+    resting pose): the paper's protocol, every attempt from that pose (the drop seeds draw the sensor noise)."""
     jobs = []
     for index, obj in enumerate(objects):
         record = pictures and index < RECORDED  # frames of the first attempt: a success and a failure to draw
@@ -139,7 +164,8 @@ def jobs_for_draw(draw: int, folder: Path, objects, attempts: int, seed: int, pi
         for arm, name in (draw_arms(folder) | {ANTIPODAL: None, ORACLE: None}).items():
             model = None if name is None else str(folder / name / "model.pt")
             scored = () if arm == ORACLE else scorers
-            job = ObjectJob(arm, 0, model, obj.name, obj.kind, obj.body, drops, plans, record, scored)
+            placement = None if poses is None else poses[obj.name]
+            job = ObjectJob(arm, 0, model, obj.name, obj.kind, obj.body, drops, plans, record, scored, placement)
             jobs.append(job)
     return jobs
 
@@ -164,11 +190,14 @@ def run(
     pictures: bool,
     done: pd.DataFrame | None = None,
     on_draw=None,
+    paper_k: int | None = None,
 ) -> tuple[pd.DataFrame, dict, str]:
     """Pick every object of every draw in every arm; (the attempts table, the summary, the report's markdown).
     ``out``: the folder the pictures go to (a staging folder). ``done``: attempts of earlier runs (a results
     folder's table); its draws are not picked again and its rows join the summary. ``on_draw(table, seconds)`` is
-    called after each draw with every attempt so far, so a long study keeps each draw as it finishes."""
+    called after each draw with every attempt so far, so a long study keeps each draw as it finishes. ``paper_k``:
+    the paper's protocol instead of fresh drops: ``paper_k`` feasible objects a draw (:func:`paper_objects`), each
+    in one fixed resting pose for all its attempts (:func:`fixed_poses`)."""
     from graspaug.sim.feasibility import feasibility
     from graspaug.sim.objects import folder_meshes, prepare_objects
 
@@ -197,7 +226,14 @@ def run(
         physics = (sim.physics, params.seed, sim.vhacd_resolution)
         rule = {name: feasibility(mesh, params.grasps.gripper.max_width) for name, mesh in meshes}  # before any pick
         objects = prepare_objects((), (), Path("."), *physics, meshes, None, params.workers)
-        jobs, arms = jobs_for_draw(d, folder, objects, attempts, params.seed, pictures), [*draw_arms(folder)]
+        poses = None
+        if paper_k is not None:
+            objects = paper_objects(objects, rule, paper_k, params.seed)
+            if not objects:
+                raise DataError(f"draw {d}: no feasible object for the paper's protocol")
+            poses = fixed_poses(objects, params.seed, sim.cell, sim.trial, params.grasps.gripper)
+        jobs = jobs_for_draw(d, folder, objects, attempts, params.seed, pictures, poses)
+        arms = [*draw_arms(folder)]
         log.info("real-picks draw %d: %d objects × %d attempts, arms %s", d, len(objects), attempts, arms)
         picked = run_trials(jobs, sim, params.render.crop, params.workers, params.grasps.gripper, params.grasps)
         for row in picked:
@@ -213,6 +249,7 @@ def run(
     summary["feasible"] = feasible_summary(table, sim.n_bootstrap, params.seed)
     summary |= {"never_held": never_held(table), "skipped": skipped, "seconds": seconds, "attempts": attempts}
     summary["kept_before"] = sorted(earlier & set(folders))
+    summary["protocol"] = "drops" if paper_k is None else f"paper: {paper_k} feasible objects a draw, one pose each"
     if pictures:
         draw_pictures(rows, out)
     return table, summary, report_markdown(table, summary)
