@@ -1,12 +1,16 @@
 """``graspaug study real-picks``: the paper's robot experiment on real objects (issue #76).
 
-For each draw's kept seed-0 networks (``<networks>/d<k>-s0/``: none@50, targeted@50, none@150, and the random
-antipodal grasp), every test object of that draw (``objects.json``'s ``test``, or the study's ``test.parquet``
+For each draw's kept seed-0 networks (``<networks>/d<k>-s0/``: none@50, targeted@50, none@150), the random
+antipodal grasp (the floor) and the mesh oracle (the ceiling: :class:`graspaug.sim.oracle.MeshOracle`), every test
+object of that draw (``objects.json``'s ``test``, or the study's ``test.parquet``
 objects for a folder of the exploratory study) is loaded from the corpora and sized as ingest sized it (the
 networks' cards' ``test_set_rules``, else the ``--profile``'s ingest surface), then picked ``--attempts`` times in
-the simulated Panda cell (the ``sim`` params: depth noise, drawn mass and friction, a shake after the lift), each
+the simulated Panda cell (the ``sim`` params: depth noise, mass from density, the 70 N hand of ``grasps.gripper``), each
 attempt a seeded drop that every arm shares. ``--objects DIR`` picks the meshes of any folder instead (the same
-objects for every draw). Writes one row per attempt to ``results/<results>/attempts.parquet`` (with the command and
+objects for every draw). Each object is declared feasible or not from its geometry before any pick
+(:func:`graspaug.sim.feasibility.feasibility`); the report gives success on feasible objects first, with the
+oracle's verdict on the cell. ``--paper K``: the paper's protocol, K feasible objects a draw, each in one fixed
+pose. Writes one row per attempt to ``results/<results>/attempts.parquet`` (with the command and
 commit in ``meta.json``), and the summary, the table beside the paper's and a success and a failure picture of each
 network arm to ``--out``.
 """
