@@ -251,6 +251,7 @@ def run(
     table = attempts_table(rows, done)  # never empty: a draw is picked now or was kept before
     summary = pick_summary(table, list(dict.fromkeys(table.arm)), sim.n_bootstrap, params.seed)
     summary["feasible"] = feasible_summary(table, sim.n_bootstrap, params.seed)
+    summary["feasibility_rule"] = {"max_width": params.grasps.gripper.max_width, "margin": 0.005, "min_height": 0.015}
     summary |= {"never_held": never_held(table), "skipped": skipped, "seconds": seconds, "attempts": attempts}
     summary["kept_before"] = sorted(earlier & set(folders))
     summary["protocol"] = "drops" if paper_k is None else f"paper: {paper_k} feasible objects a draw, one pose each"
