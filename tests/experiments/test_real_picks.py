@@ -156,3 +156,7 @@ def test_the_papers_protocol_picks_feasible_objects_each_from_one_pose(repo_root
     oracle = table[table.arm == ORACLE]
     assert len(oracle) == 2 and oracle.grasp_x.nunique() == 1  # one pose: the oracle's grasp is the same each time
     assert json.loads((out / "summary.json").read_text())["protocol"].startswith("paper: 3 feasible objects")
+    only = CliRunner().invoke(app, [*pick, "--attempts", "1", "--feasible-only", "--out", str(tmp_path / "only")])
+    assert only.exit_code == 0, only.output
+    summary = json.loads((tmp_path / "only" / "summary.json").read_text())
+    assert summary["objects"] == 1 and "d0/3D_Dollhouse_TablePurple" in summary["skipped"]

@@ -238,6 +238,9 @@ def real_picks_command(
     paper: int = typer.Option(
         None, "--paper", min=1, help="The paper's protocol: K feasible objects a draw, each in one fixed pose."
     ),
+    feasible_only: bool = typer.Option(
+        False, "--feasible-only", help="Pick only the objects declared feasible from geometry (fresh drops)."
+    ),
 ) -> None:
     import json
 
@@ -266,7 +269,13 @@ def real_picks_command(
 
     with output_folder(out, "study real-picks", [networks, corpora, objects], force) as tmp:
         table, summary, text = real_picks.run(
-            *args, tmp, pictures=True, done=done, on_draw=keep if kept else None, paper_k=paper
+            *args,
+            tmp,
+            pictures=True,
+            done=done,
+            on_draw=keep if kept else None,
+            paper_k=paper,
+            feasible_only=feasible_only,
         )
         (tmp / "report.md").write_text(text)
         (tmp / "summary.json").write_text(json.dumps(summary, indent=1, default=str))

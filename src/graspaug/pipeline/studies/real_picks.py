@@ -195,13 +195,15 @@ def run(
     done: pd.DataFrame | None = None,
     on_draw=None,
     paper_k: int | None = None,
+    feasible_only: bool = False,
 ) -> tuple[pd.DataFrame, dict, str]:
     """Pick every object of every draw in every arm; (the attempts table, the summary, the report's markdown).
     ``out``: the folder the pictures go to (a staging folder). ``done``: attempts of earlier runs (a results
     folder's table); its draws are not picked again and its rows join the summary. ``on_draw(table, seconds)`` is
     called after each draw with every attempt so far, so a long study keeps each draw as it finishes. ``paper_k``:
     the paper's protocol instead of fresh drops: ``paper_k`` feasible objects a draw (:func:`paper_objects`), each
-    in one fixed resting pose for all its attempts (:func:`fixed_poses`)."""
+    in one fixed resting pose for all its attempts (:func:`fixed_poses`). ``feasible_only``: pick only the objects
+    the feasibility rule declares feasible (fresh drops; the others are listed in ``skipped``)."""
     from graspaug.sim.feasibility import feasibility
     from graspaug.sim.objects import folder_meshes, prepare_objects
 
@@ -229,6 +231,11 @@ def run(
         skipped |= {f"d{d}/{k}": v for k, v in missed.items()}
         physics = (sim.physics, params.seed, sim.vhacd_resolution)
         rule = {name: feasibility(mesh, params.grasps.gripper.max_width) for name, mesh in meshes}  # before any pick
+        if feasible_only:
+            skipped |= {f"d{d}/{n}": "not feasible (--feasible-only)" for n, _ in meshes if not rule[n]["feasible"]}
+            meshes = [(n, m) for n, m in meshes if rule[n]["feasible"]]
+            if not meshes:
+                raise DataError(f"draw {d}: no feasible object (--feasible-only)")
         objects = prepare_objects((), (), Path("."), *physics, meshes, None, params.workers)
         poses = None
         if paper_k is not None:
