@@ -13,7 +13,8 @@ import pandas as pd
 import pytest
 
 from graspaug.errors import DataError
-from graspaug.experiments.confirm.external import combine_external, external_figures, per_object_ap, write_external
+from graspaug.experiments.confirm.external import combine_external, external_figures, write_external
+from graspaug.experiments.confirm.numbers import per_object_ap
 from graspaug.experiments.confirm.tables import column
 from graspaug.experiments.stats import weighted_average_precision
 

@@ -17,6 +17,7 @@ from graspaug.experiments.cell.picks import (
     pick_ranking,
     pick_summary,
 )
+from graspaug.experiments.cell.trials import ORACLE
 from graspaug.pipeline.cli import app
 
 KEPT = "results/attribution-real-objects-4000/networks"
@@ -95,11 +96,16 @@ def test_the_kept_networks_pick_a_few_real_objects(repo_root, tmp_path, monkeypa
     done = CliRunner().invoke(app, [*pick, "--workers", "2", "--out", str(out), "--results", "picks"])
     assert done.exit_code == 0, done.output
     table = pd.read_parquet(tmp_path / "results" / "picks" / "attempts.parquet")
-    assert len(table) == 2 * 2 * 4 and set(table.draw) == {0}
-    scores = table[["score_none@50", "score_targeted@50", "score_none@100"]]  # every network, every executed grasp
-    planned = table.outcome != "no_grasp"
+    assert len(table) == 2 * 2 * 5 and set(table.draw) == {0} and set(table.arm) >= {ORACLE, ANTIPODAL}
+    feasible = table.groupby("object").feasible.first()  # declared from geometry, the same in every arm
+    bottle = next(o for o in feasible.index if o.endswith("allergenfree_jarrodophilus"))  # as evaluate names it
+    assert feasible[bottle] and (table.groupby("object").feasible.nunique() == 1).all()
+    assert table.contacts.notna().all() and (table.mass < 0.2).any() == (table.mass.min() < 0.2)
+    table_by_images = table[table.arm != ORACLE]  # the oracle plans on the mesh: no image for a network to score
+    scores = table_by_images[["score_none@50", "score_targeted@50", "score_none@100"]]  # every network, every grasp
+    planned = table_by_images.outcome != "no_grasp"
     assert scores[planned].notna().all().all() and scores[~planned].isna().all().all()
-    own = table[(table.arm == "none@50") & planned]
+    own = table_by_images[(table_by_images.arm == "none@50") & planned]
     assert np.allclose(own["score_none@50"], own.quality, atol=1e-5)  # a network's own grasp: the quality it planned
     again = CliRunner().invoke(app, [*pick, "--out", str(tmp_path / "again"), "--results", "picks"])
     assert again.exit_code == 0 and "in the results table already" in again.output, again.output
@@ -107,10 +113,12 @@ def test_the_kept_networks_pick_a_few_real_objects(repo_root, tmp_path, monkeypa
     other = CliRunner().invoke(app, [*pick[:-1], "3", "--out", str(tmp_path / "other"), "--results", "picks"])
     assert other.exit_code == 2 and "its draws have 2 attempts" in other.output, other.output
     summary = json.loads((out / "summary.json").read_text())
-    assert set(summary["arms"]) == {"none@50", "targeted@50", "none@100", ANTIPODAL}
+    assert set(summary["arms"]) == {"none@50", "targeted@50", "none@100", ANTIPODAL, ORACLE}
+    assert summary["feasible"]["all_object_draws"] == 2 and summary["feasible"]["object_draws"] >= 1
     assert summary["attempts_per_arm"] == {arm: 4 for arm in summary["arms"]} and summary["objects"] == 2
     assert summary["contrasts"]["control"]["a"] == "none@100"  # the exploratory study kept B = 50 and 100
     report = (out / "report.md").read_text()
+    assert report.splitlines()[2].startswith("Feasible objects first:") and "the oracle picks" in report
     assert "| paper (8 everyday objects, no interval) | 8 | 10 | 68% | 86% |" in report and "none@100" in report
 
 
@@ -180,3 +188,28 @@ def test_objects_in_millimetres_load_with_unit_scale_in_evaluates_formats(tmp_pa
                                     for r in missed.values()), missed  # fmt: skip
     help_text = CliRunner().invoke(app, ["study", "real-picks", "--help"], env={"COLUMNS": "250"}).output
     assert "--unit-scale" in help_text and ".glb" in help_text
+
+
+def test_the_papers_protocol_picks_feasible_objects_each_from_one_pose(repo_root, tmp_path, monkeypatch):
+    corpus = repo_root.parent / "shared" / "corpora" / "gso100"
+    if not corpus.is_dir():
+        pytest.skip(f"{corpus} absent beside this clone")
+    objects = tmp_path / "objects"
+    objects.mkdir()
+    for name in SMALL:  # a bottle (feasible) and a doll's table (not: 8% of its landings fit the jaw)
+        shutil.copy(corpus / name, objects / name)
+    shutil.copytree(repo_root / "profiles", tmp_path / "profiles")
+    monkeypatch.chdir(tmp_path)
+    out = tmp_path / "out"
+    pick = ["study", "real-picks", "--networks", str(repo_root / KEPT), "--draws", "0", "--objects", str(objects)]
+    done = CliRunner().invoke(app, [*pick, "--attempts", "2", "--paper", "3", "--out", str(out), "--results", "p"])
+    assert done.exit_code == 0, done.output
+    table = pd.read_parquet(tmp_path / "results" / "p" / "attempts.parquet")
+    assert [o[-26:] for o in set(table.object)] == ["allergenfree_jarrodophilus"] and table.feasible.all()  # the rule
+    oracle = table[table.arm == ORACLE]
+    assert len(oracle) == 2 and oracle.grasp_x.nunique() == 1  # one pose: the oracle's grasp is the same each time
+    assert json.loads((out / "summary.json").read_text())["protocol"].startswith("paper: 3 feasible objects")
+    only = CliRunner().invoke(app, [*pick, "--attempts", "1", "--feasible-only", "--out", str(tmp_path / "only")])
+    assert only.exit_code == 0, only.output
+    summary = json.loads((tmp_path / "only" / "summary.json").read_text())
+    assert summary["objects"] == 1 and any(k.endswith("3d_dollhouse_tablepurple") for k in summary["skipped"])

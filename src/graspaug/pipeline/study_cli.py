@@ -270,6 +270,12 @@ def real_picks_command(
     out: Path = typer.Option(Path("reports/study/real_picks"), "--out", help="Folder for the report and pictures."),
     force: bool = ForceOption,
     results: str = typer.Option(None, "--results", help="Also keep the attempts in results/<NAME>/ (real-picks)."),
+    paper: int = typer.Option(
+        None, "--paper", min=1, help="The paper's protocol: K feasible objects a draw, each in one fixed pose."
+    ),
+    feasible_only: bool = typer.Option(
+        False, "--feasible-only", help="Pick only the objects declared feasible from geometry (fresh drops)."
+    ),
 ) -> None:
     import json
 
@@ -303,8 +309,16 @@ def real_picks_command(
         real_picks.write_results(kept, table, meta | {"attempts": attempts, "seconds": every, "runs": runs})
 
     with output_folder(out, "study real-picks", [networks, corpora, objects], force) as tmp:
-        on_draw = keep if kept else None
-        table, summary, text = real_picks.run(*args, tmp, True, done, on_draw, unit_scale)
+        table, summary, text = real_picks.run(
+            *args,
+            tmp,
+            pictures=True,
+            done=done,
+            on_draw=keep if kept else None,
+            paper_k=paper,
+            feasible_only=feasible_only,
+            unit_scale=unit_scale,
+        )
         (tmp / "report.md").write_text(text)
         (tmp / "summary.json").write_text(json.dumps(summary, indent=1, default=str))
     typer.echo(text)

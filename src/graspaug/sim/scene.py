@@ -13,6 +13,7 @@ import numpy as np
 import pybullet
 import pybullet_data
 
+from graspaug.grasping.gripper import ParallelJawGripper
 from graspaug.render.camera import CameraPose, look_at
 from graspaug.render.pybullet_depth import render_depth
 from graspaug.sim.objects import SimObject
@@ -29,11 +30,16 @@ def camera_pose(layout: CellLayout) -> CameraPose:
 
 
 class PickScene:
-    """A fresh physics world with the cell of ``layout`` and a Panda with ``hand``."""
+    """A fresh physics world with the cell of ``layout`` and a Panda with ``hand``, its fingers ``gripper``'s."""
 
     near, far = 0.05, 3.0  # depth camera clipping planes (m)
 
-    def __init__(self, layout: CellLayout = CellLayout(), hand: HandSettings = HandSettings()) -> None:
+    def __init__(
+        self,
+        layout: CellLayout = CellLayout(),
+        hand: HandSettings = HandSettings(),
+        gripper: ParallelJawGripper = ParallelJawGripper(),
+    ) -> None:
         self.layout = layout
         self.client = pybullet.connect(pybullet.DIRECT)
         c = self.client
@@ -53,12 +59,13 @@ class PickScene:
             useFixedBase=True,
             physicsClientId=c,
         )
-        self.robot = Panda(c, layout.robot_base, hand, layout.time_step)
+        self.robot = Panda(c, layout.robot_base, hand, layout.time_step, gripper)
         self.object: int | None = None
 
     # --- the object --------------------------------------------------------------------------
     def add_object(self, obj: SimObject, position, orientation) -> int:
-        """Put ``obj`` at ``position`` (3,) m with quaternion ``orientation`` (x, y, z, w)."""
+        """Put ``obj`` at ``position`` (3,) m with quaternion ``orientation`` (x, y, z, w). Its hulls collide
+        where they lie: no collision margin (Bullet's default adds 1 mm around every convex mesh)."""
         c = self.client
         collision = pybullet.createCollisionShape(pybullet.GEOM_MESH, fileName=str(obj.collision), physicsClientId=c)
         visual = pybullet.createVisualShape(
@@ -78,6 +85,7 @@ class PickScene:
             lateralFriction=obj.lateral_friction,
             spinningFriction=obj.spinning_friction,
             rollingFriction=obj.rolling_friction,
+            collisionMargin=0.0,
             physicsClientId=c,
         )
         return self.object
@@ -110,13 +118,17 @@ class PickScene:
         low, high = pybullet.getAABB(self.object, physicsClientId=self.client)
         return np.array(low), np.array(high)
 
-    def settle(self, max_time: float = 2.0, speed: float = 0.005) -> float:
-        """Step until the object moves slower than ``speed`` or ``max_time`` s pass; the time taken."""
+    def settle(self, max_time: float = 2.0, speed: float = 0.005, hold: float = 0.3) -> float:
+        """Step until the object has moved slower than ``speed`` for ``hold`` s (checked every 12 steps: a rocking
+        object passes through rest at each turn and rolls on) or ``max_time`` s pass; the time taken."""
         steps = int(round(max_time / self.layout.time_step))
+        slow, needed = 0, max(1, int(round(hold / (12 * self.layout.time_step))))
         for i in range(steps):
             self.robot.step(1)
-            if i % 12 == 11 and self.object_speed() < speed:
-                return (i + 1) * self.layout.time_step
+            if i % 12 == 11:
+                slow = slow + 1 if self.object_speed() < speed else 0
+                if slow >= needed:
+                    return (i + 1) * self.layout.time_step
         return max_time
 
     def shake(self, acceleration: float, pulse_time: float) -> None:
@@ -145,6 +157,11 @@ class PickScene:
             np.all(np.abs(offset) < self.layout.bin_half_extent)
             and position[2] < self.layout.bin_position[2] + self.layout.bin_height
         )
+
+    def body_name(self, body: int) -> str:
+        """What ``body`` is in the cell: ``object``, ``table``, ``bin``, ``robot`` or ``obstacle``."""
+        names = {self.object: "object", self.table: "table", self.bin: "bin", self.robot.body: "robot"}
+        return names.get(body, "obstacle")
 
     def object_touches_robot(self) -> bool:
         return len(pybullet.getContactPoints(self.object, self.robot.body, physicsClientId=self.client)) > 0

@@ -18,12 +18,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from graspaug.grasping.gripper import ParallelJawGripper
 from graspaug.planning.grasps import ImageGrasps
 from graspaug.planning.planner import PlannedGrasp
 from graspaug.render.camera import CameraPose
 from graspaug.render.settings import Intrinsics
 from graspaug.sim.objects import SimObject
-from graspaug.sim.panda import FINGER_OPEN, HandSettings
+from graspaug.sim.panda import HandSettings
 from graspaug.sim.scene import CellLayout, PickScene, camera_pose
 from graspaug.sim.sensor import sense_depth
 from graspaug.sim.settings import DepthNoise, TrialSettings
@@ -48,9 +49,23 @@ class TrialResult:
     planning_time: float | None = None  # s
     candidates: int = 0
     contact_force: float = 0.0  # largest contact force (N) of the robot before the fingers closed
+    #: the robot's contacts at that hardest-pressing step: (robot link, what it touched, normal force N) per pair
+    contacts: list[tuple[str, str, float]] = field(default_factory=list)
+    shake_grip: float | None = None  # the grip (N a finger) friction needs to hold the object through the shake
     hand_error: tuple[float, float, float] = (0.0, 0.0, 0.0)  # where the hand went off the grasp: x, y (m), angle (rad)
     depth: np.ndarray | None = None
     frames: list[tuple[str, np.ndarray]] = field(default_factory=list)
+
+
+def shake_grip(mass: float, friction: float, settings: TrialSettings, layout: CellLayout) -> float:
+    """The grip (N a finger) that holds an object of ``mass`` kg by pad ``friction`` alone through the shake of
+    ``settings`` (its weight plus the peak load, both pads pulling): m g (1 + a) / (2 μ)."""
+    return float(mass * layout.gravity * (1 + settings.shake_acceleration) / (2 * friction))
+
+
+def contacts_text(contacts) -> str:
+    """A trial's hardest contacts in a line: ``panda_leftfinger–object 12.3 N; ...`` (empty: none)."""
+    return "; ".join(f"{link}–{other} {force:.1f} N" for link, other, force in contacts)
 
 
 def random_orientation(rng: np.random.Generator) -> np.ndarray:
@@ -64,7 +79,7 @@ def random_orientation(rng: np.random.Generator) -> np.ndarray:
 GraspSource = Callable[[np.ndarray, CameraPose, Intrinsics], "PlannedGrasp | None"]
 
 
-ScriptedGrasp = Callable[[np.ndarray, np.ndarray], "tuple[np.ndarray, float]"]
+ScriptedGrasp = Callable[[np.ndarray, np.ndarray], "tuple[np.ndarray, float] | None"]
 
 
 def grasp_in_table_frame(
@@ -85,6 +100,26 @@ def grasp_in_table_frame(
     return centers, np.arctan2(direction[:, 1], direction[:, 0])
 
 
+def resting_pose(
+    obj: SimObject,
+    drop_seed: int,
+    layout: CellLayout = CellLayout(),
+    settings: TrialSettings = TrialSettings(),
+    gripper: ParallelJawGripper = ParallelJawGripper(),
+) -> tuple[np.ndarray, np.ndarray]:
+    """Where ``obj`` comes to rest when dropped as :func:`run_trial` drops it with ``drop_seed``: its body's
+    position (3,) m and quaternion (x, y, z, w), a ``placement`` for attempts that all start from one pose."""
+    rng = np.random.default_rng(drop_seed)
+    with PickScene(layout, HandSettings(), gripper) as scene:
+        xy = rng.uniform(-settings.drop_offset, settings.drop_offset, size=2)
+        orientation = random_orientation(rng)
+        scene.add_object(obj, [xy[0], xy[1], 1.0], orientation)
+        low, _ = scene.object_bounds()
+        scene.move_object([xy[0], xy[1], 1.0 - low[2] + settings.drop_clearance], orientation)
+        scene.settle(settings.settle_time)
+        return scene.object_pose()
+
+
 def run_trial(
     obj: SimObject,
     drop_seed: int,
@@ -97,15 +132,17 @@ def run_trial(
     record: bool = False,
     obstacles: tuple[Obstacle, ...] = (),
     placement: tuple[np.ndarray, np.ndarray] | None = None,
+    gripper: ParallelJawGripper = ParallelJawGripper(),
 ) -> TrialResult:
     """Drop ``obj`` at the pose drawn from ``drop_seed``, then pick it with ``planner``'s grasp
     on the ``sensor``'s depth image (or the ``scripted`` one: the object's resting position (3,) m
-    and quaternion (x, y, z, w) → table-frame grasp center (3,) m and jaw angle rad) and carry
+    and quaternion (x, y, z, w) → table-frame grasp center (3,) m and jaw angle rad, or None: no grasp) and carry
     it to the bin. ``obstacles`` are static boxes added once the object rests. With ``placement``
     (position (3,) m, quaternion (x, y, z, w) of the object's body) the object is put there and
-    left to settle instead of dropped (a stable pose on the table, as the rendered datasets have it)."""
+    left to settle instead of dropped (a stable pose on the table, as the rendered datasets have it). The hand's
+    fingers and palm are ``gripper``'s (``grasps.gripper``: the gripper the grasps are labelled for)."""
     rng = np.random.default_rng(drop_seed)
-    with PickScene(layout, hand) as scene:
+    with PickScene(layout, hand, gripper) as scene:
         if placement is None:
             xy = rng.uniform(-settings.drop_offset, settings.drop_offset, size=2)
             orientation = random_orientation(rng)
@@ -147,8 +184,10 @@ def run_trial(
                 planned.candidates,
             )
         else:
-            center, jaw_angle = scripted(*scene.object_pose())
-            center, jaw_angle = np.asarray(center, dtype=float), float(jaw_angle)
+            grasp = scripted(*scene.object_pose())
+            if grasp is None:  # a scripted source may find no grasp (the oracle where nothing is reachable)
+                return result
+            center, jaw_angle = np.asarray(grasp[0], dtype=float), float(grasp[1])
         result.grasp_center, result.jaw_angle = tuple(float(x) for x in center), jaw_angle
         if settings.position_error > 0 or settings.angle_error > 0:  # where the hand really goes
             error = np.random.default_rng([drop_seed, 2]).normal(size=3)
@@ -166,6 +205,7 @@ def run_trial(
             frames.append(("pre-grasp", scene.color_frame()))
         if result.contact_force <= limit:
             result.contact_force = max(result.contact_force, robot.move_line(center, jaw_angle, max_force=limit))
+        result.contacts = [(link, scene.body_name(b), round(f, 3)) for link, b, f in robot.hardest]
         if result.contact_force > limit:
             result.outcome = "collision"
             if record:
@@ -182,6 +222,7 @@ def run_trial(
             result.outcome = "not_lifted"
             return result
         if settings.shake_acceleration > 0:
+            result.shake_grip = shake_grip(obj.mass, obj.lateral_friction * hand.finger_friction, settings, layout)
             scene.shake(settings.shake_acceleration * layout.gravity, settings.shake_pulse)
             if record:
                 frames.append(("shaken", scene.color_frame()))
@@ -192,7 +233,7 @@ def run_trial(
         held = scene.object_touches_robot()
         if record:
             frames.append(("over the bin", scene.color_frame()))
-        robot.set_fingers(2 * FINGER_OPEN)
+        robot.set_fingers(robot.open_width)
         robot.step(int(settings.release_time / layout.time_step))
         if record:
             frames.append(("released", scene.color_frame()))

@@ -212,3 +212,13 @@ def networks_at(networks, base_size: int) -> dict[str, set[float]] | None:
         if int(b) == int(base_size) and float(r) > 0:
             out.setdefault("targeted" if pool in SAMPLED_POOLS else str(pool), set()).add(float(r))
     return out
+
+
+def listed_pools(pools, ratios, networks, base_size: int) -> tuple[list[str], list[float]]:
+    """``pools`` and targeted's ``ratios`` at ``base_size`` cut to what ``gqcnn.networks`` trains on there
+    (:func:`networks_at`); unchanged without a list."""
+    wanted = networks_at(networks, base_size)
+    if wanted is None:
+        return list(pools), list(ratios)
+    kept = sorted({0.0, *wanted["targeted"]}) if wanted.get("targeted") else list(ratios)
+    return [p for p in pools if p in wanted], kept

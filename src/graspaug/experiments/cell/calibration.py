@@ -93,14 +93,18 @@ def grasp_on_body(center: np.ndarray, axis: np.ndarray, origin: np.ndarray, posi
     return table_center, float(np.arctan2(a[1], a[0])), float(np.degrees(np.arcsin(min(1.0, abs(a[2])))))
 
 
-def run_shape(job: ShapeGrasps, layout, hand, trial_settings) -> list[dict]:
+def run_shape(job: ShapeGrasps, layout, hand, trial_settings, gripper=None) -> list[dict]:
     """Every grasp of one shape executed in a fresh cell (:func:`graspaug.sim.trials.run_trial`
     with the object placed in the grasp's stable pose): one row per grasp, the index row plus
     ``outcome``, ``executed_success``, the object's drift while settling (``settle_shift`` m),
     the jaw axis's tilt out of the table at the grasp (``axis_tilt`` deg), the grasp center's
     height above the table (``grasp_height`` m) and ``contact_force``
-    (N, the robot's largest contact before the fingers closed)."""
-    from graspaug.sim.trials import run_trial
+    (N, the robot's largest contact before the fingers closed). ``gripper``: the hand's geometry (``grasps.gripper``;
+    None: the default Franka hand)."""
+    from graspaug.grasping.gripper import ParallelJawGripper
+    from graspaug.sim.trials import contacts_text, run_trial
+
+    gripper = gripper or ParallelJawGripper()
 
     rows = []
     for pose, center, axis, row, trial_seed in zip(
@@ -126,6 +130,7 @@ def run_shape(job: ShapeGrasps, layout, hand, trial_settings) -> list[dict]:
             hand=hand,
             settings=trial_settings,
             placement=start,
+            gripper=gripper,
         )
         rows.append(
             {
@@ -136,6 +141,7 @@ def run_shape(job: ShapeGrasps, layout, hand, trial_settings) -> list[dict]:
                 "axis_tilt": seen["tilt"],
                 "grasp_height": float(seen["height"]),
                 "contact_force": round(result.contact_force, 3),
+                "contacts": contacts_text(result.contacts),
             }
         )
     return rows
@@ -179,12 +185,12 @@ def shape_jobs(chosen: pd.DataFrame, grasps: pd.DataFrame, shapes_dir, sim, seed
     return jobs
 
 
-def run_calibration(jobs: Sequence[ShapeGrasps], sim, workers) -> pd.DataFrame:
+def run_calibration(jobs: Sequence[ShapeGrasps], sim, workers, gripper=None) -> pd.DataFrame:
     """Every job's grasps (:func:`run_shape` on ``workers``), one row per executed grasp;
-    ``sim``: the ``sim`` params section (cell, hand, trial settings)."""
+    ``sim``: the ``sim`` params section (cell, hand, trial settings); ``gripper``: ``grasps.gripper`` (the hand)."""
     from graspaug.parallel import parallel_map
 
-    work = functools.partial(run_shape, layout=sim.cell, hand=sim.hand, trial_settings=sim.trial)
+    work = functools.partial(run_shape, layout=sim.cell, hand=sim.hand, trial_settings=sim.trial, gripper=gripper)
     return pd.DataFrame([row for rows in parallel_map(work, jobs, workers, "grasp calibration") for row in rows])
 
 

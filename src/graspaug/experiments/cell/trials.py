@@ -19,6 +19,9 @@ from graspaug.training.variants import network_variant
 
 log = logging.getLogger(__name__)
 
+#: The arm that picks with the best grasp on the true mesh in the dropped pose (graspaug.sim.oracle.MeshOracle).
+ORACLE = "oracle"
+
 
 @dataclass(frozen=True)
 class ObjectJob:
@@ -36,6 +39,9 @@ class ObjectJob:
     #: (arm, model.pt) of networks that also score each executed grasp (its success probability in ``score_<arm>``):
     #: every network rates the same grasps, so their ranking of the cell's outcomes can be compared
     scorers: tuple[tuple[str, str], ...] = ()
+    #: the paper's protocol: every attempt starts from this resting pose (position (3,) m, quaternion (x, y, z, w)),
+    #: the drop seeds drawing only the sensor's noise; None: each attempt is a fresh drop
+    placement: tuple | None = None
 
 
 def model_path(seed_dir: Path, base_size: int, ratio: float, pool: str = "targeted") -> Path:
@@ -193,17 +199,45 @@ def _cached_policy(model: str | None, version, layout, sampler, cem, crop_size: 
 
 
 def run_object(
-    job: ObjectJob, layout, hand, sampler, cem, crop_size: int, out_size: int, trial_settings=None, sensor=None
+    job: ObjectJob,
+    layout,
+    hand,
+    sampler,
+    cem,
+    crop_size: int,
+    out_size: int,
+    trial_settings=None,
+    sensor=None,
+    gripper=None,
+    grasps=None,
 ) -> list[dict]:
     """Every attempt of one object in one arm: a row per attempt (plus depth and frames for the
     first attempt when ``job.record``). The planner fills the sensor's missing pixels from the
-    nearest valid one."""
+    nearest valid one. ``gripper``: the hand's geometry (``grasps.gripper``; None: the default Franka hand). The
+    :data:`ORACLE` arm plans no image: its grasps are the mesh oracle's (the ``grasps`` settings' sampler, quality
+    and perturbations, with ``gripper``), seeded by the job's first planner seed; ``oracle_eps`` and
+    ``oracle_tilt`` (rad) give its chosen grasp's robust ε and the jaw's tilt out of level."""
+    import dataclasses
+
+    from graspaug.grasping.gripper import ParallelJawGripper
+    from graspaug.grasping.settings import GraspsSettings
     from graspaug.planning import check_depth
     from graspaug.sim.settings import DepthNoise
-    from graspaug.sim.trials import TrialSettings, run_trial
+    from graspaug.sim.trials import TrialSettings, contacts_text, run_trial
 
     trial_settings, sensor = trial_settings or TrialSettings(), sensor or DepthNoise()
-    policy = _policy(job.model, layout, sampler, cem, crop_size, out_size)
+    gripper = gripper or ParallelJawGripper()
+    oracle = None
+    if job.arm == ORACLE:
+        import trimesh
+
+        from graspaug.sim.oracle import MeshOracle
+
+        settings = dataclasses.replace(grasps or GraspsSettings(), gripper=gripper)
+        mesh = trimesh.load(job.sim_object.visual, force="mesh", process=False)
+        approach = trial_settings.pregrasp_height
+        oracle = MeshOracle(mesh, settings, np.random.default_rng(job.plan_seeds[0]), approach_distance=approach)
+    policy = None if oracle is not None else _policy(job.model, layout, sampler, cem, crop_size, out_size)
     rows = []
     for attempt, (drop_seed, plan_seed) in enumerate(zip(job.drop_seeds, job.plan_seeds)):
         rng = np.random.default_rng(plan_seed)
@@ -221,12 +255,15 @@ def run_object(
         result = run_trial(
             job.sim_object,
             drop_seed,
-            planner=plan,
+            planner=None if oracle is not None else plan,
+            scripted=oracle,
             layout=layout,
             hand=hand,
             settings=trial_settings,
             sensor=sensor,
             record=record,
+            gripper=gripper,
+            placement=job.placement,
         )
         g = result.image_grasp or {}
         center = result.grasp_center
@@ -252,7 +289,18 @@ def run_object(
                 "grasp_z": None if center is None else center[2],
                 "jaw_angle": result.jaw_angle,
                 "contact_force": round(result.contact_force, 3),
+                "contacts": contacts_text(result.contacts),
+                "shake_grip": result.shake_grip,
+                "mass": job.sim_object.mass,
                 "planning_time": result.planning_time,
+                **(
+                    {
+                        "oracle_eps": (oracle.chosen or {}).get("quality"),
+                        "oracle_tilt": (oracle.chosen or {}).get("tilt"),
+                    }
+                    if oracle is not None
+                    else {}
+                ),
                 "_depth": result.depth,
                 "_frames": result.frames,
                 **{f"score_{arm}": q for arm, q in scores.items()},
@@ -274,11 +322,12 @@ def trials_plan(objects: Sequence, chosen: dict, attempts: int, n_seeds: int, sk
     )
 
 
-def run_trials(jobs: Sequence[ObjectJob], sim, crop, workers) -> list[dict]:
+def run_trials(jobs: Sequence[ObjectJob], sim, crop, workers, gripper=None, grasps=None) -> list[dict]:
     """Every attempt of every job (:func:`run_object` on ``workers``, a process count or
     :class:`graspaug.parallel.Workers`): the rows of the jobs in order, one per attempt. ``sim``: the
     ``sim`` params section (cell, hand, sampler, CEM, trial settings, sensor); ``crop``: the render
-    params' crop (``crop_size``, ``out_size`` px)."""
+    params' crop (``crop_size``, ``out_size`` px); ``gripper``: ``grasps.gripper``, the hand that picks; ``grasps``:
+    the ``grasps`` settings the oracle arm samples and ranks its grasps with."""
     from graspaug.parallel import parallel_map
 
     work = functools.partial(
@@ -291,6 +340,8 @@ def run_trials(jobs: Sequence[ObjectJob], sim, crop, workers) -> list[dict]:
         out_size=crop.out_size,
         trial_settings=sim.trial,
         sensor=sim.sensor,
+        gripper=gripper,
+        grasps=grasps,
     )
     return [row for rows in parallel_map(work, jobs, workers, "sim") for row in rows]
 

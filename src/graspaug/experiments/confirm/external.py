@@ -28,34 +28,12 @@ import numpy as np
 import pandas as pd
 
 from graspaug.errors import DataError
+from graspaug.experiments.confirm.numbers import network_values
 from graspaug.experiments.confirm.tables import column
-from graspaug.experiments.stats import ObjectBootstrap, nested_t_interval, weighted_average_precision
+from graspaug.experiments.stats import nested_t_interval
 
 FILES = ("test.parquet", "predictions.parquet", "meta.json")
 READOUTS = ("pooled", "per_object")
-
-
-def per_object_ap(labels: np.ndarray, objects: np.ndarray, scores: np.ndarray) -> pd.Series:
-    """Each object's own AP (object → AP) over the objects that hold at least one positive datapoint."""
-    frame = pd.DataFrame({"label": np.asarray(labels, dtype=bool), "object": objects, "score": scores})
-    out = {}
-    for name, rows in frame.groupby("object", sort=True):
-        if rows.label.any():
-            y, p = rows.label.to_numpy(), rows.score.to_numpy()
-            out[name] = float(weighted_average_precision(y, p, np.ones(len(rows))))
-    return pd.Series(out, dtype=float)
-
-
-def network_values(labels, objects, scores, n_resamples: int, seed: int) -> dict[str, tuple[float, np.ndarray]]:
-    """One network's two readouts, each (value on every object, (n_resamples,) values under the objects' resamples):
-    the same resamples for every network (the same ``seed``), so differences are paired."""
-    boot = ObjectBootstrap(objects, n_resamples, seed)
-    ones = np.ones(len(labels), dtype=np.float32)
-    pooled = (float(weighted_average_precision(labels, scores, ones)), boot.average_precision(labels, scores))
-    aps = per_object_ap(labels, objects, scores)
-    held = ObjectBootstrap(aps.index.to_numpy(), n_resamples, seed)
-    per_object = (float(aps.mean()), held.means(aps.to_numpy()))
-    return {"pooled": pooled, "per_object": per_object}
 
 
 def combine_external(folder: Path) -> dict:

@@ -27,6 +27,7 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 
 import numpy as np
+import pandas as pd
 from scipy import stats
 
 #: The verdict words of a plan's tests (each plan may give its own sentences around them).
@@ -308,3 +309,30 @@ def nested_draw_test(full: np.ndarray, resampled: np.ndarray, level: float = 0.9
     else:
         p = 1.0 - brentq(half, lo, hi, xtol=1e-14)
     return out | {"p": float(p)}
+
+
+def per_object_ap(labels: np.ndarray, objects: np.ndarray, scores: np.ndarray) -> pd.Series:
+    """Each object's own AP (object → AP) over the objects that hold at least one positive datapoint."""
+    from graspaug.experiments.stats import weighted_average_precision
+
+    frame = pd.DataFrame({"label": np.asarray(labels, dtype=bool), "object": objects, "score": scores})
+    out = {}
+    for name, rows in frame.groupby("object", sort=True):
+        if rows.label.any():
+            y, p = rows.label.to_numpy(), rows.score.to_numpy()
+            out[name] = float(weighted_average_precision(y, p, np.ones(len(rows))))
+    return pd.Series(out, dtype=float)
+
+
+def network_values(labels, objects, scores, n_resamples: int, seed: int) -> dict[str, tuple[float, np.ndarray]]:
+    """One network's two readouts, each (value on every object, (n_resamples,) values under the objects' resamples):
+    the same resamples for every network (the same ``seed``), so differences are paired."""
+    from graspaug.experiments.stats import ObjectBootstrap, weighted_average_precision
+
+    boot = ObjectBootstrap(objects, n_resamples, seed)
+    ones = np.ones(len(labels), dtype=np.float32)
+    pooled = (float(weighted_average_precision(labels, scores, ones)), boot.average_precision(labels, scores))
+    aps = per_object_ap(labels, objects, scores)
+    held = ObjectBootstrap(aps.index.to_numpy(), n_resamples, seed)
+    per_object = (float(aps.mean()), held.means(aps.to_numpy()))
+    return {"pooled": pooled, "per_object": per_object}

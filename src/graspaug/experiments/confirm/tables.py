@@ -270,8 +270,6 @@ def external_result(folder: Path, plan: Mapping, name: str) -> dict:
     """The plan's tests on its external set ``name``: per draw, seed and arm the set's readout (its ``readout``:
     pooled AP or the mean of per-object AP) on all objects and under the objects' resamples (one set, the same
     resamples for every network), each contrast by :func:`~graspaug.experiments.confirm.numbers.nested_draw_test`."""
-    from graspaug.experiments.confirm.external import network_values
-
     spec = external_sets(plan)[name]
     readout, n = spec.get("readout", "pooled"), int(spec.get("resamples", 1000))
     test = pd.read_parquet(folder / f"test-{name}.parquet")
@@ -288,7 +286,7 @@ def external_result(folder: Path, plan: Mapping, name: str) -> dict:
                 col = column(d, s, arm_key(plan, arm))
                 if col not in predictions:
                     raise DataError(f"{path}: no column {col!r}")
-                cells[d, s, arm] = network_values(labels, objects, predictions[col].to_numpy(), n, 0)[readout]
+                cells[d, s, arm] = confirm.network_values(labels, objects, predictions[col].to_numpy(), n, 0)[readout]
 
     def test_of(c):
         full = np.array([[cells[d, s, c["a"]][0] - cells[d, s, c["b"]][0] for s in seeds] for d in draws])

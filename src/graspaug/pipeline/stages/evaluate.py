@@ -12,7 +12,6 @@ a contrast, the counts, the cache key, what shaped the test set) and ``rejects.c
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 from tqdm import tqdm
@@ -23,44 +22,19 @@ from graspaug.experiments.evaluate.numbers import test_ap
 from graspaug.experiments.evaluate.testset import (
     CARD_KEYS,
     arrange_arms,
-    cached_test_set,
-    recipe_for,
     replicate_name,
     shaped_by,
 )
 from graspaug.experiments.evaluate.words import printed_lines, report_markdown, rules_source
 from graspaug.io.checkpoints import read_gqcnn
-from graspaug.io.gqcnn import GraspImages
 from graspaug.io.outputs import output_folder
 from graspaug.io.sources import folder_sources
 from graspaug.io.tables import read_table, write_csv, write_json
-from graspaug.pipeline.params.base import params_model
-from graspaug.pipeline.params.grasps import GraspsParams
-from graspaug.pipeline.params.ingest import IngestParams
-from graspaug.pipeline.params.profiles import with_sections
-from graspaug.pipeline.params.render import RenderParams
+from graspaug.pipeline.testsets import Params, card_test_set
 from graspaug.planning.card import ModelCard
-from graspaug.training.gqcnn import GraspArrays, predict
+from graspaug.training.gqcnn import predict
 
 ARMS_HINT = "name each arm's replicates (seeds or draws) one after another (at least 2 an arm)"
-Params = params_model(
-    "The params `graspaug evaluate` reads.", ingest=IngestParams, grasps=GraspsParams, render=RenderParams
-)
-
-
-def card_test_set(params: Params, card: ModelCard, raw: dict, params_file: Path | None, sources: list, cache: Path):
-    """The test set of ``sources`` made by a network's card (its ``test_set_rules``, unless ``params_file`` gave the
-    params; its camera, crop and gripper), from or into ``cache``: (the params used, the recipe, the rules, the cached
-    folder, its counts, its :class:`GraspImages`, its :class:`GraspArrays`)."""
-    rules = None if params_file is not None else raw.get("test_set_rules")  # --params overrides the card
-    params = with_sections(params, rules) if rules else params
-    i, keys = params.ingest, {k: getattr(card, k) for k in CARD_KEYS}
-    recipe = recipe_for(i.surface, i.max_faces, i.max_file_mb, params.grasps, params.render, params.seed, keys)
-    folder = cached_test_set(sources, recipe, cache, params.workers, params.render.shard_rows)
-    counts = json.loads((folder / "counts.json").read_text())
-    data = GraspImages.open(folder / "gqcnn")
-    arrays = GraspArrays(data.images(), data.read("z"), data.read("labels"))
-    return params, recipe, rules, folder, counts, data, arrays
 
 
 def run(

@@ -2,14 +2,12 @@
 
 Targeted: the base set's rare, and separately graspable, shapes with their N-th … (N+K)-th latent neighbours,
 ``(1 - α) z_a + α z_b`` decoded by the AE-Critic and meshed (paper Section III-C); own: the same with the AE-Critic of
-``train_ae_own@B``, trained on the base set alone; random: random pairs; recon: the real pool's shapes (the GQ-CNN
-experiment's order) from their own latents; blend: the targeted pairs with no network; warp: each targeted pair's nearer
-parent randomly deformed; primitives: random assemblies of primitives; procedural: pybullet's random_urdfs objects as
-they are (beside a corpus of your own). ``gqcnn.pools`` says which; each holds ``ceil(max ratio × B)`` kept shapes, the
-first ``round(R × B)`` ratio R's set; a failed shape is replaced by the next candidate, except in the recon pool, whose
-shape k is the real pool's shape k (a failed decode is dropped, and said in the summary). Writes ``data/generated/<B>/``
-(``meshes/``, ``index``, ``rejects`` and ``base.parquet``), ``metrics/generate/<B>.json``, ``reports/generate/<B>/``
-(summary, pictures)."""
+``train_ae_own@B`` (the base set alone); random: random pairs; recon: the real pool's shapes from their own latents;
+blend: the targeted pairs with no network; warp: each pair's nearer parent randomly deformed; primitives: random
+assemblies of primitives; procedural: pybullet's random_urdfs objects. ``gqcnn.pools`` says which (``gqcnn.networks``,
+where set: those its networks train on); each holds ``ceil(max ratio × B)`` kept shapes, the first ``round(R × B)``
+ratio R's set; a failed shape is replaced by the next candidate, except in recon (dropped, and said). Writes
+``data/generated/<B>/`` (meshes, index, rejects, base), ``metrics/generate/<B>.json``, ``reports/generate/<B>/``."""
 
 from __future__ import annotations
 
@@ -38,7 +36,7 @@ from graspaug.pipeline.params.ingest import IngestParams
 from graspaug.pipeline.params.score import ScoreParams
 from graspaug.plots import generated_pairs, scatter_2d
 from graspaug.training.gqcnn_data import load_split
-from graspaug.training.settings import networks_at
+from graspaug.training.settings import listed_pools
 
 log = logging.getLogger(__name__)
 
@@ -62,10 +60,8 @@ def run(params: Params, base_size: int) -> None:
 
     ae, _, _ = load_autoencoder(paths.AE_CRITIC_MODEL, params.ae.net)
     meshes = partial(mesh_batches, device=resolve_device(params.device), settings=cfg.decode, workers=params.workers)
-    wanted = networks_at(gq.networks, base_size)  # with gqcnn.networks: only the shapes a listed network trains on
-    pools, recon, own = [p for p in GENERATED_POOLS if p in gq.pools and (wanted is None or p in wanted)], None, None
-    if wanted and wanted.get("targeted"):
-        cfg = cfg.model_copy(update={"ratios": sorted({0.0, *wanted["targeted"]})})
+    pools, ratios = listed_pools([p for p in GENERATED_POOLS if p in gq.pools], cfg.ratios, gq.networks, base_size)
+    cfg, recon, own = cfg.model_copy(update={"ratios": ratios}), None, None  # gqcnn.networks: what its networks use
     if "recon" in pools:  # the real pool as the GQ-CNN experiment draws it
         split = load_split(paths.gqcnn_dir("original"), shapes, list(cfg.base_sizes), gq.val_shapes, params.data_seed)
         real = base_set(np.array(split.real_pool), latents, scores, voxels, params.score.k)

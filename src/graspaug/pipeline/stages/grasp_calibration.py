@@ -28,6 +28,7 @@ from graspaug.experiments.cell.calibration import (
 from graspaug.io.atomic import atomic_path
 from graspaug.io.tables import read_table, write_csv, write_json, write_json_files
 from graspaug.pipeline.params.base import params_model
+from graspaug.pipeline.params.grasps import GraspsParams
 from graspaug.pipeline.params.sim import SimParams
 from graspaug.pipeline.paths import (
     CALIBRATION_METRICS,
@@ -42,7 +43,7 @@ from graspaug.training.gqcnn_data import with_split
 
 log = logging.getLogger(__name__)
 
-Params = params_model("The params the `grasp_calibration` stage reads.", sim=SimParams)
+Params = params_model("The params the `grasp_calibration` stage reads.", grasps=GraspsParams, sim=SimParams)
 
 
 def run(params: Params) -> None:
@@ -63,7 +64,7 @@ def run(params: Params) -> None:
         chosen.label.sum(),
         len(jobs),
     )
-    table = run_calibration(jobs, cfg, params.workers)
+    table = run_calibration(jobs, cfg, params.workers, params.grasps.gripper)
     summary = summarize(table, cfg.n_bootstrap, params.seed)
     summary["seconds"] = round(time.perf_counter() - start, 1)
     by_eps = success_by_eps(table)

@@ -79,7 +79,7 @@ def run(params: Params) -> None:
     objects, skipped = trial_objects(cfg, shapes, paths.SHAPES_DIR, params.ingest, params.seed, params.workers)
     jobs = object_jobs(objects, chosen, seed_dirs, cfg.attempts, params.seed, cfg.n_pictures)
     log.info("sim: %s", trials_plan(objects, chosen, cfg.attempts, len(model_seeds), skipped))
-    rows = run_trials(jobs, cfg, params.render.crop, params.workers)
+    rows = run_trials(jobs, cfg, params.render.crop, params.workers, params.grasps.gripper, params.grasps)
     trials = trials_table(rows, chosen)
     setup = trial_setup(cfg, objects, skipped, model_seeds, after_from_report=from_report, data_seed=params.data_seed)
     metrics = summarize(trials, objects, chosen, setup, cfg.n_bootstrap, params.seed)

@@ -64,7 +64,7 @@ def predict_on(models: dict, corpus: Path, cache: Path, unit_scale: float = 1.0)
     from graspaug.device import resolve_device
     from graspaug.io.checkpoints import read_gqcnn
     from graspaug.io.sources import folder_sources
-    from graspaug.pipeline.stages.evaluate import Params, card_test_set
+    from graspaug.pipeline.testsets import Params, card_test_set
     from graspaug.planning.card import ModelCard
     from graspaug.training.gqcnn import predict
 

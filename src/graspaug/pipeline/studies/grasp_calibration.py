@@ -68,7 +68,7 @@ def run(project: Path, n: int, workers: int, changes: list[str], split: str) -> 
     table = read_table(project / grasps_table("original"))
     jobs = shape_jobs(chosen, table, project / SHAPES_DIR, sim, params.seed, workers)
     prepared = time.perf_counter() - start
-    executed = run_calibration(jobs, sim, workers)
+    executed = run_calibration(jobs, sim, workers, params.grasps.gripper)
     seconds = time.perf_counter() - start
     summary = summarize(executed, sim.n_bootstrap, params.seed)
     summary.update(

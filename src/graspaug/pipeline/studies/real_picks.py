@@ -1,12 +1,16 @@
 """``graspaug study real-picks``: the paper's robot experiment on real objects (issue #76).
 
-For each draw's kept seed-0 networks (``<networks>/d<k>-s0/``: none@50, targeted@50, none@150, and the random
-antipodal grasp), every test object of that draw (``objects.json``'s ``test``, or the study's ``test.parquet``
+For each draw's kept seed-0 networks (``<networks>/d<k>-s0/``: none@50, targeted@50, none@150), the random
+antipodal grasp (the floor) and the mesh oracle (the ceiling: :class:`graspaug.sim.oracle.MeshOracle`), every test
+object of that draw (``objects.json``'s ``test``, or the study's ``test.parquet``
 objects for a folder of the exploratory study) is loaded from the corpora and sized as ingest sized it (the
 networks' cards' ``test_set_rules``, else the ``--profile``'s ingest surface), then picked ``--attempts`` times in
-the simulated Panda cell (the ``sim`` params: depth noise, drawn mass and friction, a shake after the lift), each
+the simulated Panda cell (the ``sim`` params: depth noise, mass from density, the 70 N hand of ``grasps.gripper``), each
 attempt a seeded drop that every arm shares. ``--objects DIR`` picks the meshes of any folder instead (the same
-objects for every draw). Writes one row per attempt to ``results/<results>/attempts.parquet`` (with the command and
+objects for every draw). Each object is declared feasible or not from its geometry before any pick
+(:func:`graspaug.sim.feasibility.feasibility`); the report gives success on feasible objects first, with the
+oracle's verdict on the cell. ``--paper K``: the paper's protocol, K feasible objects a draw, each in one fixed
+pose. Writes one row per attempt to ``results/<results>/attempts.parquet`` (with the command and
 commit in ``meta.json``), and the summary, the table beside the paper's and a success and a failure picture of each
 network arm to ``--out``.
 """
@@ -23,7 +27,7 @@ import pandas as pd
 
 from graspaug.errors import DataError
 from graspaug.experiments.cell.picks import ANTIPODAL, hardest_objects, never_held, paper_table, pick_summary
-from graspaug.experiments.cell.trials import ObjectJob, run_trials
+from graspaug.experiments.cell.trials import ORACLE, ObjectJob, run_trials
 from graspaug.rng import shape_rng
 
 log = logging.getLogger(__name__)
@@ -142,26 +146,55 @@ def corpus_meshes(
 RECORDED = 12  # objects whose first attempt is recorded in every arm (the pictures are drawn from them)
 
 
-def jobs_for_draw(draw: int, folder: Path, objects, attempts: int, seed: int, pictures: bool) -> list[ObjectJob]:
-    """An :class:`ObjectJob` per object and arm; an object's drops and planner seeds are drawn from ``seed`` and
-    its name, the same in every arm (and every draw: the same object is dropped alike). Every network of the draw
-    scores each executed grasp (``score_<arm>``), for their ranking of the cell's outcomes."""
+def paper_objects(objects, rule: dict[str, dict], k: int, seed: int) -> list:
+    """The paper's protocol's objects: ``k`` of ``objects`` that the feasibility ``rule`` (name → its
+    :func:`~graspaug.sim.feasibility.feasibility`) declares feasible, a seeded choice (by the rule, never by an
+    outcome); all of them where fewer are feasible."""
+    feasible = sorted((o for o in objects if rule[o.name]["feasible"]), key=lambda o: o.name)
+    order = np.random.default_rng([seed, 83]).permutation(len(feasible))[:k]
+    return [feasible[i] for i in sorted(order)]
+
+
+def fixed_poses(objects, seed: int, layout, settings, gripper) -> dict[str, tuple]:
+    """Each object's one resting pose of the paper's protocol: where its first drop (seed from ``seed`` and its
+    name) comes to rest in the cell (:func:`graspaug.sim.trials.resting_pose`)."""
+    from graspaug.sim.trials import resting_pose
+
+    poses = {}
+    for obj in objects:
+        drop = int(shape_rng(seed, obj.name, "sim-fixed-pose").integers(2**31 - 1))
+        position, quaternion = resting_pose(obj.body, drop, layout, settings, gripper)
+        poses[obj.name] = (tuple(float(x) for x in position), tuple(float(x) for x in quaternion))
+    return poses
+
+
+def jobs_for_draw(
+    draw: int, folder: Path, objects, attempts: int, seed: int, pictures: bool, poses: dict | None = None
+) -> list[ObjectJob]:
+    """An :class:`ObjectJob` per object and arm (the draw's networks, the ``antipodal`` floor and the ``oracle``
+    ceiling); an object's drops and planner seeds are drawn from ``seed`` and its name, the same in every arm (and
+    every draw: the same object is dropped alike). Every network of the draw scores each executed grasp of the
+    image-planning arms (``score_<arm>``), for their ranking of the cell's outcomes. ``poses`` (object name →
+    resting pose): the paper's protocol, every attempt from that pose (the drop seeds draw the sensor noise)."""
     jobs = []
     for index, obj in enumerate(objects):
         record = pictures and index < RECORDED  # frames of the first attempt: a success and a failure to draw
         drops = tuple(int(shape_rng(seed, obj.name, f"sim-drop-{a}").integers(2**31 - 1)) for a in range(attempts))
         plans = tuple(int(shape_rng(seed, obj.name, f"sim-plan-{a}").integers(2**31 - 1)) for a in range(attempts))
         scorers = tuple((arm, str(folder / name / "model.pt")) for arm, name in draw_arms(folder).items())
-        for arm, name in (draw_arms(folder) | {ANTIPODAL: None}).items():
+        for arm, name in (draw_arms(folder) | {ANTIPODAL: None, ORACLE: None}).items():
             model = None if name is None else str(folder / name / "model.pt")
-            job = ObjectJob(arm, 0, model, obj.name, obj.kind, obj.body, drops, plans, record, scorers)
+            scored = () if arm == ORACLE else scorers
+            placement = None if poses is None else poses[obj.name]
+            job = ObjectJob(arm, 0, model, obj.name, obj.kind, obj.body, drops, plans, record, scored, placement)
             jobs.append(job)
     return jobs
 
 
 ATTEMPT_COLUMNS = (
     "draw", "seed", "arm", "object", "attempt", "drop_seed", "success", "outcome", "quality",
-    "grasp_x", "grasp_y", "grasp_z", "jaw_angle",
+    "grasp_x", "grasp_y", "grasp_z", "jaw_angle", "feasible", "feasible_share", "mass", "contact_force", "contacts",
+    "oracle_eps", "oracle_tilt",
 )  # fmt: skip
 
 
@@ -178,13 +211,19 @@ def run(
     pictures: bool,
     done: pd.DataFrame | None = None,
     on_draw=None,
+    paper_k: int | None = None,
+    feasible_only: bool = False,
     unit_scale: float = 1.0,
 ) -> tuple[pd.DataFrame, dict, str]:
     """Pick every object of every draw in every arm; (the attempts table, the summary, the report's markdown).
     ``out``: the folder the pictures go to (a staging folder). ``done``: attempts of earlier runs (a results
     folder's table); its draws are not picked again and its rows join the summary. ``on_draw(table, seconds)`` is
-    called after each draw with every attempt so far, so a long study keeps each draw as it finishes.
-    ``unit_scale``: metres per file unit of ``objects_dir``'s meshes."""
+    called after each draw with every attempt so far, so a long study keeps each draw as it finishes. ``paper_k``:
+    the paper's protocol instead of fresh drops: ``paper_k`` feasible objects a draw (:func:`paper_objects`), each
+    in one fixed resting pose for all its attempts (:func:`fixed_poses`). ``feasible_only``: pick only the objects
+    the feasibility rule declares feasible (fresh drops; the others are listed in ``skipped``). ``unit_scale``: metres
+    per file unit of ``objects_dir``'s meshes."""
+    from graspaug.sim.feasibility import feasibility
     from graspaug.sim.objects import prepare_objects
 
     folders = draw_folders(networks, draws)
@@ -207,12 +246,26 @@ def run(
             raise DataError(f"draw {d}: no object could be loaded ({why})")
         skipped |= {f"d{d}/{k}": v for k, v in missed.items()}
         physics = (sim.physics, params.seed, sim.vhacd_resolution)
+        rule = {name: feasibility(mesh, params.grasps.gripper.max_width) for name, mesh in meshes}  # before any pick
+        if feasible_only:
+            skipped |= {f"d{d}/{n}": "not feasible (--feasible-only)" for n, _ in meshes if not rule[n]["feasible"]}
+            meshes = [(n, m) for n, m in meshes if rule[n]["feasible"]]
+            if not meshes:
+                raise DataError(f"draw {d}: no feasible object (--feasible-only)")
         objects = prepare_objects((), (), Path("."), *physics, meshes, None, params.workers)
-        jobs, arms = jobs_for_draw(d, folder, objects, attempts, params.seed, pictures), [*draw_arms(folder)]
+        poses = None
+        if paper_k is not None:
+            objects = paper_objects(objects, rule, paper_k, params.seed)
+            if not objects:
+                raise DataError(f"draw {d}: no feasible object for the paper's protocol")
+            poses = fixed_poses(objects, params.seed, sim.cell, sim.trial, params.grasps.gripper)
+        jobs = jobs_for_draw(d, folder, objects, attempts, params.seed, pictures, poses)
+        arms = [*draw_arms(folder)]
         log.info("real-picks draw %d: %d objects × %d attempts, arms %s", d, len(objects), attempts, arms)
-        picked = run_trials(jobs, sim, params.render.crop, params.workers)
+        picked = run_trials(jobs, sim, params.render.crop, params.workers, params.grasps.gripper, params.grasps)
         for row in picked:
             row["draw"] = d
+            row["feasible"], row["feasible_share"] = rule[row["object"]]["feasible"], rule[row["object"]]["share"]
         rows += picked
         seconds[d] = round(time.perf_counter() - began)
         log.info("real-picks draw %d: %d attempts in %d s", d, len(picked), seconds[d])
@@ -220,11 +273,43 @@ def run(
             on_draw(attempts_table(rows, done), seconds)
     table = attempts_table(rows, done)  # never empty: a draw is picked now or was kept before
     summary = pick_summary(table, list(dict.fromkeys(table.arm)), sim.n_bootstrap, params.seed)
+    summary["feasible"] = feasible_summary(table, sim.n_bootstrap, params.seed)
+    summary["feasibility_rule"] = {"max_width": params.grasps.gripper.max_width, "margin": 0.005, "min_height": 0.015}
     summary |= {"never_held": never_held(table), "skipped": skipped, "seconds": seconds, "attempts": attempts}
     summary["kept_before"] = sorted(earlier & set(folders))
+    summary["protocol"] = "drops" if paper_k is None else f"paper: {paper_k} feasible objects a draw, one pose each"
     if pictures:
         draw_pictures(rows, out)
     return table, summary, report_markdown(table, summary)
+
+
+#: The oracle's pick rate on feasible attempts below which the cell is not fit to compare planners (issue #83).
+ORACLE_FIT = 0.90
+
+
+def feasible_summary(table: pd.DataFrame, n_resamples: int, seed: int) -> dict:
+    """The picks on feasible objects (the ``feasible`` column, declared from geometry before any pick): counts of
+    feasible and all object-draws, :func:`pick_summary` of the feasible attempts, the oracle's rate there and
+    whether the cell is fit to compare planners (``oracle_fit``: the oracle picks at least :data:`ORACLE_FIT`),
+    and each arm's share of the oracle − antipodal span. ``{}`` where the table has no feasible attempt."""
+    if "feasible" not in table or not table.feasible.fillna(False).astype(bool).any():
+        return {}
+    feasible = table[table.feasible.fillna(False).astype(bool)]
+    pairs = table[["draw", "object"]].drop_duplicates()
+    out = {
+        "object_draws": int(len(feasible[["draw", "object"]].drop_duplicates())),
+        "all_object_draws": int(len(pairs)),
+        "attempts": int(len(feasible)),
+    }
+    out["summary"] = pick_summary(feasible, list(dict.fromkeys(feasible.arm)), n_resamples, seed)
+    arms = out["summary"]["arms"]
+    if ORACLE in arms:
+        oracle = arms[ORACLE]["mean"]
+        out["oracle_rate"], out["oracle_fit"] = oracle, bool(oracle >= ORACLE_FIT)
+        if ANTIPODAL in arms and oracle > arms[ANTIPODAL]["mean"]:
+            floor = arms[ANTIPODAL]["mean"]
+            out["span_share"] = {a: (c["mean"] - floor) / (oracle - floor) for a, c in arms.items()}
+    return out
 
 
 def attempts_table(rows: list[dict], done: pd.DataFrame | None = None) -> pd.DataFrame:
@@ -254,7 +339,7 @@ def draw_pictures(rows: list[dict], out: Path) -> None:
     """One success and one failure of each network arm (the first recorded of each), drawn as the cell's pictures."""
     from graspaug.experiments.cell.figures import pick_story, trial_picture
 
-    for arm in dict.fromkeys(r["arm"] for r in rows if r["arm"] != ANTIPODAL):
+    for arm in dict.fromkeys(r["arm"] for r in rows if r["arm"] not in (ANTIPODAL, ORACLE)):  # the networks
         for success in (True, False):
             row = next((r for r in rows if r["arm"] == arm and r["success"] == success and r.get("_frames")), None)
             if row is not None:
@@ -277,6 +362,7 @@ def report_markdown(table: pd.DataFrame, summary: dict) -> str:
     lines = [
         "# Picks of real objects by arm",
         "",
+        *feasible_lines(summary.get("feasible") or {}, text),
         f"{summary['objects']} objects (object × draw), {summary['attempts']} attempts each and arm, draws "
         f"{summary['draws']}; an object's attempts are one unit (its share of successes)."
         + (
@@ -305,6 +391,36 @@ def report_markdown(table: pd.DataFrame, summary: dict) -> str:
         hardest_objects(table).round(2).to_markdown(),
     ]
     return "\n".join(lines) + "\n"
+
+
+def feasible_lines(feasible: dict, text) -> list[str]:
+    """The report's first lines: success on the feasible objects (declared from geometry), the oracle's verdict on
+    the cell and each arm's share of the oracle − antipodal span."""
+    if not feasible:
+        return ["No feasible object (or no `feasible` column): every figure below is on all objects.", ""]
+    rate = feasible.get("oracle_rate")
+    verdict = (
+        "no oracle arm: whether the cell can tell planners apart is unknown"
+        if rate is None
+        else f"the oracle picks {rate:.0%} of feasible attempts: "
+        + ("the cell is fit to compare planners" if feasible["oracle_fit"] else
+           f"below {ORACLE_FIT:.0%}, the cell is NOT fit to compare planners (its physics caps success)")
+    )  # fmt: skip
+    span = feasible.get("span_share", {})
+    return [
+        f"Feasible objects first: {feasible['object_draws']} of {feasible['all_object_draws']} object-draws "
+        f"({feasible['attempts']} attempts); {verdict}.",
+        "",
+        "| arm (feasible objects) | success rate [95%] | share of oracle − antipodal |",
+        "|---|---|---|",
+        *(
+            f"| {a} | {text(c, '')} | {span[a]:.2f} |" if a in span else f"| {a} | {text(c, '')} | |"
+            for a, c in feasible["summary"]["arms"].items()
+        ),
+        "",
+        "All objects:",
+        "",
+    ]
 
 
 def ranking_lines(ranking: dict, text) -> list[str]:
