@@ -94,7 +94,7 @@ def run(study: Path, corpus: Path, out: Path, cache: Path, unit_scale: float, n_
     from graspaug.io.tables import read_table
     from graspaug.pipeline.studies.draws import provenance
 
-    began = time.perf_counter()
+    began, made_by = time.perf_counter(), provenance(Path.cwd(), command)  # the commit that runs, not a later one
     plan = read_plan(study / PLAN)
     draws, arms, models = kept_networks(study)
     contrasts = planned_contrasts(plan, arms)
@@ -102,7 +102,7 @@ def run(study: Path, corpus: Path, out: Path, cache: Path, unit_scale: float, n_
     labels, objects, predictions, folder, counts = predict_on(named, corpus, cache, unit_scale)
     held = {o for o, y in zip(objects, labels) if y}
     shapes = read_table(folder / "shapes.parquet").set_index("shape_id")
-    meta = provenance(Path.cwd(), command) | {
+    meta = made_by | {
         "study": str(study),
         "corpus": str(corpus),
         "test_set": folder.name,
