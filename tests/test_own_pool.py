@@ -65,6 +65,7 @@ def test_dvc_repro_own_pool_from_an_ae_of_the_base_set_alone(repo_root, tmp_path
     params = yaml.safe_load((work / "params.yaml").read_text())
     params["gqcnn"] |= {"pools": ["targeted", "own"], "control_ratios": [1.0], "members": 1, "ceiling": False}
     params["gqcnn"]["seeds"] = [0]
+    params["gqcnn"]["networks"] = [["targeted", 6, 0.5], ["own", 6, 1.0]]  # generate makes only what these train on
     params["generate"]["own"] = {"epochs_ae": 150, "epochs_critic": 1}  # the main AE's epochs (half its SGD steps)
     (work / "params.yaml").write_text(yaml.safe_dump(params, sort_keys=False))
     for cmd in (["git", "init", "-q"], ["git", "add", "-A"], ["git", "commit", "-q", "-m", "clone"]):
@@ -87,7 +88,7 @@ def test_dvc_repro_own_pool_from_an_ae_of_the_base_set_alone(repo_root, tmp_path
 
     index = pd.read_parquet(work / "data/generated/6/index.parquet")
     own, targeted = (index[index.pool == p] for p in ("own", "targeted"))
-    assert list(own.order) == list(range(6)) and list(targeted.order) == list(range(6))  # 1:1 of B = 6
+    assert list(own.order) == list(range(6)) and list(targeted.order) == list(range(3))  # 1:1 and 1:0.5 of B = 6
     assert set(own.parent_a) | set(own.parent_b) <= set(base) and set(own.selected_by) <= {"rarity", "graspness"}
     assert own.shape_id.str.startswith("gen_6_o").all() and own.rarity_vs_base.notna().all()
     assert set(index.pool) == {"targeted", "own"}  # random and the rest: not asked for
