@@ -106,24 +106,14 @@ def test_readme_example_plans_an_antipodal_grasp(scene, model_path, tmp_path):
     assert 0 <= floor.value <= 1 and floor.accepts(grasp.quality) == (grasp.quality >= floor.value)
 
 
-def test_top_k_is_ranked_and_the_best_two_are_antipodal(scene, model_path):
-    """Top-3 distinct grasps, ranked; #1 and #2 close on the mesh in force closure."""
+def test_top_k_is_ranked_and_every_grasp_antipodal(scene, model_path):
+    """Top-3 distinct grasps, ranked; each closes on the mesh in force closure. (Before vertices were read to
+    1 µm, rnd_000 rested 0.2° otherwise and its third grasp showed the image check's limit, docs/planning.md.)"""
     grasps = plan_grasps(depth_of(scene), K, model_path, top=3)
     assert len(grasps) == 3
     assert [g.quality for g in grasps] == sorted((g.quality for g in grasps), reverse=True)
-    for g in grasps[:2]:
+    for g in grasps:
         assert_antipodal(scene, g.position, g.rotation, g.width)
-
-
-@pytest.mark.xfail(
-    strict=True,
-    reason="a known limit (docs/planning.md): the 3rd distinct grasp's jaw line is 34-35 deg off the image's edge "
-    "normals (inside the image check's 38.7 deg cone, mu = 0.8) but 47-49 deg off the mesh normals, which tilt out "
-    "of the image plane on the rounded flank: no force closure. The image check is looser than the mesh.",
-)
-def test_the_third_distinct_grasp_is_antipodal_on_the_mesh(scene, model_path):
-    g = plan_grasps(depth_of(scene), K, model_path, top=3)[2]
-    assert_antipodal(scene, g.position, g.rotation, g.width)
 
 
 def test_the_cli_plans_on_a_16_bit_png(scene, model_path, tmp_path):
@@ -428,16 +418,22 @@ def test_the_picture_enlarges_the_object(scene, model_path, tmp_path):
 def carded_model(scene, model_path, tmp_path_factory):
     """The untrained GQ-CNN of ``model_path`` with a card of format /2: the operating point of a validation
     set whose successes the network scored 0.9 and above (so its floor is 0.9, above anything this untrained
-    network gives), and the training range of the crops of its own top 5 grasps on rnd_000 (2.3-2.5 cm
-    above the table, gripper depths 0.688-0.693 m)."""
+    network gives), and the training range of the crops of its own top 5 grasps on rnd_000 seen from 0.69, 0.70
+    and 0.71 m (2.3-2.5 cm above the table, gripper depths 0.679-0.703 m). Three heights, as training views
+    come from a range of them: the range's central 95% of 5 grasps seen from 0.7 m alone leaves out its
+    deepest, which may be the best (as it is since vertices are read to 1 µm)."""
     planner = load_planner(model_path)
-    depth = depth_of(scene)
-    grasps = planner.plan(depth, K, 0, top=5)
-    crops, _ = planner.network_crops(depth, K, grasps)
+    mesh, camera = scene
+    crops, depths = [], []
+    for height in (0.69, 0.70, 0.71):
+        depth = render_depth(mesh, look_at(np.array([0.02, -0.01, height]), np.zeros(3)), Intrinsics())
+        grasps = planner.plan(depth, K, 0, top=5)
+        crops.append(planner.network_crops(depth, K, grasps)[0])
+        depths += [g.depth for g in grasps]
     net, card = read_gqcnn(model_path)
     summary = {"pool": "targeted", "base_size": 50, "ratio": 0.0, "seed": 0, "train": {}, "validation": {}, "test": {}}
     point = operating_point([0, 0, 1, 1], [0.1, 0.2, 0.9, 0.95])
-    carded = finish_gqcnn_card(card, summary, point, training_range(crops, np.array([g.depth for g in grasps])))
+    carded = finish_gqcnn_card(card, summary, point, training_range(np.concatenate(crops), np.array(depths)))
     path = tmp_path_factory.mktemp("carded") / "model.pt"
     save_gqcnn(path, net, summary, carded)
     return path
@@ -478,9 +474,9 @@ def test_a_tall_object_is_warned_of_and_its_grasp_rejected_below_the_floor(
     lines = result.output.strip().splitlines()
     warnings = [line for line in lines if line.startswith("warning: ")]
     assert result.exit_code == 1, result.output
-    tall = "95% of the training crops (2.3-2.4 cm"
+    tall = "95% of the training crops (2.3-2.5 cm"
     assert any("19.0 cm above the table" in w and tall in w for w in warnings), warnings
-    assert any("gripper depth is 0.5" in w and "0.688-0.693 m" in w for w in warnings), warnings
+    assert any("gripper depth is 0.5" in w and "0.679-0.703 m" in w for w in warnings), warnings
     rejected = [line for line in lines if line.startswith("rejected: ")]
     assert len(rejected) == 1 and "below the floor 0.900" in rejected[0], result.output
     assert "the model card's validation operating point, max F1 1.00 on 4 validation grasps" in rejected[0]

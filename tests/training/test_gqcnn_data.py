@@ -66,7 +66,18 @@ def test_a_new_data_seed_redraws_base_sets_validation_and_real_pool_but_not_the_
     # stages that draw the experiment's data read data_seed
     # (fidelity takes the real pool as they do; the report names the draw its decomposition comes from; the lifelong
     # loop's rounds draw their random parents from it and name the draw in their reports; sim names the draw its
-    # contrasts cover)
+    # contrasts cover; train_ae_own trains the own pool's AE-Critic on the base set alone, which it draws with
+    # data_seed as generate does: base_ids(..., params.data_seed))
     stages = yaml.safe_load((repo_root / "dvc.yaml").read_text())["stages"]
     readers = {name for name, stage in stages.items() if "data_seed" in (stage.get("do") or stage).get("params", [])}
-    assert readers == {"split", "generate", "fidelity", "train_gqcnn", "report", "lifelong_start", "lifelong", "sim"}
+    assert readers == {
+        "split",
+        "generate",
+        "train_ae_own",
+        "fidelity",
+        "train_gqcnn",
+        "report",
+        "lifelong_start",
+        "lifelong",
+        "sim",
+    }

@@ -110,7 +110,10 @@ def test_ingest_keeps_good_shapes_and_records_every_reject(tmp_path, corpus_para
     assert closed_by.pop("f_good_two_boxes") == "filled"  # their shared faces are inside: not a closed surface
     assert set(closed_by.values()) == {"as_is"}
     hull_fill = dict(zip(shapes.shape_id, shapes.hull_fill))
-    assert hull_fill["f_good_box"] == pytest.approx(1.0) and hull_fill["f_good_holed_ball"] > 0.95  # solid, not a shell
+    # solid, not a shell. Not 1 exactly: the box is rebuilt from its field (34k faces) and decimated to 5,000; read
+    # to 1 µm its faces lie exactly on grid planes, aggression 3 pinches an edge and aggression 7, which then
+    # decides, dents it by 0.6% (hull_fill 0.994; float32 noise had let aggression 3 keep it at 1.000)
+    assert hull_fill["f_good_box"] > 0.99 and hull_fill["f_good_holed_ball"] > 0.95
     assert 0.5 < hull_fill["f_good_ring"] < 0.7  # a torus fills about 0.6 of its hull
     summary = [r.getMessage() for r in caplog.records if "closed_by" in r.getMessage()]
     assert len(summary) == 1
