@@ -213,3 +213,26 @@ def test_the_papers_protocol_picks_feasible_objects_each_from_one_pose(repo_root
     assert only.exit_code == 0, only.output
     summary = json.loads((tmp_path / "only" / "summary.json").read_text())
     assert summary["objects"] == 1 and any(k.endswith("3d_dollhouse_tablepurple") for k in summary["skipped"])
+
+
+def test_the_committed_figures_of_a_table_with_feasibility_name_the_cells_fitness_and_each_arms_span():
+    """``graspaug results``' picks figures of a table with ``feasible``: the count of feasible object-draws, whether
+    the oracle's rate makes the cell fit to compare planners (at least 90%), and each arm's share of the oracle −
+    antipodal span, from the feasible attempts alone."""
+    from graspaug.experiments.results import picks_figures
+
+    rows = []
+    for o, feasible in ((0, True), (1, True), (2, False)):
+        for arm, rate in (("oracle", 1.0), ("antipodal", 0.25), ("none@50", 0.75)):
+            rows += [{"draw": 0, "arm": arm, "object": f"o{o}", "attempt": a, "success": a < 4 * rate,
+                      "feasible": feasible} for a in range(4)]  # fmt: skip
+    table = pd.DataFrame(rows)
+    from graspaug.experiments.cell.picks import feasible_summary
+
+    result = pick_summary(table, ["none@50", "oracle", "antipodal"], 200, 0) | {
+        "feasible": feasible_summary(table, 200, 0)
+    }
+    figures = picks_figures(result, "p")
+    assert figures["p/feasible/object_draws"] == "2 feasible object-draws of 3"
+    assert figures["p/feasible/oracle_fit"] == "fit to compare planners"
+    assert figures["p/feasible/span/none@50"] == "0.67" and figures["p/feasible/span/oracle"] == "1.00"

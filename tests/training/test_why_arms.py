@@ -208,3 +208,18 @@ def test_an_explicit_list_of_networks_makes_only_the_shapes_its_networks_train_o
     assert networks_at(networks, 50) == {"targeted": {1.0}, "random": {1.0}}
     assert networks_at(networks, 200) == {"targeted": {2.0}}
     assert networks_at(networks, 100) == {} and networks_at([], 50) is None
+
+
+def test_generate_makes_only_the_pools_and_ratios_its_listed_networks_train_on():
+    from graspaug.augment.settings import GenerateSettings
+    from graspaug.training.settings import listed_pools
+
+    cfg = GenerateSettings(base_sizes=(50, 200), ratios=(0.0, 1.0, 2.0))
+    networks = [["targeted", 50, 1.0], ["own", 50, 1.0], ["targeted", 200, 2.0]]
+    assert listed_pools(cfg, ["targeted", "random", "own"], networks, 50)[1] == ["targeted", "own"]
+    assert listed_pools(cfg, ["targeted", "random", "own"], networks, 50)[0].ratios == (0.0, 1.0)
+    assert listed_pools(cfg, ["targeted", "random"], networks, 200) == (
+        GenerateSettings(**{**vars(cfg)} | {"ratios": (0.0, 2.0)}),
+        ["targeted"],
+    )
+    assert listed_pools(cfg, ["targeted", "random"], [], 200) == (cfg, ["targeted", "random"])

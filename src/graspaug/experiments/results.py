@@ -509,12 +509,12 @@ def _confirm():
 def combine_picks(folder: Path) -> dict:
     """The robot picks' summary (:func:`~graspaug.experiments.cell.picks.pick_summary`) of ``attempts.parquet``,
     with the bootstrap settings its ``meta.json`` names."""
-    from graspaug.experiments.cell.picks import pick_summary
+    from graspaug.experiments.cell.picks import feasible_summary, pick_summary
 
     attempts = pd.read_parquet(folder / "attempts.parquet")
     meta = json.loads((folder / "meta.json").read_text())
-    arms = list(dict.fromkeys(attempts.arm))
-    return pick_summary(attempts, arms, meta.get("n_bootstrap", 2000), meta.get("seed", 0))
+    arms, n, seed = list(dict.fromkeys(attempts.arm)), meta.get("n_bootstrap", 2000), meta.get("seed", 0)
+    return pick_summary(attempts, arms, n, seed) | {"feasible": feasible_summary(attempts, n, seed)}
 
 
 def picks_figures(result: dict, study: str) -> dict[str, str]:
@@ -530,6 +530,14 @@ def picks_figures(result: dict, study: str) -> dict[str, str]:
         out[f"{study}/{name}/verdict"] = c["verdict"]
         if c.get("per_draw"):
             out[f"{study}/{name}/per_draw"] = ", ".join(f"{v:+.3f}" for v in c["per_draw"])
+    feasible = result.get("feasible") or {}
+    if feasible:  # a table with the feasibility rule: the count, the oracle's verdict on the cell, each arm's share
+        n, picked = feasible["object_draws"], feasible["all_object_draws"]
+        out[f"{study}/feasible/object_draws"] = f"{n} feasible object-draws" + (f" of {picked}" if picked > n else "")
+        if "oracle_fit" in feasible:
+            fit = "fit to compare planners" if feasible["oracle_fit"] else "not fit to compare planners"
+            out[f"{study}/feasible/oracle_fit"] = fit
+        out |= {f"{study}/feasible/span/{a}": f"{v:.2f}" for a, v in feasible.get("span_share", {}).items()}
     ranking = result.get("ranking") or {}
     out |= {f"{study}/ranking/{arm}": text(c) for arm, c in ranking.get("arms", {}).items()}
     for name, c in ranking.get("contrasts", {}).items():

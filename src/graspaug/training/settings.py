@@ -214,11 +214,14 @@ def networks_at(networks, base_size: int) -> dict[str, set[float]] | None:
     return out
 
 
-def listed_pools(pools, ratios, networks, base_size: int) -> tuple[list[str], list[float]]:
-    """``pools`` and targeted's ``ratios`` at ``base_size`` cut to what ``gqcnn.networks`` trains on there
-    (:func:`networks_at`); unchanged without a list."""
+def listed_pools(cfg, pools, networks, base_size: int) -> tuple:
+    """``generate``'s settings ``cfg`` and its ``pools`` at ``base_size`` cut to what ``gqcnn.networks`` trains on there
+    (:func:`networks_at`: the pools, and targeted's ratios); unchanged without a list."""
+    import dataclasses
+
     wanted = networks_at(networks, base_size)
     if wanted is None:
-        return list(pools), list(ratios)
-    kept = sorted({0.0, *wanted["targeted"]}) if wanted.get("targeted") else list(ratios)
-    return [p for p in pools if p in wanted], kept
+        return cfg, list(pools)
+    if wanted.get("targeted"):
+        cfg = dataclasses.replace(cfg, ratios=tuple(sorted({0.0, *wanted["targeted"]})))
+    return cfg, [p for p in pools if p in wanted]

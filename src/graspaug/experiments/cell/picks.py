@@ -22,6 +22,8 @@ from graspaug.experiments.confirm.numbers import draw_test
 from graspaug.experiments.stats import ObjectBootstrap, percentile_interval
 
 ANTIPODAL = "antipodal"
+#: The arm that picks with the best grasp on the true mesh in the dropped pose (graspaug.sim.oracle.MeshOracle).
+ORACLE = "oracle"
 #: The paper's robot result (Section IV-D): 8 everyday objects, 10 attempts each, no interval.
 PAPER = {"objects": 8, "attempts": 10, "before": 0.68, "after": 0.86}
 
@@ -221,3 +223,32 @@ def pick_power(attempts: pd.DataFrame, a: str, b: str, n_objects: int, draws: Se
         "effect": effect,
         "power": {int(d): power(int(d), per_draw, effect) for d in draws},
     }
+
+
+#: The oracle's pick rate on feasible attempts below which the cell is not fit to compare planners (issue #83).
+ORACLE_FIT = 0.90
+
+
+def feasible_summary(table: pd.DataFrame, n_resamples: int, seed: int) -> dict:
+    """The picks on feasible objects (the ``feasible`` column, declared from geometry before any pick): counts of
+    feasible and all object-draws, :func:`pick_summary` of the feasible attempts, the oracle's rate there and
+    whether the cell is fit to compare planners (``oracle_fit``: the oracle picks at least :data:`ORACLE_FIT`),
+    and each arm's share of the oracle − antipodal span. ``{}`` where the table has no feasible attempt."""
+    if "feasible" not in table or not table.feasible.fillna(False).astype(bool).any():
+        return {}
+    feasible = table[table.feasible.fillna(False).astype(bool)]
+    pairs = table[["draw", "object"]].drop_duplicates()
+    out = {
+        "object_draws": int(len(feasible[["draw", "object"]].drop_duplicates())),
+        "all_object_draws": int(len(pairs)),
+        "attempts": int(len(feasible)),
+    }
+    out["summary"] = pick_summary(feasible, list(dict.fromkeys(feasible.arm)), n_resamples, seed)
+    arms = out["summary"]["arms"]
+    if ORACLE in arms:
+        oracle = arms[ORACLE]["mean"]
+        out["oracle_rate"], out["oracle_fit"] = oracle, bool(oracle >= ORACLE_FIT)
+        if ANTIPODAL in arms and oracle > arms[ANTIPODAL]["mean"]:
+            floor = arms[ANTIPODAL]["mean"]
+            out["span_share"] = {a: (c["mean"] - floor) / (oracle - floor) for a, c in arms.items()}
+    return out

@@ -13,14 +13,12 @@ import numpy as np
 import pandas as pd
 
 from graspaug.errors import DataError
+from graspaug.experiments.cell.picks import ORACLE  # the arm of the best grasp on the true mesh (sim.oracle)
 from graspaug.rng import shape_rng
 from graspaug.sim.objects import PreparedObject, prepare_objects
 from graspaug.training.variants import network_variant
 
 log = logging.getLogger(__name__)
-
-#: The arm that picks with the best grasp on the true mesh in the dropped pose (graspaug.sim.oracle.MeshOracle).
-ORACLE = "oracle"
 
 
 @dataclass(frozen=True)

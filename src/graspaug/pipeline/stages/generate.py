@@ -11,7 +11,6 @@ ratio R's set; a failed shape is replaced by the next candidate, except in recon
 
 from __future__ import annotations
 
-import dataclasses
 import logging
 import time
 from functools import partial
@@ -61,8 +60,8 @@ def run(params: Params, base_size: int) -> None:
 
     ae, _, _ = load_autoencoder(paths.AE_CRITIC_MODEL, params.ae.net)
     meshes = partial(mesh_batches, device=resolve_device(params.device), settings=cfg.decode, workers=params.workers)
-    pools, ratios = listed_pools([p for p in GENERATED_POOLS if p in gq.pools], cfg.ratios, gq.networks, base_size)
-    cfg, recon, own = dataclasses.replace(cfg, ratios=tuple(ratios)), None, None  # gqcnn.networks: what they use
+    cfg, pools = listed_pools(cfg, [p for p in GENERATED_POOLS if p in gq.pools], gq.networks, base_size)
+    recon, own = None, None
     if "recon" in pools:  # the real pool as the GQ-CNN experiment draws it
         split = load_split(paths.gqcnn_dir("original"), shapes, list(cfg.base_sizes), gq.val_shapes, params.data_seed)
         real = base_set(np.array(split.real_pool), latents, scores, voxels, params.score.k)

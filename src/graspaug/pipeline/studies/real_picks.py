@@ -26,8 +26,17 @@ import numpy as np
 import pandas as pd
 
 from graspaug.errors import DataError
-from graspaug.experiments.cell.picks import ANTIPODAL, hardest_objects, never_held, paper_table, pick_summary
-from graspaug.experiments.cell.trials import ORACLE, ObjectJob, run_trials
+from graspaug.experiments.cell.picks import (
+    ANTIPODAL,
+    ORACLE,
+    ORACLE_FIT,
+    feasible_summary,
+    hardest_objects,
+    never_held,
+    paper_table,
+    pick_summary,
+)
+from graspaug.experiments.cell.trials import ObjectJob, run_trials
 from graspaug.rng import shape_rng
 
 log = logging.getLogger(__name__)
@@ -281,35 +290,6 @@ def run(
     if pictures:
         draw_pictures(rows, out)
     return table, summary, report_markdown(table, summary)
-
-
-#: The oracle's pick rate on feasible attempts below which the cell is not fit to compare planners (issue #83).
-ORACLE_FIT = 0.90
-
-
-def feasible_summary(table: pd.DataFrame, n_resamples: int, seed: int) -> dict:
-    """The picks on feasible objects (the ``feasible`` column, declared from geometry before any pick): counts of
-    feasible and all object-draws, :func:`pick_summary` of the feasible attempts, the oracle's rate there and
-    whether the cell is fit to compare planners (``oracle_fit``: the oracle picks at least :data:`ORACLE_FIT`),
-    and each arm's share of the oracle − antipodal span. ``{}`` where the table has no feasible attempt."""
-    if "feasible" not in table or not table.feasible.fillna(False).astype(bool).any():
-        return {}
-    feasible = table[table.feasible.fillna(False).astype(bool)]
-    pairs = table[["draw", "object"]].drop_duplicates()
-    out = {
-        "object_draws": int(len(feasible[["draw", "object"]].drop_duplicates())),
-        "all_object_draws": int(len(pairs)),
-        "attempts": int(len(feasible)),
-    }
-    out["summary"] = pick_summary(feasible, list(dict.fromkeys(feasible.arm)), n_resamples, seed)
-    arms = out["summary"]["arms"]
-    if ORACLE in arms:
-        oracle = arms[ORACLE]["mean"]
-        out["oracle_rate"], out["oracle_fit"] = oracle, bool(oracle >= ORACLE_FIT)
-        if ANTIPODAL in arms and oracle > arms[ANTIPODAL]["mean"]:
-            floor = arms[ANTIPODAL]["mean"]
-            out["span_share"] = {a: (c["mean"] - floor) / (oracle - floor) for a, c in arms.items()}
-    return out
 
 
 def attempts_table(rows: list[dict], done: pd.DataFrame | None = None) -> pd.DataFrame:
