@@ -530,6 +530,8 @@ def picks_figures(result: dict, study: str) -> dict[str, str]:
         out[f"{study}/{name}/verdict"] = c["verdict"]
         if c.get("per_draw"):
             out[f"{study}/{name}/per_draw"] = ", ".join(f"{v:+.3f}" for v in c["per_draw"])
+    d = result.get("draws") or []
+    out[f"{study}/draws"] = f"{len(d)} draw{'s' if len(d) != 1 else ''} ({', '.join(str(x) for x in d)})"
     feasible = result.get("feasible") or {}
     if feasible:  # a table with the feasibility rule: the count, the oracle's verdict on the cell, each arm's share
         n, picked = feasible["object_draws"], feasible["all_object_draws"]
