@@ -68,7 +68,10 @@ def test_both_readouts_pair_by_draw_and_the_control_shows_only_when_it_is_there(
     figures = external_figures(strong, "x")
     assert figures["x/pooled/control/verdict"] == "shows" and figures["x/pooled/real_data/draws"].startswith("4 of 4")
     # the pooled value of a draw is the AP over every datapoint, the per-object one the mean of the objects' APs
-    test, p = pd.read_parquet(tmp_path / "a/ext/test.parquet"), pd.read_parquet(tmp_path / "a/ext/predictions.parquet")
+    test, p = (
+        pd.read_parquet(tmp_path / "a/ext/test.parquet"),
+        pd.read_parquet(tmp_path / "a/ext/predictions-d10.parquet"),
+    )
     col = p[column(10, 0, ("targeted", 150, 0.0))].to_numpy()
     y, ones = test.label.to_numpy().astype(bool), np.ones(len(test))
     a150, a50 = (
@@ -82,8 +85,8 @@ def test_both_readouts_pair_by_draw_and_the_control_shows_only_when_it_is_there(
 
 def test_a_missing_network_or_file_is_named(tmp_path):
     folder = _folder(tmp_path, effect=1.0)
-    p = pd.read_parquet(folder / "predictions.parquet").drop(columns=[column(12, 0, ("targeted", 50, 1.0))])
-    p.to_parquet(folder / "predictions.parquet")
+    p = pd.read_parquet(folder / "predictions-d12.parquet").drop(columns=[column(12, 0, ("targeted", 50, 1.0))])
+    p.to_parquet(folder / "predictions-d12.parquet")
     with pytest.raises(DataError, match=r"draw 12's targeted@50"):
         combine_external(folder)
     (folder / "test.parquet").unlink()
@@ -111,9 +114,9 @@ def test_the_committed_ycb_table_is_what_the_kept_networks_predict(tmp_path):
     cmd = [str(Path(sys.executable).parent / "graspaug"), "study", "external", str(study), "--corpus", str(corpus)]
     done = subprocess.run([*cmd, "--out", str(out), "--cache", str(tmp_path / "cache")], env=env, capture_output=True)
     # one draw: no interval over draws, which the figures cannot print; the tables are what is compared
-    assert (out / "predictions.parquet").is_file(), done.stderr.decode()[-2000:]
-    again, made = pd.read_parquet(out / "test.parquet"), pd.read_parquet(out / "predictions.parquet")
-    committed = pd.read_parquet(COMMITTED / "predictions.parquet")
+    assert (out / "predictions-d10.parquet").is_file(), done.stderr.decode()[-2000:]
+    again, made = pd.read_parquet(out / "test.parquet"), pd.read_parquet(out / "predictions-d10.parquet")
+    committed = pd.read_parquet(COMMITTED / "predictions-d10.parquet")
     for name in objects:
         ids = [o for o in set(test.object) if o.endswith(name) or name in o]
         assert ids, f"{name} not in the committed test set"
@@ -133,7 +136,8 @@ def test_a_plans_external_set_is_read_with_its_own_control_and_holm(tmp_path):
     from graspaug.experiments.confirm.words import confirm_figures
 
     folder = _folder(tmp_path, effect=2.0)
-    test, predictions = pd.read_parquet(folder / "test.parquet"), pd.read_parquet(folder / "predictions.parquet")
+    test = pd.read_parquet(folder / "test.parquet")
+    predictions = pd.concat([pd.read_parquet(folder / f"predictions-d{d}.parquet") for d in (10, 11, 12, 13)], axis=1)
     test.to_parquet(folder / "test-ycb78.parquet")
     for d in (10, 11, 12, 13):
         predictions[[c for c in predictions if c.startswith(f"{d}/")]].to_parquet(

@@ -271,7 +271,7 @@ def study_kind(folder: Path) -> str:
     """The study a results folder holds: ``confirm`` where it has a plan (``plan.yaml``), ``picks`` where it has a
     table of pick attempts (``attempts.parquet``), else its name's first word (``attribution-real-objects``:
     ``attribution``), or ``external`` where that names no study and it holds one table of predictions of a
-    confirmatory study's networks on an external test set (``predictions.parquet``)."""
+    confirmatory study's networks on an external test set (``test.parquet``, ``predictions-d<draw>.parquet``)."""
     from graspaug.experiments.confirm.tables import PLAN
 
     if (Path(folder) / PLAN).is_file():
@@ -279,7 +279,7 @@ def study_kind(folder: Path) -> str:
     if (Path(folder) / "attempts.parquet").is_file():
         return "picks"
     named = Path(folder).name.split("-")[0]
-    if named not in STUDIES and (Path(folder) / "predictions.parquet").is_file():
+    if named not in STUDIES and (Path(folder) / "test.parquet").is_file() and any(Path(folder).glob("predictions-d*")):
         return "external"
     return named
 

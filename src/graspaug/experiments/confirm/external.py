@@ -3,8 +3,9 @@ one fixed set of objects from another source (``../shared/external/ycb78``), in 
 study's (``results/<study>-<set>/``), so that the plan's folder holds only what the plan named.
 
 * ``test.parquet`` — the external datapoints (``label``, ``object``), one test set for every draw;
-* ``predictions.parquet`` — each network's P(success) of every datapoint, one float32 column per network,
-  ``<draw>/<seed>/<pool>/<B>-<R>`` (:func:`~graspaug.experiments.confirm.tables.column`);
+* ``predictions-d<draw>.parquet`` — each of that draw's networks' P(success) of every datapoint, one float32 column
+  per network, ``<draw>/<seed>/<pool>/<B>-<R>`` (:func:`~graspaug.experiments.confirm.tables.column`): a file a draw,
+  each well under git's comfortable size;
 * ``meta.json`` — the arms (name → pool, B, R), the draws, the contrasts (name → [a, b]; the first one the positive
   control), the bootstrap's resamples and seed, the counts, the command, commit, date, wall time and machine.
 
@@ -32,7 +33,7 @@ from graspaug.experiments.confirm.numbers import network_values
 from graspaug.experiments.confirm.tables import column
 from graspaug.experiments.stats import nested_t_interval
 
-FILES = ("test.parquet", "predictions.parquet", "meta.json")
+FILES = ("test.parquet", "meta.json")  # and predictions-d<draw>.parquet, one a draw
 READOUTS = ("pooled", "per_object")
 
 
@@ -44,16 +45,20 @@ def combine_external(folder: Path) -> dict:
     if missing:
         raise DataError(f"{folder}: lacks {', '.join(missing)} (an external check's folder holds {', '.join(FILES)})")
     meta = json.loads((folder / "meta.json").read_text())
-    test, predictions = pd.read_parquet(folder / "test.parquet"), pd.read_parquet(folder / "predictions.parquet")
+    test = pd.read_parquet(folder / "test.parquet")
     labels, objects = test.label.to_numpy().astype(bool), test.object.to_numpy()
     draws, seed, n = [int(d) for d in meta["draws"]], int(meta.get("seed", 0)), int(meta["n_resamples"])
+    missing = [f"predictions-d{d}.parquet" for d in draws if not (folder / f"predictions-d{d}.parquet").is_file()]
+    if missing:
+        raise DataError(f"{folder}: lacks {', '.join(missing)} (each draw's predictions)")
+    predictions = pd.concat([pd.read_parquet(folder / f"predictions-d{d}.parquet") for d in draws], axis=1)
     values: dict[str, dict[str, list]] = {r: {} for r in READOUTS}
     for arm, key in meta["arms"].items():
         rows = {r: [] for r in READOUTS}
         for d in draws:
             name = column(d, 0, (key[0], int(key[1]), float(key[2])))
             if name not in predictions:
-                raise DataError(f"{folder}/predictions.parquet: no column {name!r} (draw {d}'s {arm} network)")
+                raise DataError(f"{folder}/predictions-d{d}.parquet: no column {name!r} (draw {d}'s {arm} network)")
             for r, v in network_values(labels, objects, predictions[name].to_numpy(), n, seed).items():
                 rows[r].append(v)
         for r in READOUTS:
@@ -139,7 +144,8 @@ def write_external(folder: Path, labels, objects, predictions: Mapping[str, np.n
     test = pd.DataFrame({"label": np.asarray(labels, dtype=np.int8), "object": np.asarray(objects)})
     with atomic_path(folder / "test.parquet") as tmp:
         test.to_parquet(tmp, index=False)
-    columns = {k: np.asarray(v, dtype=np.float32) for k, v in predictions.items()}
-    write_predictions(columns, folder / "predictions.parquet")
+    for draw in sorted({k.split("/", 1)[0] for k in predictions}, key=int):
+        columns = {k: np.asarray(v, dtype=np.float32) for k, v in predictions.items() if k.split("/", 1)[0] == draw}
+        write_predictions(columns, folder / f"predictions-d{draw}.parquet")
     with atomic_path(folder / "meta.json") as tmp:
         tmp.write_text(json.dumps(dict(meta), indent=1) + "\n")
