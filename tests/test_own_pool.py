@@ -66,7 +66,7 @@ def test_dvc_repro_own_pool_from_an_ae_of_the_base_set_alone(repo_root, tmp_path
     params["gqcnn"] |= {"pools": ["targeted", "own"], "control_ratios": [1.0], "members": 1, "ceiling": False}
     params["gqcnn"]["seeds"] = [0]
     params["gqcnn"]["networks"] = [["targeted", 6, 0.5], ["own", 6, 1.0]]  # generate makes only what these train on
-    params["generate"]["own"] = {"epochs_ae": 40, "epochs_critic": 1}  # few: the test checks what it trained on
+    params["generate"]["own"] = {"epochs_ae": 150, "epochs_critic": 1}  # the main AE's epochs (half its SGD steps)
     (work / "params.yaml").write_text(yaml.safe_dump(params, sort_keys=False))
     for cmd in (["git", "init", "-q"], ["git", "add", "-A"], ["git", "commit", "-q", "-m", "clone"]):
         run(cmd, work, env)
@@ -78,7 +78,7 @@ def test_dvc_repro_own_pool_from_an_ae_of_the_base_set_alone(repo_root, tmp_path
     assert summary["trained"] and summary["train_ids"] == base
     _, critic, trained = load_autoencoder(work / "models/ae_own/6/ae_critic.pt", AEConfig(**params["ae"]["net"]))
     assert trained["train_ids"] == base and critic is not None  # an AE-Critic that saw the base set and nothing else
-    assert summary["n_train"] == 6 and (summary["epochs_ae"], summary["epochs_critic"]) == (40, 1)
+    assert summary["n_train"] == 6 and (summary["epochs_ae"], summary["epochs_critic"]) == (150, 1)
     assert all(summary[k] is not None and 0 <= summary[k] <= 1 for k in ("iou_base", "main_iou_base"))
     metrics = json.loads((work / "metrics/train_ae_own/6.json").read_text())
     assert metrics == {k: summary[k] for k in ("shapes", "iou_base", "main_iou_base")} and metrics["shapes"] == 6
