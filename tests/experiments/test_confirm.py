@@ -93,6 +93,59 @@ def test_exchange_rate_is_read_only_inside_the_curve():
     assert above["worth"] is None and above["outside"] == "above"
 
 
+def test_the_exchange_rate_reads_each_draws_curve_on_its_own_sizes():
+    """Each draw's own sizes (objects holding datapoints): the same sizes in every draw give the common curve's
+    answer; a curve measured at fewer objects than nominal makes the same AP worth fewer objects."""
+    sizes = np.array([25, 50, 100, 150, 200])
+    curve = np.array([[0.2, 0.3, 0.4, 0.45, 0.5]] * 4) + np.array([[0.0], [0.01], [-0.01], [0.005]])
+    arm = np.array([0.41, 0.40, 0.39, 0.405])
+    common = confirm.exchange_rate_on_curve(sizes, curve, arm)
+    same = confirm.exchange_rate_on_curve(np.tile(sizes, (4, 1)), curve, arm)
+    assert {k: same[k] for k in ("worth", "low", "high")} == {k: common[k] for k in ("worth", "low", "high")}
+    fewer = confirm.exchange_rate_on_curve(np.tile(sizes * 0.9, (4, 1)) + np.arange(4)[:, None], curve, arm)
+    assert fewer["worth"] < common["worth"] and fewer["ends"][0] == pytest.approx(25 * 0.9 + 3)
+    assert fewer["ends"][1] == pytest.approx(200 * 0.9)  # the grid stays where every draw was measured
+
+
+def test_base_objects_count_what_each_draws_base_sets_hold(tmp_path):
+    """The base sets on actual counts: drawn as train_gqcnn draws them, kept where the renders hold datapoints,
+    nested, with the train split's size; checked against a networks table's datapoints."""
+    from graspaug.experiments.confirm.tables import base_objects, check_base_objects
+
+    ids = [f"s{i:02d}" for i in range(40)]
+    objects = pd.DataFrame({"shape_id": ids, "duplicate_of": [""] * 40})
+    rendered = ids[::2] + ids[1:20:2]  # half the odd shapes have no datapoint
+    index = pd.DataFrame({"shape_id": np.repeat(rendered, 3)})
+    (tmp_path / "original").mkdir()
+    index.to_parquet(tmp_path / "original" / "index.parquet")
+    counts = base_objects(objects, tmp_path / "original", [3, 4], [5, 10], 0.2, 3, 0)
+    assert list(counts.columns) == ["draw", "base_size", "objects", "datapoints", "train_objects"]
+    assert (counts.objects <= counts.base_size).all() and (counts.datapoints == 3 * counts.objects).all()
+    assert (counts.train_objects == 32).all() and counts.objects.lt(counts.base_size).any()
+    again = base_objects(objects, tmp_path / "original", [3, 4], [5, 10], 0.2, 3, 0)
+    pd.testing.assert_frame_equal(counts, again)
+    networks = counts.rename(columns={"datapoints": "train_datapoints"}).assign(ratio=0.0)
+    check_base_objects(counts, networks)
+    networks.loc[1, "train_datapoints"] += 1
+    with pytest.raises(DataError, match=f"draw 3, base size {networks.base_size[1]}: its 1:0 network trained on"):
+        check_base_objects(counts, networks)
+
+
+def test_the_committed_base_objects_are_the_first_studys_and_read_the_worth_on_them():
+    """results/real-objects-confirm/base-objects.parquet agrees with every 1:0 network's datapoints, and the worth
+    read on actual counts lies below the nominal one (fewer objects hold datapoints than the base size names)."""
+    from pathlib import Path
+
+    from graspaug.experiments.confirm.tables import check_base_objects
+
+    folder = Path(__file__).resolve().parents[2] / "results" / "real-objects-confirm"
+    counts = pd.read_parquet(folder / "base-objects.parquet")
+    check_base_objects(counts, pd.read_parquet(folder / "networks.parquet"))
+    result = combine_confirm(folder)
+    assert result["exchange_actual"]["worth"] < result["exchange"]["worth"]
+    assert result["base_objects"]["max"] <= 50 < result["base_objects"]["train_objects_min"]
+
+
 def test_the_plan_is_read_in_its_fixed_sequence():
     values = {
         d: {"none@50": 0.3, "none@150": 0.3 + c, "targeted@50": 0.3 + g, "random@50": 0.3 + g}

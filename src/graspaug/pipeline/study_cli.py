@@ -156,10 +156,21 @@ def confirm_command(
     scheduler: str = SchedulerOption,
     workers: int = WorkersOption,
     project: Path = ProjectOption,
+    count_objects: Path = typer.Option(
+        None,
+        "--count-objects",
+        help="Run nothing: write results/<name>/base-objects.parquet, each draw's base sets on actual counts (the "
+        "objects holding datapoints, and the train objects its AutoEncoder-Critic learned), from a finished draw's "
+        "clone (its objects table and renders); refused unless every 1:0 network's datapoints agree. The worth in "
+        "real objects is then also read on these counts. Seconds.",
+    ),
 ) -> None:
     from graspaug.pipeline.studies import confirm
 
     _logging()
+    if count_objects is not None:
+        typer.echo(confirm.count_objects(project, plan, count_objects))
+        return
     workdir = workdir or project.resolve().parent / "confirm"
     chosen = list(draws) if draws else None
     text = confirm.run(project, plan, workdir, chosen, scheduler, workers, combine_only, _command_line())

@@ -226,7 +226,10 @@ def exchange_rate_on_curve(sizes: Sequence[int], curve: np.ndarray, arm: np.ndar
 
     Parameters
     ----------
-    sizes : (K,) — the real base sizes of the curve (ascending, e.g. 25, 50, 100, 150, 200)
+    sizes : (K,) — the real base sizes of the curve (ascending, e.g. 25, 50, 100, 150, 200); or (D, K), each
+        draw's own sizes (e.g. the objects of each base set that hold datapoints): each draw's curve is read on its
+        own sizes, and the common grid runs from the largest first size to the smallest last one (every draw measured
+        there)
     curve : (D, K) — each draw's mean test AP of the 1:0 network at each size
     arm : (D,) — each draw's mean test AP of the arm (e.g. targeted@50)
 
@@ -235,14 +238,23 @@ def exchange_rate_on_curve(sizes: Sequence[int], curve: np.ndarray, arm: np.ndar
     dict — ``worth`` (the real base size whose mean-curve AP equals the arm's mean AP, linearly interpolated; None
     outside the curve, with ``outside`` "below" or "above"), ``low``, ``high`` (the sizes W at which a one-sample
     t over draws of arm − curve(W) is not rejected at ``level``, on a grid inside the curve; None where the interval
-    reaches the curve's end: "≤ smallest" or "≥ largest" is all the data say), ``sizes``
+    reaches the curve's end: "≤ smallest" or "≥ largest" is all the data say), ``sizes`` (the sizes, rounded, of a
+    common curve), ``ends`` (the grid's first and last size)
     """
-    sizes = np.asarray(sizes, dtype=float)
     curve, arm = np.asarray(curve, dtype=float), np.asarray(arm, dtype=float)
-    grid = np.linspace(sizes[0], sizes[-1], 701)
-    at = np.stack([np.interp(grid, sizes, row) for row in curve])  # (D, G)
+    per_draw = np.broadcast_to(np.asarray(sizes, dtype=float), curve.shape)
+    grid = np.linspace(per_draw[:, 0].max(), per_draw[:, -1].min(), 701)
+    at = np.stack([np.interp(grid, x, row) for x, row in zip(per_draw, curve)])  # (D, G)
     mean_at, target = at.mean(axis=0), float(arm.mean())
-    out = {"sizes": [int(s) for s in sizes], "worth": None, "low": None, "high": None, "outside": None}
+    shown = np.asarray(sizes, dtype=float)
+    out = {
+        "sizes": [int(round(s)) for s in (shown if shown.ndim == 1 else shown.mean(axis=0))],
+        "ends": [float(grid[0]), float(grid[-1])],
+        "worth": None,
+        "low": None,
+        "high": None,
+        "outside": None,
+    }
     if target < mean_at[0]:
         out["outside"] = "below"
     elif target > mean_at[-1]:

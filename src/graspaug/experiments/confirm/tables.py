@@ -39,6 +39,7 @@ from graspaug.experiments.kept import write_predictions
 from graspaug.experiments.stats import weighted_average_precision
 
 PLAN = "plan.yaml"
+BASE_OBJECTS = "base-objects.parquet"  # each draw's base sets on actual counts (:func:`base_objects`)
 PLAN_FORMAT = "graspaug.confirm-plan/1"
 #: What a plan must say (its hypotheses and design); the study refuses a plan without one of them.
 PLAN_KEYS = (
@@ -256,7 +257,12 @@ def combine_confirm(folder: Path) -> dict:
         return out
     values = {d: draw_values(folder, plan, d, sorted(plan["seeds"])) for d in planned}
     external = {name: external_result(folder, plan, name) for name in external_sets(plan)}
-    return out | {"status": "complete"} | read_plan_result(plan, values) | ({"external": external} if external else {})
+    counts = None
+    if (folder / BASE_OBJECTS).is_file():
+        counts = pd.read_parquet(folder / BASE_OBJECTS)
+        check_base_objects(counts, networks)
+    result = read_plan_result(plan, values, counts)
+    return out | {"status": "complete"} | result | ({"external": external} if external else {})
 
 
 def external_sets(plan: Mapping) -> dict[str, dict]:
@@ -300,9 +306,73 @@ def external_result(folder: Path, plan: Mapping, name: str) -> dict:
     return out | {"readout": readout, "arms": arms, "counts": counts | {"positives": int(test.label.sum())}}
 
 
-def read_plan_result(plan: Mapping, values: Mapping[int, Mapping[str, float]]) -> dict:
+def base_objects(
+    objects: pd.DataFrame,
+    original: Path,
+    draws: list[int],
+    base_sizes: list[int],
+    test_fraction: float,
+    val_shapes: int,
+    seed: int,
+    independent_draws: bool = True,
+) -> pd.DataFrame:
+    """What each draw's base sets hold on actual counts: the objects table ``objects`` (ingest's) split as the
+    ``split`` stage splits it for each data seed of ``draws``, the base sets drawn as ``train_gqcnn`` draws them, kept
+    where the rendered original corpus (dataset folder ``original``) holds datapoints of the object. One row a
+    (draw, base size): ``draw``, ``base_size`` (nominal), ``objects`` (base objects holding datapoints),
+    ``datapoints`` (theirs: what a 1:0 network of that size trains on) and ``train_objects`` (the draw's train
+    split, every object of which the draw's AutoEncoder-Critic learned)."""
+    from graspaug.augment.corpus import assign_split, split_seed
+    from graspaug.io.tables import read_table
+    from graspaug.training.gqcnn_data import load_split
+
+    per_object = read_table(Path(original) / "index.parquet").groupby("shape_id").size()
+    duplicates = dict(zip(objects.shape_id, objects.duplicate_of))
+    rows = []
+    for draw in draws:
+        split_of = assign_split(
+            list(objects.shape_id), test_fraction, split_seed(seed, draw, independent_draws), duplicates
+        )
+        shapes = objects.assign(split=objects.shape_id.map(split_of))
+        split = load_split(Path(original), shapes, sorted(base_sizes), val_shapes, draw)
+        for size, ids in split.base.items():
+            rows.append(
+                {
+                    "draw": int(draw),
+                    "base_size": int(size),
+                    "objects": len(ids),
+                    "datapoints": int(per_object.reindex(list(ids)).fillna(0).sum()),
+                    "train_objects": int((shapes.split == "train").sum()),
+                }
+            )
+    return pd.DataFrame(rows)
+
+
+def check_base_objects(counts: pd.DataFrame, networks: pd.DataFrame) -> None:
+    """A :func:`base_objects` table agrees with the draws it describes: every 1:0 network of ``networks`` (a plan
+    folder's ``networks.parquet``) trained on exactly the datapoints the table gives its draw and base size; else a
+    :class:`DataError` naming the first that does not (the objects or renders it was made from are not the draws')."""
+    keys = ["draw", "base_size"]
+    plain = networks.loc[networks.ratio == 0, [*keys, "train_datapoints"]].drop_duplicates(keys)
+    both = plain.merge(counts[[*keys, "datapoints"]], on=keys, how="left")
+    wrong = both[both.datapoints.isna() | (both.datapoints != both.train_datapoints)]
+    if len(wrong):
+        draw, size, trained, counted = wrong[[*keys, "train_datapoints", "datapoints"]].to_numpy()[0]
+        counted = "none" if np.isnan(counted) else f"{counted:.0f}"
+        raise DataError(
+            f"draw {draw:.0f}, base size {size:.0f}: its 1:0 network trained on {trained:.0f} datapoints, the counted "
+            f"base set holds {counted} (count from the objects table and renders the draws used)"
+        )
+
+
+def read_plan_result(
+    plan: Mapping, values: Mapping[int, Mapping[str, float]], counts: pd.DataFrame | None = None
+) -> dict:
     """The plan's tests on per-draw arm values (draw → arm → mean test AP over its seeds), in the fixed sequence:
-    the control, then the primary, then the secondary family under Holm; with the plan's words."""
+    the control, then the primary, then the secondary family under Holm; with the plan's words. With ``counts`` (a
+    :func:`base_objects` table) the plan's exchange rate is also read on actual counts (``exchange_actual``: each
+    draw's curve at the objects its base sets hold; ``base_objects``: the arm's base set on actual counts and the
+    train objects its generator learned)."""
     alpha = float(plan["alpha"])
     draws = sorted(values)
 
@@ -316,6 +386,20 @@ def read_plan_result(plan: Mapping, values: Mapping[int, Mapping[str, float]]) -
         grid = np.array([[values[d][f"none@{b}"] for b in sizes] for d in draws])
         arm = np.array([values[d][curve["arm"]] for d in draws])
         result["exchange"] = confirm.exchange_rate_on_curve(sizes, grid, arm, 1 - alpha) | {"arm": curve["arm"]}
+        if counts is not None:
+            actual = counts.set_index(["draw", "base_size"]).objects
+            held = np.array([[actual[d, b] for b in sizes] for d in draws], dtype=float)
+            result["exchange_actual"] = confirm.exchange_rate_on_curve(held, grid, arm, 1 - alpha)
+            own = int(arm_key(plan, curve["arm"])[1])
+            on = counts[counts.base_size == own]
+            result["base_objects"] = {
+                "nominal": own,
+                "min": int(on.objects.min()),
+                "max": int(on.objects.max()),
+                "mean": float(on.objects.mean()),
+                "train_objects_min": int(on.train_objects.min()),
+                "train_objects_max": int(on.train_objects.max()),
+            }
     result["per_draw_ap"] = {str(d): values[d] for d in draws}
     return result
 

@@ -20,7 +20,9 @@ def sentence_fields(c: Mapping) -> dict:
 def confirm_figures(result: dict, study: str) -> dict[str, str]:
     """The figures a document quotes, by key: ``<study>/status``, and once complete ``<study>/control``,
     ``<study>/primary`` (``mean [low, high], p = P``), ``<study>/primary/verdict``, ``<study>/sentence``,
-    ``<study>/<secondary>`` and its ``/verdict``, ``<study>/worth`` (the exchange rate)."""
+    ``<study>/<secondary>`` and its ``/verdict``, ``<study>/worth`` (the exchange rate); with the folder's base-set
+    counts ``<study>/worth/actual`` (the same on the objects that hold datapoints), ``<study>/base_objects`` and
+    ``<study>/generator_objects`` (the train objects each draw's AutoEncoder-Critic learned)."""
     out = {f"{study}/status": result["status"]}
     if not result["complete"]:
         return out
@@ -50,6 +52,15 @@ def confirm_figures(result: dict, study: str) -> dict[str, str]:
         high = "≥ {}".format(e["sizes"][-1]) if e["high"] is None else f"{e['high']:.0f}"
         worth = f"outside the curve ({e['outside']})" if e["worth"] is None else f"{e['worth']:.0f}"
         out[f"{study}/worth"] = f"{worth} real objects [{low}, {high}]"
+    if "exchange_actual" in result:
+        e, b = result["exchange_actual"], result["base_objects"]
+        low = "≤ {:.0f}".format(e["ends"][0]) if e["low"] is None else f"{e['low']:.0f}"
+        high = "≥ {:.0f}".format(e["ends"][1]) if e["high"] is None else f"{e['high']:.0f}"
+        worth = f"outside the curve ({e['outside']})" if e["worth"] is None else f"{e['worth']:.0f}"
+        out[f"{study}/worth/actual"] = f"{worth} objects holding datapoints [{low}, {high}]"
+        out[f"{study}/base_objects"] = f"{b['min']}–{b['max']} (mean {b['mean']:.1f}) of the nominal {b['nominal']}"
+        trained = b["train_objects_min"], b["train_objects_max"]
+        out[f"{study}/generator_objects"] = f"{trained[0]}" if trained[0] == trained[1] else "{}–{}".format(*trained)
     return out
 
 

@@ -23,9 +23,12 @@ from pathlib import Path
 from graspaug.errors import DataError
 from graspaug.experiments.ap.numbers import test_labels
 from graspaug.experiments.confirm.tables import (
+    BASE_OBJECTS,
     PLAN,
     add_confirm_draw,
     arm_key,
+    base_objects,
+    check_base_objects,
     check_plan_history,
     column,
     combine_confirm,
@@ -35,7 +38,7 @@ from graspaug.experiments.confirm.tables import (
 from graspaug.experiments.confirm.words import confirm_figures
 from graspaug.io.tables import read_table
 from graspaug.pipeline.params.model import params_dict
-from graspaug.pipeline.paths import SHAPES_TABLE, gqcnn_dir
+from graspaug.pipeline.paths import OBJECTS_TABLE, SHAPES_TABLE, gqcnn_dir
 from graspaug.pipeline.studies.draws import (
     checked,
     draw_params,
@@ -153,3 +156,37 @@ def run(
     if failed:
         raise failed_draws_error(failed, f"study confirm ({result['status']})")
     return text
+
+
+def count_objects(project: Path, plan_path: Path, clone: Path) -> str:
+    """Write the plan folder's base-set counts (:data:`BASE_OBJECTS`, :func:`base_objects`): each planned draw's
+    base sets on actual counts, from ``clone``'s objects table and rendered originals (a finished draw of the plan, or
+    any clone whose ingest and renders are the draws'), split and drawn by the plan's profile; refused unless every
+    committed 1:0 network trained on exactly the datapoints counted for it. The text to print."""
+    import pandas as pd
+
+    project, clone = project.resolve(), clone.resolve()
+    plan_path = (project / plan_path) if not plan_path.is_absolute() else plan_path
+    plan, folder = read_plan(plan_path), plan_path.parent
+    for needed in (clone / OBJECTS_TABLE, clone / gqcnn_dir("original") / "index.parquet"):
+        if not needed.is_file():
+            raise DataError(f"--count-objects {clone}: no {needed.relative_to(clone)} (a finished draw's clone)")
+    if not (folder / "networks.parquet").is_file():
+        raise DataError(f"{folder}: no networks.parquet, so no draw to count (run the plan's draws first)")
+    draws = sorted(set(int(d) for d in pd.read_parquet(folder / "networks.parquet").draw))
+    params = draw_params(project, plan["profile"], draws[0])
+    counts = base_objects(
+        read_table(clone / OBJECTS_TABLE),
+        clone / gqcnn_dir("original"),
+        draws,
+        list(params.generate.base_sizes),
+        params.ingest.test_fraction,
+        params.gqcnn.val_shapes,
+        params.seed,
+        params.independent_draws,
+    )
+    check_base_objects(counts, pd.read_parquet(folder / "networks.parquet"))
+    tmp = folder / f".{BASE_OBJECTS}.tmp"
+    counts.to_parquet(tmp, index=False)
+    tmp.replace(folder / BASE_OBJECTS)
+    return counts.to_string(index=False)
