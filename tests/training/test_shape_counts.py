@@ -2,6 +2,7 @@
 `generate@6` with exit 3, "rarity needs at least 2 reference shapes", after the AutoEncoder, the grasps and the renders
 had run): the count, worked out per setting, is the least that every consumer of the split can run on."""
 
+import dataclasses
 from pathlib import Path
 
 import pandas as pd
@@ -11,7 +12,7 @@ from graspaug.augment.candidates import draw_base_sets
 from graspaug.augment.corpus import assign_split
 from graspaug.errors import DataError
 from graspaug.pipeline.params.profiles import profile_params
-from graspaug.pipeline.shape_needs import params_shape_needs
+from graspaug.pipeline.shape_needs import params_shape_needs, real_pool_ids
 from graspaug.training.gqcnn_data import experiment_split, training_shapes
 from graspaug.training.shape_counts import ShapeNeeds, n_test_shapes, shape_count_problem, shape_needs
 from graspaug.training.variants import Variant, seed_variants
@@ -121,3 +122,20 @@ def test_too_few_shapes_is_one_line_with_the_counts_the_keys_and_the_remedy():
     )
     assert shape_count_problem(14, 5, needs, params.ingest.test_fraction) is None
     assert "1 test" in shape_count_problem(14, 1, needs, params.ingest.test_fraction)  # enough train, too few test
+
+
+def test_generate_refuses_a_real_pool_that_render_left_too_small():
+    """19 shapes pass the split (14 train); render@original skipping one train shape leaves the real pool 5 shapes,
+    short of real/6-1: generate says so in one line (it had stopped with exit 3 where the pool held 1 shape)."""
+    params = profile_params("tiny", PROFILES)
+    gen, gq = params.generate, params.gqcnn
+    train, test = [f"s{i:02d}" for i in range(14)], ("t0", "t1", "t2", "t3", "t4")
+    shapes = pd.DataFrame({"shape_id": train + list(test), "split": ["train"] * 14 + ["test"] * 5})
+    base = {b: list(s) for b, s in draw_base_sets(shapes, gen.base_sizes, params.data_seed).items()}
+    full = dataclasses.replace(experiment_split(train, base, gq.val_shapes, params.data_seed), test=test)
+    assert list(real_pool_ids(full, params.ingest, gen, gq)) == list(full.real_pool)
+    skipped = full.real_pool[0]
+    rendered = [s for s in train if s != skipped]
+    short = dataclasses.replace(experiment_split(rendered, base, gq.val_shapes, params.data_seed), test=test)
+    with pytest.raises(DataError, match=r"^too few shapes: 18 with datapoints from render@original \(13 train, 5 test"):
+        real_pool_ids(short, params.ingest, gen, gq)

@@ -19,7 +19,7 @@ from graspaug.training.variants import seed_networks
 if TYPE_CHECKING:
     from graspaug.training.gqcnn_data import ExperimentSplit
 
-RENDERED = "rendered by render@original (it skips a shape with no datapoint)"
+RENDERED = "with datapoints from render@original"  # it skips a shape none of whose grasps it can picture
 
 
 def params_shape_needs(
