@@ -38,6 +38,14 @@ def make_corpus(folder):
     return expected
 
 
+#: An experiment a handful of shapes hold (the split stage refuses fewer than the settings need): base sets of 2, one
+#: validation shape, no real pool (3 train shapes, 2 test).
+SMALL_EXPERIMENT = {
+    "generate": {"base_sizes": [2]},
+    "gqcnn": {"augment_base_sizes": [2], "pools": ["targeted", "random"], "val_shapes": 1},
+}
+
+
 def run_stage(tmp_path, stage, params):
     (tmp_path / "params.yaml").write_text(yaml.safe_dump(params))
     cwd = os.getcwd()
@@ -58,6 +66,7 @@ def corpus_params(tmp_path):
         "ingest": {"max_faces": 50000, "min_shapes": 3, "test_fraction": 0.4},
         "voxelize": {"resolution": 16},
         "ae": {"net": {"resolution": 16}},
+        **SMALL_EXPERIMENT,
     }
     return params, expected
 
@@ -203,6 +212,7 @@ def test_links_special_files_and_duplicates(tmp_path, capfd):
         "n_jobs": 2,
         "data": {"source": "folder", "path": "meshes"},
         "ingest": {"max_faces": 50000, "min_shapes": 3, "test_fraction": 0.5},
+        **SMALL_EXPERIMENT,
     }
     result = run_stage(tmp_path, "ingest", params)
     assert result.exit_code == 0, result.output

@@ -7,6 +7,7 @@ import pandas as pd
 import trimesh
 from typer.testing import CliRunner
 
+from graspaug.augment.corpus import assign_split
 from graspaug.io.dexnet import read_tensor_field
 from graspaug.io.gqcnn import GraspImages
 from graspaug.pipeline.cli import app
@@ -29,9 +30,13 @@ def make_project(tmp_path):
     trimesh.creation.cylinder(radius=0.03, height=0.09).export(corpus / "can.stl")
     trimesh.creation.capsule(height=0.06, radius=0.02).export(corpus / "pill.stl")
     params = {**PARAMS, "data": {"source": "folder", "path": str(corpus)}}
-    for stage in ("ingest", "split", "grasps"):
+    for stage in ("ingest", "grasps"):
         result = run_stage(tmp_path, stage, params)
         assert result.exit_code == 0, result.output
+    # the split as the split stage draws it (the stage refuses 3 shapes: too few for any base set and validation)
+    objects = pd.read_parquet(tmp_path / "data/objects.parquet")
+    split = assign_split(list(objects.shape_id), PARAMS["ingest"]["test_fraction"], 0)
+    objects.assign(split=objects.shape_id.map(split)).to_parquet(tmp_path / "data/shapes.parquet")
     return params
 
 

@@ -15,8 +15,6 @@ import logging
 import time
 from functools import partial
 
-import numpy as np
-
 from graspaug.augment.decode import PROCEDURAL_SEED, control_runners, mesh_batches, own_source, procedural_sources
 from graspaug.augment.pool_tables import generate_headline
 from graspaug.augment.pools import GENERATED_POOLS, ReconSource, base_ids, base_set, generate_pools, tsne_groups
@@ -26,7 +24,7 @@ from graspaug.io.checkpoints import load_autoencoder
 from graspaug.io.meshes import mesh_path, read_mesh, write_obj
 from graspaug.io.tables import read_table, write_json, write_table
 from graspaug.io.voxels import read_voxels
-from graspaug.pipeline import paths
+from graspaug.pipeline import paths, shape_needs
 from graspaug.pipeline.params.ae import AEParams
 from graspaug.pipeline.params.base import params_model
 from graspaug.pipeline.params.embed import EmbedParams
@@ -64,7 +62,8 @@ def run(params: Params, base_size: int) -> None:
     recon, own = None, None
     if "recon" in pools:  # the real pool as the GQ-CNN experiment draws it
         split = load_split(paths.gqcnn_dir("original"), shapes, list(cfg.base_sizes), gq.val_shapes, params.data_seed)
-        real = base_set(np.array(split.real_pool), latents, scores, voxels, params.score.k)
+        real_ids = shape_needs.real_pool_ids(split, params.ingest, params.generate, gq)  # too few: exit 2, one line
+        real = base_set(real_ids, latents, scores, voxels, params.score.k)
         recon = ReconSource(real, meshes(ae, base=real, label=f"generate {base_size} recon"))
     if "own" in pools:  # the base set under the AE-Critic that train_ae_own@B trained on it alone
         own_ae, _, trained = load_autoencoder(paths.ae_own_model(base_size), params.ae.net)

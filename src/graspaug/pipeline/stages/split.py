@@ -5,6 +5,11 @@ goes). The seed is ``seed``, or with ``independent_draws`` on the pair (``seed``
 of the data has its own test objects while ingest, the voxels and the originals' grasps and renders, which read the
 objects table, are shared by every draw.
 
+A split with fewer train or test shapes than the settings need (the largest of ``generate.base_sizes``,
+``gqcnn.val_shapes``, the real pool that the real and recon networks, fidelity and the lifelong loop take, 2 test
+shapes: :func:`graspaug.training.shape_counts.shape_count_problem`) stops the pipeline here, exit 2 with one line
+naming the settings, before the AutoEncoder, the grasps and the renders run.
+
 Outputs: ``data/shapes.parquet`` (the objects table with a ``split`` column).
 """
 
@@ -15,12 +20,24 @@ import logging
 from graspaug.augment.corpus import assign_split, split_seed
 from graspaug.io.tables import read_table, write_table
 from graspaug.pipeline.params.base import params_model
+from graspaug.pipeline.params.generate import GenerateParams
+from graspaug.pipeline.params.gqcnn import GQCNNParams
 from graspaug.pipeline.params.ingest import IngestParams
+from graspaug.pipeline.params.lifelong import LifelongParams
 from graspaug.pipeline.paths import OBJECTS_TABLE, SHAPES_TABLE
+from graspaug.pipeline.shape_needs import params_shape_needs
+from graspaug.pipeline.stages import StageError
+from graspaug.training.shape_counts import shape_count_problem
 
 log = logging.getLogger(__name__)
 
-Params = params_model("The params the `split` stage reads.", ingest=IngestParams)
+Params = params_model(
+    "The params the `split` stage reads.",
+    ingest=IngestParams,
+    generate=GenerateParams,
+    gqcnn=GQCNNParams,
+    lifelong=LifelongParams,
+)
 
 
 def run(params: Params) -> None:
@@ -30,8 +47,13 @@ def run(params: Params) -> None:
     shapes["split"] = shapes["shape_id"].map(
         assign_split(list(shapes["shape_id"]), params.ingest.test_fraction, seed, duplicates)
     )
-    write_table(shapes, SHAPES_TABLE)
     counts = shapes["split"].value_counts()
+    needs = params_shape_needs(params.generate, params.gqcnn, params.lifelong)
+    n_train, n_test = int(counts.get("train", 0)), int(counts.get("test", 0))
+    problem = shape_count_problem(n_train, n_test, needs, params.ingest.test_fraction)
+    if problem:
+        raise StageError(problem)
+    write_table(shapes, SHAPES_TABLE)
     log.info(
         "split: %d shapes, %d train, %d test (seed %s)",
         len(shapes),
