@@ -698,7 +698,11 @@ def test_dvc_repro_sim(tiny_repo, tmp_path):
     ] == [0, 1]
     assert metrics["per_seed"]["0"]["before"]["attempts"] == metrics["per_seed"]["1"]["before"]["attempts"] == 4
     network_arms = ["before", "after"] + (["real"] if after_ratio > 0 else [])
-    assert list(metrics["arms"]) == [*network_arms, "antipodal"]  # the tiny run trains the real pool at B = 6
+    assert list(metrics["arms"]) == [*network_arms, "antipodal", "oracle"]  # the tiny run trains the real pool at B = 6
+    assert metrics["arms"]["oracle"]["attempts"] == 4  # the ceiling, once per drop as the floor (issue #83)
+    span = metrics["contrasts"]["oracle_vs_antipodal"]  # the cell's span: 4 drops, no training seed
+    assert span["n_trials"] == 4 and span["n_seeds"] == 1 and span["objects_low"] <= span["mean"]
+    assert json.loads((work / "metrics/sim/oracle_vs_antipodal.json").read_text())["mean"] == round(span["mean"], 5)
     for arm in network_arms:
         a = metrics["arms"][arm]
         assert a["attempts"] == 8 and 0 <= a["successes"] <= 8  # two training seeds, the same 4 drops each
@@ -722,13 +726,22 @@ def test_dvc_repro_sim(tiny_repo, tmp_path):
         headline = json.loads((work / f"metrics/sim/ranking_{name}.json").read_text())
         assert headline == {"mean": c["mean"], "lo": c["objects_low"], "hi": c["objects_high"]}
     trials = pd.read_csv(work / "reports/sim/trials.csv")
-    assert len(trials) == 4 * len(network_arms) * 2 + 4 and set(trials.object) == {
+    assert len(trials) == 4 * len(network_arms) * 2 + 4 + 4 and set(trials.object) == {
         "cube",
         metrics["setup"]["test_shapes"][0],
     }
-    planned = (trials.arm != "antipodal") & (trials.outcome != "no_grasp")
+    feasible = trials.groupby("object").feasible.agg(set)  # from geometry before any pick: one verdict an object
+    assert all(len(f) == 1 and f <= {True, False} for f in feasible)
+    assert all(metrics["per_object"][o]["feasible"] == f.pop() for o, f in feasible.items())
+    once = trials[trials.arm.isin(["antipodal", "oracle"])].pivot(index=["object", "attempt"], columns="arm")
+    assert len(once) == 4 and (once.drop_seed.oracle == once.drop_seed.antipodal).all()  # the drops every arm picks
+    oracle_drops = trials[trials.arm == "oracle"].set_index(["object", "attempt"]).drop_seed
+    for seed in (0, 1):
+        before = trials[(trials.arm == "before") & (trials.seed == seed)].set_index(["object", "attempt"]).drop_seed
+        assert before.sort_index().equals(oracle_drops.sort_index())
+    planned = ~trials.arm.isin(["antipodal", "oracle"]) & (trials.outcome != "no_grasp")
     assert trials.quality[trials.arm == "antipodal"].isna().all() and trials.quality[planned].notna().all()
-    trials = trials[trials.arm != "antipodal"]
+    trials = trials[~trials.arm.isin(["antipodal", "oracle"])]
     # the same seeded drops for every arm
     assert set(trials.seed) == {0, 1}  # both training seeds' networks, on the same drops
     drops = trials.pivot_table(index=["seed", "object", "attempt"], columns="arm", values="drop_seed")
@@ -738,9 +751,17 @@ def test_dvc_repro_sim(tiny_repo, tmp_path):
     assert set(trials.outcome) <= set(OUTCOMES)
     assert (trials.success == (trials.outcome == "success")).all()
     timing = json.loads((work / "reports/sim/timing.json").read_text())
-    assert timing["trials"] == len(trials) + 4 and timing["planning_time_max"] > 0
+    assert timing["trials"] == len(trials) + 8 and timing["planning_time_max"] > 0
     report = (work / "reports/sim/report.md").read_text()
     assert "## Contrasts" in report and "## Calibration" in report and "network_vs_antipodal" in report
+    lines, f = report.splitlines(), metrics["feasibility"]  # the oracle's verdict first, feasible objects beside all
+    first = lines[lines.index("# Simulated robot trials") + 2]
+    assert first.startswith("**The oracle picks" if f["oracle_rate"] is not None else "**No object is feasible"), first
+    assert f"Feasible objects first: {f['feasible']['objects']} of 2 objects" in report and f["all"]["objects"] == 2
+    head = next(i for i, line in enumerate(lines) if line.startswith("| arm | feasible objects ("))
+    assert [line.split(" | ")[0] for line in lines[head + 2 : head + 2 + len(metrics["arms"])]] == [
+        f"| {arm}" for arm in metrics["arms"]
+    ]  # every arm, the oracle too
     calibration = pd.read_csv(work / "reports/sim/calibration.csv")
     assert (
         set(calibration.object) == {"cube", metrics["setup"]["test_shapes"][0]}

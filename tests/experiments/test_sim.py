@@ -21,7 +21,12 @@ def seed_dirs_with(tmp_path, networks: list[str], seeds=(0, 1)) -> dict:
 def test_arms_pair_before_and_after_and_add_real_only_when_every_seed_has_it(tmp_path):
     dirs = seed_dirs_with(tmp_path, ["targeted/50-0", "targeted/50-1.5"])
     assert model_path(dirs[0], 50, 0.0, "real") == dirs[0] / "targeted/50-0/model.pt"  # ratio 0 is the targeted network
-    expected = {"before": ("targeted", 0.0, 50), "after": ("targeted", 1.5, 50), "antipodal": (None, None, None)}
+    expected = {
+        "before": ("targeted", 0.0, 50),
+        "after": ("targeted", 1.5, 50),
+        "antipodal": (None, None, None),  # the floor
+        "oracle": (None, None, None),  # the ceiling: on every run, as the floor
+    }
     assert arms(1.5, 50, dirs, (50, 200)) == expected  # no B = 200 network: no positive control arm
     seed_dirs_with(tmp_path, ["real/50-1.5", "targeted/100-0"])
     chosen = arms(1.5, 50, dirs, (50, 100, 200))
@@ -83,3 +88,54 @@ def test_the_plan_line_counts_objects_arms_and_seeds():
     assert trials_plan(objects, chosen, 3, 2, {"x.obj": "empty"}) == (
         "2 objects × 3 attempts; arms before, after, antipodal × 2 training seeds (after = ratio 1.5); 1 skipped meshes"
     )
+    feasible = {"a": {"feasible": True}, "b": {"feasible": False}}  # object_feasibility's, judged before the picks
+    assert trials_plan(objects, chosen, 3, 2, {}, feasible).endswith("; 0 skipped meshes; 1 feasible objects")
+
+
+def test_the_oracle_picks_each_object_once_on_the_drops_of_every_other_arm(tmp_path):
+    from types import SimpleNamespace
+
+    from graspaug.experiments.cell.trials import object_jobs
+
+    dirs = seed_dirs_with(tmp_path, ["targeted/50-0", "targeted/50-1"])
+    chosen = arms(1.0, 50, dirs)
+    objects = [SimpleNamespace(name=name, kind="everyday", body=None) for name in ("cube", "duck")]
+    jobs = object_jobs(objects, chosen, dirs, attempts=3, seed=7, n_pictures=2)
+    oracle = [j for j in jobs if j.arm == "oracle"]
+    assert [j.name for j in oracle] == ["cube", "duck"] and {(j.seed, j.model) for j in oracle} == {(-1, None)}
+    for job in oracle:  # the same drops and planner seeds as every arm's, every training seed's
+        others = [j for j in jobs if j.name == job.name and j.arm != "oracle"]
+        assert len(others) == 5 and all(
+            (j.drop_seeds, j.plan_seeds) == (job.drop_seeds, job.plan_seeds) for j in others
+        )
+    assert not any(j.record for j in oracle)  # no depth image to draw
+    assert all(j.record for j in jobs if j.arm == "antipodal")  # n_pictures = 2: both objects' first attempts
+
+
+def test_feasibility_is_judged_on_the_cells_meshes_and_marks_every_attempt(tmp_path):
+    """Real meshes in the files the cell loads: a 5 × 5 × 4 cm box fits the 80 mm jaw, a 12 cm cube does not; the
+    trials table carries each object's verdict on every attempt, whatever the arm."""
+    from types import SimpleNamespace
+
+    import pandas as pd
+    import trimesh
+
+    from graspaug.experiments.cell.trials import object_feasibility, trials_table
+
+    objects = []
+    for name, extents in (("small", (0.05, 0.05, 0.04)), ("large", (0.12, 0.12, 0.12))):
+        path = tmp_path / f"{name}.obj"
+        trimesh.creation.box(extents).export(path)
+        objects.append(SimpleNamespace(name=name, body=SimpleNamespace(visual=path)))
+    rule = object_feasibility(objects, 0.08)
+    assert rule["small"]["feasible"] and rule["small"]["share"] == 1.0
+    assert not rule["large"]["feasible"] and rule["large"]["share"] == 0.0
+    rows = [
+        {"arm": arm, "seed": seed, "object": name, "attempt": 0, "success": False, "_depth": None}
+        for arm, seed in (("before", 0), ("antipodal", -1), ("oracle", -1))
+        for name in ("small", "large")
+    ]
+    trials = trials_table(rows, arms(1.0, 50, seed_dirs_with(tmp_path, ["targeted/50-0", "targeted/50-1"])), rule)
+    assert trials.groupby("object").feasible.agg(set).to_dict() == {"large": {False}, "small": {True}}
+    assert trials.feasible_share.tolist() == [1.0, 0.0] * 3 and "_depth" not in trials
+    assert pd.isna(trials.ratio[trials.arm == "oracle"]).all()

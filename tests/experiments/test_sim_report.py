@@ -179,3 +179,79 @@ def test_the_success_bars_of_many_objects_wrap_into_rows_of_a_readable_width(tmp
         success_bars(*success_bar_data(metrics, chosen), tmp_path / f"{n}.png", "Pick success per object, B = 50")
         width, height = Image.open(tmp_path / f"{n}.png").size
         assert 400 <= width <= 1600 and height >= width / 3, (n, width, height)
+
+
+def feasible_trials(oracle_feasible: list[bool]) -> pd.DataFrame:
+    """Six objects, o0-o3 feasible, two drops each: ``before`` (one training seed; ``after`` alike) holds 3 of 4 drops
+    of a feasible object pair and every drop of the others, ``antipodal`` none, the ``oracle`` ``oracle_feasible`` (a
+    feasible object's two drops, the same for each) and every drop of the others."""
+    outcomes = {}
+    for k in range(6):
+        outcomes[("before", 0, f"o{k}")] = [True, k % 2 == 0] if k < 4 else [True, True]
+        outcomes[("antipodal", -1, f"o{k}")] = [False, False]
+        outcomes[("oracle", -1, f"o{k}")] = oracle_feasible if k < 4 else [True, True]
+    trials = trials_table(outcomes)
+    trials = pd.concat([trials, trials[trials.arm == "before"].assign(arm="after")], ignore_index=True)  # the same
+    return trials.assign(feasible=trials.object < "o4", feasible_share=np.where(trials.object < "o4", 1.0, 0.25))
+
+
+def summarized(trials: pd.DataFrame) -> dict:
+    """:func:`summarize` of ``trials`` with a setup, and the calibration, as the stage makes them."""
+    from types import SimpleNamespace
+
+    from graspaug.experiments.cell.numbers import summarize
+
+    chosen = {"before": ("targeted", 0.0, 50), "antipodal": (None, None, None), "oracle": (None, None, None)}
+    objects = [
+        SimpleNamespace(name=f"o{k}", kind="test_shape", body=SimpleNamespace(mass=0.2, lateral_friction=0.5))
+        for k in range(6)
+    ]
+    setup = {
+        "camera_height": 0.65, "sensor_noise": True, "grip_force": 70.0, "shake_acceleration": 0.0, "objects": 6,
+        "attempts": 2, "model_seeds": [0], "data_seed": 0, "base_size": 50,
+    }  # fmt: skip
+    metrics = summarize(trials, objects, {"after": ("targeted", 1.0, 50), **chosen}, setup, 200, 0)
+    _, metrics["calibration"] = calibration(trials, pd.Series(dtype=float))
+    return metrics
+
+
+def test_the_report_opens_with_the_oracles_verdict_then_success_on_feasible_objects_beside_all():
+    """Issue #83: the cell shows its ceiling (the oracle) and floor (antipodal) in every run; the report reads the
+    feasible objects first, with their count beside all objects', each arm as its share of the oracle − antipodal
+    span, and says first when the oracle picks under 90% of the feasible attempts."""
+    trials = feasible_trials([True, False])  # the oracle holds 4 of the 8 feasible drops: the cell caps success
+    metrics = summarized(trials)
+    f = metrics["feasibility"]
+    assert (f["feasible"]["objects"], f["all"]["objects"], f["oracle_rate"], f["oracle_fit"]) == (4, 6, 0.5, False)
+    assert f["feasible"]["arms"]["before"]["successes"] == 6 and f["feasible"]["arms"]["oracle"]["attempts"] == 8
+    # before 6/8 on feasible objects: (0.75 − 0) / (0.5 − 0) of the span; on all 10/12 against the oracle's 8/12
+    assert f["feasible"]["span_share"]["before"] == 1.5 and f["all"]["span_share"]["before"] == 1.25
+    assert [metrics["per_object"][f"o{k}"]["feasible"] for k in range(6)] == [True] * 4 + [False] * 2
+    span = metrics["contrasts"]["oracle_vs_antipodal"]  # the cell's span, a contrast as every other
+    assert span["mean"] == pytest.approx(8 / 12, abs=1e-4) and span["n_trials"] == 12 and span["over"] == "objects"
+    assert sim_headline(metrics)["oracle_vs_antipodal"] == {"mean": 0.66667, "lo": span["objects_low"],
+                                                             "hi": span["objects_high"]}  # fmt: skip
+    lines = report_text(metrics, trials, calibration(trials, pd.Series(dtype=float))[0], "scores.parquet").splitlines()
+    assert lines[2] == (
+        "**The oracle picks 50% of feasible attempts: below 90%, the cell is NOT fit to compare planners here (its "
+        "physics caps success).**"
+    )
+    assert lines[4].startswith("Feasible objects first: 4 of 6 objects are feasible by geometry alone")
+    assert "| arm | feasible objects (4): successes | rate | share of span | all objects (6): successes" in lines[6]
+    assert "| before | 6/8 | 0.75 | 1.50 | 10/12 | 0.83 | 1.25 |" in lines
+    assert "| oracle | 4/8 | 0.50 | 1.00 | 8/12 | 0.67 | 1.00 |" in lines
+    assert any(line.startswith("| oracle | the best collision-free grasp on the true mesh") for line in lines)
+
+    fit = summarized(feasible_trials([True, True]))  # every feasible drop held: the cell is fit
+    assert fit["feasibility"]["oracle_fit"] and fit["feasibility"]["feasible"]["span_share"]["before"] == 0.75
+    text = report_text(fit, feasible_trials([True, True]), pd.DataFrame(columns=["object"]), "scores.parquet")
+    first = text.splitlines()[2]
+    assert first == "**The oracle picks 100% of feasible attempts: the cell is fit to compare planners.**"
+
+    none = summarized(feasible_trials([True, True]).assign(feasible=False))  # no feasible object: no verdict
+    assert none["feasibility"]["feasible"] == {"objects": 0, "arms": {}, "span_share": {}}
+    assert none["feasibility"]["oracle_rate"] is None and none["feasibility"]["oracle_fit"] is None
+    assert none["feasibility"]["all"]["span_share"]["before"] == 0.83333  # 10/12 of the oracle's 12/12 over 0
+    text = report_text(none, feasible_trials([True, True]), pd.DataFrame(columns=["object"]), "scores.parquet")
+    assert text.splitlines()[2] == "**No object is feasible: whether the cell can tell planners apart is unknown.**"
+    assert "| before | – | – | – | 10/12 | 0.83 | 0.83 |" in text

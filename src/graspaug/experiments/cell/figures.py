@@ -13,6 +13,7 @@ import numpy as np
 import pandas as pd
 
 from graspaug.experiments.cell.numbers import objects_table, success_table
+from graspaug.experiments.cell.picks import ANTIPODAL, ORACLE
 from graspaug.experiments.cell.words import report_text
 from graspaug.io.tables import write_csv
 from graspaug.plots import pyplot, save_figure
@@ -117,17 +118,17 @@ def success_bars(
     save_figure(fig, path)
 
 
+#: The success bars' labels of the arms without a network.
+BAR_LABELS = {ANTIPODAL: "random antipodal grasp (no network)", ORACLE: "oracle: best grasp on the true mesh"}
+
+
 def success_bar_data(metrics: dict, chosen: dict) -> tuple[list[str], dict[str, tuple[np.ndarray, ...]]]:
     """What :func:`success_bars` draws: the objects and ``all``, and per arm's label
     (rate, Wilson low, Wilson high), each (objects + 1,)."""
     names = [*metrics["per_object"], "all"]
     bars = {}
     for arm, (pool, ratio, base_size) in chosen.items():
-        label = (
-            "random antipodal grasp (no network)"
-            if pool is None
-            else f"{arm} ({pool}, B = {base_size}, ratio {ratio:g})"
-        )
+        label = BAR_LABELS.get(arm) or f"{arm} ({pool}, B = {base_size}, ratio {ratio:g})"
         stats = [metrics["per_object"][n][arm] for n in names[:-1]] + [metrics["arms"][arm]]
         bars[label] = tuple(np.array([s[key] for s in stats]) for key in ("success_rate", "wilson_low", "wilson_high"))
     return names, bars

@@ -11,6 +11,7 @@ import pandas as pd
 
 from graspaug.errors import DataError
 from graspaug.experiments.ap.numbers import test_predictions, test_rows
+from graspaug.experiments.cell.picks import ANTIPODAL, ORACLE, oracle_fit, span_shares
 from graspaug.experiments.stats import (
     DIFFERENCE_RANGE,
     ObjectBootstrap,
@@ -30,6 +31,7 @@ CONTRASTS = {
     "after_vs_before": ("after", "before"),
     "network_vs_antipodal": ("before", "antipodal"),
     "after_vs_real": ("after", "real"),
+    "oracle_vs_antipodal": (ORACLE, ANTIPODAL),  # the cell's span: the ceiling (mesh oracle) − the floor
 }
 
 
@@ -186,6 +188,7 @@ def summarize(trials: pd.DataFrame, objects: Sequence, chosen: dict, setup: dict
         "per_seed": {str(s): compare(trials[trials.seed == s]) for s in model_seeds},
         "per_object": {},
     }
+    feasible = trials.groupby("object").feasible.first() if "feasible" in trials else None
     for obj in objects:
         sel = trials.object == obj.name
         rates = {arm: rate_summary(trials.success[sel & (trials.arm == arm)]) for arm in chosen}
@@ -193,9 +196,30 @@ def summarize(trials: pd.DataFrame, objects: Sequence, chosen: dict, setup: dict
             "kind": obj.kind,
             "mass": round(obj.body.mass, 4),
             "friction": round(obj.body.lateral_friction, 4),
+            **({} if feasible is None else {"feasible": bool(feasible[obj.name])}),
             **rates,
         }
+    if feasible is not None:
+        metrics["feasibility"] = feasible_first(trials, list(chosen))
     return metrics
+
+
+def feasible_first(trials: pd.DataFrame, arms: Sequence[str]) -> dict:
+    """Success on the feasible objects (``trials``' ``feasible`` column: the feasibility rule's, from geometry before
+    any pick) and on all objects: for each (``feasible``, ``all``) the count of objects, every arm's rate
+    (:func:`rate_summary`) and its share of the oracle − antipodal span where defined
+    (:func:`~graspaug.experiments.cell.picks.span_shares`); the oracle's rate on the feasible attempts
+    (``oracle_rate``) and whether it makes the cell fit to compare planners (``oracle_fit``,
+    :func:`~graspaug.experiments.cell.picks.oracle_fit`); both None without a feasible object."""
+    out = {}
+    for name, sel in (("feasible", trials.feasible.eq(True)), ("all", pd.Series(True, index=trials.index))):
+        n_objects = int(trials.object[sel].nunique())
+        rates = {arm: rate_summary(trials.success[sel & (trials.arm == arm)]) for arm in arms} if n_objects else {}
+        shares = span_shares({arm: r["successes"] / r["attempts"] for arm, r in rates.items()})  # not rounded
+        out[name] = {"objects": n_objects, "arms": rates, "span_share": {a: round(v, 5) for a, v in shares.items()}}
+    oracle = out["feasible"]["arms"].get(ORACLE, {}).get("success_rate")
+    out["oracle_rate"], out["oracle_fit"] = oracle, None if oracle is None else oracle_fit(oracle)
+    return out
 
 
 def sim_headline(summary: dict) -> dict[str, dict]:

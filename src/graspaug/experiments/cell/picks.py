@@ -13,7 +13,7 @@ draw it is the objects' bootstrap (attempts resampled with their object).
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 
 import numpy as np
 import pandas as pd
@@ -244,11 +244,26 @@ def feasible_summary(table: pd.DataFrame, n_resamples: int, seed: int) -> dict:
         "attempts": int(len(feasible)),
     }
     out["summary"] = pick_summary(feasible, list(dict.fromkeys(feasible.arm)), n_resamples, seed)
-    arms = out["summary"]["arms"]
-    if ORACLE in arms:
-        oracle = arms[ORACLE]["mean"]
-        out["oracle_rate"], out["oracle_fit"] = oracle, bool(oracle >= ORACLE_FIT)
-        if ANTIPODAL in arms and oracle > arms[ANTIPODAL]["mean"]:
-            floor = arms[ANTIPODAL]["mean"]
-            out["span_share"] = {a: (c["mean"] - floor) / (oracle - floor) for a, c in arms.items()}
+    rates = {a: c["mean"] for a, c in out["summary"]["arms"].items()}
+    if ORACLE in rates:
+        out["oracle_rate"], out["oracle_fit"] = rates[ORACLE], oracle_fit(rates[ORACLE])
+        shares = span_shares(rates)
+        if shares:
+            out["span_share"] = shares
     return out
+
+
+def oracle_fit(rate: float) -> bool:
+    """Whether the cell is fit to compare planners: the oracle picks at least :data:`ORACLE_FIT` of the feasible
+    attempts (``rate``)."""
+    return bool(rate >= ORACLE_FIT)
+
+
+def span_shares(rates: Mapping[str, float]) -> dict[str, float]:
+    """Each arm's share of the oracle − antipodal span, (rate − antipodal) / (oracle − antipodal), from ``rates``
+    (arm → success rate); ``{}`` where the span is not defined (no oracle or no antipodal arm, or the oracle does not
+    pick more often than the antipodal floor)."""
+    if ORACLE not in rates or ANTIPODAL not in rates or not rates[ORACLE] > rates[ANTIPODAL]:
+        return {}
+    floor, span = rates[ANTIPODAL], rates[ORACLE] - rates[ANTIPODAL]
+    return {a: (r - floor) / span for a, r in rates.items()}

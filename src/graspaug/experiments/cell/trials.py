@@ -59,8 +59,10 @@ def arms(
     the ratio chosen on validation AP for B = ``base_size``), ``real`` (real, that ratio, B) and
     ``more_real`` (targeted, 0, the largest of ``base_sizes`` above B: the most real shapes, the cell's
     positive control, as the AP experiment's ``real_data``) when their networks exist for every
-    training seed, ``antipodal`` (None, None, None). ``seed_dirs``: training seed → the folder of its
-    networks; a missing ``before`` or ``after`` network is a :class:`DataError`."""
+    training seed, ``antipodal`` (None, None, None: a random antipodal grasp, the floor) and :data:`ORACLE` (None,
+    None, None: the best grasp on the true mesh in the pose it rests in, :class:`graspaug.sim.oracle.MeshOracle`,
+    the ceiling). ``seed_dirs``: training seed → the folder of its networks; a missing ``before`` or ``after``
+    network is a :class:`DataError`."""
     best = float(best_ratio)
     chosen: dict[str, ArmNetwork] = {"before": ("targeted", 0.0, base_size), "after": ("targeted", best, base_size)}
     for seed_dir in seed_dirs.values():
@@ -76,7 +78,7 @@ def arms(
             chosen[arm] = (pool, ratio, b)
         else:
             log.info("sim: no %s network at B = %d, ratio %g for every training seed: no %s arm", pool, b, ratio, arm)
-    chosen["antipodal"] = (None, None, None)
+    chosen["antipodal"] = chosen[ORACLE] = (None, None, None)
     return chosen
 
 
@@ -130,6 +132,17 @@ def trial_objects(
     return objects, skipped
 
 
+def object_feasibility(objects: Sequence[PreparedObject], max_width: float) -> dict[str, dict]:
+    """Each object's :func:`~graspaug.sim.feasibility.feasibility` for a jaw opening ``max_width`` m (object name →
+    ``share``, ``feasible``, ``poses``, ``round``), judged from geometry alone on the mesh the cell shows (its body's
+    visual mesh, m): no pick's outcome enters it."""
+    import trimesh
+
+    from graspaug.sim.feasibility import feasibility
+
+    return {o.name: feasibility(trimesh.load(o.body.visual, force="mesh", process=False), max_width) for o in objects}
+
+
 def object_jobs(
     objects: Sequence[PreparedObject],
     chosen: dict[str, ArmNetwork],
@@ -139,8 +152,9 @@ def object_jobs(
     n_pictures: int,
 ) -> list[ObjectJob]:
     """A job per object, arm and training seed (``seed_dirs``: training seed → the folder of its
-    networks; the antipodal arm once per object); the drops and planner seeds of an object are
-    drawn from the global ``seed`` and its name, the same in every arm."""
+    networks; the arms without a network, antipodal and oracle, once per object); the drops and planner seeds of an
+    object are drawn from the global ``seed`` and its name, the same in every arm. The oracle's attempts are not
+    recorded: it sees no depth image to draw."""
     model_seeds = list(seed_dirs)
     jobs = []
     for index, obj in enumerate(objects):
@@ -149,7 +163,8 @@ def object_jobs(
         record = index < n_pictures
         for arm, (pool, ratio, base_size) in chosen.items():
             if pool is None:
-                jobs.append(ObjectJob(arm, -1, None, obj.name, obj.kind, obj.body, drops, plans, record))
+                shown = record and arm != ORACLE
+                jobs.append(ObjectJob(arm, -1, None, obj.name, obj.kind, obj.body, drops, plans, shown))
                 continue
             for s in model_seeds:
                 jobs.append(
@@ -307,10 +322,18 @@ def run_object(
     return rows
 
 
-def trials_plan(objects: Sequence, chosen: dict, attempts: int, n_seeds: int, skipped: dict[str, str]) -> str:
+def trials_plan(
+    objects: Sequence,
+    chosen: dict,
+    attempts: int,
+    n_seeds: int,
+    skipped: dict[str, str],
+    feasible: Mapping | None = None,
+) -> str:
     """One line on what :func:`run_trials` will run: objects × attempts, the arms (``chosen``: arm →
-    (pool, ratio, base size)) × training seeds, the ``after`` ratio and the count of skipped user meshes."""
-    return "%d objects × %d attempts; arms %s × %d training seeds (after = ratio %g); %d skipped meshes" % (
+    (pool, ratio, base size)) × training seeds, the ``after`` ratio, the count of skipped user meshes and, with
+    ``feasible`` (:func:`object_feasibility`), of the feasible objects."""
+    line = "%d objects × %d attempts; arms %s × %d training seeds (after = ratio %g); %d skipped meshes" % (
         len(objects),
         attempts,
         ", ".join(chosen),
@@ -318,6 +341,7 @@ def trials_plan(objects: Sequence, chosen: dict, attempts: int, n_seeds: int, sk
         chosen["after"][1],
         len(skipped),
     )
+    return line + (f"; {sum(f['feasible'] for f in feasible.values())} feasible objects" if feasible else "")
 
 
 def run_trials(jobs: Sequence[ObjectJob], sim, crop, workers, gripper=None, grasps=None) -> list[dict]:
@@ -344,9 +368,15 @@ def run_trials(jobs: Sequence[ObjectJob], sim, crop, workers, gripper=None, gras
     return [row for rows in parallel_map(work, jobs, workers, "sim") for row in rows]
 
 
-def trials_table(rows: list[dict], chosen: dict[str, ArmNetwork]) -> pd.DataFrame:
+def trials_table(
+    rows: list[dict], chosen: dict[str, ArmNetwork], feasible: Mapping[str, dict] | None = None
+) -> pd.DataFrame:
     """The trials table: a row per attempt (:func:`run_object`'s rows without the pictures) and
-    the ``ratio`` of its arm (``chosen``: arm → (pool, ratio, base size))."""
+    the ``ratio`` of its arm (``chosen``: arm → (pool, ratio, base size)); with ``feasible`` (object name → its
+    :func:`object_feasibility`), each attempt's object's ``feasible`` and ``feasible_share``."""
     trials = pd.DataFrame([{k: v for k, v in row.items() if not k.startswith("_")} for row in rows])
     trials["ratio"] = trials.arm.map({arm: network[1] for arm, network in chosen.items()})
+    if feasible is not None:
+        trials["feasible"] = trials.object.map({name: bool(f["feasible"]) for name, f in feasible.items()})
+        trials["feasible_share"] = trials.object.map({name: float(f["share"]) for name, f in feasible.items()})
     return trials

@@ -6,6 +6,7 @@ import numpy as np
 import pandas as pd
 
 from graspaug.experiments.cell.numbers import CONTRASTS
+from graspaug.experiments.cell.picks import ANTIPODAL, ORACLE, ORACLE_FIT, oracle_fit
 from graspaug.experiments.stats import (
     draw_scope,
     verdict,
@@ -60,6 +61,50 @@ def control_words(contrasts: dict) -> str:
         f"({_interval(c)}), so these picks cannot judge training data and their after_vs_before measures the cell, "
         "not the augmentation."
     )
+
+
+def oracle_words(rate: float | None, missing: str = "no oracle arm") -> str:
+    """Whether the cell is fit to compare planners, as a clause: the oracle's pick rate on the feasible attempts
+    ``rate`` against :data:`~graspaug.experiments.cell.picks.ORACLE_FIT`; ``missing`` says why there is none (None)."""
+    if rate is None:
+        return f"{missing}: whether the cell can tell planners apart is unknown"
+    head = f"the oracle picks {rate:.0%} of feasible attempts: "
+    if oracle_fit(rate):
+        return head + "the cell is fit to compare planners"
+    return head + f"below {ORACLE_FIT:.0%}, the cell is NOT fit to compare planners here (its physics caps success)"
+
+
+def feasible_lines(feasibility: dict) -> list[str]:
+    """The report's first lines (:func:`~graspaug.experiments.cell.numbers.feasible_first`): whether the oracle makes
+    the cell fit to compare planners, then each arm's success on the feasible objects and on all objects beside it,
+    with their counts and each arm's share of the oracle − antipodal span."""
+    feasible, every = feasibility["feasible"], feasibility["all"]
+    verdict = oracle_words(feasibility["oracle_rate"], "no object is feasible")
+    lines = [f"**{verdict[0].upper()}{verdict[1:]}.**", ""]
+    lines.append(
+        f"Feasible objects first: {feasible['objects']} of {every['objects']} objects are feasible by geometry alone "
+        "(a top-down parallel jaw fits across them in at least half of their landing probability, "
+        "`graspaug.sim.feasibility`; judged before any pick). Success on them, all objects beside; the share of the "
+        "oracle − antipodal span where the oracle picks more often than the antipodal floor:"
+    )
+
+    def cells(part: dict, arm: str) -> str:
+        a = part["arms"].get(arm)
+        if a is None:
+            return "– | – | –"
+        share = part["span_share"].get(arm)
+        shown = "" if share is None else f"{share:.2f}"
+        return f"{a['successes']}/{a['attempts']} | {a['success_rate']:.2f} | {shown}"
+
+    lines += [
+        "",
+        f"| arm | feasible objects ({feasible['objects']}): successes | rate | share of span "
+        f"| all objects ({every['objects']}): successes | rate | share of span |",
+        "|---|---|---|---|---|---|---|",
+        *(f"| {arm} | {cells(feasible, arm)} | {cells(every, arm)} |" for arm in every["arms"]),
+        "",
+    ]
+    return lines
 
 
 def ranking_words(ranking: dict) -> str:
@@ -121,6 +166,13 @@ def ranking_lines(ranking: dict) -> list[str]:
     return lines
 
 
+#: What the arms without a network plan with, as the report names it.
+PLANNERS = {
+    ANTIPODAL: "a random antipodal seed grasp, no network (the floor)",
+    ORACLE: "the best collision-free grasp on the true mesh in its resting pose, no camera (the ceiling)",
+}
+
+
 def report_text(metrics: dict, trials: pd.DataFrame, calibration_table: pd.DataFrame, scores_file: str) -> str:
     """The report (markdown): rates, contrasts with their verdicts, per seed and per object,
     outcomes, and the calibration table. ``scores_file``: where the graspness labels come from
@@ -134,6 +186,7 @@ def report_text(metrics: dict, trials: pd.DataFrame, calibration_table: pd.DataF
     lines = [
         "# Simulated robot trials",
         "",
+        *(feasible_lines(metrics["feasibility"]) if "feasibility" in metrics else []),
         f"Franka Panda in pybullet, overhead depth camera {setup['camera_height']} m above the table ({noise}), "
         f"{setup['objects']} objects × {drops}, the same drops and planner seeds for every arm; networks of "
         f"training seeds {setup['model_seeds']} (B = {setup['base_size']}). "
@@ -145,11 +198,7 @@ def report_text(metrics: dict, trials: pd.DataFrame, calibration_table: pd.DataF
         "|---|---|---|---|---|",
     ]
     for arm, a in arms.items():
-        planner = (
-            "a random antipodal seed grasp, no network"
-            if arm == "antipodal"
-            else f"{a['pool']} B = {a.get('base_size', setup['base_size'])}, ratio {a['ratio']:g}"
-        )
+        planner = PLANNERS.get(arm) or f"{a['pool']} B = {a.get('base_size', setup['base_size'])}, ratio {a['ratio']:g}"
         lines.append(
             f"| {arm} | {planner} | {a['successes']}/{a['attempts']} | {a['success_rate']:.2f} | "
             f"[{a['wilson_low']:.2f}, {a['wilson_high']:.2f}] |"
@@ -214,7 +263,8 @@ def report_text(metrics: dict, trials: pd.DataFrame, calibration_table: pd.DataF
         "",
         "Outcomes (no_grasp: no antipodal pair on the image; collision: the hand pressed on the object, the "
         "table or the bin before closing; not_lifted: the object stayed on the table; dropped: lost on the way; "
-        "outside_bin: released but not in the bin):",
+        "outside_bin: released but not in the bin; for the oracle, no_grasp: no collision-free grasp with a level "
+        "jaw on the mesh):",
         "",
         "| arm | " + " | ".join(counts.columns) + " |",
         "|---|" + "---|" * len(counts.columns),

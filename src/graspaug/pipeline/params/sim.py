@@ -10,8 +10,9 @@ from graspaug.sim.settings import CellLayout, DepthNoise, HandSettings, ObjectPh
 
 @settings
 class SimParams:
-    """Simulated Panda pick-and-place trials: the networks before and after augmentation, the `real` pool's network
-    and a random antipodal grasp (paper Section IV-E)."""
+    """Simulated Panda pick-and-place trials: the networks before and after augmentation, the `real` pool's network,
+    a random antipodal grasp (the floor) and the best grasp on the true mesh (the oracle: the ceiling) (paper Section
+    IV-E)."""
 
     objects: tuple[str, ...] = Field(
         tuple(EVERYDAY_OBJECTS),

@@ -1,14 +1,12 @@
 """Stage ``sim``: simulated Panda pick-and-place trials with the GQ-CNN before and after augmentation.
 
-Arms (:mod:`~graspaug.experiments.cell.trials`): ``before`` (B = ``sim.base_size``, ratio 0), ``after`` (the ratio
-chosen on validation AP), ``real`` (the ``real`` pool there), ``more_real`` (the largest B at ratio 0: the positive
-control), each per training seed, and ``antipodal`` (no network). Every object (``sim.objects``, ``sim.n_test_objects``
-test shapes, ``sim.objects_path``) is dropped ``sim.attempts`` times, the same drops for every arm; the planner sees a
-D435-like noisy depth image. Each arm's networks also rank the grasps ``grasp_calibration`` executed in this cell
-(:mod:`graspaug.experiments.cell.numbers`). Writes ``metrics/sim/<contrast>.json`` (``mean``, ``lo``, ``hi``: paired
-difference in success, bootstrap over objects; ``ranking_<contrast>``: in ROC AUC against the executed grasps'
-outcomes) and ``reports/sim/`` (``summary.json``, ``report.md``, ``trials.csv``, ``success.{csv,png}``,
-``objects.csv``, ``calibration.csv``, ``timing.json``, ``trials/<arm>-<object>.png``)."""
+Arms (:func:`~graspaug.experiments.cell.trials.arms`): ``before``, ``after`` (the ratio chosen on validation AP),
+``real``, ``more_real`` (the positive control), each per training seed, ``antipodal`` (the floor) and ``oracle`` (the
+ceiling), on the same ``sim.attempts`` drops of every object, each judged feasible from its geometry first; each
+arm's networks also rank the grasps ``grasp_calibration`` executed here. Writes ``metrics/sim/<contrast>.json``
+(``mean``, ``lo``, ``hi``; ``ranking_<contrast>``) and ``reports/sim/`` (``summary.json``, ``report.md`` opening with
+the oracle's verdict on the cell, ``trials.csv``, ``success.{csv,png}``, ``objects.csv``, ``calibration.csv``,
+``timing.json``, ``trials/<arm>-<object>.png``); docs/stages.md (``sim``) says what each holds."""
 
 from __future__ import annotations
 
@@ -28,6 +26,7 @@ from graspaug.experiments.cell.numbers import (
 from graspaug.experiments.cell.trials import (
     after_ratio,
     arms,
+    object_feasibility,
     object_jobs,
     run_trials,
     trial_objects,
@@ -77,10 +76,11 @@ def run(params: Params) -> None:
     # an empty or unreadable sim.objects_path: a DataError, which the CLI prints in one line
     shapes = read_table(paths.SHAPES_TABLE)
     objects, skipped = trial_objects(cfg, shapes, paths.SHAPES_DIR, params.ingest, params.seed, params.workers)
+    feasible = object_feasibility(objects, params.grasps.gripper.max_width)  # from geometry, before any pick
     jobs = object_jobs(objects, chosen, seed_dirs, cfg.attempts, params.seed, cfg.n_pictures)
-    log.info("sim: %s", trials_plan(objects, chosen, cfg.attempts, len(model_seeds), skipped))
+    log.info("sim: %s", trials_plan(objects, chosen, cfg.attempts, len(model_seeds), skipped, feasible))
     rows = run_trials(jobs, cfg, params.render.crop, params.workers, params.grasps.gripper, params.grasps)
-    trials = trials_table(rows, chosen)
+    trials = trials_table(rows, chosen, feasible)
     setup = trial_setup(cfg, objects, skipped, model_seeds, after_from_report=from_report, data_seed=params.data_seed)
     metrics = summarize(trials, objects, chosen, setup, cfg.n_bootstrap, params.seed)
     scores = read_table(paths.SCORES).set_index("shape_id")  # no grasp sampled: n/a, not 0

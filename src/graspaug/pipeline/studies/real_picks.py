@@ -29,7 +29,6 @@ from graspaug.errors import DataError
 from graspaug.experiments.cell.picks import (
     ANTIPODAL,
     ORACLE,
-    ORACLE_FIT,
     feasible_summary,
     hardest_objects,
     never_held,
@@ -37,6 +36,7 @@ from graspaug.experiments.cell.picks import (
     pick_summary,
 )
 from graspaug.experiments.cell.trials import ObjectJob, run_trials
+from graspaug.experiments.cell.words import oracle_words
 from graspaug.rng import shape_rng
 
 log = logging.getLogger(__name__)
@@ -378,14 +378,7 @@ def feasible_lines(feasible: dict, text) -> list[str]:
     the cell and each arm's share of the oracle − antipodal span."""
     if not feasible:
         return ["No feasible object (or no `feasible` column): every figure below is on all objects.", ""]
-    rate = feasible.get("oracle_rate")
-    verdict = (
-        "no oracle arm: whether the cell can tell planners apart is unknown"
-        if rate is None
-        else f"the oracle picks {rate:.0%} of feasible attempts: "
-        + ("the cell is fit to compare planners" if feasible["oracle_fit"] else
-           f"below {ORACLE_FIT:.0%}, the cell is NOT fit to compare planners (its physics caps success)")
-    )  # fmt: skip
+    verdict = oracle_words(feasible.get("oracle_rate"))
     span = feasible.get("span_share", {})
     return [
         f"Feasible objects first: {feasible['object_draws']} of {feasible['all_object_draws']} object-draws "
