@@ -2,7 +2,6 @@
 
 import os
 import re
-import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -16,51 +15,20 @@ from graspaug.io.checkpoints import read_gqcnn
 from graspaug.io.voxels import read_voxels
 from graspaug.nets.gqcnn import GQCNN, GQCNNEnsemble
 from graspaug.training.gqcnn_data import with_split
+from tests.clones import run, tiny_clone
 
 pytestmark = pytest.mark.slow
-
-
-def copy_repo(src: Path, dst: Path) -> None:
-    """The files a user's clone has (tracked by git), without outputs or caches."""
-    listed = subprocess.run(
-        ["git", "ls-files", "-co", "--exclude-standard"], cwd=src, capture_output=True, text=True, check=True
-    )
-    for rel in listed.stdout.splitlines():
-        if not (src / rel).is_file():
-            continue
-        (dst / rel).parent.mkdir(parents=True, exist_ok=True)
-        shutil.copy2(src / rel, dst / rel)
-
 
 SHAPES = "data/shapes.parquet"
 GRASPAUG = [sys.executable, "-m", "graspaug.pipeline.cli"]  # the CLI of the package under test
 
 
-def run(cmd, cwd, env):
-    result = subprocess.run(cmd, cwd=cwd, env=env, capture_output=True, text=True)
-    assert result.returncode == 0, f"{cmd} failed:\n{result.stdout}\n{result.stderr}"
-    return result
-
-
 @pytest.fixture(scope="module")
 def tiny_repo(repo_root, tmp_path_factory):
+    """A user's clone on the tiny profile, its stages built by the tests in file order; the cell's decompositions
+    cached for this module alone (every stage and experiment of the clone shares them)."""
     work = tmp_path_factory.mktemp("repo")
-    copy_repo(repo_root, work)
-    run(
-        [str(Path(sys.executable).parent / "graspaug"), "profile", "tiny"], work, {**os.environ}
-    )  # the documented way to apply a profile
-    env = {
-        **os.environ,
-        "DVC_NO_ANALYTICS": "1",
-        "PATH": f"{Path(sys.executable).parent}{os.pathsep}{os.environ['PATH']}",
-        "GIT_AUTHOR_NAME": "test",
-        "GIT_AUTHOR_EMAIL": "test@example.com",
-        "GIT_COMMITTER_NAME": "test",
-        "GIT_COMMITTER_EMAIL": "test@example.com",
-    }
-    run(["git", "init", "-q"], work, env)
-    run(["git", "add", "-A"], work, env)
-    run(["git", "commit", "-q", "-m", "clone"], work, env)  # a user's clone has commits (DVCLive needs one)
+    env = tiny_clone(repo_root, work, tmp_path_factory.mktemp("sim-cache"))
     return work, env
 
 
@@ -681,11 +649,10 @@ def test_a_one_member_network_is_a_plain_gqcnn(tiny_repo, tmp_path):
     assert type(net) is GQCNN and card is None
 
 
-def test_dvc_repro_sim(tiny_repo, tmp_path):
+def test_dvc_repro_sim(tiny_repo):
     import json
 
     work, env = tiny_repo
-    env = {**env, "GRASPAUG_CACHE": str(tmp_path / "cache")}
     run(["dvc", "repro", "sim"], work, env)
     metrics = json.loads((work / "reports/sim/summary.json").read_text())
     ap = json.loads((work / "reports/gqcnn/ap.json").read_text())
@@ -1087,8 +1054,7 @@ def test_queued_two_point_sweep_lines_up_metrics(tiny_repo):
     import json
     import time
 
-    work, env = tiny_repo
-    env = {**env, "GRASPAUG_CACHE": str(work.parent / "sweep-cache")}
+    work, env = tiny_repo  # the points decompose nothing: the module's cache holds the objects (the same meshes)
     run(["dvc", "repro", "sim"], work, env)  # the baseline is complete (no-op after the tests above)
     run(["git", "add", "-A"], work, env)
     run(["git", "commit", "-q", "-m", "baseline"], work, env)
