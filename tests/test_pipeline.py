@@ -1050,17 +1050,20 @@ def test_every_declared_plot_renders(tiny_repo):
 
 
 def test_queued_two_point_sweep_lines_up_metrics(tiny_repo):
-    """`dvc exp run --queue -S` twice, `dvc queue start`, then `dvc exp show` / `dvc metrics diff`."""
+    """`dvc exp run --queue -S` twice, `dvc queue start`, then `dvc exp show` / `dvc params diff` / `dvc metrics diff
+    --all`. The points sweep a key of `critic_eval`, a stage of seconds that no other stage reads: each point re-runs
+    it alone and carries the committed run's other metrics, the cell's and the AP contrasts' among them, which only
+    ``--all`` lines up (unchanged)."""
     import json
     import time
 
-    work, env = tiny_repo  # the points decompose nothing: the module's cache holds the objects (the same meshes)
-    run(["dvc", "repro", "sim"], work, env)  # the baseline is complete (no-op after the tests above)
+    work, env = tiny_repo
+    run(["dvc", "repro"], work, env)  # the baseline is complete (no-op after the tests above)
     run(["git", "add", "-A"], work, env)
     run(["git", "commit", "-q", "-m", "baseline"], work, env)
-    for force in (10.0, 40.0):
+    for pairs in (2, 4):
         run(
-            ["dvc", "exp", "run", "--queue", "-S", f"sim.hand.grip_force={force}", "--name", f"grip-{int(force)}"],
+            ["dvc", "exp", "run", "--queue", "-S", f"critic_eval.n_pairs={pairs}", "--name", f"pairs-{pairs}"],
             work,
             env,
         )
@@ -1079,21 +1082,26 @@ def test_queued_two_point_sweep_lines_up_metrics(tiny_repo):
             for rev in exp.get("revs") or []:
                 data = rev["data"]
                 experiments[rev.get("name") or data.get("name")] = data
-    assert {"grip-10", "grip-40"} <= set(experiments), list(experiments)
-    for name, force in (("grip-10", 10.0), ("grip-40", 40.0)):
+    assert {"pairs-2", "pairs-4"} <= set(experiments), list(experiments)
+    for name, pairs in (("pairs-2", 2), ("pairs-4", 4)):
         data = experiments[name]
-        assert data["params"]["params.yaml"]["data"]["sim"]["hand"]["grip_force"] == force
+        assert data["params"]["params.yaml"]["data"]["critic_eval"]["n_pairs"] == pairs
+        critic = data["metrics"]["metrics/critic_eval.json"]["data"]
         sim = data["metrics"]["metrics/sim/after_vs_before.json"]["data"]
         ap = data["metrics"]["metrics/ap/real_data.json"]["data"]
-        assert set(sim) == {"mean", "lo", "hi"} and set(ap) <= {"mean", "lo", "hi"}
-    changed = json.loads(run(["dvc", "params", "diff", "grip-10", "grip-40", "--json"], work, env).stdout)
-    assert list(changed["params.yaml"]) == ["sim.hand.grip_force"]
+        assert (
+            {"mean", "lo", "hi"} <= set(critic) and set(sim) == {"mean", "lo", "hi"} and set(ap) <= {"mean", "lo", "hi"}
+        )
+    changed = json.loads(run(["dvc", "params", "diff", "pairs-2", "pairs-4", "--json"], work, env).stdout)
+    assert list(changed["params.yaml"]) == ["critic_eval.n_pairs"]
     assert (
-        changed["params.yaml"]["sim.hand.grip_force"]["old"],
-        changed["params.yaml"]["sim.hand.grip_force"]["new"],
-    ) == (10.0, 40.0)
-    diff = json.loads(run(["dvc", "metrics", "diff", "grip-10", "grip-40", "--json", "--all"], work, env).stdout)
+        changed["params.yaml"]["critic_eval.n_pairs"]["old"],
+        changed["params.yaml"]["critic_eval.n_pairs"]["new"],
+    ) == (2, 4)
+    diff = json.loads(run(["dvc", "metrics", "diff", "pairs-2", "pairs-4", "--json", "--all"], work, env).stdout)
+    assert {"mean", "lo", "hi"} <= set(diff["metrics/critic_eval.json"])  # the swept stage's, re-run at each point
     assert set(diff["metrics/sim/after_vs_before.json"]) == {"mean", "lo", "hi"}  # --all lines up every metric
+    assert all(v["diff"] == 0 for v in diff["metrics/sim/after_vs_before.json"].values())  # the key reaches no cell
     for key in ("test_ap", "val_ap"):  # the tiny run's test AP is defined, as its validation AP
         assert set(diff["metrics/gqcnn/s0.json"][key]) == {"old", "new", "diff"}, key
     run(["dvc", "queue", "stop"], work, env)
