@@ -1,15 +1,13 @@
 """The README's "Train on your own meshes" path in a temporary copy of the repository, on the tiny profile: a folder
 of real meshes (ycb78, metres) through ``dvc exp run`` to the fidelity stage, where own meshes used to stop it."""
 
-import os
 import shutil
-import sys
 from pathlib import Path
 
 import pandas as pd
 import pytest
 
-from tests.test_pipeline import copy_repo, run
+from tests.clones import run, tiny_clone
 
 pytestmark = pytest.mark.slow
 
@@ -35,23 +33,10 @@ def test_training_on_own_meshes_runs_through_fidelity(repo_root, tmp_path):
     (parents of graspness 0, common with 8 grasps a shape, leave a figure undefined, which the report says, rather
     than stopping the stage)."""
     work, meshes = tmp_path / "repo", tmp_path / "my_meshes"
-    work.mkdir(), meshes.mkdir()
-    copy_repo(repo_root, work)
+    meshes.mkdir()
     for name in MESHES:
         shutil.copy(YCB78 / f"{name}.stl", meshes)
-    env = {
-        **os.environ,
-        "DVC_NO_ANALYTICS": "1",
-        "PATH": f"{Path(sys.executable).parent}{os.pathsep}{os.environ['PATH']}",
-        "GIT_AUTHOR_NAME": "test",
-        "GIT_AUTHOR_EMAIL": "test@example.com",
-        "GIT_COMMITTER_NAME": "test",
-        "GIT_COMMITTER_EMAIL": "test@example.com",
-    }
-    run([str(Path(sys.executable).parent / "graspaug"), "profile", "tiny"], work, env)
-    run(["git", "init", "-q"], work, env)
-    run(["git", "add", "-A"], work, env)
-    run(["git", "commit", "-q", "-m", "clone"], work, env)
+    env = tiny_clone(repo_root, work, tmp_path / "sim-cache")
     settings = ["-S", "data.source=folder", "-S", f"data.path={meshes}", "-S", "ingest.surface.size=fit"]
     run(["dvc", "exp", "run", *settings, "fidelity"], work, env)
 

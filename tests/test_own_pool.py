@@ -4,9 +4,6 @@
 set alone)."""
 
 import json
-import os
-import sys
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -22,7 +19,7 @@ from graspaug.io.checkpoints import load_autoencoder
 from graspaug.nets.settings import AEConfig
 from graspaug.training.autoencoder import batches_per_epoch, step_matched
 from graspaug.training.settings import AETrainConfig
-from tests.test_pipeline import copy_repo, run
+from tests.clones import run, tiny_clone
 
 
 def test_step_matched_takes_the_main_aes_sgd_steps_on_fewer_shapes():
@@ -49,28 +46,16 @@ def test_own_source_refuses_an_ae_trained_on_other_shapes():
 
 @pytest.mark.slow
 def test_dvc_repro_own_pool_from_an_ae_of_the_base_set_alone(repo_root, tmp_path):
+    def own_pool_only(params: dict) -> None:
+        params["gqcnn"] |= {"pools": ["targeted", "own"], "control_ratios": [1.0], "members": 1, "ceiling": False}
+        params["gqcnn"]["seeds"] = [0]
+        params["gqcnn"]["networks"] = [["targeted", 6, 0.5], ["own", 6, 1.0]]  # generate makes only what they train on
+        params["generate"]["own"] = {"epochs_ae": 150, "epochs_critic": 1}  # the main AE's epochs (half its SGD steps)
+
     work = tmp_path / "repo"
-    copy_repo(repo_root, work)
-    env = {
-        **os.environ,
-        "DVC_NO_ANALYTICS": "1",
-        "PATH": f"{Path(sys.executable).parent}{os.pathsep}{os.environ['PATH']}",
-        **{
-            f"GIT_{who}_{what}": value
-            for who in ("AUTHOR", "COMMITTER")
-            for what, value in (("NAME", "t"), ("EMAIL", "t@e"))
-        },
-    }
-    run([str(Path(sys.executable).parent / "graspaug"), "profile", "tiny"], work, env)
-    params = yaml.safe_load((work / "params.yaml").read_text())
-    params["gqcnn"] |= {"pools": ["targeted", "own"], "control_ratios": [1.0], "members": 1, "ceiling": False}
-    params["gqcnn"]["seeds"] = [0]
-    params["gqcnn"]["networks"] = [["targeted", 6, 0.5], ["own", 6, 1.0]]  # generate makes only what these train on
-    params["generate"]["own"] = {"epochs_ae": 150, "epochs_critic": 1}  # the main AE's epochs (half its SGD steps)
-    (work / "params.yaml").write_text(yaml.safe_dump(params, sort_keys=False))
-    for cmd in (["git", "init", "-q"], ["git", "add", "-A"], ["git", "commit", "-q", "-m", "clone"]):
-        run(cmd, work, env)
+    env = tiny_clone(repo_root, work, tmp_path / "sim-cache", edit=own_pool_only)
     run(["dvc", "repro", "train_gqcnn@0"], work, env)
+    params = yaml.safe_load((work / "params.yaml").read_text())
 
     shapes = pd.read_parquet(work / "data/shapes.parquet")
     base = list(draw_base_sets(shapes, (4, 6), seed=0)[6])  # the base set of B = 6 that generate and the GQ-CNN use

@@ -2,7 +2,6 @@
 
 import os
 import re
-import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -16,51 +15,20 @@ from graspaug.io.checkpoints import read_gqcnn
 from graspaug.io.voxels import read_voxels
 from graspaug.nets.gqcnn import GQCNN, GQCNNEnsemble
 from graspaug.training.gqcnn_data import with_split
+from tests.clones import run, tiny_clone
 
 pytestmark = pytest.mark.slow
-
-
-def copy_repo(src: Path, dst: Path) -> None:
-    """The files a user's clone has (tracked by git), without outputs or caches."""
-    listed = subprocess.run(
-        ["git", "ls-files", "-co", "--exclude-standard"], cwd=src, capture_output=True, text=True, check=True
-    )
-    for rel in listed.stdout.splitlines():
-        if not (src / rel).is_file():
-            continue
-        (dst / rel).parent.mkdir(parents=True, exist_ok=True)
-        shutil.copy2(src / rel, dst / rel)
-
 
 SHAPES = "data/shapes.parquet"
 GRASPAUG = [sys.executable, "-m", "graspaug.pipeline.cli"]  # the CLI of the package under test
 
 
-def run(cmd, cwd, env):
-    result = subprocess.run(cmd, cwd=cwd, env=env, capture_output=True, text=True)
-    assert result.returncode == 0, f"{cmd} failed:\n{result.stdout}\n{result.stderr}"
-    return result
-
-
 @pytest.fixture(scope="module")
 def tiny_repo(repo_root, tmp_path_factory):
+    """A user's clone on the tiny profile, its stages built by the tests in file order; the cell's decompositions
+    cached for this module alone (every stage and experiment of the clone shares them)."""
     work = tmp_path_factory.mktemp("repo")
-    copy_repo(repo_root, work)
-    run(
-        [str(Path(sys.executable).parent / "graspaug"), "profile", "tiny"], work, {**os.environ}
-    )  # the documented way to apply a profile
-    env = {
-        **os.environ,
-        "DVC_NO_ANALYTICS": "1",
-        "PATH": f"{Path(sys.executable).parent}{os.pathsep}{os.environ['PATH']}",
-        "GIT_AUTHOR_NAME": "test",
-        "GIT_AUTHOR_EMAIL": "test@example.com",
-        "GIT_COMMITTER_NAME": "test",
-        "GIT_COMMITTER_EMAIL": "test@example.com",
-    }
-    run(["git", "init", "-q"], work, env)
-    run(["git", "add", "-A"], work, env)
-    run(["git", "commit", "-q", "-m", "clone"], work, env)  # a user's clone has commits (DVCLive needs one)
+    env = tiny_clone(repo_root, work, tmp_path_factory.mktemp("sim-cache"))
     return work, env
 
 
@@ -681,11 +649,10 @@ def test_a_one_member_network_is_a_plain_gqcnn(tiny_repo, tmp_path):
     assert type(net) is GQCNN and card is None
 
 
-def test_dvc_repro_sim(tiny_repo, tmp_path):
+def test_dvc_repro_sim(tiny_repo):
     import json
 
     work, env = tiny_repo
-    env = {**env, "GRASPAUG_CACHE": str(tmp_path / "cache")}
     run(["dvc", "repro", "sim"], work, env)
     metrics = json.loads((work / "reports/sim/summary.json").read_text())
     ap = json.loads((work / "reports/gqcnn/ap.json").read_text())
@@ -1104,18 +1071,20 @@ def test_every_declared_plot_renders(tiny_repo):
 
 
 def test_queued_two_point_sweep_lines_up_metrics(tiny_repo):
-    """`dvc exp run --queue -S` twice, `dvc queue start`, then `dvc exp show` / `dvc metrics diff`."""
+    """`dvc exp run --queue -S` twice, `dvc queue start`, then `dvc exp show` / `dvc params diff` / `dvc metrics diff
+    --all`. The points sweep a key of `critic_eval`, a stage of seconds that no other stage reads: each point re-runs
+    it alone and carries the committed run's other metrics, the cell's and the AP contrasts' among them, which only
+    ``--all`` lines up (unchanged)."""
     import json
     import time
 
     work, env = tiny_repo
-    env = {**env, "GRASPAUG_CACHE": str(work.parent / "sweep-cache")}
-    run(["dvc", "repro", "sim"], work, env)  # the baseline is complete (no-op after the tests above)
+    run(["dvc", "repro"], work, env)  # the baseline is complete (no-op after the tests above)
     run(["git", "add", "-A"], work, env)
     run(["git", "commit", "-q", "-m", "baseline"], work, env)
-    for force in (10.0, 40.0):
+    for pairs in (2, 4):
         run(
-            ["dvc", "exp", "run", "--queue", "-S", f"sim.hand.grip_force={force}", "--name", f"grip-{int(force)}"],
+            ["dvc", "exp", "run", "--queue", "-S", f"critic_eval.n_pairs={pairs}", "--name", f"pairs-{pairs}"],
             work,
             env,
         )
@@ -1134,21 +1103,26 @@ def test_queued_two_point_sweep_lines_up_metrics(tiny_repo):
             for rev in exp.get("revs") or []:
                 data = rev["data"]
                 experiments[rev.get("name") or data.get("name")] = data
-    assert {"grip-10", "grip-40"} <= set(experiments), list(experiments)
-    for name, force in (("grip-10", 10.0), ("grip-40", 40.0)):
+    assert {"pairs-2", "pairs-4"} <= set(experiments), list(experiments)
+    for name, pairs in (("pairs-2", 2), ("pairs-4", 4)):
         data = experiments[name]
-        assert data["params"]["params.yaml"]["data"]["sim"]["hand"]["grip_force"] == force
+        assert data["params"]["params.yaml"]["data"]["critic_eval"]["n_pairs"] == pairs
+        critic = data["metrics"]["metrics/critic_eval.json"]["data"]
         sim = data["metrics"]["metrics/sim/after_vs_before.json"]["data"]
         ap = data["metrics"]["metrics/ap/real_data.json"]["data"]
-        assert set(sim) == {"mean", "lo", "hi"} and set(ap) <= {"mean", "lo", "hi"}
-    changed = json.loads(run(["dvc", "params", "diff", "grip-10", "grip-40", "--json"], work, env).stdout)
-    assert list(changed["params.yaml"]) == ["sim.hand.grip_force"]
+        assert (
+            {"mean", "lo", "hi"} <= set(critic) and set(sim) == {"mean", "lo", "hi"} and set(ap) <= {"mean", "lo", "hi"}
+        )
+    changed = json.loads(run(["dvc", "params", "diff", "pairs-2", "pairs-4", "--json"], work, env).stdout)
+    assert list(changed["params.yaml"]) == ["critic_eval.n_pairs"]
     assert (
-        changed["params.yaml"]["sim.hand.grip_force"]["old"],
-        changed["params.yaml"]["sim.hand.grip_force"]["new"],
-    ) == (10.0, 40.0)
-    diff = json.loads(run(["dvc", "metrics", "diff", "grip-10", "grip-40", "--json", "--all"], work, env).stdout)
+        changed["params.yaml"]["critic_eval.n_pairs"]["old"],
+        changed["params.yaml"]["critic_eval.n_pairs"]["new"],
+    ) == (2, 4)
+    diff = json.loads(run(["dvc", "metrics", "diff", "pairs-2", "pairs-4", "--json", "--all"], work, env).stdout)
+    assert {"mean", "lo", "hi"} <= set(diff["metrics/critic_eval.json"])  # the swept stage's, re-run at each point
     assert set(diff["metrics/sim/after_vs_before.json"]) == {"mean", "lo", "hi"}  # --all lines up every metric
+    assert all(v["diff"] == 0 for v in diff["metrics/sim/after_vs_before.json"].values())  # the key reaches no cell
     for key in ("test_ap", "val_ap"):  # the tiny run's test AP is defined, as its validation AP
         assert set(diff["metrics/gqcnn/s0.json"][key]) == {"old", "new", "diff"}, key
     run(["dvc", "queue", "stop"], work, env)
