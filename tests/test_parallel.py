@@ -50,10 +50,15 @@ def run_ingest_and_voxelize(folder, params, monkeypatch) -> tuple[pd.DataFrame, 
 def test_stages_on_a_dask_cluster_equal_the_local_run(repo_root, tmp_path, monkeypatch):
     distributed = pytest.importorskip("distributed")
     tiny = profile_params("tiny", repo_root / "profiles")
-    params = tiny.model_copy(
+    params = tiny.model_copy(  # 6 shapes: an experiment they hold (split refuses fewer shapes than settings need)
         update={
             "data": dataclasses.replace(tiny.data, limit=6),
             "ingest": dataclasses.replace(tiny.ingest, min_shapes=2),
+            "generate": dataclasses.replace(tiny.generate, base_sizes=[2]),
+            "gqcnn": dataclasses.replace(
+                tiny.gqcnn, augment_base_sizes=[2], pools=["targeted", "random"], val_shapes=1
+            ),
+            "lifelong": dataclasses.replace(tiny.lifelong, rounds={}),
         }
     )
     (tmp_path / "local").mkdir()
