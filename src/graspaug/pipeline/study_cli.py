@@ -256,10 +256,10 @@ def confirm_design_command(
     "report.md, summary.json and a success and a failure picture of each network arm to `--out`; with `--results` "
     "one row per attempt to `results/<NAME>/attempts.parquet` (`graspaug results` recomputes every figure), each "
     "draw as it finishes; a draw already there is not picked again (the summary covers every draw kept).\n\n"
-    "Cost on 2 cores (AMD EPYC, `--workers 2`, 2026-12-07): with `--feasible-only`, a confirm draw's 8-13 feasible "
-    "objects × 10 attempts × 5 arms (the networks, oracle, antipodal) took 266-617 s beside another study (about 0.6 s "
-    "an attempt); every object of a draw (about 70) about 7 times that. The first time an object is loaded its "
-    "collision shapes are decomposed (V-HACD, about 8 CPU-s an object, then cached).",
+    "Cost on 2 cores (AMD EPYC, `--workers 2`, 2026-12-07): with `--feasible-only`, a confirm draw's 4-14 feasible "
+    "objects × 10 attempts × 5 arms (the networks, oracle, antipodal) took 129-1,492 s beside other studies (median "
+    "about 500 s; 12 draws, 5,450 attempts an arm); every object of a draw (about 70) about 7 times that. The first "
+    "time an object is loaded its collision shapes are decomposed (V-HACD, about 8 CPU-s an object, then cached).",
 )
 def real_picks_command(
     networks: Path = typer.Option(
