@@ -139,3 +139,20 @@ def test_generate_refuses_a_real_pool_that_render_left_too_small():
     short = dataclasses.replace(experiment_split(rendered, base, gq.val_shapes, params.data_seed), test=test)
     with pytest.raises(DataError, match=r"^too few shapes: 18 with datapoints from render@original \(13 train, 5 test"):
         real_pool_ids(short, params.ingest, gen, gq)
+
+
+def test_generate_counts_the_base_sets_as_rendered():
+    """A base shape render@original skipped leaves the base set smaller and the real pool as large: 13 rendered train
+    shapes, the largest base set 5 of its nominal 6, validation 2, a real pool of 6, so real/6-1 is served and generate
+    goes on (counting the nominal base set it would have asked for 14)."""
+    params = profile_params("tiny", PROFILES)
+    gen, gq = params.generate, params.gqcnn
+    train, test = [f"s{i:02d}" for i in range(14)], ("t0", "t1", "t2", "t3", "t4")
+    shapes = pd.DataFrame({"shape_id": train + list(test), "split": ["train"] * 14 + ["test"] * 5})
+    drawn = {b: list(s) for b, s in draw_base_sets(shapes, gen.base_sizes, params.data_seed).items()}
+    skipped = drawn[max(drawn)][0]  # a shape of every base set it lies in (nested)
+    base = {b: [s for s in ids if s != skipped] for b, ids in drawn.items()}
+    rendered = [s for s in train if s != skipped]
+    split = dataclasses.replace(experiment_split(rendered, base, gq.val_shapes, params.data_seed), test=test)
+    assert len(split.base[max(base)]) == 5 and len(split.real_pool) == 6
+    assert list(real_pool_ids(split, params.ingest, gen, gq)) == list(split.real_pool)

@@ -4,6 +4,7 @@ shapes render@original could picture, which its recon pool's real pool is drawn 
 
 from __future__ import annotations
 
+import dataclasses
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -42,7 +43,9 @@ def real_pool_ids(
     fewer train or test shapes than the settings need (the split stage checked the shapes ingest kept; render skips a
     shape none of whose grasps it can picture)."""
     rendered = len(split.ceiling) + len(split.validation), len(split.test)
-    problem = shape_count_problem(*rendered, params_shape_needs(generate, gqcnn), ingest.test_fraction, RENDERED)
+    needs = params_shape_needs(generate, gqcnn)  # the base sets as rendered: load_split drops unrendered base shapes
+    needs = dataclasses.replace(needs, base=max((len(ids) for ids in split.base.values()), default=0))
+    problem = shape_count_problem(*rendered, needs, ingest.test_fraction, RENDERED)
     if problem:
         raise DataError(problem)
     return np.array(split.real_pool)

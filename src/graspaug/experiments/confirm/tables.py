@@ -361,7 +361,8 @@ def check_base_objects(counts: pd.DataFrame, networks: pd.DataFrame) -> None:
         counted = "none" if np.isnan(counted) else f"{counted:.0f}"
         raise DataError(
             f"draw {draw:.0f}, base size {size:.0f}: its 1:0 network trained on {trained:.0f} datapoints, the counted "
-            f"base set holds {counted} (count from the objects table and renders the draws used)"
+            f"base set holds {counted} (count again from a finished draw's clone: `graspaug study confirm --plan "
+            "<plan> --count-objects <clone>`)"
         )
 
 
@@ -389,7 +390,9 @@ def read_plan_result(
         if counts is not None:
             actual = counts.set_index(["draw", "base_size"]).objects
             held = np.array([[actual[d, b] for b in sizes] for d in draws], dtype=float)
-            result["exchange_actual"] = confirm.exchange_rate_on_curve(held, grid, arm, 1 - alpha)
+            result["exchange_actual"] = confirm.exchange_rate_on_curve(held, grid, arm, 1 - alpha) | {
+                "arm": curve["arm"]
+            }
             own = int(arm_key(plan, curve["arm"])[1])
             on = counts[counts.base_size == own]
             result["base_objects"] = {
