@@ -193,6 +193,15 @@ def assign_split(
     return {i: split[duplicate_of.get(i, i)] for i in shape_ids}
 
 
+def split_objects(objects: pd.DataFrame, test_fraction: float, seed: int | list[int]) -> pd.DataFrame:
+    """The objects table (``shape_id``, ``duplicate_of``) with each object's ``split`` (:func:`assign_split` seeded
+    by ``seed``, a :func:`split_seed`): the shape table the ``split`` stage writes."""
+    duplicates = dict(zip(objects.shape_id, objects.duplicate_of))
+    return objects.assign(
+        split=objects.shape_id.map(assign_split(list(objects.shape_id), test_fraction, seed, duplicates))
+    )
+
+
 def closing_summary(shapes: pd.DataFrame) -> str:
     """One line on how the corpus was closed: counts of ``closed_by`` and the ``hull_fill`` spread."""
     closed = shapes["closed_by"].value_counts()

@@ -322,18 +322,14 @@ def base_objects(
     (draw, base size): ``draw``, ``base_size`` (nominal), ``objects`` (base objects holding datapoints),
     ``datapoints`` (theirs: what a 1:0 network of that size trains on) and ``train_objects`` (the draw's train
     split, every object of which the draw's AutoEncoder-Critic learned)."""
-    from graspaug.augment.corpus import assign_split, split_seed
+    from graspaug.augment.corpus import split_objects, split_seed
     from graspaug.io.tables import read_table
     from graspaug.training.gqcnn_data import load_split
 
     per_object = read_table(Path(original) / "index.parquet").groupby("shape_id").size()
-    duplicates = dict(zip(objects.shape_id, objects.duplicate_of))
     rows = []
     for draw in draws:
-        split_of = assign_split(
-            list(objects.shape_id), test_fraction, split_seed(seed, draw, independent_draws), duplicates
-        )
-        shapes = objects.assign(split=objects.shape_id.map(split_of))
+        shapes = split_objects(objects, test_fraction, split_seed(seed, draw, independent_draws))
         split = load_split(Path(original), shapes, sorted(base_sizes), val_shapes, draw)
         for size, ids in split.base.items():
             rows.append(

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import logging
 
-from graspaug.augment.corpus import assign_split, split_seed
+from graspaug.augment.corpus import split_objects, split_seed
 from graspaug.io.tables import read_table, write_table
 from graspaug.pipeline.params.base import params_model
 from graspaug.pipeline.params.generate import GenerateParams
@@ -41,12 +41,8 @@ Params = params_model(
 
 
 def run(params: Params) -> None:
-    shapes = read_table(OBJECTS_TABLE)
     seed = split_seed(params.seed, params.data_seed, params.independent_draws)
-    duplicates = dict(zip(shapes.shape_id, shapes.duplicate_of))
-    shapes["split"] = shapes["shape_id"].map(
-        assign_split(list(shapes["shape_id"]), params.ingest.test_fraction, seed, duplicates)
-    )
+    shapes = split_objects(read_table(OBJECTS_TABLE), params.ingest.test_fraction, seed)
     counts = shapes["split"].value_counts()
     needs = params_shape_needs(params.generate, params.gqcnn, params.lifelong)
     n_train, n_test = int(counts.get("train", 0)), int(counts.get("test", 0))
