@@ -236,3 +236,19 @@ def test_the_committed_figures_of_a_table_with_feasibility_name_the_cells_fitnes
     assert figures["p/feasible/object_draws"] == "2 feasible object-draws of 3"
     assert figures["p/feasible/oracle_fit"] == "fit to compare planners"
     assert figures["p/feasible/span/none@50"] == "0.67" and figures["p/feasible/span/oracle"] == "1.00"
+
+
+def test_the_sim_report_and_the_picks_read_feasibility_and_the_oracle_alike():
+    """One reading of the feasible rows and of the oracle serves both tables: a missing ``feasible`` value is not
+    feasible, a table without the column has no feasible row, and without an oracle arm there is no verdict and no
+    span (the antipodal floor alone defines none)."""
+    from graspaug.experiments.cell.picks import feasible_rows, oracle_readout
+
+    table = pd.DataFrame({"feasible": [True, None, False, True]})
+    assert feasible_rows(table).tolist() == [True, False, False, True]
+    assert not feasible_rows(pd.DataFrame({"success": [True]})).any()
+    assert oracle_readout({"antipodal": 0.5, "none@50": 0.7}) == {"oracle_rate": None, "oracle_fit": None,
+                                                                 "span_share": {}}  # fmt: skip
+    fit = oracle_readout({"oracle": 0.9, "antipodal": 0.5, "none@50": 0.7})
+    assert fit["oracle_fit"] and fit["span_share"]["none@50"] == pytest.approx(0.5)
+    assert not oracle_readout({"oracle": 0.89})["oracle_fit"]

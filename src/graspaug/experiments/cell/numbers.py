@@ -11,7 +11,7 @@ import pandas as pd
 
 from graspaug.errors import DataError
 from graspaug.experiments.ap.numbers import test_predictions, test_rows
-from graspaug.experiments.cell.picks import ANTIPODAL, ORACLE, oracle_fit, span_shares
+from graspaug.experiments.cell.picks import ANTIPODAL, ORACLE, feasible_rows, oracle_readout
 from graspaug.experiments.stats import (
     DIFFERENCE_RANGE,
     ObjectBootstrap,
@@ -205,20 +205,21 @@ def summarize(trials: pd.DataFrame, objects: Sequence, chosen: dict, setup: dict
 
 
 def feasible_first(trials: pd.DataFrame, arms: Sequence[str]) -> dict:
-    """Success on the feasible objects (``trials``' ``feasible`` column: the feasibility rule's, from geometry before
-    any pick) and on all objects: for each (``feasible``, ``all``) the count of objects, every arm's rate
-    (:func:`rate_summary`) and its share of the oracle − antipodal span where defined
-    (:func:`~graspaug.experiments.cell.picks.span_shares`); the oracle's rate on the feasible attempts
-    (``oracle_rate``) and whether it makes the cell fit to compare planners (``oracle_fit``,
-    :func:`~graspaug.experiments.cell.picks.oracle_fit`); both None without a feasible object."""
+    """Success on the feasible objects (:func:`~graspaug.experiments.cell.picks.feasible_rows`: the feasibility
+    rule's, from geometry before any pick) and on all objects: for each (``feasible``, ``all``) the count of objects,
+    every arm's rate (:func:`rate_summary`) and its share of the oracle − antipodal span where defined; with the
+    oracle's rate on the feasible attempts and whether it makes the cell fit to compare planners
+    (:func:`~graspaug.experiments.cell.picks.oracle_readout`; both None without a feasible object)."""
     out = {}
-    for name, sel in (("feasible", trials.feasible.eq(True)), ("all", pd.Series(True, index=trials.index))):
+    for name, sel in (("feasible", feasible_rows(trials)), ("all", pd.Series(True, index=trials.index))):
         n_objects = int(trials.object[sel].nunique())
         rates = {arm: rate_summary(trials.success[sel & (trials.arm == arm)]) for arm in arms} if n_objects else {}
-        shares = span_shares({arm: r["successes"] / r["attempts"] for arm, r in rates.items()})  # not rounded
-        out[name] = {"objects": n_objects, "arms": rates, "span_share": {a: round(v, 5) for a, v in shares.items()}}
-    oracle = out["feasible"]["arms"].get(ORACLE, {}).get("success_rate")
-    out["oracle_rate"], out["oracle_fit"] = oracle, None if oracle is None else oracle_fit(oracle)
+        readout = oracle_readout({arm: r["successes"] / r["attempts"] for arm, r in rates.items()})  # not rounded
+        shares = {a: round(v, 5) for a, v in readout["span_share"].items()}
+        out[name] = {"objects": n_objects, "arms": rates, "span_share": shares}
+        if name == "feasible":
+            oracle = rates.get(ORACLE, {}).get("success_rate")  # the rounded rate the report prints
+            out["oracle_rate"], out["oracle_fit"] = oracle, readout["oracle_fit"]
     return out
 
 

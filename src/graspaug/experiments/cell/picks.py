@@ -229,28 +229,43 @@ def pick_power(attempts: pd.DataFrame, a: str, b: str, n_objects: int, draws: Se
 ORACLE_FIT = 0.90
 
 
+def feasible_rows(table: pd.DataFrame) -> pd.Series:
+    """Which rows of a table of picks (attempts or trials) are on objects declared feasible from geometry before any
+    pick (its ``feasible`` column; a missing value is not feasible). All False where the table has no such column."""
+    if "feasible" not in table:
+        return pd.Series(False, index=table.index)
+    return table.feasible.astype("boolean").fillna(False).astype(bool)
+
+
+def oracle_readout(rates: Mapping[str, float]) -> dict:
+    """What the ceiling and floor say of the cell, from each arm's success rate on the feasible objects (``rates``,
+    arm → rate): ``oracle_rate`` and ``oracle_fit`` (:func:`oracle_fit`; both None without an oracle arm) and
+    ``span_share``, each arm's share of the oracle − antipodal span (:func:`span_shares`; ``{}`` where undefined).
+    The one reading of the oracle for the sim stage's report and the real-object picks."""
+    oracle = rates.get(ORACLE)
+    return {
+        "oracle_rate": oracle,
+        "oracle_fit": None if oracle is None else oracle_fit(oracle),
+        "span_share": span_shares(rates),
+    }
+
+
 def feasible_summary(table: pd.DataFrame, n_resamples: int, seed: int) -> dict:
-    """The picks on feasible objects (the ``feasible`` column, declared from geometry before any pick): counts of
-    feasible and all object-draws, :func:`pick_summary` of the feasible attempts, the oracle's rate there and
-    whether the cell is fit to compare planners (``oracle_fit``: the oracle picks at least :data:`ORACLE_FIT`),
-    and each arm's share of the oracle − antipodal span. ``{}`` where the table has no feasible attempt."""
-    if "feasible" not in table or not table.feasible.fillna(False).astype(bool).any():
+    """The picks on feasible objects (:func:`feasible_rows`): counts of feasible and all object-draws,
+    :func:`pick_summary` of the feasible attempts and :func:`oracle_readout` of its rates. ``{}`` where the table has
+    no feasible attempt."""
+    rows = feasible_rows(table)
+    if not rows.any():
         return {}
-    feasible = table[table.feasible.fillna(False).astype(bool)]
-    pairs = table[["draw", "object"]].drop_duplicates()
+    feasible = table[rows]
     out = {
         "object_draws": int(len(feasible[["draw", "object"]].drop_duplicates())),
-        "all_object_draws": int(len(pairs)),
+        "all_object_draws": int(len(table[["draw", "object"]].drop_duplicates())),
         "attempts": int(len(feasible)),
     }
     out["summary"] = pick_summary(feasible, list(dict.fromkeys(feasible.arm)), n_resamples, seed)
-    rates = {a: c["mean"] for a, c in out["summary"]["arms"].items()}
-    if ORACLE in rates:
-        out["oracle_rate"], out["oracle_fit"] = rates[ORACLE], oracle_fit(rates[ORACLE])
-        shares = span_shares(rates)
-        if shares:
-            out["span_share"] = shares
-    return out
+    readout = oracle_readout({a: c["mean"] for a, c in out["summary"]["arms"].items()})
+    return out | {k: v for k, v in readout.items() if v not in (None, {})}
 
 
 def oracle_fit(rate: float) -> bool:

@@ -74,6 +74,11 @@ def oracle_words(rate: float | None, missing: str = "no oracle arm") -> str:
     return head + f"below {ORACLE_FIT:.0%}, the cell is NOT fit to compare planners here (its physics caps success)"
 
 
+def feasible_count(n: int, total: int, unit: str) -> str:
+    """The opening words of a report's feasible-objects section, the same in the sim stage's report and the picks'."""
+    return f"Feasible objects first: {n} of {total} {unit}"
+
+
 def feasible_lines(feasibility: dict) -> list[str]:
     """The report's first lines (:func:`~graspaug.experiments.cell.numbers.feasible_first`): whether the oracle makes
     the cell fit to compare planners, then each arm's success on the feasible objects and on all objects beside it,
@@ -82,7 +87,7 @@ def feasible_lines(feasibility: dict) -> list[str]:
     verdict = oracle_words(feasibility["oracle_rate"], "no object is feasible")
     lines = [f"**{verdict[0].upper()}{verdict[1:]}.**", ""]
     lines.append(
-        f"Feasible objects first: {feasible['objects']} of {every['objects']} objects are feasible by geometry alone "
+        f"{feasible_count(feasible['objects'], every['objects'], 'objects')} are feasible by geometry alone "
         "(a top-down parallel jaw fits across them in at least half of their landing probability, "
         "`graspaug.sim.feasibility`; judged before any pick). Success on them, all objects beside; the share of the "
         "oracle − antipodal span where the oracle picks more often than the antipodal floor:"
@@ -312,3 +317,27 @@ def outcome_words(metrics: dict, timing: dict) -> str:
         timing["planning_time_mean"] or 0,
         timing["planning_time_max"] or 0,
     )
+
+
+def picks_feasible_lines(feasible: dict, text) -> list[str]:
+    """The picks report's first lines (:func:`~graspaug.experiments.cell.picks.feasible_summary`): success on the
+    feasible objects (declared from geometry), the oracle's verdict on the cell and each arm's share of the oracle −
+    antipodal span; ``text`` words a rate with its interval."""
+    if not feasible:
+        return ["No feasible object (or no `feasible` column): every figure below is on all objects.", ""]
+    verdict = oracle_words(feasible.get("oracle_rate"))
+    span = feasible.get("span_share", {})
+    return [
+        f"{feasible_count(feasible['object_draws'], feasible['all_object_draws'], 'object-draws')} "
+        f"({feasible['attempts']} attempts); {verdict}.",
+        "",
+        "| arm (feasible objects) | success rate [95%] | share of oracle − antipodal |",
+        "|---|---|---|",
+        *(
+            f"| {a} | {text(c, '')} | {span[a]:.2f} |" if a in span else f"| {a} | {text(c, '')} | |"
+            for a, c in feasible["summary"]["arms"].items()
+        ),
+        "",
+        "All objects:",
+        "",
+    ]

@@ -36,7 +36,7 @@ from graspaug.experiments.cell.picks import (
     pick_summary,
 )
 from graspaug.experiments.cell.trials import ObjectJob, run_trials
-from graspaug.experiments.cell.words import oracle_words
+from graspaug.experiments.cell.words import picks_feasible_lines
 from graspaug.rng import shape_rng
 
 log = logging.getLogger(__name__)
@@ -342,7 +342,7 @@ def report_markdown(table: pd.DataFrame, summary: dict) -> str:
     lines = [
         "# Picks of real objects by arm",
         "",
-        *feasible_lines(summary.get("feasible") or {}, text),
+        *picks_feasible_lines(summary.get("feasible") or {}, text),
         f"{summary['objects']} objects (object × draw), {summary['attempts']} attempts each and arm, draws "
         f"{summary['draws']}; an object's attempts are one unit (its share of successes)."
         + (
@@ -371,29 +371,6 @@ def report_markdown(table: pd.DataFrame, summary: dict) -> str:
         hardest_objects(table).round(2).to_markdown(),
     ]
     return "\n".join(lines) + "\n"
-
-
-def feasible_lines(feasible: dict, text) -> list[str]:
-    """The report's first lines: success on the feasible objects (declared from geometry), the oracle's verdict on
-    the cell and each arm's share of the oracle − antipodal span."""
-    if not feasible:
-        return ["No feasible object (or no `feasible` column): every figure below is on all objects.", ""]
-    verdict = oracle_words(feasible.get("oracle_rate"))
-    span = feasible.get("span_share", {})
-    return [
-        f"Feasible objects first: {feasible['object_draws']} of {feasible['all_object_draws']} object-draws "
-        f"({feasible['attempts']} attempts); {verdict}.",
-        "",
-        "| arm (feasible objects) | success rate [95%] | share of oracle − antipodal |",
-        "|---|---|---|",
-        *(
-            f"| {a} | {text(c, '')} | {span[a]:.2f} |" if a in span else f"| {a} | {text(c, '')} | |"
-            for a, c in feasible["summary"]["arms"].items()
-        ),
-        "",
-        "All objects:",
-        "",
-    ]
 
 
 def ranking_lines(ranking: dict, text) -> list[str]:
