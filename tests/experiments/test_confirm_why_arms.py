@@ -6,9 +6,11 @@ import json
 
 import numpy as np
 import pandas as pd
+import pytest
 import yaml
 
 from graspaug.experiments.confirm.tables import add_confirm_draw, column, combine_confirm
+from graspaug.experiments.confirm.words import confirm_figures
 
 PLAN = {
     "format": "graspaug.confirm-plan/1",
@@ -29,6 +31,7 @@ PLAN = {
     "primary": {"name": "targeted_vs_balanced@50", "a": "targeted@50", "b": "balanced@50"},
     "secondary": [{"name": "targeted_vs_views@50", "a": "targeted@50", "b": "views@50"}],
     "power": {},
+    "exploratory": "Named, no verdict: balanced@50 - none@50, views@50 - none@50 (and none@50 - other@50: no arm).",
     "words": {
         "uninformative": "uninformative",
         "raises": "raises AP by {mean}",
@@ -75,3 +78,13 @@ def test_balanced_and_views_arms_go_through_a_draw_and_the_combined_result(tmp_p
     result = combine_confirm(folder)
     assert result["complete"] and result["primary"]["mean"] > 0 and "targeted_vs_views@50" in result["secondary"]
     assert {r["pool"] for r in result["train_steps"]} == {"targeted", "balanced", "views"}
+    # the plan's exploratory contrasts: over draws with the plan's interval, no verdict; each arm's mean AP
+    assert list(result["exploratory"]) == ["balanced@50-none@50", "views@50-none@50"]
+    balanced = result["exploratory"]["balanced@50-none@50"]
+    per_draw = [v["balanced@50"] - v["none@50"] for v in result["per_draw_ap"].values()]
+    assert balanced["mean"] == pytest.approx(np.mean(per_draw)) and "verdict" not in balanced
+    assert result["arms"]["targeted@50"] > result["arms"]["none@50"]
+    figures = confirm_figures(result, "why-x")
+    views = result["exploratory"]["views@50-none@50"]
+    assert figures["why-x/exploratory/views@50-none@50"].startswith(f"{views['mean']:+.4f} [")
+    assert "why-x/exploratory/balanced@50-none@50/verdict" not in figures and "why-x/ap/views@50" in figures

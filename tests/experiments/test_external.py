@@ -146,6 +146,7 @@ def test_a_plans_external_set_is_read_with_its_own_control_and_holm(tmp_path):
     plan = yaml.safe_load((ROOT / "results/real-objects-confirm/plan.yaml").read_text())
     plan |= {"draws": [10, 11, 12, 13], "arms": ARMS, "secondary": [{"name": "t", "a": "targeted@50", "b": "none@50"}]}
     plan["control"] = {"name": "real_data", "a": "none@150", "b": "none@50"}
+    plan["exploratory"] = "no verdict: none@150 - targeted@50"
     plan["test_sets"] = {
         "heldout": {"readout": "pooled"},
         "ycb78": {"corpus": "x", "readout": "per_object", "resamples": 300},
@@ -157,6 +158,11 @@ def test_a_plans_external_set_is_read_with_its_own_control_and_holm(tmp_path):
     assert (r["control"]["low"] > 0) == (r["control"]["p"] < 0.05)
     figures = confirm_figures({"status": "complete", "complete": True, "external": {"ycb78": r}} | _heldout(r), "s")
     assert figures["s/ycb78/control/verdict"] == "shows" and figures["s/ycb78/primary/verdict"] == "not shown"
+    # the plan's exploratory contrast on the external set: the same nested interval, no verdict
+    explored = r["exploratory"]["none@150-targeted@50"]
+    assert explored["mean"] > 0 and "verdict" not in explored and (explored["low"] > 0) == (explored["p"] < 0.05)
+    assert figures["s/ycb78/exploratory/none@150-targeted@50"].startswith(f"{explored['mean']:+.4f}")
+    assert float(figures["s/ycb78/ap/none@150"]) == pytest.approx(r["arms"]["none@150"], abs=1e-4)
     (folder / "predictions-ycb78-d12-s0.parquet").unlink()
     with pytest.raises(DataError, match="draw 12's ycb78 predictions are missing"):
         external_result(folder, plan, "ycb78")

@@ -300,6 +300,7 @@ def external_result(folder: Path, plan: Mapping, name: str) -> dict:
         return confirm.nested_draw_test(full, boot, 1 - float(plan["alpha"]))
 
     out = read_plan_tests(plan, test_of, words=spec.get("words"))
+    out["exploratory"] = {e["name"]: test_of(e) for e in exploratory_contrasts(plan)}
     arms = {arm: float(np.mean([cells[d, s, arm][0] for d in draws for s in seeds])) for arm in plan["arms"]}
     held = test.groupby("object").label.any()
     counts = {"objects": int(len(held)), "objects_with_positive": int(held.sum()), "datapoints": int(len(test))}
@@ -362,6 +363,17 @@ def check_base_objects(counts: pd.DataFrame, networks: pd.DataFrame) -> None:
         )
 
 
+def exploratory_contrasts(plan: Mapping) -> list[dict]:
+    """The contrasts a plan's ``exploratory`` text names as ``<arm> - <arm>`` between two of its arms, in its order, as
+    specs (``name`` ``<a>-<b>``, ``a``, ``b``): read over draws with the plan's intervals, given no verdict."""
+    text = plan.get("exploratory")
+    if not isinstance(text, str):
+        return []
+    pairs = re.findall(r"([\w@]+)\s+[-−]\s+([\w@]+)", text)
+    arms = plan["arms"]
+    return [{"name": f"{a}-{b}", "a": a, "b": b} for a, b in pairs if a in arms and b in arms]
+
+
 def read_plan_result(
     plan: Mapping, values: Mapping[int, Mapping[str, float]], counts: pd.DataFrame | None = None
 ) -> dict:
@@ -399,7 +411,9 @@ def read_plan_result(
                 "train_objects_min": int(on.train_objects.min()),
                 "train_objects_max": int(on.train_objects.max()),
             }
+    result["exploratory"] = {e["name"]: confirm.draw_test(diff(e), 1 - alpha) for e in exploratory_contrasts(plan)}
     result["per_draw_ap"] = {str(d): values[d] for d in draws}
+    result["arms"] = {arm: float(np.mean([values[d][arm] for d in draws])) for arm in plan["arms"]}
     return result
 
 

@@ -20,7 +20,9 @@ def sentence_fields(c: Mapping) -> dict:
 def confirm_figures(result: dict, study: str) -> dict[str, str]:
     """The figures a document quotes, by key: ``<study>/status``, and once complete ``<study>/control``,
     ``<study>/primary`` (``mean [low, high], p = P``), ``<study>/primary/verdict``, ``<study>/sentence``,
-    ``<study>/<secondary>`` and its ``/verdict``, ``<study>/worth`` (the exchange rate); with the folder's base-set
+    ``<study>/<secondary>`` and its ``/verdict``, ``<study>/exploratory/<a>-<b>`` (a contrast the plan names as
+    exploratory: no verdict), ``<study>/ap/<arm>`` (the arm's mean AP over draws), each again for an external test
+    set as ``<study>/<set>/...``, ``<study>/worth`` (the exchange rate); with the folder's base-set
     counts ``<study>/worth/actual`` (the same on the objects that hold datapoints), ``<study>/base_objects`` and
     ``<study>/generator_objects`` (the train objects each draw's AutoEncoder-Critic learned)."""
     out = {f"{study}/status": result["status"]}
@@ -36,6 +38,7 @@ def confirm_figures(result: dict, study: str) -> dict[str, str]:
         out[f"{study}/{name}"] = test_text(c) + holm
         if "verdict" in c:
             out[f"{study}/{name}/verdict"] = c["verdict"]
+    out |= _exploratory_and_arms(result, study)
     for name, r in result.get("external", {}).items():
         out[f"{study}/{name}/control"] = test_text(r["control"])
         out[f"{study}/{name}/control/verdict"] = "shows" if r["control"]["shows"] else "does not show"
@@ -46,6 +49,7 @@ def confirm_figures(result: dict, study: str) -> dict[str, str]:
             holm = f" (Holm p = {c['p_holm']:.3f})" if c.get("p_holm") is not None else ""
             out[f"{study}/{name}/{key}"] = test_text(c) + holm
             out[f"{study}/{name}/{key}/verdict"] = c["verdict"]
+        out |= _exploratory_and_arms(r, f"{study}/{name}")
     if "exchange" in result:
         e = result["exchange"]
         low = "≤ {}".format(e["sizes"][0]) if e["low"] is None else f"{e['low']:.0f}"
@@ -62,6 +66,12 @@ def confirm_figures(result: dict, study: str) -> dict[str, str]:
         trained = b["train_objects_min"], b["train_objects_max"]
         out[f"{study}/generator_objects"] = f"{trained[0]}" if trained[0] == trained[1] else "{}–{}".format(*trained)
     return out
+
+
+def _exploratory_and_arms(result: Mapping, prefix: str) -> dict[str, str]:
+    """``<prefix>/exploratory/<a>-<b>`` of each exploratory contrast and ``<prefix>/ap/<arm>`` (4 decimals)."""
+    out = {f"{prefix}/exploratory/{name}": test_text(c) for name, c in result.get("exploratory", {}).items()}
+    return out | {f"{prefix}/ap/{arm}": f"{v:.4f}" for arm, v in result.get("arms", {}).items()}
 
 
 def test_text(c: Mapping) -> str:
