@@ -67,13 +67,25 @@ def provenance(project: Path, command: str) -> dict:
     return {"command": command, "commit": commit, "date": time.strftime("%Y-%m-%d")}
 
 
+#: Dask settings of the local cluster a study starts: a draw's task only waits on its ``dvc repro`` for an hour, so
+#: the worker's statistical profiler (a sample every 10 ms), the 20 ms event-loop tick and the half-second system and
+#: memory monitors are overhead on the cores the draws need: 8.0 CPU seconds a minute with Dask's defaults, 0.81 lean
+#: (9.9x less, ``bench/dask_overhead.py``, 2 cores, 2026-12-07).
+LEAN_DASK = {
+    "distributed.worker.profile.enabled": False,
+    "distributed.admin.system-monitor.interval": "5s",
+    "distributed.admin.tick.interval": "1s",
+    "distributed.worker.memory.monitor-interval": "2s",
+}
+
+
 def run_on_cluster(jobs: dict, scheduler: str | None, workers: int, finished) -> dict[int, str]:
     """Run ``jobs`` (draw → (function, args)), each as one task on a Dask cluster: the scheduler at ``scheduler``
     (workers that see the project and the DVC cache at the same paths), or a ``distributed.LocalCluster`` of
-    ``workers`` processes of one thread each. ``finished(draw, result)`` runs here, in this process, as each draw
-    ends (so one process writes ``results/``); a draw that fails is logged with its reason and the others go on.
-    Returns draw → the reason of each failed draw (empty: all finished). Without ``distributed`` installed the draws
-    run here, one after another."""
+    ``workers`` processes of one thread each, with :data:`LEAN_DASK`'s settings. ``finished(draw, result)`` runs
+    here, in this process, as each draw ends (so one process writes ``results/``); a draw that fails is logged with
+    its reason and the others go on. Returns draw → the reason of each failed draw (empty: all finished). Without
+    ``distributed`` installed the draws run here, one after another."""
     log = logging.getLogger(__name__)
     failed: dict[int, str] = {}
 
@@ -89,26 +101,28 @@ def run_on_cluster(jobs: dict, scheduler: str | None, workers: int, finished) ->
     if not jobs:
         return failed
     try:
+        import dask
         from distributed import Client, LocalCluster, as_completed
     except ImportError:  # pragma: no cover - the dev extras install it
         log.warning("distributed is not installed: the draws run here, one after another")
         for draw, (function, args) in jobs.items():
             done(draw, lambda: function(*args))
         return failed
-    cluster = None
-    if scheduler is None:
-        cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None)
-    try:
-        with Client(scheduler or cluster) as client:
-            log.info("draws %s on the Dask cluster at %s", sorted(jobs), client.scheduler.address)
-            futures = {
-                client.submit(f, *a, key=f"draw-{d}-{time.time_ns()}", pure=False): d for d, (f, a) in jobs.items()
-            }
-            for future in as_completed(futures):
-                done(futures[future], future.result)
-    finally:
-        if cluster is not None:
-            cluster.close()
+    with dask.config.set(LEAN_DASK if scheduler is None else {}):  # a cluster of the user's keeps its own settings
+        cluster = None
+        if scheduler is None:
+            cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None)
+        try:
+            with Client(scheduler or cluster) as client:
+                log.info("draws %s on the Dask cluster at %s", sorted(jobs), client.scheduler.address)
+                futures = {
+                    client.submit(f, *a, key=f"draw-{d}-{time.time_ns()}", pure=False): d for d, (f, a) in jobs.items()
+                }
+                for future in as_completed(futures):
+                    done(futures[future], future.result)
+        finally:
+            if cluster is not None:
+                cluster.close()
     return failed
 
 
