@@ -13,6 +13,7 @@ from scipy import stats
 from graspaug.errors import DataError
 from graspaug.experiments.confirm import numbers as confirm
 from graspaug.experiments.confirm.tables import check_plan_history, combine_confirm, read_plan, read_plan_result
+from graspaug.experiments.confirm.words import confirm_figures
 
 PLAN = {
     "format": "graspaug.confirm-plan/1",
@@ -54,6 +55,11 @@ def test_the_draw_test_is_a_one_sample_t_and_tost_holm_and_power_behave():
     assert confirm.tost([0.001, -0.002, 0.003, 0.0, -0.001], 0.03)["p"] < 0.05
     assert confirm.tost([0.05, -0.06, 0.02, 0.0], 0.03)["p"] > 0.05
     assert confirm.holm({"a": 0.01, "b": 0.04, "c": None}) == {"a": 0.02, "b": 0.04, "c": None}
+    # how far the result rests on single draws: scipy's signed-rank test, the t with each draw left out
+    s = confirm.draw_sensitivity(x)
+    assert s["positive"] == 5 and s["n_draws"] == 6 and s["wilcoxon_p"] == pytest.approx(stats.wilcoxon(x).pvalue)
+    left_out = [stats.ttest_1samp(np.delete(x, i), 0.0).pvalue for i in range(6)]
+    assert s["loo_p"] == pytest.approx((min(left_out), max(left_out))) and confirm.draw_sensitivity(x[:2]) is None
     assert confirm.holm({"a": 0.03, "b": 0.02}) == {"a": pytest.approx(0.04), "b": pytest.approx(0.04)}
     assert confirm.power(8, 0.05, 0.0) == pytest.approx(0.05, abs=1e-6)  # no effect: the false-positive rate
     assert confirm.power(8, 0.05, 0.03) < confirm.power(16, 0.05, 0.03) < confirm.power(16, 0.03, 0.03)
@@ -155,6 +161,9 @@ def test_the_plan_is_read_in_its_fixed_sequence():
     assert shown["control"]["shows"] and shown["primary"]["verdict"] == "raises"
     assert shown["sentence"].startswith("raises AP by +0.0500 [")
     assert shown["secondary"]["targeted_vs_random@50"]["verdict"] == "equivalent within ±0.03"
+    figures = confirm_figures(shown | {"status": "complete", "complete": True}, "s")
+    assert figures["s/primary/sensitivity"].startswith("above 0 in 4 of 4 draws; Wilcoxon p = 0.125; each draw left")
+    assert figures["s/targeted_vs_random@50/equivalence"].startswith("TOST p = 0.000, its 90% interval [+0.0")
     # the same gain with a control that does not show: uninformative, never negative or positive
     flat = {d: v | {"none@150": v["none@50"] + (0.01 if d % 2 else -0.01)} for d, v in values.items()}
     assert read_plan_result(PLAN, flat)["primary"]["verdict"] == "uninformative"

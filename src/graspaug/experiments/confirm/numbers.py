@@ -70,7 +70,28 @@ def tost(draw_means: Sequence[float], margin: float, alpha: float = 0.05) -> dic
     else:
         p = float(max(stats.t.sf((mean + margin) / se, df), stats.t.cdf((mean - margin) / se, df)))
     half = float(stats.t.ppf(1 - alpha, df) * se)
-    return {"p": p, "low": mean - half, "high": mean + half, "margin": margin}
+    return {"p": p, "low": mean - half, "high": mean + half, "margin": margin, "level": 1 - 2 * alpha}
+
+
+def draw_sensitivity(draw_means: Sequence[float], level: float = 0.95) -> dict | None:
+    """How far a contrast over draws rests on single draws: an exploratory look after the plan's test, no verdict.
+
+    Returns
+    -------
+    dict — ``positive`` (draws above 0) of ``n_draws``, ``wilcoxon_p`` (the signed-rank test against 0, two-sided),
+    ``loo_p`` (the least and the largest :func:`draw_test` p with each draw left out in turn); None with fewer than
+    3 draws
+    """
+    x = np.asarray(draw_means, dtype=float)
+    if len(x) < 3 or not np.isfinite(x).all():
+        return None
+    left_out = [draw_test(np.delete(x, i), level)["p"] for i in range(len(x))]
+    return {
+        "positive": int((x > 0).sum()),
+        "n_draws": int(len(x)),
+        "wilcoxon_p": float(stats.wilcoxon(x).pvalue),
+        "loo_p": (float(min(left_out)), float(max(left_out))),
+    }
 
 
 def holm(pvalues: Mapping[str, float | None]) -> dict[str, float | None]:

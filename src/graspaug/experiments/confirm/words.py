@@ -20,17 +20,21 @@ def sentence_fields(c: Mapping) -> dict:
 def confirm_figures(result: dict, study: str) -> dict[str, str]:
     """The figures a document quotes, by key: ``<study>/status``, and once complete ``<study>/control``,
     ``<study>/primary`` (``mean [low, high], p = P``), ``<study>/primary/verdict``, ``<study>/sentence``,
-    ``<study>/<secondary>`` and its ``/verdict``, ``<study>/exploratory/<a>-<b>`` (a contrast the plan names as
-    exploratory: no verdict), ``<study>/ap/<arm>`` (the arm's mean AP over draws), each again for an external test
-    set as ``<study>/<set>/...``, ``<study>/worth`` (the exchange rate); with the folder's base-set
-    counts ``<study>/worth/actual`` (the same on the objects that hold datapoints), ``<study>/base_objects`` and
-    ``<study>/generator_objects`` (the train objects each draw's AutoEncoder-Critic learned)."""
+    ``<study>/primary/sensitivity`` (exploratory: draws above 0, Wilcoxon, each draw left out),
+    ``<study>/<secondary>`` and its ``/verdict`` (and ``/equivalence``: its TOST where the plan names a margin),
+    ``<study>/exploratory/<a>-<b>`` (a contrast the plan names as exploratory: no verdict), ``<study>/ap/<arm>``
+    (the arm's mean AP over draws), each again for an external test set as ``<study>/<set>/...``,
+    ``<study>/worth`` (the exchange rate); with the folder's base-set counts ``<study>/worth/actual`` (the same on
+    the objects that hold datapoints), ``<study>/base_objects`` and ``<study>/generator_objects`` (the train objects
+    each draw's AutoEncoder-Critic learned)."""
     out = {f"{study}/status": result["status"]}
     if not result["complete"]:
         return out
     for key in ("control", "primary"):
         out[f"{study}/{key}"] = test_text(result[key])
     out[f"{study}/primary/verdict"] = result["primary"]["verdict"]
+    if result["primary"].get("sensitivity"):
+        out[f"{study}/primary/sensitivity"] = sensitivity_text(result["primary"]["sensitivity"])
     out[f"{study}/control/verdict"] = "shows" if result["control"]["shows"] else "does not show"
     out[f"{study}/sentence"] = result["sentence"]
     for name, c in result["secondary"].items():
@@ -38,6 +42,12 @@ def confirm_figures(result: dict, study: str) -> dict[str, str]:
         out[f"{study}/{name}"] = test_text(c) + holm
         if "verdict" in c:
             out[f"{study}/{name}/verdict"] = c["verdict"]
+        e = c.get("equivalence") or {}
+        if e.get("p") is not None:
+            out[f"{study}/{name}/equivalence"] = (
+                f"TOST p = {e['p']:.3f}, its {e['level']:.0%} interval [{e['low']:+.4f}, {e['high']:+.4f}] "
+                f"against ±{e['margin']:g}"
+            )
     out |= _exploratory_and_arms(result, study)
     for name, r in result.get("external", {}).items():
         out[f"{study}/{name}/control"] = test_text(r["control"])
@@ -78,3 +88,13 @@ def test_text(c: Mapping) -> str:
     """``+0.0300 [+0.0100, +0.0500], p = 0.012`` of a :func:`~graspaug.experiments.confirm.numbers.draw_test`."""
     f = sentence_fields(c)
     return f"{f['mean']} [{f['low']}, {f['high']}], p = {f['p']}"
+
+
+def sensitivity_text(s: Mapping) -> str:
+    """``above 0 in 10 of 12 draws; Wilcoxon p = 0.005; each draw left out: p 0.011–0.035`` of a
+    :func:`~graspaug.experiments.confirm.numbers.draw_sensitivity`."""
+    low, high = s["loo_p"]
+    return (
+        f"above 0 in {s['positive']} of {s['n_draws']} draws; Wilcoxon p = {s['wilcoxon_p']:.3f}; "
+        f"each draw left out: p {low:.3f}–{high:.3f}"
+    )
