@@ -55,12 +55,13 @@ def test_the_draw_test_is_a_one_sample_t_and_tost_holm_and_power_behave():
     assert confirm.tost([0.001, -0.002, 0.003, 0.0, -0.001], 0.03)["p"] < 0.05
     assert confirm.tost([0.05, -0.06, 0.02, 0.0], 0.03)["p"] > 0.05
     assert confirm.holm({"a": 0.01, "b": 0.04, "c": None}) == {"a": 0.02, "b": 0.04, "c": None}
+    assert confirm.holm({"a": 0.03, "b": 0.02}) == {"a": pytest.approx(0.04), "b": pytest.approx(0.04)}
     # how far the result rests on single draws: scipy's signed-rank test, the t with each draw left out
     s = confirm.draw_sensitivity(x)
     assert s["positive"] == 5 and s["n_draws"] == 6 and s["wilcoxon_p"] == pytest.approx(stats.wilcoxon(x).pvalue)
     left_out = [stats.ttest_1samp(np.delete(x, i), 0.0).pvalue for i in range(6)]
     assert s["loo_p"] == pytest.approx((min(left_out), max(left_out))) and confirm.draw_sensitivity(x[:2]) is None
-    assert confirm.holm({"a": 0.03, "b": 0.02}) == {"a": pytest.approx(0.04), "b": pytest.approx(0.04)}
+    assert confirm.draw_sensitivity([0.0, 0.0, 0.0]) is None  # nothing to rank
     assert confirm.power(8, 0.05, 0.0) == pytest.approx(0.05, abs=1e-6)  # no effect: the false-positive rate
     assert confirm.power(8, 0.05, 0.03) < confirm.power(16, 0.05, 0.03) < confirm.power(16, 0.03, 0.03)
     n = confirm.draws_for_power(0.05, 0.03)

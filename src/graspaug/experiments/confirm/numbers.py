@@ -80,10 +80,10 @@ def draw_sensitivity(draw_means: Sequence[float], level: float = 0.95) -> dict |
     -------
     dict — ``positive`` (draws above 0) of ``n_draws``, ``wilcoxon_p`` (the signed-rank test against 0, two-sided),
     ``loo_p`` (the least and the largest :func:`draw_test` p with each draw left out in turn); None with fewer than
-    3 draws
+    3 draws or none away from 0
     """
     x = np.asarray(draw_means, dtype=float)
-    if len(x) < 3 or not np.isfinite(x).all():
+    if len(x) < 3 or not np.isfinite(x).all() or not x.any():
         return None
     left_out = [draw_test(np.delete(x, i), level)["p"] for i in range(len(x))]
     return {

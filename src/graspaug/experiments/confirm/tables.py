@@ -389,7 +389,7 @@ def read_plan_result(
         return [values[d][spec["a"]] - values[d][spec["b"]] for d in draws]
 
     result = read_plan_tests(plan, lambda spec: confirm.draw_test(diff(spec), 1 - alpha), diff)
-    result["primary"]["sensitivity"] = confirm.draw_sensitivity(diff(plan["primary"]), 1 - alpha)
+    result["primary"]["sensitivity"] = confirm.draw_sensitivity(result["primary"]["per_draw"], 1 - alpha)
     curve = plan.get("exchange")
     if curve and result["control"]["shows"]:
         sizes = curve["sizes"]
